@@ -1,0 +1,82 @@
+// pxf::Image — the one image type used by the path tracer, the GL passes, the tools and the tests.
+// Float pixels with named, interleaved channels ("R","G","B","A", or "Y", ...), top row first.
+#pragma once
+#include <cstddef>
+#include <functional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace pxf {
+
+// Every user-facing failure (bad file, bad flag, bad scene) is a pxf::Error with a one-line message.
+struct Error : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct Image {
+  int width = 0;
+  int height = 0;
+  std::vector<std::string> channels;
+  std::vector<float> pixels;  // width * height * channels.size()
+
+  Image() = default;
+  Image(int width, int height, std::vector<std::string> channel_names, float fill = 0.0f);
+  static Image rgb(int width, int height, float fill = 0.0f);
+  static Image rgba(int width, int height, float fill = 0.0f);
+  static Image gray(int width, int height, const std::string& name = "Y", float fill = 0.0f);
+
+  bool empty() const { return width == 0 || height == 0; }
+  int num_channels() const { return static_cast<int>(channels.size()); }
+  size_t pixel_count() const { return static_cast<size_t>(width) * height; }
+  int channel_index(const std::string& name) const;  // -1 when absent
+  float& at(int x, int y, int c) { return pixels[(static_cast<size_t>(y) * width + x) * channels.size() + c]; }
+  float at(int x, int y, int c) const { return pixels[(static_cast<size_t>(y) * width + x) * channels.size() + c]; }
+  // A copy holding only the named channels, in that order; throws pxf::Error when one is missing.
+  Image select(const std::vector<std::string>& names) const;
+};
+
+// A named layer of a multi-layer EXR; channels are stored as "<layer>.<channel>" ("" = no prefix).
+struct Layer {
+  std::string name;
+  Image image;
+};
+
+// Writes go to "<path>.tmp-<pid>" and are renamed, so an interrupted run never leaves a truncated file.
+void write_file_atomically(const std::string& path, const std::function<void(const std::string& tmp_path)>& write);
+
+void write_exr(const std::string& path, const Image& image);  // half=false: full 32-bit float
+void write_exr(const std::string& path, const std::vector<Layer>& layers);
+std::vector<Layer> read_exr_layers(const std::string& path);
+// The named layer, or with "" the unprefixed channels (falling back to the first layer).
+Image read_exr(const std::string& path, const std::string& layer = "");
+
+// 8-bit PNG of display values already in [0,1] display (sRGB-encoded) space; clamps; NaN -> 0.
+void write_png(const std::string& path, const Image& display);
+// Loads PNG/JPEG/HDR through stb; 8-bit data is returned as stored (no transfer curve applied),
+// 16-bit data is scaled to [0,1], HDR as linear floats. Channels named R,G,B,A (or Y, YA).
+Image read_ldr_or_hdr(const std::string& path);
+
+// Rec. 709 luminance of linear RGB.
+inline float luminance(float r, float g, float b) { return 0.2126f * r + 0.7152f * g + 0.0722f * b; }
+float srgb_from_linear(float linear);
+float linear_from_srgb(float encoded);
+
+// Error metrics of SPEC section 4, one implementation for tests, bench and `pxf diff`.
+struct ImageMetrics {
+  double rmse = 0;           // over finite pixels of the compared channels
+  double nrmse_percent = 0;  // 100 * rmse / mean(reference)
+  double rel_mse = 0;        // mean((t - r)^2 / (r^2 + 1e-2))
+  double max_abs_diff = 0;
+  double reference_mean = 0;
+  size_t nan_count = 0;  // samples of the test image (not pixels) that are NaN
+  size_t inf_count = 0;  // ... or +-Inf
+  size_t samples = 0;    // compared finite samples
+};
+// Compares the channels the two images share by name, ignoring "A". Throws pxf::Error on a size
+// mismatch or when they share no channel.
+ImageMetrics compare_images(const Image& test, const Image& reference);
+size_t count_nonfinite(const Image& image);
+std::string format_metrics(const ImageMetrics& m);
+
+}  // namespace pxf

@@ -1,0 +1,126 @@
+// The scene model shared by the glTF loader, the integrator and the raster range pass.
+// Everything is flattened to world space at load time: meshes hold world positions/normals.
+// This header has no Embree, GL or tinygltf dependency.
+#pragma once
+#include <glm/glm.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace pxf {
+
+enum class Wrap { Repeat, ClampToEdge, MirroredRepeat };
+
+// Linear-space texels (sRGB textures are decoded at load), 4 channels RGBA, top row first.
+struct Texture {
+  std::string name;
+  int width = 0;
+  int height = 0;
+  std::vector<glm::vec4> texels;
+  Wrap wrap_s = Wrap::Repeat;
+  Wrap wrap_t = Wrap::Repeat;
+  bool nearest = false;  // magFilter NEAREST; otherwise bilinear
+};
+
+// A material's reference to a texture (glTF textureInfo + KHR_texture_transform).
+struct TextureRef {
+  int texture = -1;  // index into Scene::textures, -1 = none
+  int texcoord = 0;  // 0 or 1
+  glm::mat3 transform{1.0f};  // applied to (u, v, 1)
+  bool valid() const { return texture >= 0; }
+};
+
+enum class AlphaMode { Opaque, Mask, Blend };
+
+// glTF metallic-roughness material (+ emissive_strength, transmission, ior, specular).
+struct Material {
+  std::string name;
+  glm::vec4 base_color{1.0f};
+  TextureRef base_color_texture;
+  float metallic = 1.0f;
+  float roughness = 1.0f;
+  TextureRef metallic_roughness_texture;  // G = roughness, B = metallic
+  TextureRef normal_texture;
+  float normal_scale = 1.0f;
+  glm::vec3 emissive{0.0f};  // already multiplied by KHR_materials_emissive_strength
+  TextureRef emissive_texture;
+  float transmission = 0.0f;
+  TextureRef transmission_texture;  // R
+  float ior = 1.5f;
+  float specular = 1.0f;                // KHR_materials_specular
+  TextureRef specular_texture;          // A
+  glm::vec3 specular_color{1.0f};
+  TextureRef specular_color_texture;    // RGB
+  AlphaMode alpha_mode = AlphaMode::Opaque;
+  float alpha_cutoff = 0.5f;
+  bool double_sided = false;
+
+  bool is_emissive() const { return emissive.x > 0 || emissive.y > 0 || emissive.z > 0; }
+};
+
+// One glTF primitive instance in world space. Optional attributes are empty when absent.
+struct Mesh {
+  std::string name;
+  std::vector<glm::vec3> positions;
+  std::vector<glm::vec3> normals;   // always filled by the loader (computed when missing)
+  std::vector<glm::vec4> tangents;  // xyz + handedness w; filled when the material has a normal map
+  std::vector<glm::vec2> uv0;
+  std::vector<glm::vec2> uv1;
+  std::vector<glm::vec4> colors;    // COLOR_0 as RGBA linear
+  std::vector<glm::uvec3> triangles;
+  int material = 0;                 // index into Scene::materials (the loader adds a default)
+};
+
+// glTF camera convention: looks down -Z of its frame, +Y up. Image rows go top to bottom.
+struct Camera {
+  glm::mat4 camera_to_world{1.0f};  // rigid transform (no scale)
+  float yfov = 0.6911f;             // vertical field of view, radians
+  float znear = 0.01f;
+  float zfar = 1000.0f;
+  float aspect = 0.0f;              // glTF aspectRatio (0 = unspecified); the image size wins
+};
+
+// KHR_lights_punctual. Radiometric: point/spot intensity in W/sr-like units (candela scaled),
+// directional in irradiance units (lux scaled), both times color.
+struct PunctualLight {
+  enum class Type { Point, Spot, Directional };
+  Type type = Type::Point;
+  std::string name;
+  glm::vec3 color{1.0f};
+  float intensity = 1.0f;
+  glm::vec3 position{0.0f};
+  glm::vec3 direction{0.0f, 0.0f, -1.0f};  // direction the light travels (spot/directional)
+  float range = 0.0f;                       // 0 = infinite
+  float inner_cone = 0.0f;
+  float outer_cone = 0.785398f;
+};
+
+// Equirectangular environment: u = 0.5 + atan2(d.x, -d.z) / (2 pi), v = acos(d.y) / pi (v = 0 top).
+struct Environment {
+  Texture image;     // linear RGB radiance
+  float strength = 1.0f;
+  std::string source;
+};
+
+// Render options a scene may carry (e.g. envmap renders with all_hv by default).
+struct SceneDefaults {
+  bool all_hv = false;
+  int width = 0;  // 0 = the tool's default
+  int height = 0;
+};
+
+struct Scene {
+  std::string source;  // file path or built-in name
+  std::vector<Mesh> meshes;
+  std::vector<Material> materials;
+  std::vector<Texture> textures;
+  std::vector<PunctualLight> lights;
+  std::optional<Environment> environment;
+  Camera camera;
+  SceneDefaults defaults;
+  std::vector<std::string> warnings;  // what the loader skipped or substituted, one line each
+
+  size_t triangle_count() const;
+};
+
+}  // namespace pxf
