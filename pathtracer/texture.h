@@ -1,0 +1,30 @@
+// Texture sampling shared by the integrator and the loader: wrap modes, bilinear or nearest
+// filtering, KHR_texture_transform. Texels are linear (sRGB textures are decoded at load time).
+#pragma once
+#include <glm/glm.hpp>
+#include "pathtracer/scene.h"
+
+namespace pxf {
+
+// Samples `texture` at `uv` (glTF convention: (0,0) = top-left texel corner, v grows downwards,
+// which matches Texture's top-row-first storage). Honors wrap_s/wrap_t and `nearest`.
+// Returns vec4(1) for an empty texture; never returns NaN for finite input.
+glm::vec4 sample_texture(const Texture& texture, glm::vec2 uv);
+
+// The coordinates a texture reference reads: picks uv0 or uv1 by ref.texcoord and applies
+// ref.transform (KHR_texture_transform) to (u, v, 1).
+glm::vec2 texture_uv(const TextureRef& ref, glm::vec2 uv0, glm::vec2 uv1);
+
+// sample_texture(scene.textures[ref.texture], texture_uv(ref, uv0, uv1)), or `fallback` when the
+// reference is unset or out of range.
+glm::vec4 eval_texture(const Scene& scene, const TextureRef& ref, glm::vec2 uv0, glm::vec2 uv1,
+                       glm::vec4 fallback = glm::vec4(1.0f));
+
+// The 3x3 matrix of KHR_texture_transform: T(offset) * R(rotation) * S(scale), as the extension
+// defines it (rotation counter-clockwise in UV space, radians).
+glm::mat3 texture_transform_matrix(glm::vec2 offset, float rotation, glm::vec2 scale);
+
+// Integer texel index for coordinate `i` (may be outside [0, size)) under `wrap`.
+int wrap_texel_index(int i, int size, Wrap wrap);
+
+}  // namespace pxf
