@@ -1,0 +1,65 @@
+#include "image/image.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <unistd.h>
+
+namespace pxf {
+
+Image::Image(int w, int h, std::vector<std::string> channel_names, float fill)
+    : width(w), height(h), channels(std::move(channel_names)) {
+  if (w < 0 || h < 0) throw Error("image size must not be negative");
+  pixels.assign(static_cast<size_t>(w) * h * channels.size(), fill);
+}
+
+Image Image::rgb(int w, int h, float fill) { return Image(w, h, {"R", "G", "B"}, fill); }
+Image Image::rgba(int w, int h, float fill) { return Image(w, h, {"R", "G", "B", "A"}, fill); }
+Image Image::gray(int w, int h, const std::string& name, float fill) { return Image(w, h, {name}, fill); }
+
+int Image::channel_index(const std::string& name) const {
+  auto it = std::find(channels.begin(), channels.end(), name);
+  return it == channels.end() ? -1 : static_cast<int>(it - channels.begin());
+}
+
+Image Image::select(const std::vector<std::string>& names) const {
+  std::vector<int> source;
+  for (const auto& name : names) {
+    int index = channel_index(name);
+    if (index < 0) throw Error("image has no channel '" + name + "'");
+    source.push_back(index);
+  }
+  Image out(width, height, names);
+  const size_t in_stride = channels.size(), out_stride = names.size();
+  for (size_t p = 0; p < pixel_count(); ++p)
+    for (size_t c = 0; c < out_stride; ++c) out.pixels[p * out_stride + c] = pixels[p * in_stride + source[c]];
+  return out;
+}
+
+void write_file_atomically(const std::string& path, const std::function<void(const std::string&)>& write) {
+  const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
+  try {
+    write(tmp);
+  } catch (...) {
+    std::remove(tmp.c_str());
+    throw;
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    std::remove(tmp.c_str());
+    throw Error(path + ": cannot rename temporary file into place");
+  }
+}
+
+float srgb_from_linear(float v) {
+  if (!(v > 0.0f)) return 0.0f;  // also maps NaN to 0
+  if (v <= 0.0031308f) return 12.92f * v;
+  return 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
+}
+
+float linear_from_srgb(float v) {
+  if (!(v > 0.0f)) return 0.0f;
+  if (v <= 0.04045f) return v / 12.92f;
+  return std::pow((v + 0.055f) / 1.055f, 2.4f);
+}
+
+}  // namespace pxf

@@ -1,0 +1,168 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include "image/image.h"
+
+namespace fs = std::filesystem;
+using namespace pxf;
+
+namespace {
+std::string temp_path(const std::string& name) {
+  fs::path dir = fs::temp_directory_path() / ("pxf_image_test_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  return (dir / name).string();
+}
+
+Image ramp(int w, int h, std::vector<std::string> channels) {
+  Image img(w, h, std::move(channels));
+  for (size_t i = 0; i < img.pixels.size(); ++i) img.pixels[i] = 0.001f * static_cast<float>(i) - 0.3f;
+  return img;
+}
+}  // namespace
+
+TEST(Image, ConstructionAndChannelAccess) {
+  Image img = Image::rgba(3, 2, 0.5f);
+  EXPECT_EQ(img.pixels.size(), 3u * 2u * 4u);
+  EXPECT_EQ(img.channel_index("B"), 2);
+  EXPECT_EQ(img.channel_index("Z"), -1);
+  img.at(2, 1, 3) = 7.0f;
+  EXPECT_EQ(img.pixels.back(), 7.0f);
+  Image ba = img.select({"B", "A"});
+  EXPECT_EQ(ba.num_channels(), 2);
+  EXPECT_EQ(ba.at(2, 1, 1), 7.0f);
+  EXPECT_THROW(img.select({"Z"}), Error);
+}
+
+TEST(ImageExr, SingleLayerRoundTripIsExact) {
+  const std::string path = temp_path("single.exr");
+  Image img = ramp(17, 5, {"R", "G", "B", "A"});
+  write_exr(path, img);
+  Image back = read_exr(path);
+  EXPECT_EQ(back.channels, img.channels);
+  ASSERT_EQ(back.width, 17);
+  ASSERT_EQ(back.height, 5);
+  EXPECT_EQ(back.pixels, img.pixels);
+}
+
+TEST(ImageExr, MultiLayerRoundTripKeepsNamesAndOrder) {
+  const std::string path = temp_path("layers.exr");
+  std::vector<Layer> layers = {{"final", ramp(8, 4, {"R", "G", "B"})},
+                               {"var_u", ramp(8, 4, {"Y"})},
+                               {"depth", ramp(8, 4, {"Z"})}};
+  write_exr(path, layers);
+  std::vector<Layer> back = read_exr_layers(path);
+  ASSERT_EQ(back.size(), 3u);
+  for (const Layer& l : layers) {
+    Image got = read_exr(path, l.name);
+    EXPECT_EQ(got.channels, l.image.channels) << l.name;
+    EXPECT_EQ(got.pixels, l.image.pixels) << l.name;
+  }
+  EXPECT_THROW(read_exr(path, "missing"), Error);
+}
+
+TEST(ImageExr, NonFiniteValuesSurviveRoundTripAndAreCounted) {
+  const std::string path = temp_path("nan.exr");
+  Image img = Image::rgb(2, 2, 1.0f);
+  img.at(0, 0, 0) = NAN;
+  img.at(1, 1, 2) = INFINITY;
+  write_exr(path, img);
+  Image back = read_exr(path);
+  EXPECT_TRUE(std::isnan(back.at(0, 0, 0)));
+  EXPECT_TRUE(std::isinf(back.at(1, 1, 2)));
+  EXPECT_EQ(count_nonfinite(back), 2u);
+}
+
+TEST(ImageExr, MissingAndCorruptFilesGiveOneLineErrorsNamingTheFile) {
+  const std::string missing = temp_path("does_not_exist.exr");
+  try {
+    read_exr(missing);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    std::string msg = e.what();
+    EXPECT_NE(msg.find(missing), std::string::npos);
+    EXPECT_EQ(msg.find('\n'), std::string::npos);
+  }
+  const std::string corrupt = temp_path("corrupt.exr");
+  std::ofstream(corrupt) << "not an exr";
+  EXPECT_THROW(read_exr(corrupt), Error);
+}
+
+TEST(ImageIo, WritesAreAtomicAndLeaveNoTemporaryFile) {
+  const std::string path = temp_path("atomic.exr");
+  write_exr(path, Image::rgb(4, 4, 0.25f));
+  for (auto& entry : fs::directory_iterator(fs::path(path).parent_path()))
+    EXPECT_EQ(entry.path().string().find(".tmp-"), std::string::npos) << entry.path();
+  // A write that fails leaves neither the target nor a temporary behind.
+  const std::string failing = temp_path("failing.bin");
+  EXPECT_THROW(write_file_atomically(failing, [](const std::string& tmp) {
+                 std::ofstream(tmp) << "partial";
+                 throw Error("interrupted");
+               }),
+               Error);
+  EXPECT_FALSE(fs::exists(failing));
+  EXPECT_FALSE(fs::exists(failing + ".tmp-" + std::to_string(::getpid())));
+}
+
+TEST(ImagePng, WriteThenReadGivesQuantizedValues) {
+  const std::string path = temp_path("out.png");
+  Image img = Image::rgb(3, 1);
+  img.at(0, 0, 0) = 1.0f;   // 255
+  img.at(1, 0, 1) = 0.5f;   // 128
+  img.at(2, 0, 2) = NAN;    // 0
+  img.at(2, 0, 0) = 7.0f;   // clamped to 255
+  write_png(path, img);
+  Image back = read_ldr_or_hdr(path);
+  ASSERT_EQ(back.channels, (std::vector<std::string>{"R", "G", "B"}));
+  EXPECT_FLOAT_EQ(back.at(0, 0, 0), 1.0f);
+  EXPECT_FLOAT_EQ(back.at(1, 0, 1), 128.0f / 255.0f);
+  EXPECT_FLOAT_EQ(back.at(2, 0, 2), 0.0f);
+  EXPECT_FLOAT_EQ(back.at(2, 0, 0), 1.0f);
+}
+
+TEST(ImageColor, SrgbCurveRoundTripsAndHandlesEdges) {
+  for (float v : {0.0f, 0.001f, 0.0031308f, 0.18f, 0.5f, 1.0f})
+    EXPECT_NEAR(linear_from_srgb(srgb_from_linear(v)), v, 1e-6f);
+  EXPECT_NEAR(srgb_from_linear(0.18f), 0.4614f, 1e-4f);
+  EXPECT_EQ(srgb_from_linear(NAN), 0.0f);
+  EXPECT_EQ(srgb_from_linear(-1.0f), 0.0f);
+  EXPECT_NEAR(luminance(1, 1, 1), 1.0f, 1e-6f);
+}
+
+TEST(ImageMetrics, MatchHandComputedValues) {
+  // reference RGB pixels: (1,2,3), (3,2,1); test: (1,2,3), (4,2,0) -> diffs 0,0,0,1,0,-1
+  Image ref = Image::rgb(2, 1), test = Image::rgb(2, 1);
+  const float r[] = {1, 2, 3, 3, 2, 1}, t[] = {1, 2, 3, 4, 2, 0};
+  std::copy(r, r + 6, ref.pixels.begin());
+  std::copy(t, t + 6, test.pixels.begin());
+  ImageMetrics m = compare_images(test, ref);
+  EXPECT_EQ(m.samples, 6u);
+  EXPECT_NEAR(m.rmse, std::sqrt(2.0 / 6.0), 1e-12);
+  EXPECT_NEAR(m.reference_mean, 2.0, 1e-12);
+  EXPECT_NEAR(m.nrmse_percent, 100.0 * std::sqrt(2.0 / 6.0) / 2.0, 1e-9);
+  EXPECT_NEAR(m.rel_mse, (1.0 / (9 + 1e-2) + 1.0 / (1 + 1e-2)) / 6.0, 1e-12);
+  EXPECT_NEAR(m.max_abs_diff, 1.0, 1e-12);
+  EXPECT_EQ(m.nan_count, 0u);
+}
+
+TEST(ImageMetrics, CountsNonFiniteTestSamplesAndSkipsThem) {
+  Image ref = Image::rgb(2, 1, 1.0f), test = Image::rgb(2, 1, 1.0f);
+  test.at(0, 0, 0) = NAN;
+  test.at(1, 0, 1) = -INFINITY;
+  ImageMetrics m = compare_images(test, ref);
+  EXPECT_EQ(m.nan_count, 1u);
+  EXPECT_EQ(m.inf_count, 1u);
+  EXPECT_EQ(m.samples, 4u);
+  EXPECT_EQ(m.rmse, 0.0);
+}
+
+TEST(ImageMetrics, IgnoresAlphaAndRejectsMismatches) {
+  Image ref = Image::rgba(1, 1, 1.0f), test = Image::rgba(1, 1, 1.0f);
+  test.at(0, 0, 3) = 0.0f;
+  EXPECT_EQ(compare_images(test, ref).rmse, 0.0);
+  EXPECT_THROW(compare_images(Image::rgb(2, 1), Image::rgb(1, 1)), Error);
+  EXPECT_THROW(compare_images(Image::gray(1, 1, "Z"), Image::rgb(1, 1)), Error);
+}
