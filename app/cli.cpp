@@ -1,0 +1,152 @@
+#include "app/cli.h"
+
+#include <cctype>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <sstream>
+
+namespace pxf {
+
+namespace {
+std::string join(const std::vector<std::string>& words, const char* sep) {
+  std::string out;
+  for (const auto& w : words) out += (out.empty() ? "" : sep) + w;
+  return out;
+}
+
+double parse_number(const std::string& option, const std::string& text) {
+  errno = 0;
+  char* end = nullptr;
+  const double value = std::strtod(text.c_str(), &end);
+  if (text.empty() || end != text.c_str() + text.size() || errno == ERANGE || !std::isfinite(value))
+    throw UsageError(option + ": '" + text + "' is not a number");
+  return value;
+}
+
+template <typename T>
+std::function<void(const std::string&)> number_setter(const std::string& name, T* target, double min, double max,
+                                                      bool integer) {
+  return [=](const std::string& text) {
+    const double value = parse_number(name, text);
+    if (integer && value != std::floor(value)) throw UsageError(name + ": '" + text + "' is not an integer");
+    if (value < min || value > max) {
+      std::ostringstream msg;
+      msg << name << ": " << text << " is out of range [" << min << ", " << max << "]";
+      throw UsageError(msg.str());
+    }
+    *target = static_cast<T>(value);
+  };
+}
+}  // namespace
+
+CommandLine::CommandLine(std::string command, std::string usage, std::string summary)
+    : command_(std::move(command)), usage_(std::move(usage)), summary_(std::move(summary)) {}
+
+void CommandLine::flag(const std::string& name, bool* target, const std::string& help) {
+  options_.push_back({name, "", help, true, [target](const std::string&) { *target = true; }});
+}
+
+void CommandLine::option(const std::string& name, std::string* target, const std::string& metavar,
+                         const std::string& help) {
+  options_.push_back({name, metavar, help, false, [target](const std::string& v) { *target = v; }});
+}
+
+void CommandLine::option(const std::string& name, int* target, const std::string& help, int min, int max) {
+  options_.push_back({name, "N", help + " [" + std::to_string(min) + ".." + std::to_string(max) + "]", false,
+                      number_setter(name, target, min, max, true)});
+}
+
+void CommandLine::option(const std::string& name, float* target, const std::string& help, float min, float max) {
+  options_.push_back({name, "X", help, false, number_setter(name, target, min, max, false)});
+}
+
+void CommandLine::option(const std::string& name, double* target, const std::string& help, double min, double max) {
+  options_.push_back({name, "X", help, false, number_setter(name, target, min, max, false)});
+}
+
+void CommandLine::choice(const std::string& name, std::string* target, const std::vector<std::string>& choices,
+                         const std::string& help) {
+  options_.push_back({name, join(choices, "|"), help, false, [=](const std::string& v) {
+                        for (const auto& c : choices)
+                          if (c == v) {
+                            *target = v;
+                            return;
+                          }
+                        throw UsageError(name + ": '" + v + "' is not one of " + join(choices, ", "));
+                      }});
+}
+
+void CommandLine::size_option(const std::string& name, int* width, int* height, const std::string& help) {
+  options_.push_back({name, "WxH", help, false, [=](const std::string& v) {
+                        const size_t x = v.find('x');
+                        if (x == std::string::npos) throw UsageError(name + ": '" + v + "' is not of the form WxH");
+                        int w = 0, h = 0;
+                        number_setter(name, &w, 1, 16384, true)(v.substr(0, x));
+                        number_setter(name, &h, 1, 16384, true)(v.substr(x + 1));
+                        *width = w;
+                        *height = h;
+                      }});
+}
+
+void CommandLine::positional(const std::string& name, std::string* target, const std::string& help) {
+  positionals_.push_back({name, help, target});
+}
+
+bool CommandLine::given(const std::string& name) const {
+  for (const auto& g : given_)
+    if (g == name) return true;
+  return false;
+}
+
+bool CommandLine::parse(const std::vector<std::string>& args) {
+  size_t next_positional = 0;
+  for (size_t i = 0; i < args.size(); ++i) {
+    const std::string& arg = args[i];
+    if (arg == "--help" || arg == "-h") {
+      std::fputs(help().c_str(), stdout);
+      return false;
+    }
+    if (arg.size() > 1 && arg[0] == '-' && !(arg.size() > 1 && (std::isdigit(arg[1]) || arg[1] == '.'))) {
+      std::string name = arg, value;
+      const size_t eq = arg.find('=');
+      const bool inline_value = eq != std::string::npos;
+      if (inline_value) name = arg.substr(0, eq), value = arg.substr(eq + 1);
+      const Option* found = nullptr;
+      for (const auto& o : options_)
+        if (o.name == name) found = &o;
+      if (!found) throw UsageError("unknown option '" + name + "' (see pxf " + command_ + " --help)");
+      if (found->is_flag) {
+        if (inline_value) throw UsageError(name + " takes no value");
+      } else if (!inline_value) {
+        if (i + 1 >= args.size()) throw UsageError(name + " needs a value (" + found->metavar + ")");
+        value = args[++i];
+      }
+      found->set(value);
+      given_.push_back(name);
+      continue;
+    }
+    if (next_positional >= positionals_.size()) throw UsageError("unexpected argument '" + arg + "'");
+    *positionals_[next_positional++].target = arg;
+  }
+  if (next_positional < positionals_.size())
+    throw UsageError("missing argument " + positionals_[next_positional].name + " (see pxf " + command_ + " --help)");
+  return true;
+}
+
+std::string CommandLine::help() const {
+  std::ostringstream out;
+  out << "usage: pxf " << command_ << " " << usage_ << "\n\n" << summary_ << "\n";
+  if (!positionals_.empty()) {
+    out << "\narguments:\n";
+    for (const auto& p : positionals_) out << "  " << p.name << "\n      " << p.help << "\n";
+  }
+  out << "\noptions:\n";
+  for (const auto& o : options_)
+    out << "  " << o.name << (o.metavar.empty() ? "" : " " + o.metavar) << "\n      " << o.help << "\n";
+  out << "  --help\n      show this help\n";
+  return out.str();
+}
+
+}  // namespace pxf

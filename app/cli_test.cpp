@@ -1,0 +1,80 @@
+#include <gtest/gtest.h>
+
+#include "app/cli.h"
+
+using namespace pxf;
+
+namespace {
+struct Fixture {
+  int spp = 4;
+  float threshold = 0.01f;
+  bool all_hv = false;
+  std::string filter = "bilateral-depth", out;
+  int width = 0, height = 0;
+  CommandLine cli{"render", "[options]", "test"};
+  Fixture() {
+    cli.option("--spp", &spp, "samples", 1, 1 << 20);
+    cli.option("--threshold", &threshold, "t", 0.0f, 1e6f);
+    cli.flag("--all-hv", &all_hv, "all HV");
+    cli.choice("--filter", &filter, {"bilateral-depth", "bilateral", "none"}, "variant");
+    cli.option("--out", &out, "DIR", "output");
+    cli.size_option("--size", &width, &height, "size");
+  }
+};
+}  // namespace
+
+TEST(CommandLine, ParsesEveryKindOfOption) {
+  Fixture f;
+  ASSERT_TRUE(f.cli.parse({"--spp", "64", "--threshold=0.5", "--all-hv", "--filter", "bilateral", "--out", "x",
+                           "--size", "320x200"}));
+  EXPECT_EQ(f.spp, 64);
+  EXPECT_FLOAT_EQ(f.threshold, 0.5f);
+  EXPECT_TRUE(f.all_hv);
+  EXPECT_EQ(f.filter, "bilateral");
+  EXPECT_EQ(f.out, "x");
+  EXPECT_EQ(f.width, 320);
+  EXPECT_EQ(f.height, 200);
+  EXPECT_TRUE(f.cli.given("--spp"));
+  EXPECT_FALSE(Fixture().cli.given("--spp"));
+}
+
+TEST(CommandLine, RejectsBadInputWithOneLineMessages) {
+  const std::vector<std::vector<std::string>> bad = {
+      {"--nope"},              {"--spp"},          {"--spp", "abc"},     {"--spp", "0"},
+      {"--spp", "1.5"},        {"--spp", "1e30"},  {"--threshold", "-1"}, {"--threshold", "nan"},
+      {"--filter", "gauss"},   {"--size", "12"},   {"--size", "0x5"},    {"--all-hv=1"},
+      {"stray"},
+  };
+  for (const auto& args : bad) {
+    Fixture f;
+    try {
+      f.cli.parse(args);
+      ADD_FAILURE() << "accepted: " << args[0];
+    } catch (const UsageError& e) {
+      EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos);
+    }
+  }
+}
+
+TEST(CommandLine, HelpListsEveryOptionAndStopsParsing) {
+  Fixture f;
+  testing::internal::CaptureStdout();
+  EXPECT_FALSE(f.cli.parse({"--help"}));
+  const std::string help = testing::internal::GetCapturedStdout();
+  for (const char* name : {"--spp", "--threshold", "--all-hv", "--filter", "--out", "--size"})
+    EXPECT_NE(help.find(name), std::string::npos) << name;
+}
+
+TEST(CommandLine, RequiresPositionals) {
+  std::string a, b;
+  CommandLine cli("diff", "A B", "test");
+  cli.positional("A", &a, "first");
+  cli.positional("B", &b, "second");
+  EXPECT_THROW(cli.parse({"only-one"}), UsageError);
+  CommandLine cli2("diff", "A B", "test");
+  cli2.positional("A", &a, "first");
+  cli2.positional("B", &b, "second");
+  EXPECT_TRUE(cli2.parse({"x.exr", "y.exr"}));
+  EXPECT_EQ(a, "x.exr");
+  EXPECT_EQ(b, "y.exr");
+}

@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# Installs whatever Debian 12 packages are missing, then configures and builds pxf (Release) in
+# build/ (or $PXF_BUILD_DIR). Idempotent: with everything installed and built it takes seconds.
+#   scripts/setup.sh [extra cmake arguments]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+PACKAGES=(
+  cmake g++ make pkg-config ca-certificates
+  python3 python3-glad                 # GL loader generated at build time
+  libosmesa6-dev libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri   # OSMesa and EGL (llvmpipe)
+  libglfw3-dev libimgui-dev            # explorer window and UI
+  libglm-dev libtinygltf-dev nlohmann-json3-dev libstb-dev
+  libopenexr-dev libembree-dev libtbb-dev
+  libgtest-dev
+  xvfb xauth                           # explorer test under a virtual display
+)
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "setup: installing ${missing[*]}"
+  SUDO=""
+  [ "$(id -u)" -eq 0 ] || SUDO="sudo"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+BUILD_DIR="${PXF_BUILD_DIR:-build}"
+JOBS="${PXF_JOBS:-$(nproc)}"
+if [ ! -f "$BUILD_DIR/CMakeCache.txt" ]; then
+  cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release "$@" >/dev/null
+elif [ $# -gt 0 ]; then
+  cmake -S . -B "$BUILD_DIR" "$@" >/dev/null
+fi
+cmake --build "$BUILD_DIR" -j "$JOBS"
