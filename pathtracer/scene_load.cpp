@@ -1,0 +1,733 @@
+// glTF 2.0 scene loading (tinygltf) into the flattened world-space pxf::Scene, built-in scene
+// lookup and environment maps. Bad input throws pxf::Error("<file>: <problem>"); anything we can
+// render around (missing textures, bad triangles, unknown optional extensions) becomes one warning
+// line in Scene::warnings.
+#include <tiny_gltf.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/quaternion.hpp>
+#include <glm/gtc/type_ptr.hpp>
+
+#include "image/image.h"
+#include "pathtracer/gltf_accessor.h"
+#include "pathtracer/gltf_geometry.h"
+#include "pathtracer/gltf_images.h"
+#include "pathtracer/pathtracer.h"
+#include "pathtracer/texture.h"
+
+#ifndef PXF_ASSETS_DIR
+#define PXF_ASSETS_DIR ""
+#endif
+
+namespace pxf {
+
+size_t Scene::triangle_count() const {
+  size_t count = 0;
+  for (const Mesh& mesh : meshes) count += mesh.triangles.size();
+  return count;
+}
+
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::set<std::string>& supported_extensions() {
+  static const std::set<std::string> names = {
+      "KHR_lights_punctual",      "KHR_texture_transform", "KHR_materials_emissive_strength",
+      "KHR_materials_transmission", "KHR_materials_ior",   "KHR_materials_specular",
+      "KHR_mesh_quantization"};
+  return names;
+}
+
+struct BuiltinInfo {
+  const char* name;
+  const char* description;
+};
+const BuiltinInfo kBuiltins[] = {
+    {"cornell", "Cornell box lit by its ceiling light (the source's test scene)"},
+    {"atrium", "Atrium with columns, mostly indirect light from a skylight"},
+    {"kitchen", "Kitchen interior with glossy, textured and glass materials"},
+    {"envmap", "Objects lit only by an environment map (renders with all_hv)"},
+};
+
+std::string builtin_path(const std::string& name) {
+  return std::string(PXF_ASSETS_DIR) + "/" + name + "/" + name + ".gltf";
+}
+
+// ---------------------------------------------------------------------------------------------
+// Small conversions
+
+float finite_or(double value, float fallback) {
+  return std::isfinite(value) ? static_cast<float>(value) : fallback;
+}
+
+float clamp01(double value, float fallback) { return std::clamp(finite_or(value, fallback), 0.0f, 1.0f); }
+
+glm::vec3 vec3_or(const std::vector<double>& v, glm::vec3 fallback) {
+  if (v.size() < 3) return fallback;
+  return {finite_or(v[0], fallback.x), finite_or(v[1], fallback.y), finite_or(v[2], fallback.z)};
+}
+
+double number_or(const tinygltf::Value& value, double fallback) {
+  return value.IsNumber() ? value.GetNumberAsDouble() : fallback;
+}
+
+glm::vec3 value_vec3_or(const tinygltf::Value& value, glm::vec3 fallback) {
+  if (!value.IsArray() || value.ArrayLen() < 3) return fallback;
+  glm::vec3 out;
+  for (int i = 0; i < 3; ++i) out[i] = finite_or(number_or(value.Get(i), fallback[i]), fallback[i]);
+  return out;
+}
+
+const tinygltf::Value* find_extension(const tinygltf::ExtensionMap& extensions, const std::string& name) {
+  auto it = extensions.find(name);
+  return it != extensions.end() && it->second.IsObject() ? &it->second : nullptr;
+}
+
+// First non-empty line of a (possibly multi-line) tinygltf message.
+std::string first_line(const std::string& text) {
+  std::istringstream in(text);
+  std::string line;
+  while (std::getline(in, line))
+    if (line.find_first_not_of(" \t\r") != std::string::npos) return line;
+  return "unknown error";
+}
+
+std::vector<std::string> lines_of(const std::string& text) {
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  std::string line;
+  while (std::getline(in, line))
+    if (line.find_first_not_of(" \t\r") != std::string::npos) lines.push_back(line);
+  return lines;
+}
+
+glm::mat4 node_local_transform(const tinygltf::Node& node) {
+  if (node.matrix.size() == 16) {
+    glm::mat4 m;
+    for (int i = 0; i < 16; ++i) glm::value_ptr(m)[i] = static_cast<float>(node.matrix[i]);  // column-major
+    return m;
+  }
+  glm::mat4 m(1.0f);
+  if (node.translation.size() == 3)
+    m = glm::translate(m, glm::vec3(node.translation[0], node.translation[1], node.translation[2]));
+  if (node.rotation.size() == 4) {
+    glm::quat q(static_cast<float>(node.rotation[3]), static_cast<float>(node.rotation[0]),
+                static_cast<float>(node.rotation[1]), static_cast<float>(node.rotation[2]));  // w, x, y, z
+    float len = glm::length(q);
+    if (len > 0.0f && std::isfinite(len)) m *= glm::mat4_cast(q / len);
+  }
+  if (node.scale.size() == 3) m = glm::scale(m, glm::vec3(node.scale[0], node.scale[1], node.scale[2]));
+  return m;
+}
+
+// The rigid part of a node transform: camera frames must not carry scale or shear.
+glm::mat4 rigid_frame(const glm::mat4& m) {
+  glm::vec3 z = glm::vec3(m[2]);
+  glm::vec3 x = glm::vec3(m[0]);
+  if (!gltf::is_finite(z) || glm::length(z) == 0.0f) z = glm::vec3(0, 0, 1);
+  z = glm::normalize(z);
+  x -= z * glm::dot(x, z);
+  if (!gltf::is_finite(x) || glm::length(x) < 1e-12f) x = gltf::any_orthogonal(z);
+  x = glm::normalize(x);
+  glm::vec3 y = glm::cross(z, x);
+  glm::vec3 origin = gltf::is_finite(glm::vec3(m[3])) ? glm::vec3(m[3]) : glm::vec3(0.0f);
+  return glm::mat4(glm::vec4(x, 0), glm::vec4(y, 0), glm::vec4(z, 0), glm::vec4(origin, 1));
+}
+
+// ---------------------------------------------------------------------------------------------
+// The loader
+
+class GltfLoader {
+ public:
+  explicit GltfLoader(std::string file) : file_(std::move(file)) {}
+
+  Scene load() {
+    read_model();
+    check_extensions();
+    images_.decode_buffer_view_images(model_, file_);
+    load_materials();
+    traverse_scene();
+    finish_camera();
+    read_scene_defaults();
+    report_dropped_triangles();
+    return std::move(scene_);
+  }
+
+ private:
+  [[noreturn]] void fail(const std::string& problem) const { throw Error(file_ + ": " + problem); }
+  void warn(const std::string& message) { scene_.warnings.push_back(file_ + ": " + message); }
+
+  void read_model() {
+    std::error_code ec;
+    if (!fs::is_regular_file(file_, ec)) fail("no such file");
+    char magic[4] = {0, 0, 0, 0};
+    {
+      std::ifstream in(file_, std::ios::binary);
+      if (!in) fail("cannot open file");
+      in.read(magic, 4);
+    }
+    bool binary = std::string(magic, 4) == "glTF";
+    tinygltf::TinyGLTF loader;
+    images_.install(loader);
+    std::string err, warn_text;
+    bool ok = false;
+    try {
+      ok = binary ? loader.LoadBinaryFromFile(&model_, &err, &warn_text, file_)
+                  : loader.LoadASCIIFromFile(&model_, &err, &warn_text, file_);
+    } catch (const std::exception& e) {
+      fail(std::string("invalid glTF: ") + e.what());
+    }
+    if (!ok) fail(first_line(err.empty() ? warn_text : err));
+    for (const std::string& line : lines_of(warn_text)) warn(line);
+  }
+
+  void check_extensions() {
+    for (const std::string& name : model_.extensionsRequired)
+      if (!supported_extensions().count(name)) fail("required extension " + name + " is not supported");
+    std::string unsupported;
+    for (const std::string& name : model_.extensionsUsed)
+      if (!supported_extensions().count(name)) unsupported += (unsupported.empty() ? "" : ", ") + name;
+    if (!unsupported.empty()) warn("ignoring unsupported extensions " + unsupported + " (rendered without them)");
+  }
+
+  // -- textures ---------------------------------------------------------------------------------
+
+  // A glTF textureInfo in any of its three spellings (TextureInfo, NormalTextureInfo, JSON value).
+  struct TextureInfoView {
+    int index = -1;
+    int texcoord = 0;
+    const tinygltf::Value* transform = nullptr;  // KHR_texture_transform object
+  };
+
+  static TextureInfoView info_of(const tinygltf::TextureInfo& info) {
+    return {info.index, info.texCoord, find_extension(info.extensions, "KHR_texture_transform")};
+  }
+  static TextureInfoView info_of(const tinygltf::NormalTextureInfo& info) {
+    return {info.index, info.texCoord, find_extension(info.extensions, "KHR_texture_transform")};
+  }
+  static TextureInfoView info_of(const tinygltf::Value& value) {
+    TextureInfoView view;
+    if (!value.IsObject()) return view;
+    view.index = static_cast<int>(number_or(value.Get("index"), -1));
+    view.texcoord = static_cast<int>(number_or(value.Get("texCoord"), 0));
+    const tinygltf::Value& ext = value.Get("extensions").Get("KHR_texture_transform");
+    if (ext.IsObject()) view.transform = &ext;
+    return view;
+  }
+
+  TextureRef texture_ref(const TextureInfoView& info, bool srgb, const std::string& material, const char* slot) {
+    TextureRef ref;
+    if (info.index < 0) return ref;
+    ref.texture = scene_texture(info.index, srgb, material, slot);
+    if (ref.texture < 0) return ref;
+    ref.texcoord = info.texcoord;
+    if (info.transform) {
+      const tinygltf::Value& t = *info.transform;
+      glm::vec2 offset(0.0f), scale(1.0f);
+      const tinygltf::Value& o = t.Get("offset");
+      const tinygltf::Value& s = t.Get("scale");
+      if (o.IsArray() && o.ArrayLen() >= 2)
+        offset = {finite_or(number_or(o.Get(0), 0), 0), finite_or(number_or(o.Get(1), 0), 0)};
+      if (s.IsArray() && s.ArrayLen() >= 2)
+        scale = {finite_or(number_or(s.Get(0), 1), 1), finite_or(number_or(s.Get(1), 1), 1)};
+      float rotation = finite_or(number_or(t.Get("rotation"), 0), 0);
+      ref.transform = texture_transform_matrix(offset, rotation, scale);
+      if (t.Get("texCoord").IsNumber()) ref.texcoord = t.Get("texCoord").GetNumberAsInt();
+    }
+    if (ref.texcoord != 0 && ref.texcoord != 1) {
+      warn("material '" + material + "' " + slot + " uses TEXCOORD_" + std::to_string(ref.texcoord) +
+           ", only sets 0 and 1 are supported; using TEXCOORD_0");
+      ref.texcoord = 0;
+    }
+    return ref;
+  }
+
+  // Index into scene_.textures of glTF texture `index` decoded as sRGB or linear; -1 (with a
+  // warning naming the image) when its image is unavailable.
+  int scene_texture(int index, bool srgb, const std::string& material, const char* slot) {
+    auto key = std::make_pair(index, srgb);
+    auto cached = texture_cache_.find(key);
+    if (cached != texture_cache_.end()) return cached->second;
+    if (index >= static_cast<int>(model_.textures.size())) fail("texture " + std::to_string(index) + " out of range");
+    const tinygltf::Texture& texture = model_.textures[index];
+    int& slot_index = texture_cache_[key];
+    slot_index = -1;
+    if (texture.source < 0) {
+      warn("texture " + std::to_string(index) + " has no supported image source; material '" + material +
+           "' renders without its " + slot + " texture");
+      return -1;
+    }
+    if (texture.source >= static_cast<int>(model_.images.size()))
+      fail("texture " + std::to_string(index) + " references image " + std::to_string(texture.source) + " out of range");
+    const tinygltf::Image& image = model_.images[texture.source];
+    const gltf::DecodedImage* decoded =
+        texture.source < static_cast<int>(images_.images.size()) ? &images_.images[texture.source] : nullptr;
+    if (!decoded || !decoded->decoded) {
+      std::string what = !image.uri.empty() ? "'" + image.uri + "'" : "image " + std::to_string(texture.source);
+      std::string why = decoded && !decoded->failure.empty() ? " (" + decoded->failure + ")" : " (missing or unreadable)";
+      warn("texture image " + what + " could not be loaded" + why + "; material '" + material +
+           "' renders without its " + slot + " texture");
+      return -1;
+    }
+    scene_.textures.push_back(make_texture(*decoded, srgb, texture, image));
+    slot_index = static_cast<int>(scene_.textures.size()) - 1;
+    return slot_index;
+  }
+
+  static Wrap wrap_mode(int gl_wrap) {
+    switch (gl_wrap) {
+      case TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE: return Wrap::ClampToEdge;
+      case TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT: return Wrap::MirroredRepeat;
+      default: return Wrap::Repeat;
+    }
+  }
+
+  Texture make_texture(const gltf::DecodedImage& decoded, bool srgb, const tinygltf::Texture& texture,
+                       const tinygltf::Image& image) {
+    Texture out;
+    out.name = !image.uri.empty() && image.uri.rfind("data:", 0) != 0 ? image.uri : image.name;
+    out.width = decoded.width;
+    out.height = decoded.height;
+    if (texture.sampler >= 0) {
+      if (texture.sampler >= static_cast<int>(model_.samplers.size()))
+        fail("sampler " + std::to_string(texture.sampler) + " out of range");
+      const tinygltf::Sampler& sampler = model_.samplers[texture.sampler];
+      out.wrap_s = wrap_mode(sampler.wrapS);
+      out.wrap_t = wrap_mode(sampler.wrapT);
+      out.nearest = sampler.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST;
+    }
+    size_t texel_count = static_cast<size_t>(decoded.width) * decoded.height;
+    out.texels.resize(texel_count);
+    int c = decoded.channels;
+    // Decoding sRGB per 8/16-bit value is the bulk of texture load time; a table would help
+    // 8-bit images, but linear_from_srgb is already fast enough for our asset sizes.
+    auto color = [&](float v) {
+      float x = std::isfinite(v) ? std::max(v, 0.0f) : 0.0f;
+      return srgb ? linear_from_srgb(x) : x;
+    };
+    for (size_t i = 0; i < texel_count; ++i) {
+      const float* p = &decoded.values[i * c];
+      glm::vec4 t;
+      if (c <= 2) {
+        float g = color(p[0]);
+        t = glm::vec4(g, g, g, c == 2 ? p[1] : 1.0f);
+      } else {
+        t = glm::vec4(color(p[0]), color(p[1]), color(p[2]), c == 4 ? p[3] : 1.0f);
+      }
+      if (!std::isfinite(t.w)) t.w = 1.0f;
+      out.texels[i] = t;
+    }
+    return out;
+  }
+
+  // -- materials --------------------------------------------------------------------------------
+
+  void load_materials() {
+    for (size_t i = 0; i < model_.materials.size(); ++i) scene_.materials.push_back(load_material(model_.materials[i], i));
+    // Primitives without a material use this one (glTF's default material is white; we make it
+    // a plain diffuse rather than glTF's metallic default, which renders black without an environment).
+    Material fallback;
+    fallback.name = "pxf_default";
+    fallback.metallic = 0.0f;
+    fallback.roughness = 1.0f;
+    scene_.materials.push_back(fallback);
+  }
+
+  Material load_material(const tinygltf::Material& gm, size_t index) {
+    Material m;
+    m.name = gm.name.empty() ? "material " + std::to_string(index) : gm.name;
+    const auto& pbr = gm.pbrMetallicRoughness;
+    if (pbr.baseColorFactor.size() == 4)
+      for (int c = 0; c < 4; ++c) m.base_color[c] = clamp01(pbr.baseColorFactor[c], 1.0f);
+    m.base_color_texture = texture_ref(info_of(pbr.baseColorTexture), true, m.name, "base color");
+    m.metallic = clamp01(pbr.metallicFactor, 1.0f);
+    m.roughness = clamp01(pbr.roughnessFactor, 1.0f);
+    m.metallic_roughness_texture = texture_ref(info_of(pbr.metallicRoughnessTexture), false, m.name, "metallic-roughness");
+    m.normal_texture = texture_ref(info_of(gm.normalTexture), false, m.name, "normal");
+    m.normal_scale = finite_or(gm.normalTexture.scale, 1.0f);
+    m.emissive = glm::max(vec3_or(gm.emissiveFactor, glm::vec3(0.0f)), glm::vec3(0.0f));
+    m.emissive_texture = texture_ref(info_of(gm.emissiveTexture), true, m.name, "emissive");
+    if (const tinygltf::Value* ext = find_extension(gm.extensions, "KHR_materials_emissive_strength"))
+      m.emissive *= std::max(finite_or(number_or(ext->Get("emissiveStrength"), 1.0), 1.0f), 0.0f);
+    if (const tinygltf::Value* ext = find_extension(gm.extensions, "KHR_materials_transmission")) {
+      m.transmission = clamp01(number_or(ext->Get("transmissionFactor"), 0.0), 0.0f);
+      m.transmission_texture = texture_ref(info_of(ext->Get("transmissionTexture")), false, m.name, "transmission");
+    }
+    if (const tinygltf::Value* ext = find_extension(gm.extensions, "KHR_materials_ior")) {
+      float ior = finite_or(number_or(ext->Get("ior"), 1.5), 1.5f);
+      // ior 0 is not meaningful for a path tracer; keep it physical.
+      if (ior < 1.0f) {
+        warn("material '" + m.name + "' has ior " + std::to_string(ior) + " < 1; using 1.5");
+        ior = 1.5f;
+      }
+      m.ior = std::min(ior, 10.0f);
+    }
+    if (const tinygltf::Value* ext = find_extension(gm.extensions, "KHR_materials_specular")) {
+      m.specular = clamp01(number_or(ext->Get("specularFactor"), 1.0), 1.0f);
+      m.specular_texture = texture_ref(info_of(ext->Get("specularTexture")), false, m.name, "specular");
+      m.specular_color = glm::max(value_vec3_or(ext->Get("specularColorFactor"), glm::vec3(1.0f)), glm::vec3(0.0f));
+      m.specular_color_texture = texture_ref(info_of(ext->Get("specularColorTexture")), true, m.name, "specular color");
+    }
+    if (gm.alphaMode == "MASK") m.alpha_mode = AlphaMode::Mask;
+    else if (gm.alphaMode == "BLEND") m.alpha_mode = AlphaMode::Blend;
+    m.alpha_cutoff = std::max(finite_or(gm.alphaCutoff, 0.5f), 0.0f);
+    m.double_sided = gm.doubleSided;
+    return m;
+  }
+
+  // -- node hierarchy ---------------------------------------------------------------------------
+
+  void traverse_scene() {
+    std::vector<int> roots;
+    if (!model_.scenes.empty()) {
+      scene_index_ = model_.defaultScene >= 0 ? model_.defaultScene : 0;
+      if (scene_index_ >= static_cast<int>(model_.scenes.size()))
+        fail("default scene " + std::to_string(scene_index_) + " out of range");
+      roots = model_.scenes[scene_index_].nodes;
+    } else {
+      // No scene: every node that is nobody's child is a root.
+      std::vector<bool> is_child(model_.nodes.size(), false);
+      for (const tinygltf::Node& node : model_.nodes)
+        for (int child : node.children)
+          if (child >= 0 && child < static_cast<int>(is_child.size())) is_child[child] = true;
+      for (size_t i = 0; i < model_.nodes.size(); ++i)
+        if (!is_child[i]) roots.push_back(static_cast<int>(i));
+    }
+    std::vector<bool> on_path(model_.nodes.size(), false);
+    for (int root : roots) visit_node(root, glm::mat4(1.0f), on_path);
+  }
+
+  void visit_node(int index, const glm::mat4& parent, std::vector<bool>& on_path) {
+    if (index < 0 || index >= static_cast<int>(model_.nodes.size())) fail("node " + std::to_string(index) + " out of range");
+    if (on_path[index]) fail("node " + std::to_string(index) + " is its own ancestor (cycle in the node hierarchy)");
+    on_path[index] = true;
+    const tinygltf::Node& node = model_.nodes[index];
+    glm::mat4 world = parent * node_local_transform(node);
+    if (node.mesh >= 0) add_mesh(node.mesh, world);
+    else if (node.mesh < -1) fail("node " + std::to_string(index) + " mesh index out of range");
+    if (node.camera >= 0) add_camera(node.camera, world);
+    if (const tinygltf::Value* ext = find_extension(node.extensions, "KHR_lights_punctual"))
+      add_light(static_cast<int>(number_or(ext->Get("light"), -1)), world);
+    for (int child : node.children) visit_node(child, world, on_path);
+    on_path[index] = false;
+  }
+
+  void add_camera(int index, const glm::mat4& world) {
+    if (index >= static_cast<int>(model_.cameras.size())) fail("camera " + std::to_string(index) + " out of range");
+    if (have_camera_) return;  // the first camera in the hierarchy wins
+    const tinygltf::Camera& camera = model_.cameras[index];
+    if (camera.type != "perspective") {
+      warn("camera " + std::to_string(index) + " is " + camera.type + ", only perspective cameras are supported; ignoring it");
+      return;
+    }
+    const auto& p = camera.perspective;
+    Camera& out = scene_.camera;
+    out.camera_to_world = rigid_frame(world);
+    float yfov = finite_or(p.yfov, 0.0f);
+    out.yfov = (yfov > 1e-4f && yfov < 3.1f) ? yfov : Camera{}.yfov;
+    float znear = finite_or(p.znear, 0.0f);
+    out.znear = znear > 0.0f ? znear : Camera{}.znear;
+    float zfar = finite_or(p.zfar, 0.0f);
+    infinite_far_ = !(zfar > out.znear);
+    out.zfar = infinite_far_ ? Camera{}.zfar : zfar;
+    float aspect = finite_or(p.aspectRatio, 0.0f);
+    out.aspect = aspect > 0.0f ? aspect : 0.0f;
+    have_camera_ = true;
+  }
+
+  void add_light(int index, const glm::mat4& world) {
+    if (index < 0 || index >= static_cast<int>(model_.lights.size())) fail("light " + std::to_string(index) + " out of range");
+    const tinygltf::Light& light = model_.lights[index];
+    PunctualLight out;
+    if (light.type == "point") out.type = PunctualLight::Type::Point;
+    else if (light.type == "spot") out.type = PunctualLight::Type::Spot;
+    else if (light.type == "directional") out.type = PunctualLight::Type::Directional;
+    else {
+      warn("light " + std::to_string(index) + " has unknown type '" + light.type + "'; ignoring it");
+      return;
+    }
+    out.name = light.name;
+    out.color = glm::max(vec3_or(light.color, glm::vec3(1.0f)), glm::vec3(0.0f));
+    out.intensity = std::max(finite_or(light.intensity, 1.0f), 0.0f);
+    out.range = std::max(finite_or(light.range, 0.0f), 0.0f);
+    out.position = glm::vec3(world[3]);
+    glm::vec3 direction = glm::mat3(world) * glm::vec3(0.0f, 0.0f, -1.0f);  // lights shine down -Z
+    float len = glm::length(direction);
+    out.direction = (len > 0.0f && std::isfinite(len)) ? direction / len : glm::vec3(0.0f, 0.0f, -1.0f);
+    out.outer_cone = std::clamp(finite_or(light.spot.outerConeAngle, 0.785398f), 0.0f, 1.5707963f);
+    out.inner_cone = std::clamp(finite_or(light.spot.innerConeAngle, 0.0f), 0.0f, out.outer_cone);
+    if (!gltf::is_finite(out.position)) {
+      warn("light " + std::to_string(index) + " has a non-finite position; ignoring it");
+      return;
+    }
+    scene_.lights.push_back(out);
+  }
+
+  // -- meshes -----------------------------------------------------------------------------------
+
+  void add_mesh(int index, const glm::mat4& world) {
+    if (index >= static_cast<int>(model_.meshes.size())) fail("mesh " + std::to_string(index) + " out of range");
+    const tinygltf::Mesh& mesh = model_.meshes[index];
+    for (size_t p = 0; p < mesh.primitives.size(); ++p) add_primitive(mesh, index, p, world);
+  }
+
+  int attribute(const tinygltf::Primitive& primitive, const char* name) const {
+    auto it = primitive.attributes.find(name);
+    return it == primitive.attributes.end() ? -1 : it->second;
+  }
+
+  static std::vector<glm::uvec3> assemble_triangles(const std::vector<uint32_t>& idx, int mode) {
+    std::vector<glm::uvec3> tris;
+    if (mode == TINYGLTF_MODE_TRIANGLES) {
+      for (size_t i = 0; i + 2 < idx.size(); i += 3) tris.emplace_back(idx[i], idx[i + 1], idx[i + 2]);
+    } else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+      for (size_t i = 0; i + 2 < idx.size(); ++i)
+        tris.push_back(i % 2 == 0 ? glm::uvec3(idx[i], idx[i + 1], idx[i + 2]) : glm::uvec3(idx[i + 1], idx[i], idx[i + 2]));
+    } else if (mode == TINYGLTF_MODE_TRIANGLE_FAN) {
+      for (size_t i = 1; i + 1 < idx.size(); ++i) tris.emplace_back(idx[0], idx[i], idx[i + 1]);
+    }
+    return tris;
+  }
+
+  void add_primitive(const tinygltf::Mesh& gmesh, int mesh_index, size_t prim_index, const glm::mat4& world) {
+    const tinygltf::Primitive& prim = gmesh.primitives[prim_index];
+    std::string what = "mesh " + std::to_string(mesh_index) + " primitive " + std::to_string(prim_index);
+    int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
+    if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP && mode != TINYGLTF_MODE_TRIANGLE_FAN) {
+      warn(what + " uses mode " + std::to_string(mode) + " (points or lines); skipped");
+      return;
+    }
+    int position_accessor = attribute(prim, "POSITION");
+    if (position_accessor < 0) {
+      warn(what + " has no POSITION; skipped");
+      return;
+    }
+    Mesh mesh;
+    mesh.name = gmesh.name.empty() ? what : gmesh.name;
+    mesh.positions = gltf::read_vec3(model_, position_accessor, file_, what + " POSITION");
+    size_t n = mesh.positions.size();
+    auto check_count = [&](size_t count, const char* name) {
+      if (count != n) fail(what + " " + name + " has " + std::to_string(count) + " elements, POSITION has " + std::to_string(n));
+    };
+    if (int a = attribute(prim, "NORMAL"); a >= 0) {
+      mesh.normals = gltf::read_vec3(model_, a, file_, what + " NORMAL");
+      check_count(mesh.normals.size(), "NORMAL");
+    }
+    if (int a = attribute(prim, "TANGENT"); a >= 0) {
+      mesh.tangents = gltf::read_vec4(model_, a, file_, what + " TANGENT");
+      check_count(mesh.tangents.size(), "TANGENT");
+    }
+    if (int a = attribute(prim, "TEXCOORD_0"); a >= 0) {
+      mesh.uv0 = gltf::read_vec2(model_, a, file_, what + " TEXCOORD_0");
+      check_count(mesh.uv0.size(), "TEXCOORD_0");
+    }
+    if (int a = attribute(prim, "TEXCOORD_1"); a >= 0) {
+      mesh.uv1 = gltf::read_vec2(model_, a, file_, what + " TEXCOORD_1");
+      check_count(mesh.uv1.size(), "TEXCOORD_1");
+    }
+    if (int a = attribute(prim, "COLOR_0"); a >= 0) {
+      mesh.colors = gltf::read_color(model_, a, file_, what + " COLOR_0");
+      check_count(mesh.colors.size(), "COLOR_0");
+    }
+    std::vector<uint32_t> indices;
+    if (prim.indices >= 0) {
+      indices = gltf::read_indices(model_, prim.indices, file_, what + " indices");
+      for (uint32_t i : indices)
+        if (i >= n) fail(what + " index " + std::to_string(i) + " out of range (" + std::to_string(n) + " vertices)");
+    } else {
+      indices.resize(n);
+      for (size_t i = 0; i < n; ++i) indices[i] = static_cast<uint32_t>(i);
+    }
+    mesh.triangles = assemble_triangles(indices, mode);
+    if (prim.material >= static_cast<int>(model_.materials.size()) || prim.material < -1)
+      fail(what + " material " + std::to_string(prim.material) + " out of range");
+    mesh.material = prim.material >= 0 ? prim.material : static_cast<int>(model_.materials.size());
+
+    transform_to_world(mesh, world);
+    gltf::drop_invalid_triangles(mesh, dropped_);
+    if (mesh.triangles.empty()) return;
+    finish_attributes(mesh, what);
+    scene_.meshes.push_back(std::move(mesh));
+  }
+
+  static void transform_to_world(Mesh& mesh, const glm::mat4& world) {
+    glm::mat3 linear(world);
+    float det = glm::determinant(linear);
+    glm::mat3 normal_matrix = glm::transpose(glm::inverse(linear));
+    for (glm::vec3& p : mesh.positions) p = glm::vec3(world * glm::vec4(p, 1.0f));
+    for (glm::vec3& nrm : mesh.normals) nrm = normal_matrix * nrm;
+    // A mirroring transform flips the handedness of the tangent frame and, per glTF, the winding.
+    float handedness = det < 0.0f ? -1.0f : 1.0f;
+    for (glm::vec4& t : mesh.tangents) t = glm::vec4(linear * glm::vec3(t), t.w * handedness);
+    if (det < 0.0f)
+      for (glm::uvec3& tri : mesh.triangles) std::swap(tri.y, tri.z);
+  }
+
+  // Normals always, tangents when the material has a normal map, finite UVs and colors.
+  void finish_attributes(Mesh& mesh, const std::string& what) {
+    std::vector<glm::vec3> geometric = gltf::area_weighted_normals(mesh);
+    if (mesh.normals.empty()) mesh.normals = geometric;
+    else gltf::sanitize_normals(mesh, geometric);
+    for (glm::vec2& uv : mesh.uv0) if (!gltf::is_finite(uv)) uv = glm::vec2(0.0f);
+    for (glm::vec2& uv : mesh.uv1) if (!gltf::is_finite(uv)) uv = glm::vec2(0.0f);
+    for (glm::vec4& c : mesh.colors) c = gltf::is_finite(c) ? glm::max(c, glm::vec4(0.0f)) : glm::vec4(1.0f);
+
+    const Material& material = scene_.materials[mesh.material];
+    if (!material.normal_texture.valid()) {
+      if (!mesh.tangents.empty()) gltf::sanitize_tangents(mesh);
+      return;
+    }
+    if (mesh.tangents.empty()) {
+      const std::vector<glm::vec2>& uvs = material.normal_texture.texcoord == 1 ? mesh.uv1 : mesh.uv0;
+      if (uvs.empty()) warn(what + " has a normal map but no texture coordinates; its tangents are arbitrary");
+      mesh.tangents = gltf::compute_tangents(mesh, uvs);
+    }
+    gltf::sanitize_tangents(mesh);
+  }
+
+  // -- camera, defaults, warnings ---------------------------------------------------------------
+
+  void scene_bounds(glm::vec3& lo, glm::vec3& hi) const {
+    lo = glm::vec3(std::numeric_limits<float>::max());
+    hi = -lo;
+    for (const Mesh& mesh : scene_.meshes)
+      for (const glm::uvec3& t : mesh.triangles)
+        for (uint32_t v : {t.x, t.y, t.z}) {
+          lo = glm::min(lo, mesh.positions[v]);
+          hi = glm::max(hi, mesh.positions[v]);
+        }
+    if (!(lo.x <= hi.x)) lo = hi = glm::vec3(0.0f);
+  }
+
+  void finish_camera() {
+    glm::vec3 lo, hi;
+    scene_bounds(lo, hi);
+    glm::vec3 center = 0.5f * (lo + hi);
+    float radius = std::max(0.5f * glm::length(hi - lo), 1e-3f);
+    if (!have_camera_) {
+      // Frame the bounding sphere from +Z, looking down -Z (glTF's camera convention).
+      Camera camera;
+      float distance = radius / std::sin(0.5f * camera.yfov) * 1.05f;
+      camera.camera_to_world = glm::translate(glm::mat4(1.0f), center + glm::vec3(0.0f, 0.0f, distance));
+      camera.znear = std::max(distance * 1e-3f, 1e-4f);
+      camera.zfar = (distance + radius) * 2.0f;
+      scene_.camera = camera;
+      return;
+    }
+    if (infinite_far_) {
+      glm::vec3 eye(scene_.camera.camera_to_world[3]);
+      scene_.camera.zfar = std::max(scene_.camera.zfar, 2.0f * (glm::length(eye - center) + radius));
+    }
+  }
+
+  void read_scene_defaults() {
+    if (scene_index_ < 0) return;
+    const tinygltf::Value& pxf = model_.scenes[scene_index_].extras.Get("pxf");
+    if (!pxf.IsObject()) return;
+    const tinygltf::Value& all_hv = pxf.Get("all_hv");
+    if (all_hv.IsBool()) scene_.defaults.all_hv = all_hv.Get<bool>();
+    auto size = [&](const char* key) {
+      double v = number_or(pxf.Get(key), 0.0);
+      return std::isfinite(v) && v > 0 && v <= 16384 ? static_cast<int>(v) : 0;
+    };
+    scene_.defaults.width = size("width");
+    scene_.defaults.height = size("height");
+  }
+
+  void report_dropped_triangles() {
+    if (dropped_.nonfinite)
+      warn("dropped " + std::to_string(dropped_.nonfinite) + " triangles with NaN/Inf vertex positions");
+    if (dropped_.degenerate)
+      warn("dropped " + std::to_string(dropped_.degenerate) + " degenerate (zero-area) triangles");
+  }
+
+  std::string file_;
+  tinygltf::Model model_;
+  gltf::ImageStore images_;
+  Scene scene_;
+  std::map<std::pair<int, bool>, int> texture_cache_;
+  gltf::DroppedTriangles dropped_;
+  int scene_index_ = -1;
+  bool have_camera_ = false;
+  bool infinite_far_ = false;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Environment
+
+Environment load_environment(const std::string& path, float strength, std::vector<std::string>& warnings) {
+  if (!std::isfinite(strength) || strength < 0.0f)
+    throw Error(path + ": environment strength " + std::to_string(strength) + " must be finite and >= 0");
+  Image image = read_exr(path);
+  int r = image.channel_index("R"), g = image.channel_index("G"), b = image.channel_index("B");
+  int y = image.channel_index("Y");
+  if ((r < 0 || g < 0 || b < 0) && y < 0) throw Error(path + ": environment map needs R, G, B (or Y) channels");
+  if (image.empty()) throw Error(path + ": environment map is empty");
+  Environment env;
+  env.strength = strength;
+  env.source = path;
+  Texture& tex = env.image;
+  tex.name = path;
+  tex.width = image.width;
+  tex.height = image.height;
+  tex.wrap_s = Wrap::Repeat;       // longitude wraps around
+  tex.wrap_t = Wrap::ClampToEdge;  // latitude stops at the poles
+  tex.texels.resize(image.pixel_count());
+  size_t replaced = 0;
+  auto clean = [&](float v) {
+    if (std::isfinite(v) && v >= 0.0f) return v;
+    ++replaced;
+    return 0.0f;
+  };
+  for (int py = 0; py < image.height; ++py)
+    for (int px = 0; px < image.width; ++px) {
+      glm::vec3 c = r >= 0 && g >= 0 && b >= 0
+                        ? glm::vec3(image.at(px, py, r), image.at(px, py, g), image.at(px, py, b))
+                        : glm::vec3(image.at(px, py, y));
+      tex.texels[static_cast<size_t>(py) * image.width + px] = glm::vec4(clean(c.x), clean(c.y), clean(c.z), 1.0f);
+    }
+  if (replaced)
+    warnings.push_back(path + ": replaced " + std::to_string(replaced) + " NaN/Inf/negative environment values by 0");
+  return env;
+}
+
+}  // namespace
+
+std::vector<BuiltinScene> builtin_scenes() {
+  std::vector<BuiltinScene> scenes;
+  for (const BuiltinInfo& info : kBuiltins) {
+    std::string path = builtin_path(info.name);
+    std::error_code ec;
+    if (fs::is_regular_file(path, ec)) scenes.push_back({info.name, info.description, path});
+  }
+  return scenes;
+}
+
+Scene load_scene(const std::string& name_or_path, const std::string& env_path, float env_strength) {
+  std::string path = name_or_path;
+  std::string builtin_env;
+  for (const BuiltinScene& builtin : builtin_scenes())
+    if (builtin.name == name_or_path) {
+      path = builtin.path;
+      std::string env = (fs::path(path).parent_path() / "environment.exr").string();
+      std::error_code ec;
+      if (fs::is_regular_file(env, ec)) builtin_env = env;
+    }
+  Scene scene = GltfLoader(path).load();
+  scene.source = name_or_path;
+  std::string env = env_path.empty() ? builtin_env : env_path;
+  if (!env.empty()) scene.environment = load_environment(env, env_strength, scene.warnings);
+  return scene;
+}
+
+}  // namespace pxf
