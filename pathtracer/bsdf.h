@@ -1,0 +1,95 @@
+// Materials as BSDFs (glTF metallic-roughness + transmission, ior, specular):
+//   metallic * GGX conductor (Schlick, F0 = base color)
+// + (1 - metallic) * (1 - transmission) * (GGX dielectric specular (F0 from ior and KHR specular)
+//                                        + (1 - F) * Lambert(base color))
+// + (1 - metallic) * transmission * smooth dielectric (exact Fresnel, transmission tinted by base).
+// Roughness below kDeltaRoughness makes the GGX lobe a perfect mirror. Lobes are picked
+// stochastically by an estimate of their weight; pdf() is the combined pdf of the non-delta lobes.
+#pragma once
+#include <glm/glm.hpp>
+#include "pathtracer/sampling.h"
+#include "pathtracer/scene.h"
+
+namespace pxf {
+
+constexpr float kDeltaRoughness = 1e-3f;
+constexpr float kMinAlpha = 1e-3f;  // GGX alpha floor for near-smooth (but not delta) surfaces
+
+// Material parameters at one surface point (textures, vertex colors applied).
+struct BsdfParams {
+  glm::vec3 base_color{1.0f};
+  float metallic = 0.0f;
+  float roughness = 1.0f;
+  float transmission = 0.0f;
+  float ior = 1.5f;
+  float specular = 1.0f;
+  glm::vec3 specular_color{1.0f};
+};
+
+// The material evaluated at a surface point: base color x texture x vertex color, etc.
+BsdfParams eval_material(const Scene& scene, const Material& material, glm::vec2 uv0, glm::vec2 uv1,
+                         glm::vec4 vertex_color);
+// Emitted radiance of the material's front side (emissive factor x emissive texture).
+glm::vec3 eval_emission(const Scene& scene, const Material& material, glm::vec2 uv0, glm::vec2 uv1);
+// Base color alpha x texture alpha x vertex alpha (for MASK cutouts).
+float eval_opacity(const Scene& scene, const Material& material, glm::vec2 uv0, glm::vec2 uv1, float vertex_alpha);
+
+// Material-level classification (factors only, a texture on metallic/roughness/transmission
+// disqualifies): a perfect mirror or a smooth dielectric, i.e. every interaction is a delta.
+bool material_is_perfect_specular(const Material& material);
+bool material_is_perfect_mirror(const Material& material);
+
+struct BsdfSample {
+  glm::vec3 wi{0.0f};      // world space, unit
+  glm::vec3 weight{0.0f};  // f |cos| / pdf (for a delta branch: its throughput factor)
+  float pdf = 0.0f;        // combined solid-angle pdf of the non-delta lobes (0 for delta)
+  bool delta = false;      // drawn from a delta lobe (mirror or smooth dielectric)
+  bool transmitted = false;
+};
+
+class Bsdf {
+ public:
+  Bsdf() = default;
+  // shading_normal and geometric_normal: unit, any orientation (flipped to wo's side here);
+  // front_face: wo is on the side the geometric normal points to (outside of a dielectric).
+  Bsdf(const BsdfParams& params, glm::vec3 shading_normal, glm::vec3 geometric_normal, glm::vec3 wo,
+       bool front_face);
+
+  glm::vec3 eval(glm::vec3 wi) const;  // f(wo, wi) |cos(wi)| of the non-delta lobes
+  float pdf(glm::vec3 wi) const;       // combined pdf of the non-delta lobes
+  // u_lobe picks the lobe, u the direction. Returns false when no valid direction was drawn.
+  bool sample(float u_lobe, glm::vec2 u, BsdfSample* out) const;
+
+  bool is_perfectly_specular() const { return !has_nondelta_; }
+  bool has_nondelta() const { return has_nondelta_; }
+  bool is_black() const { return black_; }
+  glm::vec3 shading_normal() const { return frame_.n; }
+
+ private:
+  glm::vec3 eval_local(glm::vec3 wi) const;
+  float pdf_local(glm::vec3 wi) const;
+  glm::vec3 glossy_fresnel(float cos_oh) const;
+
+  Frame frame_{};
+  glm::vec3 ng_{0.0f};      // geometric normal on wo's side
+  glm::vec3 wo_local_{0.0f};
+  BsdfParams p_{};
+  float alpha_ = 1.0f;
+  bool glossy_delta_ = false;
+  bool front_face_ = true;
+  float c_diffuse_ = 0.0f, c_glass_ = 0.0f;  // mixing coefficients
+  glm::vec3 f0_dielectric_{0.0f};
+  float f90_dielectric_ = 1.0f;
+  glm::vec3 diffuse_factor_{0.0f};  // c_diffuse * base / pi * (1 - F_dielectric(cos_o))
+  float p_diffuse_ = 0.0f, p_glossy_ = 0.0f, p_glass_ = 0.0f;  // lobe selection probabilities
+  bool has_nondelta_ = false;
+  bool black_ = true;
+};
+
+// GGX helpers (local frame, n = +z), exposed for tests.
+float ggx_d(glm::vec3 h, float alpha);
+float ggx_lambda(glm::vec3 w, float alpha);
+glm::vec3 ggx_sample_vndf(glm::vec3 wo, float alpha, glm::vec2 u);
+float fresnel_dielectric(float cos_i, float eta);  // eta = eta_t / eta_i, cos_i >= 0
+
+}  // namespace pxf

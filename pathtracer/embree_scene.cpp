@@ -1,0 +1,191 @@
+#include "pathtracer/embree_scene.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <string>
+
+#include "image/image.h"
+#include "pathtracer/bsdf.h"
+#include "pathtracer/texture.h"
+
+namespace pxf {
+namespace {
+
+template <typename T>
+T interpolate(const std::vector<T>& attribute, const glm::uvec3& tri, float u, float v) {
+  return attribute[tri.x] * (1.0f - u - v) + attribute[tri.y] * u + attribute[tri.z] * v;
+}
+
+glm::vec2 interpolate_uv(const std::vector<glm::vec2>& uv, const glm::uvec3& tri, float u, float v) {
+  return uv.empty() ? glm::vec2(0.0f) : interpolate(uv, tri, u, v);
+}
+
+// Embree filter: rejects hits whose opacity is below the material's alpha cutoff.
+void alpha_mask_filter(const RTCFilterFunctionNArguments* args) {
+  const auto* data = static_cast<const EmbreeScene::MaskData*>(args->geometryUserPtr);
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] == 0) continue;
+    unsigned prim = RTCHitN_primID(args->hit, args->N, i);
+    float u = RTCHitN_u(args->hit, args->N, i), v = RTCHitN_v(args->hit, args->N, i);
+    const glm::uvec3& tri = data->mesh->triangles[prim];
+    glm::vec2 uv0 = interpolate_uv(data->mesh->uv0, tri, u, v);
+    glm::vec2 uv1 = interpolate_uv(data->mesh->uv1, tri, u, v);
+    float vertex_alpha = data->mesh->colors.empty() ? 1.0f : interpolate(data->mesh->colors, tri, u, v).a;
+    float opacity = eval_opacity(*data->scene, *data->material, uv0, uv1, vertex_alpha);
+    if (!(opacity >= data->material->alpha_cutoff)) args->valid[i] = 0;
+  }
+}
+
+void embree_error(void*, RTCError code, const char* message) {
+  // Only reported through the return values of the calls; build errors throw below.
+  (void)code;
+  (void)message;
+}
+
+}  // namespace
+
+glm::vec3 offset_ray_origin(glm::vec3 position, glm::vec3 geometric_normal, glm::vec3 direction) {
+  float scale = std::max(std::max(std::abs(position.x), std::abs(position.y)), std::abs(position.z));
+  float eps = 1e-4f * (1.0f + scale);
+  return position + (glm::dot(direction, geometric_normal) >= 0.0f ? eps : -eps) * geometric_normal;
+}
+
+EmbreeScene::EmbreeScene(const Scene& scene) : scene_(scene) {
+  device_ = rtcNewDevice(nullptr);
+  if (!device_) throw Error("embree: cannot create a device (error " + std::to_string(rtcGetDeviceError(nullptr)) + ")");
+  rtcSetDeviceErrorFunction(device_, embree_error, nullptr);
+  rtc_scene_ = rtcNewScene(device_);
+  rtcSetSceneBuildQuality(rtc_scene_, RTC_BUILD_QUALITY_HIGH);
+  mask_data_.reserve(scene.meshes.size());  // filter functions keep pointers into it
+  face_normals_.resize(scene.meshes.size());
+  for (size_t m = 0; m < scene.meshes.size(); ++m) {
+    const Mesh& mesh = scene.meshes[m];
+    auto& normals = face_normals_[m];
+    normals.resize(mesh.triangles.size());
+    for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+      const glm::uvec3& tri = mesh.triangles[t];
+      glm::vec3 n = glm::cross(mesh.positions[tri.y] - mesh.positions[tri.x], mesh.positions[tri.z] - mesh.positions[tri.x]);
+      float len = glm::length(n);
+      normals[t] = len > 0.0f ? n / len : glm::vec3(0.0f, 0.0f, 1.0f);
+    }
+    RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                                 3 * sizeof(float), mesh.positions.size()));
+    if (!mesh.positions.empty()) std::memcpy(vertices, mesh.positions.data(), mesh.positions.size() * sizeof(glm::vec3));
+    auto* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                                   3 * sizeof(unsigned), mesh.triangles.size()));
+    if (!mesh.triangles.empty()) std::memcpy(indices, mesh.triangles.data(), mesh.triangles.size() * sizeof(glm::uvec3));
+    const Material& material = scene.materials[mesh.material];
+    if (material.alpha_mode == AlphaMode::Mask) {
+      mask_data_.push_back({&scene_, &mesh, &material});
+      rtcSetGeometryUserData(geom, &mask_data_.back());
+      rtcSetGeometryIntersectFilterFunction(geom, alpha_mask_filter);
+      rtcSetGeometryOccludedFilterFunction(geom, alpha_mask_filter);
+    }
+    rtcCommitGeometry(geom);
+    unsigned id = rtcAttachGeometry(rtc_scene_, geom);  // ids are sequential: id == mesh index
+    rtcReleaseGeometry(geom);
+    if (id != m) throw Error("embree: unexpected geometry id");
+  }
+  rtcCommitScene(rtc_scene_);
+  RTCError err = rtcGetDeviceError(device_);
+  if (err != RTC_ERROR_NONE) throw Error("embree: building the BVH failed (error " + std::to_string(err) + ")");
+}
+
+EmbreeScene::~EmbreeScene() {
+  if (rtc_scene_) rtcReleaseScene(rtc_scene_);
+  if (device_) rtcReleaseDevice(device_);
+}
+
+Hit EmbreeScene::intersect(const Ray& ray, float tmax) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  RTCRayHit rh;
+  rh.ray.org_x = ray.origin.x;
+  rh.ray.org_y = ray.origin.y;
+  rh.ray.org_z = ray.origin.z;
+  rh.ray.dir_x = ray.direction.x;
+  rh.ray.dir_y = ray.direction.y;
+  rh.ray.dir_z = ray.direction.z;
+  rh.ray.tnear = 0.0f;
+  rh.ray.tfar = tmax;
+  rh.ray.time = 0.0f;
+  rh.ray.mask = 0xffffffffu;
+  rh.ray.id = 0;
+  rh.ray.flags = 0;
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(rtc_scene_, &context, &rh);
+  Hit hit;
+  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return hit;
+  hit.mesh = rh.hit.geomID;
+  hit.prim = rh.hit.primID;
+  hit.u = rh.hit.u;
+  hit.v = rh.hit.v;
+  hit.t = rh.ray.tfar;
+  return hit;
+}
+
+bool EmbreeScene::occluded(glm::vec3 origin, glm::vec3 direction, float tmax) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  RTCRay r;
+  r.org_x = origin.x;
+  r.org_y = origin.y;
+  r.org_z = origin.z;
+  r.dir_x = direction.x;
+  r.dir_y = direction.y;
+  r.dir_z = direction.z;
+  r.tnear = 0.0f;
+  r.tfar = tmax;
+  r.time = 0.0f;
+  r.mask = 0xffffffffu;
+  r.id = 0;
+  r.flags = 0;
+  rtcOccluded1(rtc_scene_, &context, &r);
+  return r.tfar < 0.0f;  // Embree sets tfar = -inf on occlusion
+}
+
+float EmbreeScene::triangle_area(unsigned mesh, unsigned prim) const {
+  const Mesh& m = scene_.meshes[mesh];
+  const glm::uvec3& tri = m.triangles[prim];
+  return 0.5f * glm::length(glm::cross(m.positions[tri.y] - m.positions[tri.x], m.positions[tri.z] - m.positions[tri.x]));
+}
+
+SurfacePoint EmbreeScene::surface_point(const Hit& hit, const Ray& ray) const {
+  const Mesh& mesh = scene_.meshes[hit.mesh];
+  const glm::uvec3& tri = mesh.triangles[hit.prim];
+  SurfacePoint sp;
+  sp.position = interpolate(mesh.positions, tri, hit.u, hit.v);
+  sp.geometric_normal = face_normals_[hit.mesh][hit.prim];
+  sp.front_face = glm::dot(ray.direction, sp.geometric_normal) < 0.0f;
+  sp.material = &scene_.materials[mesh.material];
+  glm::vec3 n = mesh.normals.empty() ? sp.geometric_normal : interpolate(mesh.normals, tri, hit.u, hit.v);
+  float len = glm::length(n);
+  sp.vertex_normal = len > 0.0f && std::isfinite(len) ? n / len : sp.geometric_normal;
+  sp.shading_normal = sp.vertex_normal;
+  sp.uv0 = interpolate_uv(mesh.uv0, tri, hit.u, hit.v);
+  sp.uv1 = interpolate_uv(mesh.uv1, tri, hit.u, hit.v);
+  if (!mesh.colors.empty()) sp.color = interpolate(mesh.colors, tri, hit.u, hit.v);
+  const Material& mat = *sp.material;
+  if (mat.normal_texture.valid() && !mesh.tangents.empty()) {
+    glm::vec4 t4 = interpolate(mesh.tangents, tri, hit.u, hit.v);
+    glm::vec3 t = glm::vec3(t4) - sp.vertex_normal * glm::dot(glm::vec3(t4), sp.vertex_normal);
+    float tl = glm::length(t);
+    if (tl > 1e-8f) {
+      t /= tl;
+      glm::vec3 b = glm::cross(sp.vertex_normal, t) * (t4.w < 0.0f ? -1.0f : 1.0f);
+      glm::vec3 m = glm::vec3(eval_texture(scene_, mat.normal_texture, sp.uv0, sp.uv1, glm::vec4(0.5f, 0.5f, 1.0f, 1.0f)));
+      m = m * 2.0f - 1.0f;
+      m.x *= mat.normal_scale;
+      m.y *= mat.normal_scale;
+      glm::vec3 mapped = t * m.x + b * m.y + sp.vertex_normal * m.z;
+      float ml = glm::length(mapped);
+      if (ml > 1e-8f && std::isfinite(ml)) sp.shading_normal = mapped / ml;
+    }
+  }
+  return sp;
+}
+
+}  // namespace pxf

@@ -1,0 +1,70 @@
+// The scene's triangles in an Embree 3 BVH, plus the per-triangle data the integrator needs at a
+// hit (face normal, interpolated attributes). Alpha MASK materials are cut out by Embree filter
+// functions, so every query (camera, continuation, shadow) sees the same holes.
+#pragma once
+#include <limits>
+#include <memory>
+#include <vector>
+#include <embree3/rtcore.h>
+#include <glm/glm.hpp>
+#include "pathtracer/camera.h"
+#include "pathtracer/scene.h"
+
+namespace pxf {
+
+struct Hit {
+  unsigned mesh = RTC_INVALID_GEOMETRY_ID;
+  unsigned prim = 0;
+  float u = 0, v = 0;  // barycentrics of vertices 1 and 2
+  float t = 0;
+  bool valid() const { return mesh != RTC_INVALID_GEOMETRY_ID; }
+};
+
+struct SurfacePoint {
+  glm::vec3 position{0.0f};
+  glm::vec3 geometric_normal{0.0f};  // unit, the triangle's winding orientation
+  glm::vec3 vertex_normal{0.0f};     // interpolated vertex normal, unit, no normal map
+  glm::vec3 shading_normal{0.0f};    // vertex normal with the normal map applied
+  glm::vec2 uv0{0.0f}, uv1{0.0f};
+  glm::vec4 color{1.0f};             // COLOR_0
+  const Material* material = nullptr;
+  bool front_face = true;            // the ray arrived on the side the geometric normal faces
+};
+
+class EmbreeScene {
+ public:
+  explicit EmbreeScene(const Scene& scene);
+  ~EmbreeScene();
+  EmbreeScene(const EmbreeScene&) = delete;
+  EmbreeScene& operator=(const EmbreeScene&) = delete;
+
+  // Closest hit in (0, tmax]. The ray's origin must already be offset off the surface it leaves.
+  Hit intersect(const Ray& ray, float tmax = std::numeric_limits<float>::infinity()) const;
+  bool occluded(glm::vec3 origin, glm::vec3 direction, float tmax) const;
+  SurfacePoint surface_point(const Hit& hit, const Ray& ray) const;
+
+  const Scene& scene() const { return scene_; }
+  RTCScene handle() const { return rtc_scene_; }
+  float triangle_area(unsigned mesh, unsigned prim) const;
+  glm::vec3 face_normal(unsigned mesh, unsigned prim) const { return face_normals_[mesh][prim]; }
+
+  // Alpha-mask data handed to Embree's filter functions (one per mesh with a MASK material).
+  struct MaskData {
+    const Scene* scene;
+    const Mesh* mesh;
+    const Material* material;
+  };
+
+ private:
+  const Scene& scene_;
+  RTCDevice device_ = nullptr;
+  RTCScene rtc_scene_ = nullptr;
+  std::vector<std::vector<glm::vec3>> face_normals_;  // per mesh, per triangle, unit
+  std::vector<MaskData> mask_data_;
+};
+
+// Moves a point off a surface to the side `direction` leaves to, scaled to the point's magnitude
+// so far-away geometry does not self-intersect.
+glm::vec3 offset_ray_origin(glm::vec3 position, glm::vec3 geometric_normal, glm::vec3 direction);
+
+}  // namespace pxf

@@ -1,0 +1,228 @@
+#include "pathtracer/lights.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "pathtracer/bsdf.h"
+#include "pathtracer/texture.h"
+
+namespace pxf {
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+float emission_power_weight(const Material& m) { return std::max(0.0f, luminance(m.emissive)); }
+
+// glTF's recommended smooth range window (KHR_lights_punctual).
+float range_window(float distance, float range) {
+  if (range <= 0.0f) return 1.0f;
+  float r = distance / range;
+  float w = std::min(std::max(1.0f - r * r * r * r, 0.0f), 1.0f);
+  return w * w;
+}
+
+// glTF's smooth spot cone falloff between the outer and inner cone angles.
+float spot_attenuation(const PunctualLight& light, glm::vec3 to_point) {
+  float cos_outer = std::cos(light.outer_cone), cos_inner = std::cos(light.inner_cone);
+  float scale = 1.0f / std::max(1e-3f, cos_inner - cos_outer);
+  float offset = -cos_outer * scale;
+  float cd = glm::dot(glm::normalize(light.direction), to_point);
+  float a = std::min(std::max(cd * scale + offset, 0.0f), 1.0f);
+  return a * a;
+}
+
+}  // namespace
+
+glm::vec2 equirect_uv(glm::vec3 d) {
+  float u = 0.5f + std::atan2(d.x, -d.z) * (0.5f * kInvPi);
+  float v = std::acos(std::min(std::max(d.y, -1.0f), 1.0f)) * kInvPi;
+  return glm::vec2(u - std::floor(u), v);
+}
+
+glm::vec3 equirect_direction(glm::vec2 uv) {
+  float theta = uv.y * kPi, phi = (uv.x - 0.5f) * 2.0f * kPi;
+  float s = std::sin(theta);
+  return glm::vec3(s * std::sin(phi), std::cos(theta), -s * std::cos(phi));
+}
+
+LightSampler::LightSampler(const Scene& scene) : scene_(scene) {
+  std::vector<float> powers;
+  mesh_light_offset_.assign(scene.meshes.size(), -1);
+  for (size_t m = 0; m < scene.meshes.size(); ++m) {
+    const Mesh& mesh = scene.meshes[m];
+    const Material& material = scene.materials[mesh.material];
+    float weight = emission_power_weight(material);
+    if (!(weight > 0.0f) || !std::isfinite(weight)) continue;
+    mesh_light_offset_[m] = static_cast<int>(triangles_.size());
+    for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+      const glm::uvec3& tri = mesh.triangles[t];
+      EmissiveTriangle e;
+      e.mesh = static_cast<unsigned>(m);
+      e.prim = static_cast<unsigned>(t);
+      e.p0 = mesh.positions[tri.x];
+      e.e1 = mesh.positions[tri.y] - e.p0;
+      e.e2 = mesh.positions[tri.z] - e.p0;
+      glm::vec3 n = glm::cross(e.e1, e.e2);
+      float len = glm::length(n);
+      e.area = 0.5f * len;
+      e.normal = len > 0.0f ? n / len : glm::vec3(0.0f, 0.0f, 1.0f);
+      e.material = &material;
+      triangles_.push_back(e);
+      powers.push_back(e.area * weight * (material.double_sided ? 2.0f : 1.0f));
+    }
+  }
+  triangle_dist_ = Distribution1D(powers);
+
+  if (scene.environment && scene.environment->strength > 0.0f && !scene.environment->image.texels.empty()) {
+    const Texture& image = scene.environment->image;
+    std::vector<float> weights(static_cast<size_t>(image.width) * image.height);
+    for (int y = 0; y < image.height; ++y) {
+      float sin_theta = std::sin(kPi * (y + 0.5f) / image.height);
+      for (int x = 0; x < image.width; ++x) {
+        size_t i = static_cast<size_t>(y) * image.width + x;
+        weights[i] = luminance(glm::vec3(image.texels[i])) * sin_theta;
+      }
+    }
+    env_dist_ = Distribution2D(weights, image.width, image.height);
+    if (env_dist_.valid()) env_ = &*scene.environment;
+  }
+  for (const PunctualLight& light : scene.lights)
+    if (light.intensity > 0.0f && std::isfinite(light.intensity) && max_component(light.color) > 0.0f)
+      punctual_.push_back(&light);
+
+  bool has_tri = triangle_dist_.valid(), has_env = env_ != nullptr, has_punctual = !punctual_.empty();
+  category_count_ = int(has_tri) + int(has_env) + int(has_punctual);
+  if (category_count_ == 0) return;
+  float share = 1.0f / category_count_;
+  p_triangles_ = has_tri ? share : 0.0f;
+  p_environment_ = has_env ? share : 0.0f;
+  p_punctual_ = has_punctual ? 1.0f - p_triangles_ - p_environment_ : 0.0f;
+}
+
+bool LightSampler::sample(glm::vec3 position, float u_select, glm::vec2 u, LightSample* out) const {
+  if (category_count_ == 0) return false;
+  // Remap u_select within the chosen category so it can pick the light inside it.
+  if (u_select < p_triangles_) return sample_triangles(position, u_select / p_triangles_, u, out);
+  u_select -= p_triangles_;
+  if (u_select < p_environment_) return sample_environment(position, u, out);
+  u_select -= p_environment_;
+  if (p_punctual_ <= 0.0f) return false;
+  return sample_punctual(position, std::min(u_select / p_punctual_, 0x1.fffffep-1f), out);
+}
+
+size_t LightSampler::sample_triangle_point(float u_select, glm::vec2 u, glm::vec3* point, glm::vec2* bary,
+                                           float* area_pdf) const {
+  float pmf;
+  size_t i = triangle_dist_.sample(u_select, nullptr, &pmf);
+  const EmissiveTriangle& e = triangles_[i];
+  glm::vec2 b = sample_triangle_barycentrics(u);
+  *point = e.p0 + b.x * e.e1 + b.y * e.e2;
+  *bary = b;
+  *area_pdf = e.area > 0.0f ? pmf / e.area : 0.0f;
+  return i;
+}
+
+bool LightSampler::sample_triangles(glm::vec3 position, float u_select, glm::vec2 u, LightSample* out) const {
+  glm::vec3 point;
+  glm::vec2 b;
+  float area_pdf;
+  size_t i = sample_triangle_point(u_select, u, &point, &b, &area_pdf);
+  const EmissiveTriangle& e = triangles_[i];
+  glm::vec3 d = point - position;
+  float dist2 = glm::dot(d, d);
+  if (!(dist2 > 0.0f) || !(area_pdf > 0.0f)) return false;
+  float dist = std::sqrt(dist2);
+  glm::vec3 wi = d / dist;
+  float cos_light = -glm::dot(wi, e.normal);
+  if (e.material->double_sided) cos_light = std::abs(cos_light);
+  if (cos_light <= 1e-7f) return false;  // the back of a one-sided emitter, or edge-on
+  const Mesh& mesh = scene_.meshes[e.mesh];
+  const glm::uvec3& tri = mesh.triangles[e.prim];
+  float b0 = 1.0f - b.x - b.y;
+  glm::vec2 uv0 = mesh.uv0.empty() ? glm::vec2(0.0f) : mesh.uv0[tri.x] * b0 + mesh.uv0[tri.y] * b.x + mesh.uv0[tri.z] * b.y;
+  glm::vec2 uv1 = mesh.uv1.empty() ? glm::vec2(0.0f) : mesh.uv1[tri.x] * b0 + mesh.uv1[tri.y] * b.x + mesh.uv1[tri.z] * b.y;
+  out->wi = wi;
+  out->distance = dist;
+  out->radiance = eval_emission(scene_, *e.material, uv0, uv1);
+  out->pdf = p_triangles_ * area_pdf * dist2 / cos_light;
+  out->delta = false;
+  out->point = point;
+  out->normal = e.normal;
+  return true;
+}
+
+float LightSampler::pdf_triangle(unsigned mesh, unsigned prim, glm::vec3 from, glm::vec3 point,
+                                 glm::vec3 face_normal) const {
+  if (p_triangles_ <= 0.0f || mesh >= mesh_light_offset_.size() || mesh_light_offset_[mesh] < 0) return 0.0f;
+  const EmissiveTriangle& e = triangles_[static_cast<size_t>(mesh_light_offset_[mesh]) + prim];
+  if (!(e.area > 0.0f)) return 0.0f;
+  glm::vec3 d = point - from;
+  float dist2 = glm::dot(d, d);
+  float cos_light = std::abs(glm::dot(d, face_normal)) / std::sqrt(dist2);
+  if (!(cos_light > 0.0f)) return 0.0f;
+  float pmf = triangle_dist_.pmf(static_cast<size_t>(mesh_light_offset_[mesh]) + prim);
+  return p_triangles_ * pmf / e.area * dist2 / cos_light;
+}
+
+glm::vec3 LightSampler::sample_environment_direction(glm::vec2 u, float* pdf) const {
+  float pdf_uv;
+  glm::vec2 uv = env_dist_.sample(u, &pdf_uv);
+  glm::vec3 wi = equirect_direction(uv);
+  float sin_theta = std::sin(uv.y * kPi);
+  *pdf = sin_theta > 0.0f ? pdf_uv / (2.0f * kPi * kPi * sin_theta) : 0.0f;
+  return wi;
+}
+
+float LightSampler::environment_direction_pdf(glm::vec3 direction) const {
+  if (!env_) return 0.0f;
+  glm::vec2 uv = equirect_uv(direction);
+  float sin_theta = std::sqrt(std::max(0.0f, 1.0f - direction.y * direction.y));
+  return sin_theta > 0.0f ? env_dist_.pdf(uv) / (2.0f * kPi * kPi * sin_theta) : 0.0f;
+}
+
+bool LightSampler::sample_environment(glm::vec3, glm::vec2 u, LightSample* out) const {
+  float pdf;
+  glm::vec3 wi = sample_environment_direction(u, &pdf);
+  if (!(pdf > 0.0f)) return false;
+  out->wi = wi;
+  out->distance = kInf;
+  out->radiance = environment_radiance(wi);
+  out->pdf = p_environment_ * pdf;
+  out->delta = false;
+  return true;
+}
+
+float LightSampler::pdf_environment(glm::vec3 direction) const {
+  return p_environment_ * environment_direction_pdf(direction);
+}
+
+glm::vec3 LightSampler::environment_radiance(glm::vec3 direction) const {
+  if (!env_) return glm::vec3(0.0f);
+  return glm::vec3(sample_texture(env_->image, equirect_uv(direction))) * env_->strength;
+}
+
+bool LightSampler::sample_punctual(glm::vec3 position, float u_select, LightSample* out) const {
+  size_t index = std::min(static_cast<size_t>(u_select * punctual_.size()), punctual_.size() - 1);
+  const PunctualLight& light = *punctual_[index];
+  glm::vec3 power = light.color * light.intensity;
+  out->delta = true;
+  out->pdf = p_punctual_ / static_cast<float>(punctual_.size());
+  if (light.type == PunctualLight::Type::Directional) {
+    out->wi = -glm::normalize(light.direction);
+    out->distance = kInf;
+    out->radiance = power;
+    return true;
+  }
+  glm::vec3 d = light.position - position;
+  float dist2 = glm::dot(d, d);
+  if (!(dist2 > 0.0f)) return false;
+  float dist = std::sqrt(dist2);
+  out->wi = d / dist;
+  out->distance = dist;
+  float falloff = range_window(dist, light.range) / dist2;
+  if (light.type == PunctualLight::Type::Spot) falloff *= spot_attenuation(light, -out->wi);
+  out->radiance = power * falloff;
+  return falloff > 0.0f;
+}
+
+}  // namespace pxf

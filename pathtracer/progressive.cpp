@@ -1,0 +1,170 @@
+// ProgressiveRenderer: one path per pixel per frame over tiles on a oneTBB arena; accumulation.
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include "pathtracer/integrator.h"
+#include "pathtracer/pathtracer.h"
+
+namespace pxf {
+namespace {
+
+constexpr int kTileSize = 16;
+
+}  // namespace
+
+struct ProgressiveRenderer::Impl {
+  Scene scene;  // owned: the Embree scene and the light sampler point into it
+  Camera camera;
+  TraceParams params;
+  int width, height;
+  std::unique_ptr<PathTracer> tracer;
+  Accumulation acc;
+  TraceStats stats;
+  int frames = 0;
+
+  Impl(const Scene& s, const TraceParams& p, int w, int h) : scene(s), camera(s.camera), params(p), width(w), height(h) {
+    if (w <= 0 || h <= 0) throw Error("path tracer: image size must be positive");
+    tracer = std::make_unique<PathTracer>(scene);
+    resize_accumulation(acc, w, h);
+  }
+
+  void render_frame() {
+    const int tiles_x = (width + kTileSize - 1) / kTileSize;
+    const int tiles_y = (height + kTileSize - 1) / kTileSize;
+    const uint32_t frame = static_cast<uint32_t>(frames);
+    std::atomic<uint64_t> rays{0}, paths{0}, dropped{0};
+    auto render_tiles = [&](const tbb::blocked_range<int>& range) {
+      uint64_t tile_rays = 0, tile_paths = 0, tile_dropped = 0;
+      for (int tile = range.begin(); tile != range.end(); ++tile) {
+        int x0 = (tile % tiles_x) * kTileSize, y0 = (tile / tiles_x) * kTileSize;
+        int x1 = std::min(x0 + kTileSize, width), y1 = std::min(y0 + kTileSize, height);
+        for (int y = y0; y < y1; ++y) {
+          for (int x = x0; x < x1; ++x) {
+            PathSample sample = tracer->trace_pixel(camera, width, height, x, y, frame, params);
+            tile_rays += sample.rays;
+            ++tile_paths;
+            if (!sample.finite()) {  // LV and HV of a path are dropped together
+              ++tile_dropped;
+              continue;
+            }
+            accumulate_sample(acc, static_cast<size_t>(y) * width + x, sample.lv, sample.hv);
+          }
+        }
+      }
+      rays += tile_rays;
+      paths += tile_paths;
+      dropped += tile_dropped;
+    };
+    int arena_threads = params.threads > 0 ? params.threads : tbb::task_arena::automatic;
+    tbb::task_arena arena(arena_threads);
+    arena.execute([&] { tbb::parallel_for(tbb::blocked_range<int>(0, tiles_x * tiles_y, 1), render_tiles); });
+    stats.rays += rays;
+    stats.paths += paths;
+    stats.nan_samples_dropped += dropped;
+  }
+
+  // A dark scene is black: every pixel gets an exact zero sample without tracing.
+  void add_dark_frame() {
+    for (size_t i = 0; i < acc.samples.size(); ++i) accumulate_sample(acc, i, glm::vec3(0.0f), glm::vec3(0.0f));
+  }
+};
+
+ProgressiveRenderer::ProgressiveRenderer(const Scene& scene, const TraceParams& params, int width, int height)
+    : impl_(std::make_unique<Impl>(scene, params, width, height)) {}
+ProgressiveRenderer::~ProgressiveRenderer() = default;
+
+void ProgressiveRenderer::reset() {
+  resize_accumulation(impl_->acc, impl_->width, impl_->height);
+  impl_->stats = TraceStats{};
+  impl_->frames = 0;
+}
+
+void ProgressiveRenderer::set_camera(const Camera& camera) {
+  impl_->camera = camera;
+  reset();
+}
+
+void ProgressiveRenderer::set_params(const TraceParams& params) {
+  impl_->params = params;
+  reset();
+}
+
+void ProgressiveRenderer::add_frame() {
+  auto start = std::chrono::steady_clock::now();
+  if (impl_->tracer->dark())
+    impl_->add_dark_frame();
+  else
+    impl_->render_frame();
+  ++impl_->frames;
+  impl_->stats.last_frame_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+int ProgressiveRenderer::frames() const { return impl_->frames; }
+const Accumulation& ProgressiveRenderer::accumulation() const { return impl_->acc; }
+const TraceStats& ProgressiveRenderer::stats() const { return impl_->stats; }
+const Scene& ProgressiveRenderer::scene() const { return impl_->scene; }
+const Camera& ProgressiveRenderer::camera() const { return impl_->camera; }
+const TraceParams& ProgressiveRenderer::params() const { return impl_->params; }
+int ProgressiveRenderer::width() const { return impl_->width; }
+int ProgressiveRenderer::height() const { return impl_->height; }
+
+namespace {
+Image rgb_image(const std::vector<glm::vec3>& values, int width, int height) {
+  Image image = Image::rgb(width, height);
+  for (size_t i = 0; i < values.size(); ++i) {
+    image.pixels[3 * i + 0] = values[i].r;
+    image.pixels[3 * i + 1] = values[i].g;
+    image.pixels[3 * i + 2] = values[i].b;
+  }
+  return image;
+}
+}  // namespace
+
+Image ProgressiveRenderer::lv_image() const { return rgb_image(impl_->acc.lv_mean, impl_->width, impl_->height); }
+Image ProgressiveRenderer::hv_image() const { return rgb_image(impl_->acc.hv_mean, impl_->width, impl_->height); }
+
+Image ProgressiveRenderer::variance_image() const {
+  Image image = Image::gray(impl_->width, impl_->height);
+  for (size_t i = 0; i < impl_->acc.samples.size(); ++i) image.pixels[i] = std::max(0.0f, impl_->acc.variance_of_mean(i));
+  return image;
+}
+
+Image ProgressiveRenderer::samples_image() const {
+  Image image = Image::gray(impl_->width, impl_->height);
+  for (size_t i = 0; i < impl_->acc.samples.size(); ++i) image.pixels[i] = static_cast<float>(impl_->acc.samples[i]);
+  return image;
+}
+
+std::vector<float> ProgressiveRenderer::variance_of_mean() const {
+  std::vector<float> v(impl_->acc.samples.size());
+  for (size_t i = 0; i < v.size(); ++i) v[i] = impl_->acc.variance_of_mean(i);
+  return v;
+}
+
+bool ProgressiveRenderer::scene_has_perfect_specular() const { return impl_->tracer->has_perfect_specular(); }
+bool ProgressiveRenderer::scene_is_dark() const { return impl_->tracer->dark(); }
+
+std::vector<SpecularChainHit> ProgressiveRenderer::trace_specular_chains(const std::vector<uint32_t>& pixels,
+                                                                         glm::vec2 jitter) const {
+  std::vector<SpecularChainHit> hits(pixels.size());
+  const int w = impl_->width, h = impl_->height;
+  auto trace_range = [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t i = range.begin(); i != range.end(); ++i) {
+      uint32_t p = pixels[i];
+      if (p >= static_cast<uint32_t>(w) * static_cast<uint32_t>(h)) continue;
+      float x = static_cast<float>(p % w) + jitter.x, y = static_cast<float>(p / w) + jitter.y;
+      hits[i] = impl_->tracer->trace_specular_chain(camera_ray(impl_->camera, w, h, x, y));
+    }
+  };
+  int arena_threads = impl_->params.threads > 0 ? impl_->params.threads : tbb::task_arena::automatic;
+  tbb::task_arena arena(arena_threads);
+  arena.execute([&] { tbb::parallel_for(tbb::blocked_range<size_t>(0, pixels.size(), 256), trace_range); });
+  return hits;
+}
+
+}  // namespace pxf

@@ -1,0 +1,163 @@
+// Sampling building blocks: orthonormal frames, warps from [0,1)^2, MIS heuristics and piecewise
+// constant 1D/2D distributions (light selection, environment importance sampling).
+#pragma once
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+#include <glm/glm.hpp>
+
+namespace pxf {
+
+constexpr float kPi = 3.14159265358979323846f;
+constexpr float kInvPi = 0.31830988618379067154f;
+
+// An orthonormal basis around a unit normal (Duff et al. 2017, branchless, no singularity).
+struct Frame {
+  glm::vec3 t, b, n;
+  static Frame from_normal(glm::vec3 n) {
+    float sign = std::copysign(1.0f, n.z);
+    float a = -1.0f / (sign + n.z);
+    float bb = n.x * n.y * a;
+    Frame f;
+    f.n = n;
+    f.t = glm::vec3(1.0f + sign * n.x * n.x * a, sign * bb, -sign * n.x);
+    f.b = glm::vec3(bb, sign + n.y * n.y * a, -n.y);
+    return f;
+  }
+  glm::vec3 to_local(glm::vec3 v) const { return glm::vec3(glm::dot(v, t), glm::dot(v, b), glm::dot(v, n)); }
+  glm::vec3 to_world(glm::vec3 v) const { return t * v.x + b * v.y + n * v.z; }
+};
+
+inline glm::vec2 sample_concentric_disk(glm::vec2 u) {
+  float x = 2.0f * u.x - 1.0f, y = 2.0f * u.y - 1.0f;
+  if (x == 0.0f && y == 0.0f) return glm::vec2(0.0f);
+  float r, phi;
+  if (std::abs(x) > std::abs(y)) {
+    r = x;
+    phi = (kPi / 4.0f) * (y / x);
+  } else {
+    r = y;
+    phi = (kPi / 2.0f) - (kPi / 4.0f) * (x / y);
+  }
+  return glm::vec2(r * std::cos(phi), r * std::sin(phi));
+}
+
+// Cosine-weighted hemisphere around +z; pdf = cos(theta) / pi.
+inline glm::vec3 sample_cosine_hemisphere(glm::vec2 u) {
+  glm::vec2 d = sample_concentric_disk(u);
+  float z = std::sqrt(std::max(0.0f, 1.0f - d.x * d.x - d.y * d.y));
+  return glm::vec3(d.x, d.y, z);
+}
+
+// Uniform on the unit sphere; pdf = 1 / (4 pi).
+inline glm::vec3 sample_uniform_sphere(glm::vec2 u) {
+  float z = 1.0f - 2.0f * u.x;
+  float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
+  float phi = 2.0f * kPi * u.y;
+  return glm::vec3(r * std::cos(phi), r * std::sin(phi), z);
+}
+
+// Uniform barycentrics (b1, b2) on a triangle (b0 = 1 - b1 - b2).
+inline glm::vec2 sample_triangle_barycentrics(glm::vec2 u) {
+  float s = std::sqrt(u.x);
+  return glm::vec2(1.0f - s, u.y * s);
+}
+
+inline float power_heuristic(float pdf_a, float pdf_b) {
+  float a = pdf_a * pdf_a, b = pdf_b * pdf_b;
+  return a > 0.0f ? a / (a + b) : 0.0f;
+}
+
+inline float max_component(glm::vec3 v) { return std::max(v.x, std::max(v.y, v.z)); }
+inline float luminance(glm::vec3 c) { return 0.2126f * c.r + 0.7152f * c.g + 0.0722f * c.b; }
+inline bool is_finite(glm::vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+// Piecewise-constant distribution over n bins from non-negative weights (non-finite or negative
+// weights count as 0). Sampling is a binary search in the CDF; O(log n), no allocation.
+class Distribution1D {
+ public:
+  Distribution1D() = default;
+  explicit Distribution1D(const std::vector<float>& weights) { build(weights.data(), weights.size()); }
+  Distribution1D(const float* weights, size_t n) { build(weights, n); }
+
+  size_t size() const { return pmf_.size(); }
+  double total() const { return total_; }
+  bool valid() const { return total_ > 0.0; }
+  float pmf(size_t i) const { return pmf_[i]; }
+
+  // Returns the bin and the position u' in [0,1) within the bin (reused as a fresh random number).
+  size_t sample(float u, float* u_remapped = nullptr, float* pmf = nullptr) const {
+    size_t i = static_cast<size_t>(std::upper_bound(cdf_.begin(), cdf_.end(), u) - cdf_.begin());
+    i = std::min(i == 0 ? size_t(0) : i - 1, pmf_.size() - 1);
+    // Skip zero-probability bins that share a CDF value (u exactly on a boundary).
+    while (pmf_[i] == 0.0f && i + 1 < pmf_.size()) ++i;
+    if (u_remapped) {
+      float width = cdf_[i + 1] - cdf_[i];
+      float t = width > 0.0f ? (u - cdf_[i]) / width : 0.5f;
+      *u_remapped = std::min(std::max(t, 0.0f), 0x1.fffffep-1f);
+    }
+    if (pmf) *pmf = pmf_[i];
+    return i;
+  }
+
+ private:
+  void build(const float* weights, size_t n) {
+    pmf_.assign(n, 0.0f);
+    cdf_.assign(n + 1, 0.0f);
+    std::vector<double> cdf(n + 1, 0.0);
+    for (size_t i = 0; i < n; ++i) {
+      double w = std::isfinite(weights[i]) && weights[i] > 0.0f ? weights[i] : 0.0;
+      cdf[i + 1] = cdf[i] + w;
+    }
+    total_ = cdf[n];
+    if (!(total_ > 0.0)) return;
+    for (size_t i = 0; i < n; ++i) {
+      pmf_[i] = static_cast<float>((cdf[i + 1] - cdf[i]) / total_);
+      cdf_[i + 1] = static_cast<float>(cdf[i + 1] / total_);
+    }
+    cdf_[n] = 1.0f;
+  }
+
+  std::vector<float> pmf_;
+  std::vector<float> cdf_;
+  double total_ = 0.0;
+};
+
+// Piecewise-constant 2D distribution on [0,1)^2 over a width x height grid (row = y): a marginal
+// over rows and one conditional per row. pdf is a density with respect to area in [0,1)^2.
+class Distribution2D {
+ public:
+  Distribution2D() = default;
+  Distribution2D(const std::vector<float>& weights, int width, int height) : width_(width), height_(height) {
+    std::vector<float> row_sums(height);
+    conditional_.reserve(height);
+    for (int y = 0; y < height; ++y) {
+      conditional_.emplace_back(weights.data() + static_cast<size_t>(y) * width, width);
+      row_sums[y] = static_cast<float>(conditional_.back().total());
+    }
+    marginal_ = Distribution1D(row_sums);
+  }
+  bool valid() const { return marginal_.valid(); }
+
+  glm::vec2 sample(glm::vec2 u, float* pdf) const {
+    float uy, ux, pmf_y, pmf_x;
+    size_t y = marginal_.sample(u.y, &uy, &pmf_y);
+    size_t x = conditional_[y].sample(u.x, &ux, &pmf_x);
+    *pdf = pmf_y * pmf_x * static_cast<float>(width_) * static_cast<float>(height_);
+    return glm::vec2((static_cast<float>(x) + ux) / width_, (static_cast<float>(y) + uy) / height_);
+  }
+
+  float pdf(glm::vec2 uv) const {
+    int x = std::min(std::max(static_cast<int>(uv.x * width_), 0), width_ - 1);
+    int y = std::min(std::max(static_cast<int>(uv.y * height_), 0), height_ - 1);
+    return marginal_.pmf(y) * conditional_[y].pmf(x) * static_cast<float>(width_) * static_cast<float>(height_);
+  }
+
+ private:
+  int width_ = 0, height_ = 0;
+  std::vector<Distribution1D> conditional_;
+  Distribution1D marginal_;
+};
+
+}  // namespace pxf
