@@ -32,6 +32,7 @@ struct Expectation {
 const std::vector<Expectation>& expectations() {
   static const std::vector<Expectation> table = {
       {"cornell", 1000, 20000, true, false, false, false},
+      {"atrium", 5000, 300000, false, true, true, false},
   };
   return table;
 }

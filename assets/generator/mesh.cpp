@@ -126,7 +126,10 @@ MeshData makeLathe(const std::vector<glm::vec2>& profile, int segments, float uv
     arcLength[j] = arcLength[j - 1] + glm::length(profile[j] - profile[j - 1]);
   MeshData mesh = makeGrid(segments, rows, [&](MeshData& m, float u, float v) {
     const int j = int(std::lround(v * rows));
-    const glm::vec2 prev = profile[std::max(j - 1, 0)], next = profile[std::min(j + 1, rows)];
+    // One-sided differences next to a repeated point, so repeated points make sharp creases.
+    const int before = (j > 0 && profile[j - 1] != profile[j]) ? j - 1 : j;
+    const int after = (j < rows && profile[j + 1] != profile[j]) ? j + 1 : j;
+    const glm::vec2 prev = profile[before], next = profile[after];
     const glm::vec2 tangent = next - prev;  // (dr, dy) along the profile, bottom to top
     const float phi = u * kTwoPi;
     const glm::vec3 radial(std::cos(phi), 0.0f, -std::sin(phi));

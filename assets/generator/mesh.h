@@ -35,7 +35,8 @@ MeshData makeCylinder(const glm::vec3& baseCenter, float radius, float height, i
                       bool capTop = true, bool capBottom = true);
 
 // A surface of revolution around +Y through the profile points (radius, y), bottom to top.
-// Normals come from the profile's tangents, so lathed bowls and bottles look smooth.
+// Normals come from the profile's tangents, so lathed bowls and bottles look smooth; a point
+// given twice in a row makes a sharp crease there.
 MeshData makeLathe(const std::vector<glm::vec2>& profile, int segments, float uvPerMeter = 1.0f);
 
 // A tube of circular cross-section swept along a closed curve `center(t)`, t in [0, 1).

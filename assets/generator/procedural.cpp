@@ -1,0 +1,198 @@
+#include "procedural.h"
+
+#include <algorithm>
+#include <cmath>
+#include <glm/gtc/constants.hpp>
+
+namespace pxf::scenegen {
+namespace {
+
+float fract(float v) { return v - std::floor(v); }
+
+float smoothstep(float e0, float e1, float x) {
+  const float t = std::clamp((x - e0) / (e1 - e0), 0.0f, 1.0f);
+  return t * t * (3.0f - 2.0f * t);
+}
+
+// Storage for one texel of every map, set by the painters below.
+struct Texel {
+  glm::vec3 albedo{0.5f};
+  float alpha = 1.0f;
+  float height = 0.0f;
+  float roughness = 0.5f;
+  float specular = 0.5f;
+};
+
+template <typename Painter>
+TextureSet paint(int size, bool withAlpha, bool withSpecular, Painter painter) {
+  TextureSet set;
+  set.albedo = FloatImage(size, size, withAlpha ? 4 : 3);
+  set.height = FloatImage(size, size, 1);
+  set.roughness = FloatImage(size, size, 1);
+  if (withSpecular) set.specular = FloatImage(size, size, 1);
+  for (int y = 0; y < size; ++y) {
+    for (int x = 0; x < size; ++x) {
+      Texel t = painter((x + 0.5f) / size, (y + 0.5f) / size);
+      float* a = set.albedo.at(x, y);
+      a[0] = t.albedo.r, a[1] = t.albedo.g, a[2] = t.albedo.b;
+      if (withAlpha) a[3] = t.alpha;
+      set.height.at(x, y)[0] = t.height;
+      set.roughness.at(x, y)[0] = std::clamp(t.roughness, 0.02f, 1.0f);
+      if (withSpecular) set.specular.at(x, y)[0] = std::clamp(t.specular, 0.0f, 1.0f);
+    }
+  }
+  return set;
+}
+
+// Per-cell random color variation around `base`.
+glm::vec3 vary(const glm::vec3& base, float amount, uint32_t cx, uint32_t cy, uint32_t seed) {
+  const float brightness = 1.0f + amount * (2.0f * hash01(cx, cy, seed) - 1.0f);
+  const float warmth = amount * 0.5f * (2.0f * hash01(cx, cy, seed + 7) - 1.0f);
+  return glm::clamp(base * brightness * glm::vec3(1.0f + warmth, 1.0f, 1.0f - warmth), 0.0f, 1.0f);
+}
+
+}  // namespace
+
+TextureSet paintTiles(int size, const TileStyle& s) {
+  return paint(size, false, false, [&](float x, float y) {
+    const float gx = x * s.tilesPerSide, gy = y * s.tilesPerSide;
+    const int ix = int(gx), iy = int(gy);
+    const float fx = fract(gx), fy = fract(gy);
+    const float edge = std::min(std::min(fx, 1.0f - fx), std::min(fy, 1.0f - fy));
+    const float tileMask = smoothstep(s.groutWidth, s.groutWidth * 2.0f, edge);
+    const float grain = tileableFbm(x, y, 8, 5, 0.55f, s.seed);
+    const float fine = tileableFbm(x, y, 64, 3, 0.5f, s.seed + 3);
+
+    glm::vec3 tile = (!s.checker || ((ix + iy) & 1) == 0) ? s.colorA : s.colorB;
+    tile = vary(tile, 0.12f, ix, iy, s.seed);
+    // Marble veins: thin dark bands along a noise-warped diagonal.
+    const float warp = tileableFbm(x, y, 4, 5, 0.6f, s.seed + 11);
+    const float vein = std::pow(1.0f - std::abs(std::sin((x + y) * glm::pi<float>() * 3.0f + warp * 9.0f)), 12.0f);
+    tile *= 1.0f - s.veins * 0.6f * vein;
+    tile *= 0.9f + 0.2f * grain;
+
+    Texel t;
+    t.albedo = glm::mix(s.groutColor * (0.8f + 0.4f * fine), tile, tileMask);
+    t.height = tileMask * (1.0f + 0.02f * grain) + 0.15f * fine * (1.0f - tileMask);
+    t.roughness = glm::mix(0.9f, s.tileRoughness + 0.15f * (grain - 0.5f) + 0.3f * s.veins * vein, tileMask);
+    return t;
+  });
+}
+
+TextureSet paintBricks(int size, int rows, int columns, uint32_t seed) {
+  static const glm::vec3 palette[] = {
+      {0.50f, 0.18f, 0.10f}, {0.38f, 0.12f, 0.07f}, {0.56f, 0.28f, 0.15f}, {0.30f, 0.11f, 0.07f}, {0.46f, 0.22f, 0.14f}};
+  return paint(size, false, true, [&](float x, float y) {
+    const int row = int(y * rows);
+    const float gx = x * columns + ((row & 1) ? 0.5f : 0.0f);
+    const int column = int(gx) % columns;
+    const float fx = fract(gx), fy = fract(y * rows);
+    // Mortar joints about 1 cm wide for a 1 m texture: distances in texture units.
+    const float edge = std::min(std::min(fx, 1.0f - fx) / columns, std::min(fy, 1.0f - fy) / rows);
+    const float brickMask = smoothstep(0.004f, 0.008f, edge);
+    const float speckle = tileableFbm(x, y, 32, 4, 0.6f, seed + 1);
+    const float pits = std::pow(tileableFbm(x, y, 96, 2, 0.5f, seed + 2), 4.0f);
+    const float blotch = tileableFbm(x, y, 6, 4, 0.5f, seed + 5);
+
+    const glm::vec3 brick = palette[int(hash01(column, row, seed) * 5.0f) % 5] * (0.75f + 0.5f * speckle) *
+                            (0.85f + 0.3f * blotch);
+    const glm::vec3 mortar = glm::vec3(0.55f, 0.52f, 0.47f) * (0.8f + 0.4f * speckle);
+    Texel t;
+    t.albedo = glm::mix(mortar, brick, brickMask);
+    t.height = brickMask * (1.0f - 1.0f * pits) + 0.15f * blotch;
+    t.roughness = glm::mix(0.95f, 0.7f + 0.2f * speckle, brickMask);
+    t.specular = glm::mix(0.15f, 0.35f + 0.4f * blotch, brickMask);
+    return t;
+  });
+}
+
+TextureSet paintStone(int size, glm::vec3 tint, uint32_t seed) {
+  // Ashlar courses: two rows of two blocks per tile, offset by half a block.
+  return paint(size, false, true, [&](float x, float y) {
+    const int row = int(y * 2.0f);
+    const float gx = x * 2.0f + ((row & 1) ? 0.5f : 0.0f);
+    const int column = int(gx) % 2;
+    const float fx = fract(gx), fy = fract(y * 2.0f);
+    const float edge = std::min(std::min(fx, 1.0f - fx), std::min(fy, 1.0f - fy)) * 0.5f;
+    const float blockMask = smoothstep(0.002f, 0.006f, edge);
+    const float grain = tileableFbm(x, y, 16, 6, 0.55f, seed);
+    const float strata = 0.5f + 0.5f * std::sin(y * glm::pi<float>() * 2.0f * 24.0f + grain * 10.0f);
+    const float relief = tileableFbm(x, y, 8, 4, 0.5f, seed + 4);
+    const float pits = std::pow(tileableFbm(x, y, 64, 2, 0.5f, seed + 9), 6.0f);
+
+    Texel t;
+    const glm::vec3 stone = vary(tint, 0.1f, column, row, seed) * (0.8f + 0.25f * grain + 0.1f * strata);
+    t.albedo = glm::mix(tint * 0.55f, stone, blockMask);
+    t.height = blockMask * (1.0f + 0.5f * relief - 1.5f * pits);
+    t.roughness = 0.55f + 0.35f * relief + 0.1f * (1.0f - blockMask);
+    t.specular = 0.3f + 0.4f * strata * blockMask;
+    return t;
+  });
+}
+
+TextureSet paintWood(int size, int planks, glm::vec3 light, glm::vec3 dark, uint32_t seed) {
+  // Planks run along x; growth rings are noise-warped bands along each plank.
+  return paint(size, false, false, [&](float x, float y) {
+    const int plank = int(y * planks);
+    const float fy = fract(y * planks);
+    const float shift = hash01(plank, 0, seed);  // each plank shows another part of the log
+    const float seam = smoothstep(0.0f, 0.03f, std::min(fy, 1.0f - fy));
+    const float warp = tileableFbm(fract(x + shift), y, 2, 5, 0.5f, seed + plank);
+    const float rings = fract(fy * 6.0f + warp * 5.0f + 13.0f * shift);
+    const float ringMask = smoothstep(0.0f, 0.25f, rings) * smoothstep(1.0f, 0.6f, rings);
+    const float streaks = tileableFbm(x, y * 8.0f - std::floor(y * 8.0f), 64, 3, 0.5f, seed + 4);
+
+    Texel t;
+    glm::vec3 wood = glm::mix(dark, light, ringMask * (0.7f + 0.3f * streaks));
+    wood = vary(wood, 0.08f, plank, 0, seed + 2);
+    t.albedo = wood * (0.4f + 0.6f * seam);
+    t.height = seam + 0.05f * ringMask;
+    t.roughness = 0.35f + 0.2f * (1.0f - ringMask) + 0.3f * (1.0f - seam);
+    return t;
+  });
+}
+
+TextureSet paintGrille(int size, int bars) {
+  return paint(size, true, false, [&](float x, float y) {
+    // Vertical bars, top and bottom rails, and three rings between each pair of bars.
+    // Distances are in texture units (the texture spans 1 m x 1 m).
+    const float bx = fract(x * bars);
+    const float barDistance = std::abs(bx - 0.5f) / bars;
+    const float railDistance = std::min(std::abs(y - 0.06f), std::abs(y - 0.94f));
+    const float cx = (bx < 0.5f ? bx : bx - 1.0f) / bars;  // offset from the gap's center line
+    float ringDistance = 1.0f;
+    for (float ringY : {0.28f, 0.5f, 0.72f})  // rings just touching the bars on either side
+      ringDistance = std::min(ringDistance, std::abs(std::hypot(cx, y - ringY) - 0.46f / bars));
+    const float d = std::min({barDistance, railDistance, ringDistance});
+    const float barHalfWidth = 0.008f;
+    Texel t;
+    t.alpha = d < barHalfWidth ? 1.0f : 0.0f;
+    t.albedo = glm::vec3(0.06f, 0.055f, 0.05f);
+    t.height = std::max(0.0f, 1.0f - d / barHalfWidth);
+    t.roughness = 0.45f;
+    return t;
+  });
+}
+
+MaterialDesc addTextureSet(SceneBuilder& scene, const TextureSet& set, const std::string& stem,
+                           float normalStrength, glm::vec2 uvScale, float metallic) {
+  MaterialDesc desc;
+  desc.name = stem;
+  desc.uvScale = uvScale;
+  desc.metallic = 1.0f;  // the texture's B channel carries the metallic value
+  desc.roughness = 1.0f;
+  desc.baseColorTexture = scene.addTexture(encodeSrgb(set.albedo), stem + "_basecolor");
+  desc.normalTexture = scene.addTexture(encodeNormalMap(normalMapFromHeight(set.height, normalStrength)),
+                                        stem + "_normal");
+  const bool hasSpecular = !set.specular.data.empty();
+  desc.metallicRoughnessTexture = scene.addTexture(
+      packMetallicRoughness(set.roughness, metallic, hasSpecular ? &set.specular : nullptr), stem + "_mr");
+  if (hasSpecular) {
+    desc.useSpecular = true;
+    desc.specularTexture = desc.metallicRoughnessTexture;
+  }
+  if (set.albedo.channels == 4) desc.alphaMask = true;
+  return desc;
+}
+
+}  // namespace pxf::scenegen

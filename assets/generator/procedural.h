@@ -1,0 +1,44 @@
+// Procedural surface materials (tiles, bricks, stone, wood, iron grille) painted as texture sets:
+// linear albedo, height (for the normal map), roughness and an optional specular map. All
+// patterns tile seamlessly, so the REPEAT sampler hides the texture borders.
+#pragma once
+#include <cstdint>
+#include <string>
+
+#include "gltf_builder.h"
+#include "texture.h"
+
+namespace pxf::scenegen {
+
+struct TextureSet {
+  FloatImage albedo;     // 3 or 4 channels (4 = alpha for MASK materials), linear
+  FloatImage height;     // 1 channel, any range; slopes scaled by normalStrength
+  FloatImage roughness;  // 1 channel
+  FloatImage specular;   // 1 channel or empty (no KHR_materials_specular texture)
+};
+
+struct TileStyle {
+  int tilesPerSide = 4;
+  float groutWidth = 0.03f;  // fraction of a tile
+  glm::vec3 colorA{0.75f, 0.7f, 0.62f};
+  glm::vec3 colorB{0.45f, 0.2f, 0.12f};
+  bool checker = true;
+  float veins = 0.5f;        // marble veining amount, 0 for plain glazed tiles
+  glm::vec3 groutColor{0.32f, 0.3f, 0.28f};
+  float tileRoughness = 0.3f;
+  uint32_t seed = 1;
+};
+
+TextureSet paintTiles(int size, const TileStyle& style);
+TextureSet paintBricks(int size, int rows, int columns, uint32_t seed);
+TextureSet paintStone(int size, glm::vec3 tint, uint32_t seed);
+TextureSet paintWood(int size, int planks, glm::vec3 light, glm::vec3 dark, uint32_t seed);
+// An ornamental wrought-iron grille: albedo alpha is 1 on the bars, 0 in the openings.
+TextureSet paintGrille(int size, int bars);
+
+// Adds the set's PNGs (<stem>_basecolor, _normal, _mr) and returns a material using them;
+// the specular map, if any, goes into the A channel of the _mr texture.
+MaterialDesc addTextureSet(SceneBuilder& scene, const TextureSet& set, const std::string& stem,
+                           float normalStrength, glm::vec2 uvScale = glm::vec2(1.0f), float metallic = 0.0f);
+
+}  // namespace pxf::scenegen

@@ -1,0 +1,170 @@
+// A Sponza-like courtyard, 20 m x 14 m: a tiled floor, two-storey arcades (piers + round arches)
+// on both long sides with aisles behind them, brick walls, a fountain, iron balustrade grilles
+// (alpha mask) and an open roof. Lit by a sun (KHR_lights_punctual) through the roof and a sky
+// environment (environment.exr). The camera stands in the shaded aisle looking along the arcade,
+// so most of what it sees is lit indirectly by the sunlit courtyard.
+#include <glm/gtc/constants.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/quaternion.hpp>
+
+#include "../exr_writer.h"
+#include "../gltf_builder.h"
+#include "../procedural.h"
+#include "../scenes.h"
+
+namespace pxf::scenegen {
+namespace {
+
+constexpr float kHalfLength = 10.0f;   // courtyard spans x in [-10, 10]
+constexpr float kArcadeZ = 4.0f;       // arcade center lines at z = +-4
+constexpr float kBackWallZ = 7.0f;     // aisle back walls at z = +-7
+constexpr float kBay = 2.5f;           // pier spacing
+constexpr int kBays = 8;
+constexpr float kFirstFloor = 5.0f;    // top of the ground arcade
+constexpr float kSlab = 0.35f;
+constexpr float kRoof = 9.0f;          // top of the upper arcade
+const glm::vec3 kSunDirection = glm::normalize(glm::vec3(0.25f, -0.9f, -0.35f));  // travel direction
+
+struct Storey {
+  float base, springing, top, pierWidth;
+};
+const Storey kGround{0.0f, 3.0f, kFirstFloor, 0.6f};
+const Storey kUpper{kFirstFloor + kSlab, 7.4f, kRoof, 0.45f};
+
+MeshData makePier(const Storey& s) {
+  const float h = 0.5f * s.pierWidth;
+  MeshData pier = makeBox({-h, s.base, -h}, {h, s.top, h});
+  // A plinth and a capital a little wider than the shaft.
+  pier.append(makeBox({-h - 0.08f, s.base, -h - 0.08f}, {h + 0.08f, s.base + 0.3f, h + 0.08f}));
+  pier.append(makeBox({-h - 0.06f, s.springing - 0.2f, -h - 0.06f}, {h + 0.06f, s.springing, h + 0.06f}));
+  return pier;
+}
+
+MeshData makeArch(const Storey& s) {
+  MeshData arch;
+  const float halfSpan = 0.5f * (kBay - s.pierWidth);
+  arch.append(makeArchWall(halfSpan, s.top - s.springing, s.pierWidth, 48, 1.0f),
+              glm::translate(glm::mat4(1.0f), {0.0f, s.springing, 0.0f}));
+  return arch;
+}
+
+// Both aisles' floor slabs (first floor and roof) as world-space boxes.
+MeshData makeSlabs() {
+  MeshData slabs;
+  for (float side : {1.0f, -1.0f}) {
+    const float inner = kArcadeZ - 0.5f * kGround.pierWidth;
+    for (float bottom : {kFirstFloor, kRoof}) {
+      const glm::vec3 lo(-kHalfLength, bottom, side > 0 ? inner : -kBackWallZ);
+      const glm::vec3 hi(kHalfLength, bottom + kSlab, side > 0 ? kBackWallZ : -inner);
+      slabs.append(makeBox(lo, hi));
+    }
+  }
+  return slabs;
+}
+
+MeshData makeWalls() {
+  MeshData walls;
+  const float height = kRoof + kSlab;
+  const float endHeight = 12.0f;
+  const glm::vec3 x(1, 0, 0), y(0, 1, 0), z(0, 0, 1);
+  const float length = 2.0f * kHalfLength, width = 2.0f * kBackWallZ;
+  // Back walls face the courtyard; UVs in meters (the brick texture spans 1 m).
+  walls.append(makeQuad({kHalfLength, 0, kBackWallZ}, -length * x, height * y, {length, height}));
+  walls.append(makeQuad({-kHalfLength, 0, -kBackWallZ}, length * x, height * y, {length, height}));
+  walls.append(makeQuad({-kHalfLength, 0, kBackWallZ}, -width * z, endHeight * y, {width, endHeight}));
+  walls.append(makeQuad({kHalfLength, 0, -kBackWallZ}, width * z, endHeight * y, {width, endHeight}));
+  return walls;
+}
+
+MeshData makeFountain() {
+  // Basin: a lathed ring wall with a rim; a central column carrying a bowl.
+  // Repeated profile points are creases (see makeLathe).
+  const std::vector<glm::vec2> basin = {{1.3f, 0.0f}, {1.3f, 0.45f}, {1.3f, 0.45f}, {1.35f, 0.5f},
+                                        {1.2f, 0.56f}, {1.1f, 0.5f}, {1.1f, 0.5f}, {1.1f, 0.15f},
+                                        {1.1f, 0.15f}, {0.0f, 0.15f}};
+  const std::vector<glm::vec2> bowl = {{0.0f, 1.1f}, {0.3f, 1.12f}, {0.55f, 1.25f}, {0.7f, 1.45f},
+                                       {0.72f, 1.5f}, {0.65f, 1.5f}, {0.5f, 1.32f}, {0.0f, 1.28f}};
+  MeshData fountain = makeLathe(basin, 64);
+  fountain.append(makeCylinder({0, 0.15f, 0}, 0.14f, 0.97f, 32, false, false));
+  fountain.append(makeLathe(bowl, 64));
+  return fountain;
+}
+
+// Clear-sky radiance (linear RGB) for a direction, without the sun's disc (the sun is the
+// punctual light); a circumsolar glow keeps the sun's direction visible in reflections.
+glm::vec3 skyRadiance(const glm::vec3& d) {
+  const glm::vec3 zenith(0.30f, 0.50f, 1.00f), horizon(0.85f, 0.92f, 1.05f), ground(0.22f, 0.2f, 0.18f);
+  if (d.y < 0.0f) return glm::mix(horizon * 0.5f, ground, std::min(1.0f, -d.y * 6.0f));
+  const float t = std::pow(1.0f - d.y, 3.0f);
+  const float toSun = std::acos(std::clamp(glm::dot(d, -kSunDirection), -1.0f, 1.0f));
+  const float glow = 3.0f * std::exp(-toSun * toSun / 0.02f) + 0.3f * std::exp(-toSun * toSun / 0.3f);
+  return glm::mix(zenith, horizon, t) + glm::vec3(1.0f, 0.9f, 0.7f) * glow;
+}
+
+FloatImage paintSky(int width, int height) {
+  FloatImage sky(width, height, 3);
+  for (int j = 0; j < height; ++j) {
+    const float theta = (j + 0.5f) / height * glm::pi<float>();
+    for (int i = 0; i < width; ++i) {
+      // Inverse of u = 0.5 + atan2(d.x, -d.z) / (2 pi), v = acos(d.y) / pi.
+      const float phi = ((i + 0.5f) / width - 0.5f) * glm::two_pi<float>();
+      const glm::vec3 d(std::sin(theta) * std::sin(phi), std::cos(theta), -std::sin(theta) * std::cos(phi));
+      const glm::vec3 radiance = skyRadiance(d);
+      float* texel = sky.at(i, j);
+      texel[0] = radiance.r, texel[1] = radiance.g, texel[2] = radiance.b;
+    }
+  }
+  return sky;
+}
+
+}  // namespace
+
+bool writeAtrium(const std::string& dir, std::string* error) {
+  SceneBuilder scene("atrium");
+  TileStyle floorStyle;  // 4 x 4 tiles of 0.5 m per 2 m texture repeat
+  const int floor = scene.addMaterial(addTextureSet(scene, paintTiles(512, floorStyle), "tiles", 0.02f, glm::vec2(0.5f)));
+  const int brick = scene.addMaterial(addTextureSet(scene, paintBricks(512, 14, 4, 21), "brick", 0.008f));
+  const int stone = scene.addMaterial(
+      addTextureSet(scene, paintStone(512, {0.62f, 0.53f, 0.41f}, 31), "stone", 0.01f));
+  MaterialDesc grille = addTextureSet(scene, paintGrille(512, 8), "grille", 0.01f, glm::vec2(1.0f), 1.0f);
+  grille.doubleSided = true;  // seen from both the courtyard and the gallery
+  const int grilleMaterial = scene.addMaterial(grille);
+
+  scene.addObject("floor", makeQuad({-kHalfLength, 0, kBackWallZ}, {2 * kHalfLength, 0, 0},
+                                    {0, 0, -2 * kBackWallZ}, {2 * kHalfLength, 2 * kBackWallZ}),
+                  floor);
+  scene.addObject("walls", makeWalls(), brick);
+  scene.addObject("slabs", makeSlabs(), stone);
+  scene.addObject("fountain", makeFountain(), stone);
+
+  const int groundPier = scene.addMesh("ground_pier", makePier(kGround), stone);
+  const int upperPier = scene.addMesh("upper_pier", makePier(kUpper), stone);
+  const int groundArch = scene.addMesh("ground_arch", makeArch(kGround), stone);
+  const int upperArch = scene.addMesh("upper_arch", makeArch(kUpper), stone);
+  const float grilleWidth = kBay - kUpper.pierWidth;
+  const int balustrade = scene.addMesh(
+      "balustrade", makeQuad({-0.5f * grilleWidth, kUpper.base, 0}, {grilleWidth, 0, 0}, {0, 1, 0}, {grilleWidth, 1}),
+      grilleMaterial);
+  for (float side : {1.0f, -1.0f}) {
+    const std::string prefix = side > 0 ? "south_" : "north_";
+    for (int k = 0; k <= kBays; ++k) {
+      const float x = -kHalfLength + kBay * float(k);
+      scene.addNode(prefix + "pier_" + std::to_string(k), groundPier, {x, 0, side * kArcadeZ});
+      scene.addNode(prefix + "upper_pier_" + std::to_string(k), upperPier, {x, 0, side * kArcadeZ});
+    }
+    for (int k = 0; k < kBays; ++k) {
+      const glm::vec3 center(-kHalfLength + kBay * (float(k) + 0.5f), 0, side * kArcadeZ);
+      scene.addNode(prefix + "arch_" + std::to_string(k), groundArch, center);
+      scene.addNode(prefix + "upper_arch_" + std::to_string(k), upperArch, center);
+      scene.addNode(prefix + "balustrade_" + std::to_string(k), balustrade, center);
+    }
+  }
+
+  scene.addSun("sun", kSunDirection, {1.0f, 0.93f, 0.82f}, 10.0f);
+  scene.setCamera({8.6f, 1.7f, 5.7f}, {-10.0f, 2.9f, 3.0f}, 1.0f, 16.0f / 9.0f);
+  scene.setRenderDefaults(false, 960, 540);
+  if (!scene.write(dir, error)) return false;
+  return writeExrRgb(dir + "/environment.exr", paintSky(1024, 512), error);
+}
+
+}  // namespace pxf::scenegen
