@@ -1,0 +1,55 @@
+#include "gl/blend_pass.h"
+
+#include "gl/gl.h"
+
+namespace pxf {
+
+BlendPass::BlendPass(int width, int height)
+    : width_(width), height_(height), program_(Program::from_embedded("fullscreen.vert", "blend.frag")),
+      output_(width, height, TextureFormat::RGBA32F), case_(width, height, TextureFormat::R32F),
+      counts_(sizeof(uint32_t) * kBlendCaseCount) {
+  fbo_.attach(0, output_);
+  fbo_.attach(1, case_);
+  fbo_.check("blend pass");
+}
+
+void BlendPass::run(const PreviewInputs& inputs, const FilterPass* filtered, const BlendParams& params) {
+  run(inputs, filtered && filtered->has_output() ? &filtered->output() : nullptr, params);
+}
+
+void BlendPass::run(const PreviewInputs& inputs, const Texture2D* filtered, const BlendParams& params) {
+  if (inputs.width() != width_ || inputs.height() != height_ ||
+      (filtered && (filtered->width() != width_ || filtered->height() != height_)))
+    throw Error("blend pass: input size differs from the pass size");
+  timer_.begin();
+  program_.set("has_filtered", filtered ? 1 : 0);
+  program_.set("t", params.t);
+  const std::array<uint32_t, kBlendCaseCount> zeros{};
+  counts_.upload(zeros.data(), sizeof zeros);
+  counts_.bind_storage(0);
+  inputs.hv().bind(0);
+  inputs.lv().bind(1);
+  if (filtered) filtered->bind(2); else inputs.hv().bind(2);  // unused, but keep the unit valid
+  program_.use();
+  quad_.draw(fbo_, width_, height_);
+  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+  timer_.end();
+  check_gl_error("blend pass");
+}
+
+std::array<uint32_t, kBlendCaseCount> BlendPass::case_counts() const {
+  std::array<uint32_t, kBlendCaseCount> counts{};
+  counts_.download(counts.data(), sizeof counts);
+  return counts;
+}
+
+Image BlendPass::final_image() const { return output_.download({"R", "G", "B"}); }
+Image BlendPass::s_image() const {
+  Image rgba = output_.download({"R", "G", "B", "A"});
+  Image out = Image::gray(width_, height_);
+  for (size_t i = 0; i < out.pixel_count(); ++i) out.pixels[i] = rgba.pixels[4 * i + 3];
+  return out;
+}
+Image BlendPass::case_image() const { return case_.download({"Y"}); }
+
+}  // namespace pxf

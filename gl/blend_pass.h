@@ -1,0 +1,46 @@
+// Blend pass (SPEC 3.4): per pixel s from u = Var[L_u]/L_b^2 and f = Var[L_f]/L_b^2 and threshold t,
+// composite L = L_lv + s L_u + (1 - s) L_f. Runs every displayed frame with the newest L_f.
+// Usage:
+//   BlendPass blend(w, h);
+//   blend.run(inputs, filter.has_output() ? &filter : nullptr, {t});
+//   tonemap.run(blend.output(), tonemap_params);
+//   auto counts = blend.case_counts();  // e.g. counts[kCaseUnfiltered] == w*h: stop filtering
+//   blend.final_image(), blend.s_image(), blend.case_image(), blend.last_ms()
+#pragma once
+#include <array>
+#include "gl/filter_pass.h"
+#include "gl/inputs.h"
+#include "gl/preview_params.h"
+#include "gl/resources.h"
+
+namespace pxf {
+
+class BlendPass {
+ public:
+  BlendPass(int width, int height);
+  // filtered == nullptr (or without output): no L_f yet, s = 1 everywhere (kCaseNoFiltered).
+  void run(const PreviewInputs& inputs, const FilterPass* filtered, const BlendParams& params);
+  // Same with a raw L_f texture (rgb L_f, a Var[L_f]); used by tests and custom filters.
+  void run(const PreviewInputs& inputs, const Texture2D* filtered, const BlendParams& params);
+
+  const Texture2D& output() const { return output_; }       // rgb L, a s
+  const Texture2D& case_texture() const { return case_; }   // r: BlendCase code
+  // Pixels per BlendCase of the last run (a 20-byte read-back).
+  std::array<uint32_t, kBlendCaseCount> case_counts() const;
+  double last_ms() const { return timer_.last_ms(); }
+
+  Image final_image() const;  // "R,G,B"
+  Image s_image() const;      // "Y"
+  Image case_image() const;   // "Y"
+
+ private:
+  int width_, height_;
+  Program program_;
+  Texture2D output_, case_;
+  Framebuffer fbo_;
+  Buffer counts_;
+  FullscreenPass quad_;
+  StageTimer timer_;
+};
+
+}  // namespace pxf

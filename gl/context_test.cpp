@@ -1,0 +1,133 @@
+#include <gtest/gtest.h>
+
+#include "gl/context.h"
+#include "gl/gl.h"
+#include "gl/resources.h"
+#include "gl/test_util.h"
+
+namespace pxf {
+namespace {
+
+// Draws a known pattern (per-pixel values written by a fragment shader from gl_FragCoord) into a
+// float FBO and reads it back exactly.
+void draw_and_check_pattern() {
+  const int w = 13, h = 7;
+  const std::string frag = R"(#version 450 core
+layout(location = 0) out vec4 color;
+void main() {
+  ivec2 p = ivec2(gl_FragCoord.xy);
+  color = vec4(float(p.x), float(p.y), float(p.x * 100 + p.y), 0.25);
+}
+)";
+  Shader vs(ShaderStage::Vertex, "fullscreen.vert", embedded_shader("fullscreen.vert"));
+  Shader fs(ShaderStage::Fragment, "pattern.frag", frag);
+  Program program({&vs, &fs});
+  Texture2D target(w, h, TextureFormat::RGBA32F);
+  Framebuffer fbo;
+  fbo.attach(0, target);
+  fbo.check("pattern");
+  FullscreenPass quad;
+  program.use();
+  quad.draw(fbo, w, h);
+  Image image = target.download({"R", "G", "B", "A"});
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      ASSERT_EQ(image.at(x, y, 0), float(x));
+      ASSERT_EQ(image.at(x, y, 1), float(y));
+      ASSERT_EQ(image.at(x, y, 2), float(x * 100 + y));
+      ASSERT_EQ(image.at(x, y, 3), 0.25f);
+    }
+  check_gl_error("pattern");
+}
+
+TEST(GlContext, BackendNamesRoundTrip) {
+  for (GlBackend b : {GlBackend::Auto, GlBackend::OSMesa, GlBackend::Egl, GlBackend::Window})
+    EXPECT_EQ(parse_gl_backend(gl_backend_name(b)), b);
+  EXPECT_THROW(parse_gl_backend("vulkan"), Error);
+}
+
+TEST(GlContext, OSMesaDrawsKnownPattern) {
+  GlContext& ctx = test::osmesa_context();
+  EXPECT_EQ(ctx.backend(), GlBackend::OSMesa);
+  EXPECT_NE(ctx.gl_version().find("4.5"), std::string::npos) << ctx.gl_version();
+  draw_and_check_pattern();
+}
+
+TEST(GlContext, EglSurfacelessDrawsKnownPattern) {
+  std::unique_ptr<GlContext> egl;
+  try {
+    egl = create_gl_context(GlBackend::Egl);
+  } catch (const Error& e) {
+    GTEST_SKIP() << e.what();
+  }
+  EXPECT_EQ(egl->backend(), GlBackend::Egl);
+  EXPECT_FALSE(egl->gl_version().empty());
+  draw_and_check_pattern();
+  egl.reset();
+  // Back to OSMesa: the entry points are reloaded for it.
+  test::osmesa_context();
+  draw_and_check_pattern();
+}
+
+TEST(GlContext, AutoWithoutWindowIsHeadless) {
+  GlContextOptions options;
+  options.want_window = false;
+  auto ctx = create_gl_context(GlBackend::Auto, options);
+  EXPECT_NE(ctx->backend(), GlBackend::Window);
+  draw_and_check_pattern();
+  ctx.reset();
+  test::osmesa_context();
+}
+
+TEST(Shader, CompileErrorNamesFileAndLine) {
+  test::osmesa_context();
+  const std::string src = "#version 450 core\nout vec4 c;\nvoid main() {\n  c = vec4(undefined_name);\n}\n";
+  try {
+    Shader s(ShaderStage::Fragment, "broken.frag", src);
+    FAIL() << "compiled";
+  } catch (const Error& e) {
+    std::string m = e.what();
+    EXPECT_NE(m.find("broken.frag:4"), std::string::npos) << m;
+    EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+  }
+}
+
+TEST(Shader, CompileErrorInIncludeNamesIncludedFile) {
+  test::osmesa_context();
+  const std::string src = "#version 450 core\n#include \"helpers.glsl\"\nout vec4 c;\nvoid main() {\n  c = vec4(f(), bad_main);\n}\n";
+  auto resolve = [](const std::string& name) -> std::string {
+    if (name == "helpers.glsl") return "float f() {\n  return 1.0;\n}\nfloat g() { return missing_thing; }\n";
+    throw Error("no " + name);
+  };
+  try {
+    Shader s(ShaderStage::Fragment, "main.frag", src, resolve);
+    FAIL() << "compiled";
+  } catch (const Error& e) {
+    std::string m = e.what();
+    EXPECT_NE(m.find("helpers.glsl:4"), std::string::npos) << m;
+  }
+  const std::string src2 = "#version 450 core\n#include \"ok.glsl\"\nout vec4 c;\nvoid main() {\n  c = vec4(bad_main);\n}\n";
+  auto resolve2 = [](const std::string&) -> std::string { return "float f() {\n  return 1.0;\n}\n"; };
+  try {
+    Shader s(ShaderStage::Fragment, "main.frag", src2, resolve2);
+    FAIL() << "compiled";
+  } catch (const Error& e) {
+    std::string m = e.what();
+    EXPECT_NE(m.find("main.frag:5"), std::string::npos) << m;
+  }
+}
+
+TEST(Shader, EveryEmbeddedPassCompiles) {
+  test::osmesa_context();
+  EXPECT_NO_THROW(Program::from_embedded("fullscreen.vert", "bilateral.frag"));
+  EXPECT_NO_THROW(Program::from_embedded("fullscreen.vert", "blend.frag"));
+  EXPECT_NO_THROW(Program::from_embedded("fullscreen.vert", "tonemap.frag"));
+  EXPECT_NO_THROW(Program::from_embedded("range.vert", "range.frag"));
+  EXPECT_NO_THROW(Program::from_embedded("specular_points.vert", "specular_points.frag"));
+  EXPECT_NO_THROW(Program::from_embedded("fullscreen.vert", "range_accumulate.frag"));
+  EXPECT_NO_THROW(Program::from_embedded_compute("reduce.comp"));
+  EXPECT_THROW(embedded_shader("nope.frag"), Error);
+}
+
+}  // namespace
+}  // namespace pxf

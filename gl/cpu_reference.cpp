@@ -1,0 +1,183 @@
+#include "gl/cpu_reference.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace pxf {
+
+const std::vector<std::string>& filter_kind_names() {
+  static const std::vector<std::string> names = {"bilateral-depth", "bilateral"};
+  return names;
+}
+const char* filter_kind_name(FilterKind kind) { return filter_kind_names()[static_cast<int>(kind)].c_str(); }
+FilterKind parse_filter_kind(const std::string& name) {
+  const auto& names = filter_kind_names();
+  for (size_t i = 0; i < names.size(); ++i)
+    if (names[i] == name) return static_cast<FilterKind>(i);
+  throw Error("unknown filter '" + name + "' (expected bilateral-depth or bilateral)");
+}
+
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+// The shaders' sanitize(): non-finite -> 0, magnitude clamped.
+float clean(float v) { return std::isfinite(v) ? std::clamp(v, -kMaxInput, kMaxInput) : 0.0f; }
+// Variance channel: negative or non-finite = unknown.
+float clean_var(float v) { return (std::isfinite(v) && v >= 0.0f) ? std::min(v, kMaxInput) : kVarUnknown; }
+float lum(const float* c) { return luminance(c[0], c[1], c[2]); }
+float inv_two_sigma2(float sigma) {
+  float s = std::max(sigma, 1.0e-6f);
+  return 1.0f / (2.0f * s * s);
+}
+
+struct Px {
+  float c[3];
+};
+Px rgb_at(const Image& im, int x, int y) {
+  return {{clean(im.at(x, y, 0)), clean(im.at(x, y, 1)), clean(im.at(x, y, 2))}};
+}
+
+}  // namespace
+
+float relative_variance(float var, float lb) {
+  if (!(var > 0.0f)) return 0.0f;
+  if (!(lb > 0.0f)) return kInf;
+  return (var / lb) / lb;
+}
+
+BlendDecision blend_decision(float u, float f, float t) {
+  if (!(t >= 0.0f)) t = 0.0f;
+  if (std::isnan(u)) u = kInf;
+  if (std::isnan(f)) f = kInf;
+  u = std::max(u, 0.0f);
+  f = std::max(f, 0.0f);
+  if (u <= t) return {1.0f, kCaseUnfiltered};
+  float m = std::max(u, f);  // > t >= 0
+  float uh = std::isinf(m) ? (std::isinf(u) ? 1.0f : 0.0f) : u / m;
+  float fh = std::isinf(m) ? (std::isinf(f) ? 1.0f : 0.0f) : f / m;
+  float th = t / m;
+  float d = th * (uh + fh) - uh * fh;  // D / m^2
+  if (d < 0.0f) return {0.0f, kCaseFilteredOnly};
+  float s = (fh + std::sqrt(d)) / (uh + fh);  // denominator >= 1: one of uh, fh is 1
+  return {std::clamp(s, 0.0f, 1.0f), kCaseMixed};
+}
+
+FilterOutput cpu_filter(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
+                        const Image& depth, const FilterParams& p) {
+  const int w = hv.width, h = hv.height;
+  FilterOutput out{Image::rgb(w, h), Image::gray(w, h)};
+  const int radius = std::min(kMaxFilterRadius, static_cast<int>(std::ceil(3.0f * std::max(p.sigma_s, 0.0f))));
+  const float ks = inv_two_sigma2(p.sigma_s), kc = inv_two_sigma2(p.sigma_c);
+  const float kd = p.kind == FilterKind::BilateralDepth ? inv_two_sigma2(p.sigma_d) : 0.0f;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      Px lu = rgb_at(hv, x, y);
+      float v = clean_var(var_u.at(x, y, 0));
+      if (p.skip_case2 && v >= 0.0f) {
+        Px l = rgb_at(lv, x, y);
+        float lb = std::max(lum(lu.c) + lum(l.c), 0.0f);
+        if (relative_variance(v, lb) <= std::max(p.t, 0.0f)) {
+          for (int c = 0; c < 3; ++c) out.filtered.at(x, y, c) = lu.c[c];
+          out.variance.at(x, y, 0) = kVarSkipped;
+          continue;
+        }
+      }
+      Px rp = rgb_at(range_color, x, y);
+      float dp = clean(depth.at(x, y, 0));
+      double sw = 0, swl[3] = {0, 0, 0}, sw2v = 0, sw2u = 0, swk = 0, swv = 0;
+      for (int qy = std::max(0, y - radius); qy <= std::min(h - 1, y + radius); ++qy)
+        for (int qx = std::max(0, x - radius); qx <= std::min(w - 1, x + radius); ++qx) {
+          Px rq = rgb_at(range_color, qx, qy);
+          float dq = clean(depth.at(qx, qy, 0));
+          double dc2 = 0;
+          for (int c = 0; c < 3; ++c) dc2 += double(rp.c[c] - rq.c[c]) * (rp.c[c] - rq.c[c]);
+          double dd = double(dp) - dq;
+          double e = double((qx - x) * (qx - x) + (qy - y) * (qy - y)) * ks + dc2 * kc + dd * dd * kd;
+          double wq = std::exp(-e);
+          Px lq = rgb_at(hv, qx, qy);
+          float vq = clean_var(var_u.at(qx, qy, 0));
+          sw += wq;
+          for (int c = 0; c < 3; ++c) swl[c] += wq * lq.c[c];
+          if (vq >= 0.0f) {
+            sw2v += wq * wq * vq;
+            swk += wq;
+            swv += wq * vq;
+          } else {
+            sw2u += wq * wq;
+          }
+        }
+      // sw >= 1: the center pixel has weight exp(0).
+      for (int c = 0; c < 3; ++c) out.filtered.at(x, y, c) = static_cast<float>(swl[c] / sw);
+      // Neighbours of unknown variance (n < 2) count with the kernel-weighted mean of the known ones.
+      out.variance.at(x, y, 0) =
+          swk > 0 ? static_cast<float>((sw2v + sw2u * (swv / swk)) / (sw * sw)) : kVarUnknown;
+    }
+  return out;
+}
+
+BlendOutput cpu_blend(const Image& lv, const Image& hv, const Image& var_u, const FilterOutput* filtered,
+                      const BlendParams& params) {
+  const int w = hv.width, h = hv.height;
+  BlendOutput out{Image::rgb(w, h), Image::gray(w, h), Image::gray(w, h)};
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      Px l = rgb_at(lv, x, y), lu = rgb_at(hv, x, y);
+      Px lf = lu;
+      BlendDecision d{1.0f, kCaseNoFiltered};
+      if (filtered) {
+        lf = rgb_at(filtered->filtered, x, y);
+        float vf_raw = filtered->variance.at(x, y, 0);
+        float vu = clean_var(var_u.at(x, y, 0));
+        if (vf_raw < -1.5f) {
+          d = {1.0f, kCaseUnfiltered};
+        } else if (vu < 0.0f) {
+          d = {0.0f, kCaseUnknownVar};
+        } else {
+          float vf = std::max(clean_var(vf_raw), 0.0f);  // unknown Var[L_f] (unreachable) reads as 0
+          float lb = std::max(lum(lf.c) + lum(l.c), 0.0f);
+          d = blend_decision(relative_variance(vu, lb), relative_variance(vf, lb), params.t);
+        }
+      }
+      for (int c = 0; c < 3; ++c)
+        out.final_rgb.at(x, y, c) = clean(l.c[c] + d.s * lu.c[c] + (1.0f - d.s) * lf.c[c]);
+      out.s.at(x, y, 0) = d.s;
+      out.blend_case.at(x, y, 0) = static_cast<float>(d.blend_case);
+    }
+  return out;
+}
+
+namespace {
+float sanitize_display(float v) { return std::isfinite(v) ? std::clamp(v, 0.0f, kMaxInput) : 0.0f; }
+}  // namespace
+
+double cpu_log_average(const Image& rgb, float delta) {
+  double sum = 0;
+  for (int y = 0; y < rgb.height; ++y)
+    for (int x = 0; x < rgb.width; ++x) {
+      float c[3] = {sanitize_display(rgb.at(x, y, 0)), sanitize_display(rgb.at(x, y, 1)),
+                    sanitize_display(rgb.at(x, y, 2))};
+      sum += std::log(double(delta) + lum(c));
+    }
+  return std::exp(sum / std::max<size_t>(rgb.pixel_count(), 1));
+}
+
+Image cpu_tonemap(const Image& rgb, const TonemapParams& p) {
+  Image out = Image::rgb(rgb.width, rgb.height);
+  double lavg = p.log_average > 0 ? p.log_average : cpu_log_average(rgb, p.delta);
+  float k = static_cast<float>(p.key / std::max(lavg, 1e-30));
+  for (int y = 0; y < rgb.height; ++y)
+    for (int x = 0; x < rgb.width; ++x) {
+      float c[3] = {sanitize_display(rgb.at(x, y, 0)), sanitize_display(rgb.at(x, y, 1)),
+                    sanitize_display(rgb.at(x, y, 2))};
+      float lm = k * lum(c);
+      // Ld / Y without dividing by Y: k (1 + Lm / white^2) / (1 + Lm).
+      float burn = p.white > 0 ? 1.0f + lm / (p.white * p.white) : 1.0f;
+      float scale = k * burn / (1.0f + lm);
+      for (int i = 0; i < 3; ++i) out.at(x, y, i) = srgb_from_linear(std::clamp(c[i] * scale, 0.0f, 1.0f));
+    }
+  return out;
+}
+
+}  // namespace pxf

@@ -1,0 +1,43 @@
+// Plain C++ implementation of the preview formulas (SPEC 3.3–3.5) on pxf::Image: the reference the
+// GL shaders are tested against, and the single CPU definition of the blend case logic.
+// Images: L_u/L_lv "R,G,B"; Var[L_u] one channel (kVarUnknown where n < 2); the range guide
+// "R,G,B" + depth one channel. Every function sanitizes exactly like the shaders (non-finite
+// inputs read as 0, magnitudes clamped to kMaxInput), so outputs are always finite.
+#pragma once
+#include "gl/preview_params.h"
+#include "image/image.h"
+
+namespace pxf {
+
+struct BlendDecision {
+  float s = 1.0f;
+  int blend_case = kCaseUnfiltered;
+};
+// SPEC 3.4's case logic on relative variances u, f (>= 0, may be +inf) and threshold t, computed
+// after scaling by max(u, f) so that no intermediate overflows: case 2 (u <= t) first, then
+// case 1 (D < 0), else case 3. NaN u or f count as +inf, NaN or negative t as 0.
+BlendDecision blend_decision(float u, float f, float t);
+inline float blend_factor(float u, float f, float t) { return blend_decision(u, f, t).s; }
+// var / lb^2 without overflow in the intermediate: 0 when var <= 0, +inf when lb <= 0.
+float relative_variance(float var, float lb);
+
+struct FilterOutput {
+  Image filtered;  // "R,G,B": L_f (L_u where skipped)
+  Image variance;  // "Y": Var[L_f]; kVarUnknown, or kVarSkipped where skipped
+};
+FilterOutput cpu_filter(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
+                        const Image& depth, const FilterParams& params);
+
+struct BlendOutput {
+  Image final_rgb;   // "R,G,B"
+  Image s;           // "Y"
+  Image blend_case;  // "Y": BlendCase codes
+};
+// `filtered` empty = the filter never ran.
+BlendOutput cpu_blend(const Image& lv, const Image& hv, const Image& var_u, const FilterOutput* filtered,
+                      const BlendParams& params);
+
+double cpu_log_average(const Image& rgb, float delta);
+Image cpu_tonemap(const Image& rgb, const TonemapParams& params);  // "R,G,B" display values in [0,1]
+
+}  // namespace pxf

@@ -1,0 +1,45 @@
+// Cross bilateral filter pass (SPEC 3.3): L_f and Var[L_f] from the HV buffer, guided by the
+// range buffer (color + distance). Runs on a schedule; the output texture persists between runs.
+// Usage:
+//   FilterPass filter(w, h);
+//   filter.run(inputs, range.guide(), params);      // params.t = the blend's t (for skipping)
+//   blend.run(inputs, &filter, blend_params);        // uses filter.output()
+//   filter.filtered_image(), filter.variance_image(), filter.last_ms()
+// Pixels in case 2 (u <= t with the unfiltered background) are skipped: L_f = L_u there and
+// Var[L_f] = kVarSkipped, the blend then uses s = 1 (see FilterParams::skip_case2).
+#pragma once
+#include "gl/inputs.h"
+#include "gl/preview_params.h"
+#include "gl/resources.h"
+
+namespace pxf {
+
+class FilterPass {
+ public:
+  FilterPass(int width, int height);
+  // guide: rgb range color, a distance (RangePass::guide()).
+  void run(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& params);
+
+  bool has_output() const { return runs_ > 0; }
+  int runs() const { return runs_; }
+  const Texture2D& output() const { return output_; }  // rgb L_f, a Var[L_f] or a sentinel
+  // Pixels actually filtered (not skipped) by the last run; 0 = every pixel was in case 2.
+  uint32_t filtered_pixels() const;
+  double last_ms() const { return timer_.last_ms(); }
+
+  Image filtered_image() const;  // "R,G,B" L_f
+  Image variance_image() const;  // "Y" Var[L_f], 0 where unknown or skipped
+  Image raw_variance_image() const;  // "Y" with the sentinels kept
+
+ private:
+  int width_, height_;
+  Program program_;
+  Texture2D output_;
+  Framebuffer fbo_;
+  Buffer counter_;
+  FullscreenPass quad_;
+  StageTimer timer_;
+  int runs_ = 0;
+};
+
+}  // namespace pxf

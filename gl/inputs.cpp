@@ -1,0 +1,45 @@
+#include "gl/inputs.h"
+
+#include "gl/preview_params.h"
+
+namespace pxf {
+
+PreviewInputs::PreviewInputs(int width, int height)
+    : width_(width), height_(height), lv_(width, height, TextureFormat::RGBA32F),
+      hv_(width, height, TextureFormat::RGBA32F) {}
+
+void PreviewInputs::upload(const float* lv_rgb, const float* hv_rgb, const float* var_of_mean,
+                           const uint32_t* samples) {
+  timer_.begin();
+  const size_t n = static_cast<size_t>(width_) * height_;
+  packed_.resize(n * 4);
+  for (size_t i = 0; i < n; ++i) {
+    packed_[4 * i + 0] = hv_rgb[3 * i + 0];
+    packed_[4 * i + 1] = hv_rgb[3 * i + 1];
+    packed_[4 * i + 2] = hv_rgb[3 * i + 2];
+    bool unknown = samples && samples[i] < 2;
+    packed_[4 * i + 3] = unknown ? kVarUnknown : var_of_mean[i];
+  }
+  lv_.upload(lv_rgb, 3);
+  hv_.upload(packed_.data(), 4);
+  timer_.end();
+}
+
+void PreviewInputs::upload(const Image& lv, const Image& hv, const Image& var) {
+  for (const Image* im : {&lv, &hv, &var})
+    if (im->width != width_ || im->height != height_) throw Error("preview inputs: image size differs from the textures");
+  if (lv.num_channels() != 3 || hv.num_channels() != 3 || var.num_channels() != 1)
+    throw Error("preview inputs: expected RGB lv and hv and a one-channel variance");
+  upload(lv.pixels.data(), hv.pixels.data(), var.pixels.data());
+}
+
+Image PreviewInputs::lv_image() const { return lv_.download({"R", "G", "B"}); }
+Image PreviewInputs::hv_image() const { return hv_.download({"R", "G", "B"}); }
+Image PreviewInputs::var_image() const {
+  Image rgba = hv_.download({"R", "G", "B", "A"});
+  Image out = Image::gray(width_, height_);
+  for (size_t i = 0; i < out.pixel_count(); ++i) out.pixels[i] = rgba.pixels[4 * i + 3] > 0 ? rgba.pixels[4 * i + 3] : 0.0f;
+  return out;
+}
+
+}  // namespace pxf

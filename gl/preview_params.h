@@ -1,0 +1,60 @@
+// Parameters and codes of the preview passes (SPEC 3.3–3.5), shared by the GL passes, the CPU
+// reference and the app. No GL here.
+#pragma once
+#include <string>
+#include <vector>
+
+namespace pxf {
+
+// Cross bilateral filter variants: "bilateral-depth" (SPEC default: spatial x color x depth) and
+// "bilateral" (spatial x color, no depth term). Both are the exact (non-separable) kernel.
+enum class FilterKind { BilateralDepth, Bilateral };
+const std::vector<std::string>& filter_kind_names();  // "bilateral-depth", "bilateral"
+const char* filter_kind_name(FilterKind kind);
+FilterKind parse_filter_kind(const std::string& name);  // throws pxf::Error listing the names
+
+struct FilterParams {
+  FilterKind kind = FilterKind::BilateralDepth;
+  float sigma_s = 8.0f;   // pixels; kernel radius ceil(3 sigma_s), at most kMaxFilterRadius
+  float sigma_c = 0.02f;  // range color, Euclidean distance in linear RGB
+  float sigma_d = 2.0f;   // depth, scene units
+  // Skip pixels in case 2 (u <= t): they need no filtered value. u is computed with the
+  // *unfiltered* background L_b = Y(L_u) + Y(L_lv), so the decision needs no history; a skipped
+  // pixel gets L_f = L_u and Var[L_f] = kVarSkipped, and the blend uses s = 1 there.
+  bool skip_case2 = true;
+  float t = 0.01f;  // the blend threshold (only used for skipping)
+};
+constexpr int kMaxFilterRadius = 64;
+
+// Sentinels of the variance channels (alpha of the HV and filtered textures).
+constexpr float kVarUnknown = -1.0f;  // n < 2 (Var[L_u]); no known neighbour variance (Var[L_f])
+constexpr float kVarSkipped = -2.0f;  // Var[L_f] of a pixel the filter skipped (case 2)
+
+// Background depth (distance) of the range buffer where no surface is hit.
+constexpr float kBackgroundDepth = 1.0e4f;
+
+// Inputs larger than this are clamped, so that sums of a whole kernel stay finite in float.
+constexpr float kMaxInput = 1.0e30f;
+
+struct BlendParams {
+  float t = 0.01f;  // perceived-variance threshold; sqrt(t) = allowed relative std. deviation
+};
+
+// Blend case per pixel (the "case" buffer). 1, 2, 3 are SPEC 3.4's cases.
+enum BlendCase : int {
+  kCaseNoFiltered = 0,   // no L_f exists yet (the filter never ran): s = 1
+  kCaseFilteredOnly = 1, // D < 0: s = 0
+  kCaseUnfiltered = 2,   // u <= t (or the filter skipped the pixel): s = 1
+  kCaseMixed = 3,        // s = (f + sqrt(D)) / (u + f)
+  kCaseUnknownVar = 4,   // n < 2, variance unknown: s = 0 (filtered value only)
+};
+constexpr int kBlendCaseCount = 5;
+
+struct TonemapParams {
+  float key = 0.18f;         // Reinhard's key a
+  float white = 0.0f;        // white point in key-scaled luminance; 0 = none (L/(1+L))
+  float log_average = 0.0f;  // > 0: use this log-average luminance instead of the image's
+  float delta = 1.0e-4f;     // log-average offset: exp(mean(log(delta + Y)))
+};
+
+}  // namespace pxf

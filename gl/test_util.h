@@ -1,0 +1,15 @@
+// Test helpers of gl_tests: one shared OSMesa context (made current by each test).
+#pragma once
+#include <gtest/gtest.h>
+#include <memory>
+#include "gl/context.h"
+
+namespace pxf::test {
+
+inline GlContext& osmesa_context() {
+  static std::unique_ptr<GlContext> context = create_gl_context(GlBackend::OSMesa);
+  context->make_current();
+  return *context;
+}
+
+}  // namespace pxf::test

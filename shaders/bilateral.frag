@@ -1,0 +1,65 @@
+#version 450 core
+// Cross bilateral filter (SPEC 3.3) of the HV buffer guided by the range buffer, with the variance
+// of the result: L_f = sum w L_u / sum w, Var[L_f] = sum w^2 Var[L_u] / (sum w)^2.
+#include "common.glsl"
+
+layout(binding = 0) uniform sampler2D hv_tex;     // rgb L_u, a Var[L_u] (kVarUnknown: n < 2)
+layout(binding = 1) uniform sampler2D lv_tex;     // rgb L_lv (only for skipping)
+layout(binding = 2) uniform sampler2D guide_tex;  // rgb range color, a distance
+uniform int radius;
+uniform float k_s;   // 1 / (2 sigma_s^2)
+uniform float k_c;   // 1 / (2 sigma_c^2)
+uniform float k_d;   // 1 / (2 sigma_d^2), 0 for the color-only variant
+uniform int skip_case2;
+uniform float t;
+
+layout(std430, binding = 0) buffer Counter { uint filtered_pixels; };
+layout(location = 0) out vec4 out_filtered;  // rgb L_f, a Var[L_f] (kVarUnknown, kVarSkipped)
+
+void main() {
+  ivec2 p = ivec2(gl_FragCoord.xy);
+  ivec2 size = textureSize(hv_tex, 0);
+  vec4 hv_p = texelFetch(hv_tex, p, 0);
+  vec3 lu_p = clean(hv_p.rgb);
+  float v_p = clean_var(hv_p.a);
+  if (skip_case2 != 0 && v_p >= 0.0) {
+    float lb = max(luminance(lu_p) + luminance(clean(texelFetch(lv_tex, p, 0).rgb)), 0.0);
+    if (relative_variance(v_p, lb) <= max(t, 0.0)) {
+      out_filtered = vec4(lu_p, kVarSkipped);
+      return;
+    }
+  }
+  atomicAdd(filtered_pixels, 1u);
+  vec4 g_p = texelFetch(guide_tex, p, 0);
+  vec3 r_p = clean(g_p.rgb);
+  float d_p = clean(g_p.a);
+  float sw = 0.0, sw2v = 0.0, sw2u = 0.0, swk = 0.0, swv = 0.0;
+  vec3 swl = vec3(0.0);
+  ivec2 lo = max(p - radius, ivec2(0)), hi = min(p + radius, size - 1);
+  for (int qy = lo.y; qy <= hi.y; ++qy) {
+    float dy2 = float((qy - p.y) * (qy - p.y));
+    for (int qx = lo.x; qx <= hi.x; ++qx) {
+      ivec2 q = ivec2(qx, qy);
+      vec4 g_q = texelFetch(guide_tex, q, 0);
+      vec3 dr = r_p - clean(g_q.rgb);
+      float dd = d_p - clean(g_q.a);
+      float e = (float((qx - p.x) * (qx - p.x)) + dy2) * k_s + dot(dr, dr) * k_c + dd * dd * k_d;
+      float w = exp(-e);
+      vec4 hv_q = texelFetch(hv_tex, q, 0);
+      float v_q = clean_var(hv_q.a);
+      sw += w;
+      swl += w * clean(hv_q.rgb);
+      if (v_q >= 0.0) {
+        sw2v += w * w * v_q;
+        swk += w;
+        swv += w * v_q;
+      } else {
+        sw2u += w * w;
+      }
+    }
+  }
+  // sw >= 1 (the center's weight is exp(0)). Unknown neighbour variances (n < 2) count with the
+  // kernel-weighted mean of the known ones.
+  float var_f = swk > 0.0 ? (sw2v + sw2u * (swv / swk)) / (sw * sw) : kVarUnknown;
+  out_filtered = vec4(swl / sw, var_f);
+}

@@ -1,0 +1,42 @@
+#version 450 core
+// Blend of filtered and unfiltered HV light (SPEC 3.4): s per pixel, L = L_lv + s L_u + (1-s) L_f.
+#include "common.glsl"
+
+layout(binding = 0) uniform sampler2D hv_tex;        // rgb L_u, a Var[L_u]
+layout(binding = 1) uniform sampler2D lv_tex;        // rgb L_lv
+layout(binding = 2) uniform sampler2D filtered_tex;  // rgb L_f, a Var[L_f] (or a sentinel)
+uniform int has_filtered;
+uniform float t;
+
+layout(std430, binding = 0) buffer CaseCounts { uint case_counts[5]; };
+layout(location = 0) out vec4 out_final;  // rgb L, a s
+layout(location = 1) out float out_case;
+
+void main() {
+  ivec2 p = ivec2(gl_FragCoord.xy);
+  vec4 hv = texelFetch(hv_tex, p, 0);
+  vec3 lu = clean(hv.rgb);
+  vec3 lv = clean(texelFetch(lv_tex, p, 0).rgb);
+  vec3 lf = lu;
+  float s = 1.0;
+  int blend_case = 0;
+  if (has_filtered != 0) {
+    vec4 fv = texelFetch(filtered_tex, p, 0);
+    lf = clean(fv.rgb);
+    float vu = clean_var(hv.a);
+    if (fv.a < -1.5) {
+      s = 1.0;
+      blend_case = 2;  // skipped by the filter: case 2
+    } else if (vu < 0.0) {
+      s = 0.0;
+      blend_case = 4;  // n < 2
+    } else {
+      float vf = max(clean_var(fv.a), 0.0);
+      float lb = max(luminance(lf) + luminance(lv), 0.0);
+      s = blend_factor(relative_variance(vu, lb), relative_variance(vf, lb), t, blend_case);
+    }
+  }
+  atomicAdd(case_counts[blend_case], 1u);
+  out_final = vec4(clean(lv + s * lu + (1.0 - s) * lf), s);
+  out_case = float(blend_case);
+}

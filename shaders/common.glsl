@@ -1,0 +1,39 @@
+// Shared helpers of the preview passes. Mirrors gl/cpu_reference.cpp and gl/preview_params.h:
+// keep the two in step (the gl_tests compare them).
+const float kMaxInput = 1.0e30;
+const float kVarUnknown = -1.0;
+const float kVarSkipped = -2.0;
+const float kInf = uintBitsToFloat(0x7f800000u);
+
+float luminance(vec3 c) { return dot(c, vec3(0.2126, 0.7152, 0.0722)); }
+
+// Non-finite -> 0, magnitude clamped (so kernel sums stay finite in float).
+float clean(float v) { return (isnan(v) || isinf(v)) ? 0.0 : clamp(v, -kMaxInput, kMaxInput); }
+vec3 clean(vec3 c) { return vec3(clean(c.r), clean(c.g), clean(c.b)); }
+// Variance channel: negative or non-finite = unknown.
+float clean_var(float v) { return (isnan(v) || isinf(v) || v < 0.0) ? kVarUnknown : min(v, kMaxInput); }
+
+// var / lb^2 without overflow in the intermediate; 0 when var <= 0, +inf when lb <= 0.
+float relative_variance(float var, float lb) {
+  if (!(var > 0.0)) return 0.0;
+  if (!(lb > 0.0)) return kInf;
+  return (var / lb) / lb;
+}
+
+// SPEC 3.4, computed after scaling by max(u, f): case 2 (u <= t) first, case 1 (D < 0), case 3.
+float blend_factor(float u, float f, float t, out int blend_case) {
+  if (!(t >= 0.0)) t = 0.0;
+  if (isnan(u)) u = kInf;
+  if (isnan(f)) f = kInf;
+  u = max(u, 0.0);
+  f = max(f, 0.0);
+  if (u <= t) { blend_case = 2; return 1.0; }
+  float m = max(u, f);
+  float uh = isinf(m) ? (isinf(u) ? 1.0 : 0.0) : u / m;
+  float fh = isinf(m) ? (isinf(f) ? 1.0 : 0.0) : f / m;
+  float th = t / m;
+  float d = th * (uh + fh) - uh * fh;
+  if (d < 0.0) { blend_case = 1; return 0.0; }
+  blend_case = 3;
+  return clamp((fh + sqrt(d)) / (uh + fh), 0.0, 1.0);
+}

@@ -1,0 +1,37 @@
+#version 450 core
+// Range color = range_shading(albedo, interpolated normal, to_viewer) (pathtracer.h), albedo =
+// base color factor x base color texture x vertex color (linear); distance to the camera; the
+// perfectly-specular flag. Alpha-mask cutouts are discarded; nothing is culled.
+in vec3 world_position;
+in vec3 world_normal;
+in vec2 uv0;
+in vec2 uv1;
+in vec4 vertex_color;
+
+layout(binding = 0) uniform sampler2D base_color_tex;  // 1x1 white when the material has none
+uniform vec4 base_color;
+uniform int texcoord;      // 0 or 1
+uniform mat3 uv_transform; // KHR_texture_transform, applied to (u, v, 1)
+uniform int alpha_mask;
+uniform float alpha_cutoff;
+uniform int double_sided;
+uniform float specular;    // 1: perfectly specular material
+uniform vec3 camera_position;
+
+layout(location = 0) out vec4 out_color;  // rgb range color, a specular flag
+layout(location = 1) out float out_distance;
+
+void main() {
+  vec2 uv = (uv_transform * vec3(texcoord == 1 ? uv1 : uv0, 1.0)).xy;
+  vec4 albedo = base_color * texture(base_color_tex, uv) * vertex_color;
+  if (alpha_mask != 0 && !(albedo.a >= alpha_cutoff)) discard;
+  vec3 to_camera = camera_position - world_position;
+  float distance = length(to_camera);
+  vec3 v = to_camera / max(distance, 1e-30);
+  vec3 n = normalize(world_normal);
+  // As the path tracer: only double-sided materials flip the normal toward the viewer.
+  if (double_sided != 0 && dot(n, v) < 0.0) n = -n;
+  float c = dot(n, v);
+  out_color = vec4(albedo.rgb * (0.2 + 0.8 * max(c, 0.0)), specular);
+  out_distance = distance;
+}
