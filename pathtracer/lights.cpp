@@ -176,7 +176,7 @@ glm::vec3 LightSampler::sample_environment_direction(glm::vec2 u, float* pdf) co
 float LightSampler::environment_direction_pdf(glm::vec3 direction) const {
   if (!env_) return 0.0f;
   glm::vec2 uv = equirect_uv(direction);
-  float sin_theta = std::sqrt(std::max(0.0f, 1.0f - direction.y * direction.y));
+  float sin_theta = std::sqrt(direction.x * direction.x + direction.z * direction.z);  // exact near the poles
   return sin_theta > 0.0f ? env_dist_.pdf(uv) / (2.0f * kPi * kPi * sin_theta) : 0.0f;
 }
 

@@ -1,0 +1,91 @@
+// Accumulation: running means and Welford variance stay exact over long streams; the
+// renderer's buffers, reset and image getters.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "pathtracer/integrator.h"
+#include "pathtracer/rng.h"
+#include "pathtracer/shapes.h"
+
+namespace pxf {
+namespace {
+
+TEST(Accumulation, LongStreamMatchesDoubleSums) {
+  Accumulation acc;
+  resize_accumulation(acc, 1, 1);
+  Rng rng(42, 0, 0);
+  const int n = 200000;
+  double sum_lv[3] = {0, 0, 0}, sum_hv[3] = {0, 0, 0}, sum_y = 0, sum_y2 = 0;
+  std::vector<double> ys;
+  ys.reserve(n);
+  for (int i = 0; i < n; ++i) {
+    // Heavy-tailed HV (rare fireflies) over a bright LV, like a real pixel.
+    float u = rng.next_float();
+    glm::vec3 lv(3.0f + rng.next_float(), 0.5f, 7.25f);
+    glm::vec3 hv = glm::vec3(0.2f, 0.3f, 0.1f) * (u < 0.001f ? 500.0f : rng.next_float());
+    accumulate_sample(acc, 0, lv, hv);
+    for (int c = 0; c < 3; ++c) {
+      sum_lv[c] += lv[c];
+      sum_hv[c] += hv[c];
+    }
+    double y = luminance(hv);
+    ys.push_back(y);
+    sum_y += y;
+  }
+  double mean_y = sum_y / n;
+  for (double y : ys) sum_y2 += (y - mean_y) * (y - mean_y);
+  EXPECT_EQ(acc.samples[0], static_cast<uint32_t>(n));
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(acc.lv_mean[0][c], sum_lv[c] / n, 2e-5 * std::abs(sum_lv[c] / n)) << c;
+    EXPECT_NEAR(acc.hv_mean[0][c], sum_hv[c] / n, 2e-4 * std::abs(sum_hv[c] / n)) << c;
+  }
+  EXPECT_NEAR(acc.hv_lum_mean[0], mean_y, 1e-10 * mean_y);
+  double var_of_mean = sum_y2 / (n - 1) / n;
+  EXPECT_NEAR(acc.variance_of_mean(0), var_of_mean, 1e-6 * var_of_mean);
+}
+
+TEST(Accumulation, VarianceOfMeanNeedsTwoSamples) {
+  Accumulation acc;
+  resize_accumulation(acc, 2, 1);
+  EXPECT_EQ(acc.variance_of_mean(0), -1.0f);
+  accumulate_sample(acc, 0, glm::vec3(0), glm::vec3(1.0f));
+  EXPECT_EQ(acc.variance_of_mean(0), -1.0f);
+  accumulate_sample(acc, 0, glm::vec3(0), glm::vec3(3.0f));
+  // Y = 1 and 3: s^2 = 2, Var[mean] = s^2 / n = 1.
+  EXPECT_NEAR(acc.variance_of_mean(0), 1.0f, 1e-6f);
+  EXPECT_EQ(acc.variance_of_mean(1), -1.0f);
+}
+
+TEST(Accumulation, RendererBuffersResetAndImages) {
+  Scene scene = make_cornell_box(false);
+  TraceParams params;
+  params.threads = 2;
+  ProgressiveRenderer renderer(scene, params, 16, 12);
+  for (int i = 0; i < 3; ++i) renderer.add_frame();
+  EXPECT_EQ(renderer.frames(), 3);
+  EXPECT_EQ(renderer.stats().paths, 3u * 16 * 12);
+  EXPECT_GT(renderer.stats().rays, renderer.stats().paths);
+  Image samples = renderer.samples_image();
+  ASSERT_EQ(samples.channels, std::vector<std::string>{"Y"});
+  for (float s : samples.pixels) EXPECT_EQ(s, 3.0f);
+  Image variance = renderer.variance_image();
+  std::vector<float> vom = renderer.variance_of_mean();
+  for (size_t i = 0; i < vom.size(); ++i) {
+    EXPECT_GE(vom[i], 0.0f);
+    EXPECT_EQ(variance.pixels[i], vom[i]);
+  }
+  Image lv = renderer.lv_image();
+  EXPECT_EQ(lv.width, 16);
+  EXPECT_EQ(lv.num_channels(), 3);
+  Camera moved = renderer.camera();
+  moved.yfov *= 0.5f;
+  renderer.set_camera(moved);
+  EXPECT_EQ(renderer.frames(), 0);
+  EXPECT_EQ(renderer.accumulation().samples[0], 0u);
+  EXPECT_EQ(renderer.variance_of_mean()[0], -1.0f);
+  EXPECT_EQ(renderer.stats().paths, 0u);
+}
+
+}  // namespace
+}  // namespace pxf

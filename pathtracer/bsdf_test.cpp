@@ -1,0 +1,195 @@
+// BSDF sampling against its pdf (chi-square), sample weights against eval/pdf, glass branches.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "pathtracer/bsdf.h"
+#include "pathtracer/rng.h"
+#include "pathtracer/shapes.h"
+#include "pathtracer/stat_tests.h"
+
+namespace pxf {
+namespace {
+
+constexpr int kThetaBins = 16, kPhiBins = 32;
+constexpr int kSamples = 200000;
+
+struct Case {
+  const char* name;
+  BsdfParams params;
+  float incident_degrees;
+};
+
+BsdfParams conductor(glm::vec3 f0, float roughness) {
+  BsdfParams p;
+  p.base_color = f0;
+  p.metallic = 1.0f;
+  p.roughness = roughness;
+  return p;
+}
+
+BsdfParams plastic(glm::vec3 base, float roughness, float metallic = 0.0f) {
+  BsdfParams p;
+  p.base_color = base;
+  p.metallic = metallic;
+  p.roughness = roughness;
+  return p;
+}
+
+BsdfParams lambert(glm::vec3 albedo) {
+  BsdfParams p;
+  p.base_color = albedo;
+  p.metallic = 0.0f;
+  p.specular = 0.0f;
+  return p;
+}
+
+// Bin of a direction in (cos theta in [-1, 1], phi) around the z axis (the normal).
+int bin_of(glm::vec3 w) {
+  int ti = std::min(kThetaBins - 1, std::max(0, static_cast<int>((w.z + 1.0f) * 0.5f * kThetaBins)));
+  float phi = std::atan2(w.y, w.x);
+  if (phi < 0) phi += 2.0f * kPi;
+  int pi = std::min(kPhiBins - 1, std::max(0, static_cast<int>(phi / (2.0f * kPi) * kPhiBins)));
+  return ti * kPhiBins + pi;
+}
+
+// Integrates pdf over every bin with a fine midpoint rule (dω = d cos(theta) d phi).
+std::vector<double> expected_counts(const Bsdf& bsdf, double n) {
+  const int sub = 16;
+  std::vector<double> expected(kThetaBins * kPhiBins, 0.0);
+  double dz = 2.0 / (kThetaBins * sub), dphi = 2.0 * M_PI / (kPhiBins * sub);
+  for (int t = 0; t < kThetaBins * sub; ++t) {
+    double z = -1.0 + (t + 0.5) * dz;
+    double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+    for (int p = 0; p < kPhiBins * sub; ++p) {
+      double phi = (p + 0.5) * dphi;
+      glm::vec3 w(static_cast<float>(r * std::cos(phi)), static_cast<float>(r * std::sin(phi)), static_cast<float>(z));
+      expected[(t / sub) * kPhiBins + p / sub] += bsdf.pdf(w) * dz * dphi * n;
+    }
+  }
+  return expected;
+}
+
+TEST(Bsdf, SamplingMatchesPdfChiSquare) {
+  const std::vector<Case> cases = {
+      {"lambert normal", lambert(glm::vec3(0.8f)), 0.0f},
+      {"lambert grazing", lambert(glm::vec3(0.8f)), 70.0f},
+      {"conductor r0.3 10deg", conductor(glm::vec3(0.9f, 0.6f, 0.3f), 0.3f), 10.0f},
+      {"conductor r0.3 60deg", conductor(glm::vec3(0.9f, 0.6f, 0.3f), 0.3f), 60.0f},
+      {"conductor r0.6 45deg", conductor(glm::vec3(1.0f), 0.6f), 45.0f},
+      {"conductor r1 80deg", conductor(glm::vec3(1.0f), 1.0f), 80.0f},
+      {"plastic r0.25 30deg", plastic(glm::vec3(0.5f), 0.25f), 30.0f},
+      {"plastic r0.5 75deg", plastic(glm::vec3(0.2f, 0.4f, 0.8f), 0.5f), 75.0f},
+      {"half metal r0.4 40deg", plastic(glm::vec3(0.7f, 0.5f, 0.3f), 0.4f, 0.5f), 40.0f},
+  };
+  const double alpha = 0.01 / cases.size();  // Bonferroni
+  for (const Case& c : cases) {
+    float theta = glm::radians(c.incident_degrees);
+    glm::vec3 wo(std::sin(theta), 0.0f, std::cos(theta));
+    Bsdf bsdf(c.params, glm::vec3(0, 0, 1), glm::vec3(0, 0, 1), wo, true);
+    ASSERT_TRUE(bsdf.has_nondelta()) << c.name;
+    std::vector<double> observed(kThetaBins * kPhiBins, 0.0);
+    Rng rng(11, static_cast<uint64_t>(&c - cases.data()), 0);
+    int weight_mismatches = 0;
+    for (int i = 0; i < kSamples; ++i) {
+      float u_lobe = rng.next_float();
+      glm::vec2 u = rng.next_2d();
+      BsdfSample s;
+      if (!bsdf.sample(u_lobe, u, &s)) continue;
+      ASSERT_FALSE(s.delta) << c.name;
+      observed[bin_of(s.wi)] += 1.0;
+      // The sample's pdf and weight agree with pdf() and eval() / pdf().
+      float pdf = bsdf.pdf(s.wi);
+      glm::vec3 expect_weight = bsdf.eval(s.wi) / pdf;
+      if (std::abs(pdf - s.pdf) > 1e-3f * pdf || glm::length(expect_weight - s.weight) > 1e-3f * (1.0f + glm::length(s.weight)))
+        ++weight_mismatches;
+    }
+    EXPECT_EQ(weight_mismatches, 0) << c.name;
+    stat::ChiSquareResult r = stat::chi_square(observed, expected_counts(bsdf, kSamples));
+    EXPECT_TRUE(r.problem.empty()) << c.name << ": " << r.problem;
+    EXPECT_GT(r.p_value, alpha) << c.name << ": chi2 = " << r.statistic << ", dof = " << r.dof;
+  }
+}
+
+TEST(Bsdf, GgxDistributionIsNormalized) {
+  for (float alpha : {0.05f, 0.3f, 1.0f}) {
+    double sum = 0;
+    const int n = 400000;
+    for (int i = 0; i < n; ++i) {  // ∫ D(h) cos(theta_h) dω over the hemisphere, midpoint in cos theta
+      double z = (i + 0.5) / n;
+      glm::vec3 h(static_cast<float>(std::sqrt(1 - z * z)), 0.0f, static_cast<float>(z));
+      sum += ggx_d(h, alpha) * z * (1.0 / n) * 2.0 * M_PI;
+    }
+    EXPECT_NEAR(sum, 1.0, 2e-3) << "alpha " << alpha;
+  }
+}
+
+TEST(Bsdf, LambertAlbedoOneConservesEnergy) {
+  Bsdf bsdf(lambert(glm::vec3(1.0f)), glm::vec3(0, 0, 1), glm::vec3(0, 0, 1), glm::normalize(glm::vec3(0.3f, 0.1f, 1.0f)), true);
+  Rng rng(3, 0, 0);
+  double sum = 0;
+  const int n = 20000;
+  for (int i = 0; i < n; ++i) {
+    BsdfSample s;
+    float u = rng.next_float();
+    if (bsdf.sample(u, rng.next_2d(), &s)) sum += s.weight.g;
+  }
+  EXPECT_NEAR(sum / n, 1.0, 1e-4);  // cosine sampling of a Lambertian: every weight is exactly 1
+}
+
+TEST(Bsdf, SmoothGlassBranchesFollowFresnel) {
+  BsdfParams glass;
+  glass.metallic = 0.0f;
+  glass.roughness = 0.0f;
+  glass.transmission = 1.0f;
+  glass.ior = 1.5f;
+  for (bool front : {true, false}) {
+    for (float cos_i : {1.0f, 0.7f, 0.3f}) {
+      glm::vec3 wo(std::sqrt(1.0f - cos_i * cos_i), 0.0f, cos_i);
+      glm::vec3 ng = front ? glm::vec3(0, 0, 1) : glm::vec3(0, 0, -1);  // exiting: wo is behind the face
+      Bsdf bsdf(glass, ng, ng, wo, front);
+      ASSERT_TRUE(bsdf.is_perfectly_specular());
+      float fresnel = fresnel_dielectric(cos_i, front ? 1.5f : 1.0f / 1.5f);
+      Rng rng(5, front, static_cast<uint64_t>(cos_i * 100));
+      const int n = 50000;
+      int reflected = 0;
+      for (int i = 0; i < n; ++i) {
+        BsdfSample s;
+        float u = rng.next_float();
+        ASSERT_TRUE(bsdf.sample(u, rng.next_2d(), &s));
+        ASSERT_TRUE(s.delta);
+        if (!s.transmitted) {
+          ++reflected;
+          EXPECT_NEAR(glm::dot(s.wi, wo), 2 * cos_i * cos_i - 1, 1e-4f);
+        } else {
+          // Snell: sin_t = sin_i / eta.
+          float eta = front ? 1.5f : 1.0f / 1.5f;
+          float sin_i = std::sqrt(1 - cos_i * cos_i);
+          EXPECT_NEAR(std::sqrt(s.wi.x * s.wi.x + s.wi.y * s.wi.y), sin_i / eta, 1e-4f);
+          EXPECT_LT(s.wi.z * wo.z, 0.0f);
+        }
+      }
+      double p = fresnel, sd = std::sqrt(n * p * (1 - p)) + 1e-9;
+      EXPECT_LT(std::abs(reflected - n * p) / sd, 4.0) << "front " << front << " cos " << cos_i;
+    }
+  }
+  // Total internal reflection from inside at grazing angles.
+  glm::vec3 wo(std::sin(1.2f), 0.0f, std::cos(1.2f));
+  Bsdf inside(glass, glm::vec3(0, 0, -1), glm::vec3(0, 0, -1), wo, false);
+  BsdfSample s;
+  ASSERT_TRUE(inside.sample(0.5f, glm::vec2(0.99f, 0.5f), &s));
+  EXPECT_FALSE(s.transmitted);
+}
+
+TEST(Bsdf, MaterialClassification) {
+  EXPECT_TRUE(material_is_perfect_specular(make_mirror()));
+  EXPECT_TRUE(material_is_perfect_mirror(make_mirror()));
+  EXPECT_TRUE(material_is_perfect_specular(make_glass()));
+  EXPECT_FALSE(material_is_perfect_mirror(make_glass()));
+  EXPECT_FALSE(material_is_perfect_specular(make_conductor(glm::vec3(1), 0.2f)));
+  EXPECT_FALSE(material_is_perfect_specular(make_diffuse(glm::vec3(0.5f))));
+}
+
+}  // namespace
+}  // namespace pxf

@@ -1,0 +1,272 @@
+// The integrator against analytic answers (furnaces, closed sphere, plane under a sky), the LV/HV
+// split against the unsplit estimator, determinism across thread counts, NaN dropping, and the
+// specular-chain queries of the range buffer.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+
+#include "pathtracer/bsdf.h"
+#include "pathtracer/integrator.h"
+#include "pathtracer/shapes.h"
+
+namespace pxf {
+namespace {
+
+Environment uniform_environment(float radiance) {
+  Environment env;
+  env.image.width = 8;
+  env.image.height = 4;
+  env.image.texels.assign(32, glm::vec4(radiance, radiance, radiance, 1.0f));
+  return env;
+}
+
+double image_mean(const std::vector<glm::vec3>& lv, const std::vector<glm::vec3>& hv) {
+  double sum = 0;
+  for (size_t i = 0; i < lv.size(); ++i) sum += luminance(lv[i] + hv[i]);
+  return sum / lv.size();
+}
+
+double render_mean(const Scene& scene, const TraceParams& params, int size, int frames, double* worst_pixel = nullptr,
+                   double expected = 0) {
+  ProgressiveRenderer renderer(scene, params, size, size);
+  for (int i = 0; i < frames; ++i) renderer.add_frame();
+  const Accumulation& acc = renderer.accumulation();
+  if (worst_pixel) {
+    *worst_pixel = 0;
+    for (size_t i = 0; i < acc.samples.size(); ++i)
+      *worst_pixel = std::max(*worst_pixel, std::abs(luminance(acc.lv_mean[i] + acc.hv_mean[i]) - expected));
+  }
+  return image_mean(acc.lv_mean, acc.hv_mean);
+}
+
+TraceParams furnace_params() {
+  TraceParams params;
+  params.max_vertices = 64;
+  params.rr_start_vertex = 3;
+  params.threads = 2;
+  return params;
+}
+
+Scene sphere_in_furnace(const Material& material) {
+  Scene scene;
+  scene.materials = {material};
+  scene.meshes.push_back(make_sphere(glm::vec3(0), 1.0f, 0, 64, 32));
+  scene.environment = uniform_environment(1.0f);
+  scene.camera = look_at_camera(glm::vec3(0, 0, 3.0f), glm::vec3(0), glm::vec3(0, 1, 0), 0.75f);  // sphere fills most
+  return scene;
+}
+
+TEST(Integrator, WhiteFurnaceDiffuseSphere) {
+  double worst;
+  double mean = render_mean(sphere_in_furnace(make_diffuse(glm::vec3(1.0f))), furnace_params(), 16, 512, &worst, 1.0);
+  EXPECT_NEAR(mean, 1.0, 0.01);
+  EXPECT_LT(worst, 0.05);
+  std::printf("mean %.5f worst %.4f\n", mean, worst);
+}
+
+TEST(Integrator, WhiteFurnaceRoughConductorSphere) {
+  // Single-scattering GGX loses a little energy at grazing angles; at roughness 0.2 it is < 1%.
+  double worst;
+  double mean = render_mean(sphere_in_furnace(make_conductor(glm::vec3(1.0f), 0.2f)), furnace_params(), 16, 256, &worst, 1.0);
+  EXPECT_NEAR(mean, 1.0, 0.01);
+  EXPECT_LT(worst, 0.05);
+  std::printf("mean %.5f worst %.4f\n", mean, worst);
+}
+
+TEST(Integrator, ClosedDiffuseSphereSumsBounces) {
+  const float rho = 0.5f, le = 1.0f;
+  Material m = make_diffuse(glm::vec3(rho));
+  m.emissive = glm::vec3(le);
+  Scene scene;
+  scene.materials = {m};
+  scene.meshes.push_back(make_sphere(glm::vec3(0), 2.0f, 0, 32, 16, /*inward=*/true));
+  scene.camera = look_at_camera(glm::vec3(0.3f, 0.1f, 0), glm::vec3(1, 0, 0), glm::vec3(0, 1, 0), 1.0f);
+  for (int vertices : {2, 3, 5}) {
+    TraceParams params;
+    params.max_vertices = vertices;
+    params.rr_start_vertex = 100;  // no roulette: exact truncation at the path-length limit
+    params.threads = 2;
+    double expected = 0;
+    for (int k = 0; k < vertices - 1; ++k) expected += le * std::pow(rho, k);
+    EXPECT_NEAR(render_mean(scene, params, 16, 32), expected, 0.01 * expected) << vertices << " vertices";
+  }
+}
+
+TEST(Integrator, DiffusePlaneUnderUniformSkyReadsAlbedo) {
+  Scene scene;
+  scene.materials = {make_diffuse(glm::vec3(0.6f))};
+  scene.meshes.push_back(make_quad(glm::vec3(-50, 0, 50), glm::vec3(100, 0, 0), glm::vec3(0, 0, -100), 0));
+  scene.environment = uniform_environment(1.0f);
+  scene.camera = look_at_camera(glm::vec3(0, 2, 0.01f), glm::vec3(0, 0, 0), glm::vec3(0, 0, -1), 0.8f);
+  double worst;
+  double mean = render_mean(scene, furnace_params(), 16, 256, &worst, 0.6);
+  EXPECT_NEAR(mean, 0.6, 0.006);
+  EXPECT_LT(worst, 0.05);
+  std::printf("mean %.5f worst %.4f\n", mean, worst);
+}
+
+// Per-pixel mean and variance of Y(LV + HV) from trace_pixel.
+struct PixelStats {
+  std::vector<double> sum, sum2;
+  int n = 0;
+};
+
+PixelStats sample_pixels(const PathTracer& tracer, const Camera& camera, int size, int spp, const TraceParams& params,
+                         double* lv_total) {
+  PixelStats s;
+  s.sum.assign(size * size, 0.0);
+  s.sum2.assign(size * size, 0.0);
+  s.n = spp;
+  *lv_total = 0;
+  for (int f = 0; f < spp; ++f)
+    for (int y = 0; y < size; ++y)
+      for (int x = 0; x < size; ++x) {
+        PathSample p = tracer.trace_pixel(camera, size, size, x, y, static_cast<uint32_t>(f), params);
+        double v = luminance(p.lv + p.hv);
+        s.sum[y * size + x] += v;
+        s.sum2[y * size + x] += v * v;
+        *lv_total += luminance(p.lv);
+      }
+  return s;
+}
+
+TEST(Integrator, LvPlusHvEqualsUnsplitEstimator) {
+  Scene scene = make_cornell_box(true);
+  PathTracer tracer(scene);
+  const int size = 20, spp = 384;
+  TraceParams split, unsplit;
+  split.seed = 1;
+  unsplit.seed = 2;
+  unsplit.all_hv = true;
+  double lv_split, lv_unsplit;
+  PixelStats a = sample_pixels(tracer, scene.camera, size, spp, split, &lv_split);
+  PixelStats b = sample_pixels(tracer, scene.camera, size, spp, unsplit, &lv_unsplit);
+  EXPECT_GT(lv_split, 0.0);
+  EXPECT_EQ(lv_unsplit, 0.0);
+  int outliers = 0;
+  double total_a = 0, total_b = 0;
+  for (int i = 0; i < size * size; ++i) {
+    double ma = a.sum[i] / spp, mb = b.sum[i] / spp;
+    double va = std::max(0.0, a.sum2[i] / spp - ma * ma) / (spp - 1);
+    double vb = std::max(0.0, b.sum2[i] / spp - mb * mb) / (spp - 1);
+    total_a += ma;
+    total_b += mb;
+    if (va + vb <= 0.0) {
+      EXPECT_NEAR(ma, mb, 1e-6) << "pixel " << i;
+      continue;
+    }
+    if (std::abs(ma - mb) / std::sqrt(va + vb) > 3.5) ++outliers;
+  }
+  // P(|Z| > 3.5) = 4.7e-4 for a normal Z; heavy-tailed pixels (caustics) get some slack.
+  EXPECT_LE(outliers, size * size / 100) << outliers << " pixels with |Z| > 3.5";
+  EXPECT_NEAR(total_a / total_b, 1.0, 0.02);
+}
+
+TEST(Integrator, DeterministicAcrossThreadCounts) {
+  Scene scene = make_cornell_box(true);
+  TraceParams params;
+  params.seed = 77;
+  params.threads = 1;
+  ProgressiveRenderer one(scene, params, 40, 30);
+  params.threads = 2;
+  ProgressiveRenderer two(scene, params, 40, 30);
+  for (int i = 0; i < 4; ++i) {
+    one.add_frame();
+    two.add_frame();
+  }
+  const Accumulation &a = one.accumulation(), &b = two.accumulation();
+  ASSERT_EQ(a.samples, b.samples);
+  EXPECT_EQ(std::memcmp(a.lv_mean.data(), b.lv_mean.data(), a.lv_mean.size() * sizeof(glm::vec3)), 0);
+  EXPECT_EQ(std::memcmp(a.hv_mean.data(), b.hv_mean.data(), a.hv_mean.size() * sizeof(glm::vec3)), 0);
+  EXPECT_EQ(std::memcmp(a.hv_lum_m2.data(), b.hv_lum_m2.data(), a.hv_lum_m2.size() * sizeof(double)), 0);
+  EXPECT_EQ(one.stats().rays, two.stats().rays);
+}
+
+TEST(Integrator, NonFiniteSamplesAreDroppedAndCounted) {
+  Scene scene;
+  scene.materials = {make_diffuse(glm::vec3(0.6f))};
+  scene.meshes.push_back(make_quad(glm::vec3(-50, 0, 50), glm::vec3(100, 0, 0), glm::vec3(0, 0, -100), 0));
+  scene.environment = uniform_environment(1.0f);
+  for (int i = 0; i < 8; ++i) scene.environment->image.texels[i] = glm::vec4(NAN, 1.0f, 1.0f, 1.0f);  // top row
+  scene.environment->image.texels[12] = glm::vec4(INFINITY);
+  scene.camera = look_at_camera(glm::vec3(0, 2, 0.01f), glm::vec3(0, 0, 0), glm::vec3(0, 0, -1), 0.8f);
+  TraceParams params;
+  params.threads = 2;
+  ProgressiveRenderer renderer(scene, params, 16, 16);
+  for (int i = 0; i < 16; ++i) renderer.add_frame();
+  EXPECT_GT(renderer.stats().nan_samples_dropped, 0u);
+  const Accumulation& acc = renderer.accumulation();
+  uint64_t accepted = 0;
+  for (size_t i = 0; i < acc.samples.size(); ++i) {
+    accepted += acc.samples[i];
+    ASSERT_TRUE(is_finite(acc.lv_mean[i]) && is_finite(acc.hv_mean[i])) << i;
+    ASSERT_TRUE(std::isfinite(acc.hv_lum_m2[i]) && std::isfinite(acc.hv_lum_mean[i])) << i;
+  }
+  EXPECT_EQ(accepted + renderer.stats().nan_samples_dropped, renderer.stats().paths);
+  EXPECT_EQ(count_nonfinite(renderer.lv_image()) + count_nonfinite(renderer.hv_image()) +
+                count_nonfinite(renderer.variance_image()),
+            0u);
+}
+
+TEST(Integrator, DarkSceneRendersBlackWithoutTracing) {
+  Scene scene = make_cornell_box(false);
+  scene.materials[3].emissive = glm::vec3(0.0f);
+  TraceParams params;
+  ProgressiveRenderer renderer(scene, params, 8, 8);
+  EXPECT_TRUE(renderer.scene_is_dark());
+  renderer.add_frame();
+  renderer.add_frame();
+  EXPECT_EQ(renderer.frames(), 2);
+  EXPECT_EQ(renderer.stats().rays, 0u);
+  for (float v : renderer.hv_image().pixels) EXPECT_EQ(v, 0.0f);
+  EXPECT_EQ(renderer.variance_of_mean()[0], 0.0f);
+}
+
+TEST(Integrator, SpecularChainsReachTheFirstDiffuseSurface) {
+  Scene scene = make_cornell_box(true);
+  TraceParams params;
+  const int size = 64;
+  ProgressiveRenderer renderer(scene, params, size, size);
+  EXPECT_TRUE(renderer.scene_has_perfect_specular());
+  ProgressiveRenderer plain(make_cornell_box(false), params, size, size);
+  EXPECT_FALSE(plain.scene_has_perfect_specular());
+
+  // Find pixels whose camera ray hits the mirror / glass sphere and one that hits the back wall.
+  PathTracer tracer(scene);
+  std::vector<uint32_t> pixels;
+  std::vector<float> first_t;
+  std::vector<int> kind;  // 0 diffuse, 4 mirror, 5 glass (material index)
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x) {
+      Ray ray = camera_ray(scene.camera, size, size, x + 0.5f, y + 0.5f);
+      Hit hit = tracer.geometry().intersect(ray);
+      if (!hit.valid()) continue;
+      pixels.push_back(static_cast<uint32_t>(y * size + x));
+      first_t.push_back(hit.t);
+      kind.push_back(scene.meshes[hit.mesh].material);
+    }
+  std::vector<SpecularChainHit> hits = renderer.trace_specular_chains(pixels, glm::vec2(0.5f));
+  ASSERT_EQ(hits.size(), pixels.size());
+  int mirror = 0, glass = 0;
+  for (size_t i = 0; i < hits.size(); ++i) {
+    if (kind[i] == 4 || kind[i] == 5) {
+      (kind[i] == 4 ? mirror : glass)++;
+      if (hits[i].hit) EXPECT_GT(hits[i].distance, first_t[i] + 1e-3f);
+    } else if (kind[i] != 3) {  // a diffuse surface (the light is black)
+      ASSERT_TRUE(hits[i].hit);
+      EXPECT_NEAR(hits[i].distance, first_t[i], 1e-4f);
+      EXPECT_GT(max_component(hits[i].range_color), 0.0f);
+    }
+  }
+  EXPECT_GT(mirror, 10);
+  EXPECT_GT(glass, 10);
+  // The back wall's center faces the camera: albedo x (0.2 + 0.8 cos) with cos ~ 1.
+  std::vector<SpecularChainHit> center = renderer.trace_specular_chains({static_cast<uint32_t>((size / 2 - 4) * size + size / 2)}, glm::vec2(0.5f));
+  ASSERT_TRUE(center[0].hit);
+  EXPECT_NEAR(center[0].range_color.x, 0.73f, 0.02f);
+}
+
+}  // namespace
+}  // namespace pxf

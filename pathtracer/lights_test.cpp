@@ -1,0 +1,162 @@
+// Light sampling: emissive triangles (power-weighted choice, uniform on area) and the environment
+// (luminance x sin(theta)) against their pdfs by chi-square; punctual light falloffs.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "pathtracer/lights.h"
+#include "pathtracer/rng.h"
+#include "pathtracer/shapes.h"
+#include "pathtracer/stat_tests.h"
+
+namespace pxf {
+namespace {
+
+constexpr double kAlpha = 0.01 / 2;  // Bonferroni over the two distributions tested here
+
+Scene three_emitters() {
+  Scene scene;
+  scene.materials = {make_diffuse(glm::vec3(0.5f)), make_emitter(glm::vec3(1.0f, 2.0f, 3.0f)),
+                     make_emitter(glm::vec3(10.0f)), make_emitter(glm::vec3(0.5f, 0.1f, 0.1f))};
+  scene.meshes.push_back(make_quad(glm::vec3(-5, 0, -5), glm::vec3(10, 0, 0), glm::vec3(0, 0, 10), 0));  // not a light
+  scene.meshes.push_back(make_quad(glm::vec3(0, 2, 0), glm::vec3(1, 0, 0), glm::vec3(0, 0, 1), 1));
+  scene.meshes.push_back(make_quad(glm::vec3(2, 3, 0), glm::vec3(0.2f, 0, 0), glm::vec3(0, 0.1f, 0.3f), 2));
+  scene.meshes.push_back(make_box(glm::vec3(-2, 1, -2), glm::vec3(-1, 1.5f, -1.7f), 3));
+  return scene;
+}
+
+// Which of the 4 midpoint-subdivision sub-triangles (equal areas) barycentrics (b1, b2) fall in.
+int sub_triangle(glm::vec2 b) {
+  float b0 = 1.0f - b.x - b.y;
+  if (b0 > 0.5f) return 0;
+  if (b.x > 0.5f) return 1;
+  if (b.y > 0.5f) return 2;
+  return 3;
+}
+
+TEST(Lights, EmissiveTriangleSamplingIsPowerWeightedAndUniform) {
+  Scene scene = three_emitters();
+  LightSampler lights(scene);
+  ASSERT_FALSE(lights.empty());
+  const size_t count = lights.emissive_triangle_count();
+  ASSERT_EQ(count, 2u + 2u + 12u);
+  double total_power = 0;
+  for (size_t i = 0; i < count; ++i) total_power += lights.triangle(i).area * luminance(lights.triangle(i).material->emissive);
+  for (size_t i = 0; i < count; ++i) {
+    double power = lights.triangle(i).area * luminance(lights.triangle(i).material->emissive);
+    EXPECT_NEAR(lights.triangle_selection_pmf(i), power / total_power, 1e-6);
+  }
+  const int n = 200000;
+  std::vector<double> observed(count * 4, 0.0), expected(count * 4, 0.0);
+  for (size_t i = 0; i < count; ++i)
+    for (int s = 0; s < 4; ++s) expected[i * 4 + s] = n * lights.triangle_selection_pmf(i) / 4.0;
+  Rng rng(9, 0, 0);
+  int pdf_mismatches = 0;
+  for (int k = 0; k < n; ++k) {
+    float u_select = rng.next_float();
+    glm::vec2 u = rng.next_2d();
+    glm::vec3 point;
+    glm::vec2 b;
+    float area_pdf;
+    size_t i = lights.sample_triangle_point(u_select, u, &point, &b, &area_pdf);
+    observed[i * 4 + sub_triangle(b)] += 1.0;
+    // The full light sample's solid-angle pdf equals pdf_triangle() for the same point.
+    LightSample ls;
+    glm::vec3 from(0.3f, 0.01f, 0.2f);
+    if (k % 50 == 0 && lights.sample(from, u_select, u, &ls)) {
+      const auto& tri = lights.triangle(i);
+      float pdf = lights.pdf_triangle(tri.mesh, tri.prim, from, ls.point, tri.normal);
+      if (std::abs(pdf - ls.pdf) > 1e-3f * pdf) ++pdf_mismatches;
+    }
+  }
+  EXPECT_EQ(pdf_mismatches, 0);
+  stat::ChiSquareResult r = stat::chi_square(observed, expected);
+  EXPECT_TRUE(r.problem.empty()) << r.problem;
+  EXPECT_GT(r.p_value, kAlpha) << "chi2 " << r.statistic << " dof " << r.dof;
+}
+
+Scene random_environment(int width, int height, uint64_t seed) {
+  Scene scene;
+  scene.materials = {make_diffuse(glm::vec3(0.5f))};
+  Environment env;
+  env.image.width = width;
+  env.image.height = height;
+  env.image.nearest = true;
+  env.image.wrap_t = Wrap::ClampToEdge;
+  Rng rng(seed, 0, 0);
+  for (int i = 0; i < width * height; ++i) {
+    float v = rng.next_float();
+    v = v < 0.2f ? 0.0f : v * v * 10.0f;  // some black texels, a wide dynamic range
+    env.image.texels.push_back(glm::vec4(v, 0.5f * v, 2.0f * v, 1.0f));
+  }
+  scene.environment = env;
+  return scene;
+}
+
+TEST(Lights, EnvironmentSamplingMatchesItsPdf) {
+  Scene scene = random_environment(16, 8, 21);
+  LightSampler lights(scene);
+  ASSERT_TRUE(lights.has_environment());
+  // Bins finer than the texels, in (u, v); expected counts integrate pdf(direction) over each bin.
+  const int bu = 48, bv = 24, sub = 6, n = 300000;
+  std::vector<double> observed(bu * bv, 0.0), expected(bu * bv, 0.0);
+  for (int y = 0; y < bv * sub; ++y) {
+    for (int x = 0; x < bu * sub; ++x) {
+      glm::vec2 uv((x + 0.5f) / (bu * sub), (y + 0.5f) / (bv * sub));
+      glm::vec3 d = equirect_direction(uv);
+      double jacobian = 2.0 * M_PI * M_PI * std::sin(M_PI * uv.y);  // dω = 2 pi^2 sin(theta) du dv
+      expected[(y / sub) * bu + x / sub] +=
+          n * lights.environment_direction_pdf(d) * jacobian / (double(bu * sub) * double(bv * sub));
+    }
+  }
+  Rng rng(4, 0, 0);
+  int pdf_mismatches = 0;
+  for (int k = 0; k < n; ++k) {
+    float pdf;
+    glm::vec3 d = lights.sample_environment_direction(rng.next_2d(), &pdf);
+    glm::vec2 uv = equirect_uv(d);
+    int x = std::min(bu - 1, static_cast<int>(uv.x * bu)), y = std::min(bv - 1, static_cast<int>(uv.y * bv));
+    observed[y * bu + x] += 1.0;
+    float again = lights.environment_direction_pdf(d);
+    if (std::abs(again - pdf) > 2e-3f * pdf) ++pdf_mismatches;
+  }
+  EXPECT_LE(pdf_mismatches, n / 10000);  // texel-boundary round-off only
+  stat::ChiSquareResult r = stat::chi_square(observed, expected);
+  EXPECT_TRUE(r.problem.empty()) << r.problem;
+  EXPECT_GT(r.p_value, kAlpha) << "chi2 " << r.statistic << " dof " << r.dof;
+}
+
+TEST(Lights, EquirectRoundTrip) {
+  for (glm::vec3 d : {glm::vec3(0, 0, -1), glm::vec3(1, 0, 0), glm::normalize(glm::vec3(0.3f, 0.8f, 0.5f))}) {
+    glm::vec3 back = equirect_direction(equirect_uv(d));
+    EXPECT_NEAR(glm::length(back - d), 0.0f, 1e-5f);
+  }
+  EXPECT_NEAR(equirect_uv(glm::vec3(0, 0, -1)).x, 0.5f, 1e-6f);  // -z is the image center
+  EXPECT_NEAR(equirect_uv(glm::vec3(0, 1, 0)).y, 0.0f, 1e-6f);   // up is the top row
+}
+
+TEST(Lights, PunctualFalloffs) {
+  Scene scene;
+  PunctualLight spot;
+  spot.type = PunctualLight::Type::Spot;
+  spot.position = glm::vec3(0, 2, 0);
+  spot.direction = glm::vec3(0, -1, 0);
+  spot.intensity = 8.0f;
+  spot.inner_cone = 0.2f;
+  spot.outer_cone = 0.4f;
+  scene.lights.push_back(spot);
+  LightSampler lights(scene);
+  LightSample ls;
+  ASSERT_TRUE(lights.sample(glm::vec3(0, 0, 0), 0.5f, glm::vec2(0.5f), &ls));
+  EXPECT_TRUE(ls.delta);
+  EXPECT_NEAR(ls.radiance.x, 8.0f / 4.0f, 1e-5f);  // inside the inner cone: I / d^2
+  EXPECT_NEAR(ls.distance, 2.0f, 1e-6f);
+  float inside_outer = std::tan(0.3f) * 2.0f;    // between the cones: partial
+  EXPECT_TRUE(lights.sample(glm::vec3(inside_outer, 0, 0), 0.5f, glm::vec2(0.5f), &ls));
+  EXPECT_GT(ls.radiance.x, 0.0f);
+  EXPECT_LT(ls.radiance.x, 8.0f / (4.0f + inside_outer * inside_outer));
+  EXPECT_FALSE(lights.sample(glm::vec3(std::tan(0.5f) * 2.0f, 0, 0), 0.5f, glm::vec2(0.5f), &ls));  // outside
+}
+
+}  // namespace
+}  // namespace pxf
