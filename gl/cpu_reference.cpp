@@ -54,13 +54,18 @@ BlendDecision blend_decision(float u, float f, float t) {
   u = std::max(u, 0.0f);
   f = std::max(f, 0.0f);
   if (u <= t) return {1.0f, kCaseUnfiltered};
-  float m = std::max(u, f);  // > t >= 0
-  float uh = std::isinf(m) ? (std::isinf(u) ? 1.0f : 0.0f) : u / m;
-  float fh = std::isinf(m) ? (std::isinf(f) ? 1.0f : 0.0f) : f / m;
-  float th = t / m;
-  float d = th * (uh + fh) - uh * fh;  // D / m^2
-  if (d < 0.0f) return {0.0f, kCaseFilteredOnly};
-  float s = (fh + std::sqrt(d)) / (uh + fh);  // denominator >= 1: one of uh, fh is 1
+  // D = t u + t f - u f < 0  <=>  t < H = u f / (u + f) = lo / (1 + lo / hi): no product of two
+  // large or two small numbers, so nothing overflows or underflows into a wrong case.
+  const float hi = std::max(u, f), lo = std::min(u, f);  // hi > t >= 0
+  const float r = std::isinf(hi) ? (std::isinf(lo) ? 1.0f : 0.0f) : lo / hi;
+  const float harmonic = std::isinf(lo) ? kInf : lo / (1.0f + r);
+  if (t < harmonic) return {0.0f, kCaseFilteredOnly};
+  // s = (f + sqrt(D)) / (u + f) = f / (u + f) + sqrt((t - H) / (u + f)). The first term is the
+  // minimizer of g (g = H <= t there), so an underflowing second term stays under t.
+  const float uh = std::isinf(hi) ? (std::isinf(u) ? 1.0f : 0.0f) : u / hi;
+  const float fh = std::isinf(hi) ? (std::isinf(f) ? 1.0f : 0.0f) : f / hi;
+  const float q = std::isinf(hi) ? 0.0f : ((t - harmonic) / hi) / (1.0f + r);
+  const float s = fh / (uh + fh) + std::sqrt(q);  // uh + fh >= 1
   return {std::clamp(s, 0.0f, 1.0f), kCaseMixed};
 }
 

@@ -20,7 +20,9 @@ float relative_variance(float var, float lb) {
   return (var / lb) / lb;
 }
 
-// SPEC 3.4, computed after scaling by max(u, f): case 2 (u <= t) first, case 1 (D < 0), case 3.
+// SPEC 3.4: case 2 (u <= t) first, case 1 (D < 0), else case 3. Same algorithm as
+// blend_decision() in gl/cpu_reference.cpp: D < 0 <=> t < H = u f / (u + f) = lo / (1 + lo / hi),
+// s = f / (u + f) + sqrt((t - H) / (u + f)), all without overflow or harmful underflow.
 float blend_factor(float u, float f, float t, out int blend_case) {
   if (!(t >= 0.0)) t = 0.0;
   if (isnan(u)) u = kInf;
@@ -28,12 +30,13 @@ float blend_factor(float u, float f, float t, out int blend_case) {
   u = max(u, 0.0);
   f = max(f, 0.0);
   if (u <= t) { blend_case = 2; return 1.0; }
-  float m = max(u, f);
-  float uh = isinf(m) ? (isinf(u) ? 1.0 : 0.0) : u / m;
-  float fh = isinf(m) ? (isinf(f) ? 1.0 : 0.0) : f / m;
-  float th = t / m;
-  float d = th * (uh + fh) - uh * fh;
-  if (d < 0.0) { blend_case = 1; return 0.0; }
+  float hi = max(u, f), lo = min(u, f);
+  float r = isinf(hi) ? (isinf(lo) ? 1.0 : 0.0) : lo / hi;
+  float harmonic = isinf(lo) ? kInf : lo / (1.0 + r);
+  if (t < harmonic) { blend_case = 1; return 0.0; }
+  float uh = isinf(hi) ? (isinf(u) ? 1.0 : 0.0) : u / hi;
+  float fh = isinf(hi) ? (isinf(f) ? 1.0 : 0.0) : f / hi;
+  float q = isinf(hi) ? 0.0 : ((t - harmonic) / hi) / (1.0 + r);
   blend_case = 3;
-  return clamp((fh + sqrt(d)) / (uh + fh), 0.0, 1.0);
+  return clamp(fh / (uh + fh) + sqrt(q), 0.0, 1.0);
 }

@@ -1,0 +1,143 @@
+// The blend factor s (SPEC 3.4) at every case boundary and at extreme magnitudes, for the CPU
+// definition (blend_decision) and for the shader (blend.frag through BlendPass).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include "gl/blend_pass.h"
+#include "gl/cpu_reference.h"
+#include "gl/inputs.h"
+#include "gl/test_util.h"
+
+namespace pxf {
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+
+// g(s) <= t whenever case 3 applies (tiny relative slack for float rounding).
+void check_decision(float u, float f, float t, BlendDecision d) {
+  SCOPED_TRACE(testing::Message() << "u=" << u << " f=" << f << " t=" << t);
+  ASSERT_TRUE(std::isfinite(d.s));
+  ASSERT_GE(d.s, 0.0f);
+  ASSERT_LE(d.s, 1.0f);
+  if (d.blend_case == kCaseMixed) {
+    double s = d.s, g = s * s * double(u) + (1 - s) * (1 - s) * double(f);
+    EXPECT_LE(g, double(t) * (1 + 1e-4) + 1e-30);
+  }
+  if (d.blend_case == kCaseUnfiltered) {
+    EXPECT_EQ(d.s, 1.0f);
+  }
+  if (d.blend_case == kCaseFilteredOnly) {
+    EXPECT_EQ(d.s, 0.0f);
+  }
+}
+
+const std::vector<float>& magnitudes() {
+  static const std::vector<float> v = {0.0f, 1e-30f, 1e-20f, 1e-10f, 1e-5f, 1e-3f, 0.01f, 0.05f, 0.1f,
+                                       0.2f, 0.25f, 0.5f, 1.0f, 2.0f, 10.0f, 1e5f, 1e10f, 1e20f, 1e30f};
+  return v;
+}
+const std::vector<float>& thresholds() {
+  static const std::vector<float> v = {0.0f, 1e-30f, 1e-3f, 0.01f, 0.2f, 0.25f, 1.0f, 1e30f};
+  return v;
+}
+
+TEST(BlendFactorCpu, SpecCases) {
+  EXPECT_EQ(blend_decision(0, 0, 0.01f).blend_case, kCaseUnfiltered);  // u = f = 0: case 2
+  EXPECT_EQ(blend_factor(0, 0, 0.0f), 1.0f);                          // ... even with t = 0
+  EXPECT_EQ(blend_factor(0.5f, 0.0f, 0.0f), 0.0f);                    // t = 0, u > 0: s = 0
+  EXPECT_EQ(blend_factor(0.5f, 0.3f, 0.0f), 0.0f);
+  EXPECT_EQ(blend_decision(0.01f, 0.5f, 0.01f).s, 1.0f);              // u = t: case 2 first
+  EXPECT_EQ(blend_decision(0.01f, 0.5f, 0.01f).blend_case, kCaseUnfiltered);
+  // D = t u + t f - u f = 0 at t = 0.25, u = f = 0.5: case 3 with s = f / (u + f).
+  BlendDecision d = blend_decision(0.5f, 0.5f, 0.25f);
+  EXPECT_EQ(d.blend_case, kCaseMixed);
+  EXPECT_FLOAT_EQ(d.s, 0.5f);
+  // Just past D = 0: case 1.
+  EXPECT_EQ(blend_decision(0.5f, 0.5001f, 0.25f).blend_case, kCaseFilteredOnly);
+  // f = 0 and u > t: s = sqrt(t / u).
+  EXPECT_NEAR(blend_factor(0.04f, 0.0f, 0.01f), 0.5f, 1e-6f);
+  // L_b = 0: relative variances are infinite (or 0 without noise).
+  EXPECT_EQ(relative_variance(1.0f, 0.0f), kInf);
+  EXPECT_EQ(relative_variance(0.0f, 0.0f), 0.0f);
+  EXPECT_EQ(relative_variance(1e30f, 1e-30f), kInf);
+  EXPECT_EQ(blend_factor(kInf, kInf, 0.01f), 0.0f);
+  EXPECT_EQ(blend_factor(kInf, 0.0f, 0.01f), 0.0f);
+  EXPECT_EQ(blend_factor(0.0f, kInf, 0.01f), 1.0f);
+  // Non-finite inputs stay finite.
+  for (float x : {kNaN, kInf, -kInf, -1.0f})
+    for (float y : {kNaN, kInf, 0.0f, 0.5f})
+      for (float t : {kNaN, -1.0f, 0.0f, 0.01f, kInf}) {
+        float s = blend_factor(x, y, t);
+        EXPECT_TRUE(s >= 0.0f && s <= 1.0f) << x << " " << y << " " << t;
+      }
+}
+
+TEST(BlendFactorCpu, GridAndRandomExtremes) {
+  for (float t : thresholds())
+    for (float u : magnitudes())
+      for (float f : magnitudes()) check_decision(u, f, t, blend_decision(u, f, t));
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<float> e(-30.0f, 30.0f);
+  for (int i = 0; i < 200000; ++i) {
+    float u = std::pow(10.0f, e(rng)), f = std::pow(10.0f, e(rng)), t = std::pow(10.0f, e(rng) / 10.0f - 1.0f);
+    check_decision(u, f, t, blend_decision(u, f, t));
+  }
+}
+
+// s from the shader for (u, f) pairs: L_lv = 0, L_f = (1,1,1) so L_b = 1, Var[L_u] = u, Var[L_f] = f.
+TEST(BlendFactorShader, MatchesCpuOnGridAndBoundaries) {
+  test::osmesa_context();
+  const auto& mags = magnitudes();
+  const int w = static_cast<int>(mags.size()), h = w + 1;
+  Image lv = Image::rgb(w, h), hv = Image::rgb(w, h, 1.0f), var = Image::gray(w, h);
+  Image filtered = Image::rgba(w, h, 1.0f);
+  for (int y = 0; y < w; ++y)
+    for (int x = 0; x < w; ++x) {
+      var.at(x, y, 0) = mags[y];
+      filtered.at(x, y, 3) = mags[x];
+    }
+  // Last row: D = 0 (t = 0.25), n < 2, L_b = 0 with noise, L_b = 0 without noise, tiny L_b.
+  const int r = w;
+  var.at(0, r, 0) = 0.5f, filtered.at(0, r, 3) = 0.5f;
+  var.at(1, r, 0) = kVarUnknown;
+  var.at(2, r, 0) = 0.3f;
+  for (int c = 0; c < 3; ++c) filtered.at(2, r, c) = 0.0f;
+  var.at(3, r, 0) = 0.0f, filtered.at(3, r, 3) = 0.0f;
+  for (int c = 0; c < 3; ++c) filtered.at(3, r, c) = 0.0f;
+  var.at(4, r, 0) = 1e30f, filtered.at(4, r, 3) = 1e-30f;
+  for (int c = 0; c < 3; ++c) filtered.at(4, r, c) = 1e-30f;
+  PreviewInputs inputs(w, h);
+  inputs.upload(lv, hv, var);
+  Texture2D ftex(w, h, TextureFormat::RGBA32F);
+  ftex.upload(filtered);
+  BlendPass blend(w, h);
+  for (float t : thresholds()) {
+    blend.run(inputs, &ftex, {t});
+    Image s = blend.s_image(), cases = blend.case_image(), final_rgb = blend.final_image();
+    EXPECT_EQ(count_nonfinite(final_rgb), 0u);
+    for (int y = 0; y < w; ++y)
+      for (int x = 0; x < w; ++x) {
+        float u = mags[y], f = mags[x];
+        BlendDecision ref = blend_decision(u, f, t);
+        BlendDecision gpu{s.at(x, y, 0), static_cast<int>(cases.at(x, y, 0))};
+        check_decision(u, f, t, gpu);
+        EXPECT_EQ(gpu.blend_case, ref.blend_case) << "u=" << u << " f=" << f << " t=" << t;
+        EXPECT_NEAR(gpu.s, ref.s, 1e-5f + 1e-4f * ref.s) << "u=" << u << " f=" << f << " t=" << t;
+      }
+    if (t == 0.25f) {
+      EXPECT_EQ(cases.at(0, r, 0), float(kCaseMixed));
+      EXPECT_NEAR(s.at(0, r, 0), 0.5f, 1e-6f);
+    }
+    EXPECT_EQ(cases.at(1, r, 0), float(kCaseUnknownVar));  // n < 2: s = 0
+    EXPECT_EQ(s.at(1, r, 0), 0.0f);
+    EXPECT_EQ(s.at(2, r, 0), 0.0f);                        // L_b = 0 with noise: filtered only
+    EXPECT_EQ(s.at(3, r, 0), 1.0f);                        // L_b = 0, no noise: case 2
+    for (float v : s.pixels) EXPECT_TRUE(v >= 0.0f && v <= 1.0f);
+  }
+}
+
+}  // namespace
+}  // namespace pxf

@@ -1,0 +1,245 @@
+// Filter, blend and tone-map shaders against the CPU reference (gl/cpu_reference.h) on small
+// random images with edges in range color and depth.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include "gl/blend_pass.h"
+#include "gl/cpu_reference.h"
+#include "gl/filter_pass.h"
+#include "gl/inputs.h"
+#include "gl/test_util.h"
+#include "gl/tonemap_pass.h"
+
+namespace pxf {
+namespace {
+
+constexpr int W = 37, H = 29;
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+struct Scenario {
+  Image lv = Image::rgb(W, H), hv = Image::rgb(W, H), var = Image::gray(W, H);
+  Image range = Image::rgb(W, H), depth = Image::gray(W, H);
+};
+
+// Two range-color regions split by a diagonal, two depth regions split horizontally, noisy HV
+// with known and unknown (n < 2) variance, a few L_b = 0 pixels.
+Scenario make_scenario(unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u01(0.0f, 1.0f);
+  Scenario s;
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      bool left = x + y / 2 < W / 2, top = y < H / 2;
+      float base[3] = {left ? 0.5f : 0.1f, left ? 0.2f : 0.4f, left ? 0.1f : 0.6f};
+      for (int c = 0; c < 3; ++c) {
+        s.range.at(x, y, c) = base[c] + 0.02f * u01(rng);
+        s.hv.at(x, y, c) = (top ? 2.0f : 0.5f) * base[c] * (0.2f + 1.6f * u01(rng));
+        s.lv.at(x, y, c) = 0.3f * u01(rng);
+      }
+      s.depth.at(x, y, 0) = (top ? 2.0f : 5.0f) + 0.3f * u01(rng);
+      float r = u01(rng);
+      s.var.at(x, y, 0) = r < 0.05f ? kVarUnknown : 0.002f * std::pow(10.0f, 3.0f * u01(rng));
+      if (r > 0.97f)  // black pixel: L_b = 0 unless the filter brings light
+        for (int c = 0; c < 3; ++c) s.hv.at(x, y, c) = s.lv.at(x, y, c) = 0.0f;
+    }
+  return s;
+}
+
+Image guide_image(const Scenario& s) {
+  Image g = Image::rgba(W, H);
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      for (int c = 0; c < 3; ++c) g.at(x, y, c) = s.range.at(x, y, c);
+      g.at(x, y, 3) = s.depth.at(x, y, 0);
+    }
+  return g;
+}
+
+void expect_close(const Image& gpu, const Image& cpu, float rel, float abs, const char* what) {
+  ASSERT_EQ(gpu.pixels.size(), cpu.pixels.size());
+  size_t bad = 0;
+  for (size_t i = 0; i < gpu.pixels.size(); ++i) {
+    float a = gpu.pixels[i], b = cpu.pixels[i];
+    ASSERT_TRUE(std::isfinite(a)) << what << " sample " << i;
+    if (std::abs(a - b) > rel * std::max(std::abs(a), std::abs(b)) + abs && bad++ < 5) {
+      ADD_FAILURE() << what << " sample " << i << ": gpu " << a << " cpu " << b;
+    }
+  }
+  EXPECT_EQ(bad, 0u) << what;
+}
+
+struct GpuFixture {
+  PreviewInputs inputs{W, H};
+  Texture2D guide{W, H, TextureFormat::RGBA32F};
+  explicit GpuFixture(const Scenario& s) {
+    inputs.upload(s.lv, s.hv, s.var);
+    guide.upload(guide_image(s));
+  }
+};
+
+class FilterVsCpu : public ::testing::TestWithParam<std::tuple<FilterKind, bool, float>> {};
+
+TEST_P(FilterVsCpu, MatchesReference) {
+  test::osmesa_context();
+  auto [kind, skip, sigma_s] = GetParam();
+  Scenario s = make_scenario(7);
+  GpuFixture gpu(s);
+  FilterParams p;
+  p.kind = kind;
+  p.skip_case2 = skip;
+  p.sigma_s = sigma_s;
+  p.t = 0.05f;
+  FilterPass filter(W, H);
+  filter.run(gpu.inputs, gpu.guide, p);
+  FilterOutput ref = cpu_filter(s.hv, s.var, s.lv, s.range, s.depth, p);
+  expect_close(filter.filtered_image(), ref.filtered, 1e-4f, 1e-7f, "L_f");
+  expect_close(filter.raw_variance_image(), ref.variance, 1e-4f, 1e-12f, "Var[L_f]");
+  size_t skipped = 0;
+  for (float v : ref.variance.pixels) skipped += v == kVarSkipped;
+  if (skip) {
+    EXPECT_GT(skipped, 0u);
+  }
+  EXPECT_EQ(filter.filtered_pixels(), W * H - skipped);
+}
+
+INSTANTIATE_TEST_SUITE_P(Variants, FilterVsCpu,
+                         ::testing::Values(std::make_tuple(FilterKind::BilateralDepth, false, 8.0f),
+                                           std::make_tuple(FilterKind::BilateralDepth, true, 8.0f),
+                                           std::make_tuple(FilterKind::Bilateral, false, 8.0f),
+                                           std::make_tuple(FilterKind::Bilateral, true, 2.5f),
+                                           std::make_tuple(FilterKind::BilateralDepth, false, 0.0f)));
+
+TEST(FilterVsCpu, EdgesArePreserved) {
+  // A step in range color with constant HV on each side: the filter must not mix the sides.
+  test::osmesa_context();
+  Scenario s = make_scenario(3);
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      bool left = x < W / 2;
+      for (int c = 0; c < 3; ++c) {
+        s.range.at(x, y, c) = left ? 0.8f : 0.1f;
+        s.hv.at(x, y, c) = left ? 1.0f : 3.0f;
+      }
+      s.depth.at(x, y, 0) = 3.0f;
+      s.var.at(x, y, 0) = 0.5f;
+    }
+  GpuFixture gpu(s);
+  FilterPass filter(W, H);
+  FilterParams p;
+  p.skip_case2 = false;
+  filter.run(gpu.inputs, gpu.guide, p);
+  Image f = filter.filtered_image();
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) EXPECT_NEAR(f.at(x, y, 0), x < W / 2 ? 1.0f : 3.0f, 1e-5f);
+}
+
+TEST(BlendVsCpu, MatchesReferenceWithFilteredInput) {
+  test::osmesa_context();
+  Scenario s = make_scenario(11);
+  // Non-finite and extreme inputs must come out finite.
+  s.hv.at(1, 1, 0) = kNaN;
+  s.hv.at(2, 1, 1) = kInf;
+  s.lv.at(3, 1, 2) = -kInf;
+  s.var.at(4, 1, 0) = kNaN;
+  s.var.at(5, 1, 0) = 1e30f;
+  s.var.at(6, 1, 0) = 1e-30f;
+  s.hv.at(7, 1, 0) = 1e30f;
+  GpuFixture gpu(s);
+  for (bool skip : {false, true}) {
+    FilterParams fp;
+    fp.skip_case2 = skip;
+    fp.t = 0.02f;
+    FilterOutput ref_f = cpu_filter(s.hv, s.var, s.lv, s.range, s.depth, fp);
+    Image packed = Image::rgba(W, H);
+    for (size_t i = 0; i < packed.pixel_count(); ++i) {
+      for (int c = 0; c < 3; ++c) packed.pixels[4 * i + c] = ref_f.filtered.pixels[3 * i + c];
+      packed.pixels[4 * i + 3] = ref_f.variance.pixels[i];
+    }
+    Texture2D filtered(W, H, TextureFormat::RGBA32F);
+    filtered.upload(packed);
+    for (float t : {0.0f, 0.001f, 0.02f, 0.2f}) {
+      BlendPass blend(W, H);
+      blend.run(gpu.inputs, &filtered, {t});
+      BlendOutput ref = cpu_blend(s.lv, s.hv, s.var, &ref_f, {t});
+      expect_close(blend.final_image(), ref.final_rgb, 1e-4f, 1e-6f, "final");
+      expect_close(blend.s_image(), ref.s, 1e-4f, 1e-5f, "s");
+      expect_close(blend.case_image(), ref.blend_case, 0.0f, 0.0f, "case");
+      auto counts = blend.case_counts();
+      uint32_t total = 0;
+      for (int c = 0; c < kBlendCaseCount; ++c) {
+        uint32_t expected = 0;
+        for (float v : ref.blend_case.pixels) expected += static_cast<int>(v) == c;
+        EXPECT_EQ(counts[c], expected) << "case " << c;
+        total += counts[c];
+      }
+      EXPECT_EQ(total, uint32_t(W * H));
+    }
+  }
+}
+
+TEST(BlendVsCpu, NoFilteredValueMeansUnfiltered) {
+  test::osmesa_context();
+  Scenario s = make_scenario(5);
+  GpuFixture gpu(s);
+  BlendPass blend(W, H);
+  blend.run(gpu.inputs, static_cast<const FilterPass*>(nullptr), {0.01f});
+  BlendOutput ref = cpu_blend(s.lv, s.hv, s.var, nullptr, {0.01f});
+  expect_close(blend.final_image(), ref.final_rgb, 1e-5f, 1e-7f, "final");
+  EXPECT_EQ(blend.case_counts()[kCaseNoFiltered], uint32_t(W * H));
+}
+
+TEST(FullChain, FilterBlendTonemapOnGpuMatchesCpu) {
+  test::osmesa_context();
+  Scenario s = make_scenario(21);
+  GpuFixture gpu(s);
+  FilterParams fp;
+  fp.t = 0.01f;
+  FilterPass filter(W, H);
+  BlendPass blend(W, H);
+  TonemapPass tonemap(W, H);
+  filter.run(gpu.inputs, gpu.guide, fp);
+  blend.run(gpu.inputs, &filter, {fp.t});
+  tonemap.run(blend.output(), {});
+  FilterOutput rf = cpu_filter(s.hv, s.var, s.lv, s.range, s.depth, fp);
+  BlendOutput rb = cpu_blend(s.lv, s.hv, s.var, &rf, {fp.t});
+  expect_close(blend.final_image(), rb.final_rgb, 2e-4f, 1e-6f, "final");
+  expect_close(tonemap.display_image(), cpu_tonemap(rb.final_rgb, {}), 2e-4f, 2e-5f, "display");
+  for (const Image& im : {filter.filtered_image(), filter.variance_image(), blend.final_image(), blend.s_image(),
+                          blend.case_image(), tonemap.display_image()})
+    EXPECT_EQ(count_nonfinite(im), 0u);
+}
+
+TEST(TonemapVsCpu, MatchesReference) {
+  test::osmesa_context();
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u01(0.0f, 1.0f);
+  Image hdr = Image::rgb(W, H);
+  for (float& v : hdr.pixels) v = std::pow(10.0f, 4.0f * u01(rng) - 3.0f);
+  hdr.at(0, 0, 0) = kNaN;
+  hdr.at(1, 0, 1) = kInf;
+  hdr.at(2, 0, 2) = -1.0f;
+  hdr.at(3, 0, 0) = 1e30f;
+  for (int c = 0; c < 3; ++c) hdr.at(4, 0, c) = 0.0f;
+  Texture2D tex(W, H, TextureFormat::RGBA32F);
+  tex.upload(hdr);
+  TonemapPass tonemap(W, H);
+  for (TonemapParams p : {TonemapParams{}, TonemapParams{0.36f, 2.0f, 0.0f, 1e-4f}, TonemapParams{0.18f, 0.0f, 0.5f, 1e-4f}}) {
+    tonemap.run(tex, p);
+    Image gpu = tonemap.display_image();
+    expect_close(gpu, cpu_tonemap(hdr, p), 1e-4f, 2e-5f, "display");
+    for (float v : gpu.pixels) {
+      EXPECT_GE(v, 0.0f);
+      EXPECT_LE(v, 1.0f);
+    }
+    if (p.log_average == 0) {
+      double ref = cpu_log_average(hdr, p.delta);
+      EXPECT_NEAR(tonemap.log_average(), ref, 1e-4 * ref);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace pxf
