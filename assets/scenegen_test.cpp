@@ -33,6 +33,8 @@ const std::vector<Expectation>& expectations() {
   static const std::vector<Expectation> table = {
       {"cornell", 1000, 20000, true, false, false, false},
       {"atrium", 5000, 300000, false, true, true, false},
+      {"kitchen", 2000, 300000, true, false, false, false},
+      {"envmap", 10000, 300000, false, false, true, true},
   };
   return table;
 }

@@ -79,28 +79,29 @@ TextureSet paintTiles(int size, const TileStyle& s) {
   });
 }
 
-TextureSet paintBricks(int size, int rows, int columns, uint32_t seed) {
-  static const glm::vec3 palette[] = {
-      {0.50f, 0.18f, 0.10f}, {0.38f, 0.12f, 0.07f}, {0.56f, 0.28f, 0.15f}, {0.30f, 0.11f, 0.07f}, {0.46f, 0.22f, 0.14f}};
+TextureSet paintBricks(int size, const BrickStyle& s) {
+  const int rows = s.rows, columns = s.columns;
+  const uint32_t seed = s.seed;
   return paint(size, false, true, [&](float x, float y) {
     const int row = int(y * rows);
     const float gx = x * columns + ((row & 1) ? 0.5f : 0.0f);
     const int column = int(gx) % columns;
     const float fx = fract(gx), fy = fract(y * rows);
-    // Mortar joints about 1 cm wide for a 1 m texture: distances in texture units.
+    // Distance to the nearest joint in texture units.
     const float edge = std::min(std::min(fx, 1.0f - fx) / columns, std::min(fy, 1.0f - fy) / rows);
-    const float brickMask = smoothstep(0.004f, 0.008f, edge);
+    const float brickMask = smoothstep(s.jointWidth, 2.0f * s.jointWidth, edge);
     const float speckle = tileableFbm(x, y, 32, 4, 0.6f, seed + 1);
     const float pits = std::pow(tileableFbm(x, y, 96, 2, 0.5f, seed + 2), 4.0f);
     const float blotch = tileableFbm(x, y, 6, 4, 0.5f, seed + 5);
 
-    const glm::vec3 brick = palette[int(hash01(column, row, seed) * 5.0f) % 5] * (0.75f + 0.5f * speckle) *
-                            (0.85f + 0.3f * blotch);
-    const glm::vec3 mortar = glm::vec3(0.55f, 0.52f, 0.47f) * (0.8f + 0.4f * speckle);
+    const size_t pick = size_t(hash01(column, row, seed) * float(s.palette.size())) % s.palette.size();
+    const float texture = s.pitting > 0.0f ? (0.75f + 0.5f * speckle) * (0.85f + 0.3f * blotch) : 0.96f + 0.08f * blotch;
+    const glm::vec3 brick = s.palette[pick] * texture;
+    const glm::vec3 mortar = s.mortar * (0.8f + 0.4f * speckle);
     Texel t;
     t.albedo = glm::mix(mortar, brick, brickMask);
-    t.height = brickMask * (1.0f - 1.0f * pits) + 0.15f * blotch;
-    t.roughness = glm::mix(0.95f, 0.7f + 0.2f * speckle, brickMask);
+    t.height = brickMask * (1.0f - s.pitting * pits) + 0.15f * blotch;
+    t.roughness = glm::mix(0.95f, s.brickRoughness + 0.2f * (speckle - 0.5f), brickMask);
     t.specular = glm::mix(0.15f, 0.35f + 0.4f * blotch, brickMask);
     return t;
   });
@@ -125,7 +126,7 @@ TextureSet paintStone(int size, glm::vec3 tint, uint32_t seed) {
     t.albedo = glm::mix(tint * 0.55f, stone, blockMask);
     t.height = blockMask * (1.0f + 0.5f * relief - 1.5f * pits);
     t.roughness = 0.55f + 0.35f * relief + 0.1f * (1.0f - blockMask);
-    t.specular = 0.3f + 0.4f * strata * blockMask;
+    t.specular = 0.3f + 0.4f * relief * blockMask;
     return t;
   });
 }
@@ -170,6 +171,35 @@ TextureSet paintGrille(int size, int bars) {
     t.albedo = glm::vec3(0.06f, 0.055f, 0.05f);
     t.height = std::max(0.0f, 1.0f - d / barHalfWidth);
     t.roughness = 0.45f;
+    return t;
+  });
+}
+
+TextureSet paintScales(int size, int rows, uint32_t seed) {
+  const glm::vec3 teal(0.02f, 0.22f, 0.26f), gold(0.62f, 0.42f, 0.12f), rim(0.03f, 0.03f, 0.035f);
+  return paint(size, false, false, [&](float x, float y) {
+    // Scales sit on a staggered grid; where domes overlap the one from the lower row wins.
+    const float gx = x * rows, gy = y * rows;
+    float best = -1.0f, bestDome = 0.0f;
+    int bestI = 0, bestJ = 0;
+    for (int j = int(gy) - 1; j <= int(gy) + 1; ++j) {
+      for (int i = int(gx) - 1; i <= int(gx) + 1; ++i) {
+        const glm::vec2 center(float(i) + 0.5f + ((j & 1) ? 0.5f : 0.0f), float(j));
+        const float r = glm::length(glm::vec2(gx, gy) - center) / 0.68f;
+        if (r >= 1.0f) continue;
+        const float dome = std::sqrt(1.0f - r * r);
+        const float order = float(j) + 0.5f * dome;  // lower rows overlap upper ones
+        if (order > best) best = order, bestDome = dome, bestI = i, bestJ = j;
+      }
+    }
+    const uint32_t ci = uint32_t((bestI % rows + rows) % rows), cj = uint32_t((bestJ % rows + rows) % rows);
+    const float pick = hash01(ci, cj, seed);
+    const float glaze = tileableFbm(x, y, 16, 3, 0.5f, seed + 1);
+    Texel t;
+    const glm::vec3 color = pick < 0.8f ? vary(teal, 0.25f, ci, cj, seed + 2) : vary(gold, 0.15f, ci, cj, seed + 2);
+    t.albedo = glm::mix(rim, color * (0.85f + 0.3f * glaze), smoothstep(0.0f, 0.35f, bestDome));
+    t.height = bestDome + 0.03f * glaze;
+    t.roughness = glm::mix(0.6f, 0.08f + 0.15f * glaze, smoothstep(0.05f, 0.5f, bestDome));
     return t;
   });
 }

@@ -4,6 +4,7 @@
 #pragma once
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "gltf_builder.h"
 #include "texture.h"
@@ -30,9 +31,23 @@ struct TileStyle {
 };
 
 TextureSet paintTiles(int size, const TileStyle& style);
-TextureSet paintBricks(int size, int rows, int columns, uint32_t seed);
+struct BrickStyle {
+  int rows = 14;      // courses per texture
+  int columns = 4;    // bricks per course
+  float jointWidth = 0.004f;  // half width of a joint, texture units
+  std::vector<glm::vec3> palette{{0.50f, 0.18f, 0.10f}, {0.38f, 0.12f, 0.07f}, {0.56f, 0.28f, 0.15f},
+                                 {0.30f, 0.11f, 0.07f}, {0.46f, 0.22f, 0.14f}};
+  glm::vec3 mortar{0.55f, 0.52f, 0.47f};
+  float brickRoughness = 0.8f;  // glazed tiles: low
+  float pitting = 1.0f;         // 0 for a smooth glaze
+  uint32_t seed = 21;
+};
+
+TextureSet paintBricks(int size, const BrickStyle& style);
 TextureSet paintStone(int size, glm::vec3 tint, uint32_t seed);
 TextureSet paintWood(int size, int planks, glm::vec3 light, glm::vec3 dark, uint32_t seed);
+// Overlapping fish scales (`rows` x `rows` per tile), glazed in two colors.
+TextureSet paintScales(int size, int rows, uint32_t seed);
 // An ornamental wrought-iron grille: albedo alpha is 1 on the bars, 0 in the openings.
 TextureSet paintGrille(int size, int bars);
 

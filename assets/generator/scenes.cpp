@@ -5,7 +5,7 @@
 namespace pxf::scenegen {
 
 const std::vector<std::string>& sceneNames() {
-  static const std::vector<std::string> names = {"cornell", "atrium"};
+  static const std::vector<std::string> names = {"cornell", "atrium", "kitchen", "envmap"};
   return names;
 }
 
@@ -13,6 +13,8 @@ bool writeScene(const std::string& name, const std::string& assetsRoot, std::str
   const std::string dir = (std::filesystem::path(assetsRoot) / name).string();
   if (name == "cornell") return writeCornell(dir, error);
   if (name == "atrium") return writeAtrium(dir, error);
+  if (name == "kitchen") return writeKitchen(dir, error);
+  if (name == "envmap") return writeEnvmap(dir, error);
   *error = "unknown scene '" + name + "'";
   return false;
 }

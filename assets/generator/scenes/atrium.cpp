@@ -123,7 +123,7 @@ bool writeAtrium(const std::string& dir, std::string* error) {
   SceneBuilder scene("atrium");
   TileStyle floorStyle;  // 4 x 4 tiles of 0.5 m per 2 m texture repeat
   const int floor = scene.addMaterial(addTextureSet(scene, paintTiles(512, floorStyle), "tiles", 0.02f, glm::vec2(0.5f)));
-  const int brick = scene.addMaterial(addTextureSet(scene, paintBricks(512, 14, 4, 21), "brick", 0.008f));
+  const int brick = scene.addMaterial(addTextureSet(scene, paintBricks(512, BrickStyle()), "brick", 0.008f));
   const int stone = scene.addMaterial(
       addTextureSet(scene, paintStone(512, {0.62f, 0.53f, 0.41f}, 31), "stone", 0.01f));
   MaterialDesc grille = addTextureSet(scene, paintGrille(512, 8), "grille", 0.01f, glm::vec2(1.0f), 1.0f);
