@@ -110,6 +110,7 @@ Bsdf::Bsdf(const BsdfParams& params, glm::vec3 shading_normal, glm::vec3 geometr
   c_glass_ = (1.0f - m) * t;
   glossy_delta_ = p_.roughness < kDeltaRoughness;
   alpha_ = std::max(p_.roughness * p_.roughness, kMinAlpha);
+  lambda_o_ = ggx_lambda(wo_local_, alpha_);
   float r0 = (p_.ior - 1.0f) / (p_.ior + 1.0f);
   f0_dielectric_ = glm::min(glm::vec3(r0 * r0) * p_.specular_color, glm::vec3(1.0f)) * p_.specular;
   f90_dielectric_ = p_.specular;
@@ -135,37 +136,37 @@ glm::vec3 Bsdf::glossy_fresnel(float cos_oh) const {
          c_diffuse_ * schlick(f0_dielectric_, f90_dielectric_, cos_oh);
 }
 
-glm::vec3 Bsdf::eval_local(glm::vec3 wi) const {
+glm::vec3 Bsdf::eval_local(glm::vec3 wi, float* pdf) const {
+  *pdf = 0.0f;
   if (wi.z <= 0.0f) return glm::vec3(0.0f);
   glm::vec3 f = diffuse_factor_ * wi.z;
+  *pdf = p_diffuse_ * wi.z * kInvPi;
   if (p_glossy_ > 0.0f && !glossy_delta_) {
     glm::vec3 h = glm::normalize(wo_local_ + wi);
-    float g2 = 1.0f / (1.0f + ggx_lambda(wo_local_, alpha_) + ggx_lambda(wi, alpha_));
-    float spec = ggx_d(h, alpha_) * g2 / (4.0f * wo_local_.z);  // times cos(wi) / cos(wi)
+    float d = ggx_d(h, alpha_);
+    float g2 = 1.0f / (1.0f + lambda_o_ + ggx_lambda(wi, alpha_));
+    float spec = d * g2 / (4.0f * wo_local_.z);  // D G2 / (4 cos_o cos_i), times cos_i
     f += glossy_fresnel(std::max(0.0f, glm::dot(wo_local_, h))) * spec;
+    *pdf += p_glossy_ * d / ((1.0f + lambda_o_) * 4.0f * wo_local_.z);  // VNDF: G1(wo) D / (4 cos_o)
   }
   return f;
 }
 
-float Bsdf::pdf_local(glm::vec3 wi) const {
-  if (wi.z <= 0.0f) return 0.0f;
-  float pdf = p_diffuse_ * wi.z * kInvPi;
-  if (p_glossy_ > 0.0f && !glossy_delta_) {
-    glm::vec3 h = glm::normalize(wo_local_ + wi);
-    float g1 = 1.0f / (1.0f + ggx_lambda(wo_local_, alpha_));
-    pdf += p_glossy_ * g1 * ggx_d(h, alpha_) / (4.0f * wo_local_.z);
-  }
-  return pdf;
+glm::vec3 Bsdf::eval(glm::vec3 wi, float* pdf) const {
+  *pdf = 0.0f;
+  if (black_ || glm::dot(wi, ng_) <= 0.0f) return glm::vec3(0.0f);  // no light through opaque faces
+  return eval_local(frame_.to_local(wi), pdf);
 }
 
 glm::vec3 Bsdf::eval(glm::vec3 wi) const {
-  if (black_ || glm::dot(wi, ng_) <= 0.0f) return glm::vec3(0.0f);  // no light through opaque faces
-  return eval_local(frame_.to_local(wi));
+  float pdf;
+  return eval(wi, &pdf);
 }
 
 float Bsdf::pdf(glm::vec3 wi) const {
-  if (black_ || glm::dot(wi, ng_) <= 0.0f) return 0.0f;
-  return pdf_local(frame_.to_local(wi));
+  float pdf;
+  eval(wi, &pdf);
+  return pdf;
 }
 
 bool Bsdf::sample(float u_lobe, glm::vec2 u, BsdfSample* out) const {
@@ -192,9 +193,9 @@ bool Bsdf::sample(float u_lobe, glm::vec2 u, BsdfSample* out) const {
     if (wi.z <= 0.0f) return false;
     out->wi = frame_.to_world(wi);
     if (glm::dot(out->wi, ng_) <= 0.0f) return false;
-    out->pdf = pdf_local(wi);
+    glm::vec3 f = eval_local(wi, &out->pdf);
     if (!(out->pdf > 0.0f)) return false;
-    out->weight = eval_local(wi) / out->pdf;
+    out->weight = f / out->pdf;
     out->delta = false;
     out->transmitted = false;
     return true;

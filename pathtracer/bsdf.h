@@ -57,6 +57,7 @@ class Bsdf {
 
   glm::vec3 eval(glm::vec3 wi) const;  // f(wo, wi) |cos(wi)| of the non-delta lobes
   float pdf(glm::vec3 wi) const;       // combined pdf of the non-delta lobes
+  glm::vec3 eval(glm::vec3 wi, float* pdf) const;  // both at once (shares the half-vector work)
   // u_lobe picks the lobe, u the direction. Returns false when no valid direction was drawn.
   bool sample(float u_lobe, glm::vec2 u, BsdfSample* out) const;
 
@@ -66,8 +67,7 @@ class Bsdf {
   glm::vec3 shading_normal() const { return frame_.n; }
 
  private:
-  glm::vec3 eval_local(glm::vec3 wi) const;
-  float pdf_local(glm::vec3 wi) const;
+  glm::vec3 eval_local(glm::vec3 wi, float* pdf) const;
   glm::vec3 glossy_fresnel(float cos_oh) const;
 
   Frame frame_{};
@@ -75,6 +75,7 @@ class Bsdf {
   glm::vec3 wo_local_{0.0f};
   BsdfParams p_{};
   float alpha_ = 1.0f;
+  float lambda_o_ = 0.0f;  // Smith Lambda(wo), fixed per shading point
   bool glossy_delta_ = false;
   bool front_face_ = true;
   float c_diffuse_ = 0.0f, c_glass_ = 0.0f;  // mixing coefficients

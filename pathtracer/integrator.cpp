@@ -88,13 +88,14 @@ PathSample PathTracer::trace_ray(const Ray& camera_ray, uint64_t pixel_index, ui
     if (bsdf.has_nondelta()) {
       LightSample ls;
       if (lights_.sample(sp.position, u_light, u_light2, &ls)) {
-        glm::vec3 f = bsdf.eval(ls.wi);
+        float bsdf_pdf;
+        glm::vec3 f = bsdf.eval(ls.wi, &bsdf_pdf);
         if (max_component(f) > 0.0f && max_component(ls.radiance) > 0.0f) {
           glm::vec3 origin = offset_ray_origin(sp.position, sp.geometric_normal, ls.wi);
           float tmax = std::isinf(ls.distance) ? ls.distance : ls.distance * (1.0f - 1e-3f);
           ++out.rays;
           if (!geometry_.occluded(origin, ls.wi, tmax)) {
-            float w = ls.delta ? 1.0f : power_heuristic(ls.pdf, bsdf.pdf(ls.wi));
+            float w = ls.delta ? 1.0f : power_heuristic(ls.pdf, bsdf_pdf);
             add_contribution(out, s.throughput * f * ls.radiance * (w / ls.pdf), s.nonspecular == 0, params.all_hv);
           }
         }

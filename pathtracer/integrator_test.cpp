@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 
 #include "pathtracer/bsdf.h"
@@ -268,5 +269,21 @@ TEST(Integrator, SpecularChainsReachTheFirstDiffuseSurface) {
   EXPECT_NEAR(center[0].range_color.x, 0.73f, 0.02f);
 }
 
+}  // namespace
+}  // namespace pxf
+
+// Throughput figures, not a pass/fail test (tests never assert wall time). Run with
+//   pathtracer_tests --gtest_also_run_disabled_tests --gtest_filter=IntegratorBench.*
+#include "pathtracer/bench.h"
+namespace pxf {
+namespace {
+TEST(IntegratorBench, DISABLED_CornellBox512) {
+  const char* name = std::getenv("PXF_BENCH_SCENE");
+  Scene scene = load_scene(name ? name : "cornell");
+  TraceParams params;  // 6 vertices, RR from vertex 3, all cores
+  BenchResult r = run_benchmark(scene, 512, 512, params, 3, 20);
+  std::printf("%s: %s\n", name ? name : "cornell", format_benchmark(r).c_str());
+  EXPECT_GT(r.paths_per_s, 0.0);
+}
 }  // namespace
 }  // namespace pxf

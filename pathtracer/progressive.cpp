@@ -23,6 +23,7 @@ struct ProgressiveRenderer::Impl {
   TraceParams params;
   int width, height;
   std::unique_ptr<PathTracer> tracer;
+  std::unique_ptr<tbb::task_arena> arena;  // kept across frames: its worker threads stay warm
   Accumulation acc;
   TraceStats stats;
   int frames = 0;
@@ -31,6 +32,12 @@ struct ProgressiveRenderer::Impl {
     if (w <= 0 || h <= 0) throw Error("path tracer: image size must be positive");
     tracer = std::make_unique<PathTracer>(scene);
     resize_accumulation(acc, w, h);
+    make_arena();
+  }
+
+  void make_arena() {
+    int threads = params.threads > 0 ? params.threads : static_cast<int>(tbb::task_arena::automatic);
+    arena = std::make_unique<tbb::task_arena>(threads);
   }
 
   void render_frame() {
@@ -60,9 +67,7 @@ struct ProgressiveRenderer::Impl {
       paths += tile_paths;
       dropped += tile_dropped;
     };
-    int arena_threads = params.threads > 0 ? params.threads : tbb::task_arena::automatic;
-    tbb::task_arena arena(arena_threads);
-    arena.execute([&] { tbb::parallel_for(tbb::blocked_range<int>(0, tiles_x * tiles_y, 1), render_tiles); });
+    arena->execute([&] { tbb::parallel_for(tbb::blocked_range<int>(0, tiles_x * tiles_y, 1), render_tiles); });
     stats.rays += rays;
     stats.paths += paths;
     stats.nan_samples_dropped += dropped;
@@ -91,6 +96,7 @@ void ProgressiveRenderer::set_camera(const Camera& camera) {
 
 void ProgressiveRenderer::set_params(const TraceParams& params) {
   impl_->params = params;
+  impl_->make_arena();
   reset();
 }
 
@@ -161,9 +167,7 @@ std::vector<SpecularChainHit> ProgressiveRenderer::trace_specular_chains(const s
       hits[i] = impl_->tracer->trace_specular_chain(camera_ray(impl_->camera, w, h, x, y));
     }
   };
-  int arena_threads = impl_->params.threads > 0 ? impl_->params.threads : tbb::task_arena::automatic;
-  tbb::task_arena arena(arena_threads);
-  arena.execute([&] { tbb::parallel_for(tbb::blocked_range<size_t>(0, pixels.size(), 256), trace_range); });
+  impl_->arena->execute([&] { tbb::parallel_for(tbb::blocked_range<size_t>(0, pixels.size(), 256), trace_range); });
   return hits;
 }
 
