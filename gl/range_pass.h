@@ -25,8 +25,8 @@ namespace pxf {
 
 struct RangeSettings {
   int max_frames = 32;      // frame cap of the accumulation
-  int min_frames = 4;
-  float tolerance = 1e-3f;  // mean over pixels of the per-frame change (color, relative distance)
+  int min_frames = 8;        // so that the jitter sequence's mean is near the pixel center
+  float tolerance = 2e-4f;  // mean over pixels of the per-frame change (color, relative distance)
 };
 
 class RangePass {
