@@ -137,6 +137,53 @@ TEST_P(SceneTest, LoadsWithCameraEmittersAndSaneSize) {
   }
 }
 
+// Reads accessor `index` (tightly packed floats or unsigned indices) as doubles.
+template <typename T>
+std::vector<T> readAccessor(const tinygltf::Model& model, int index) {
+  const tinygltf::Accessor& accessor = model.accessors[size_t(index)];
+  const tinygltf::BufferView& view = model.bufferViews[size_t(accessor.bufferView)];
+  const unsigned char* data = model.buffers[size_t(view.buffer)].data.data() + view.byteOffset + accessor.byteOffset;
+  const size_t components = size_t(tinygltf::GetNumComponentsInType(uint32_t(accessor.type)));
+  std::vector<T> out(accessor.count * components);
+  for (size_t i = 0; i < out.size(); ++i) {
+    switch (accessor.componentType) {
+      case TINYGLTF_COMPONENT_TYPE_FLOAT: out[i] = T(reinterpret_cast<const float*>(data)[i]); break;
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: out[i] = T(reinterpret_cast<const uint16_t*>(data)[i]); break;
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: out[i] = T(reinterpret_cast<const uint32_t*>(data)[i]); break;
+      default: ADD_FAILURE() << "unexpected component type";
+    }
+  }
+  return out;
+}
+
+// Every triangle is wound counter-clockwise around its vertex normals (front faces are the
+// shaded sides), and every vertex has unit normal and a UV.
+TEST_P(SceneTest, WindingAgreesWithNormals) {
+  const tinygltf::Model model = load(GetParam().name);
+  for (const tinygltf::Mesh& mesh : model.meshes) {
+    for (const tinygltf::Primitive& primitive : mesh.primitives) {
+      ASSERT_TRUE(primitive.attributes.count("NORMAL") && primitive.attributes.count("TEXCOORD_0")) << mesh.name;
+      const auto p = readAccessor<double>(model, primitive.attributes.at("POSITION"));
+      const auto n = readAccessor<double>(model, primitive.attributes.at("NORMAL"));
+      const auto indices = readAccessor<uint32_t>(model, primitive.indices);
+      size_t flipped = 0;
+      for (size_t t = 0; t + 2 < indices.size(); t += 3) {
+        const size_t a = 3 * indices[t], b = 3 * indices[t + 1], c = 3 * indices[t + 2];
+        const double e1[3] = {p[b] - p[a], p[b + 1] - p[a + 1], p[b + 2] - p[a + 2]};
+        const double e2[3] = {p[c] - p[a], p[c + 1] - p[a + 1], p[c + 2] - p[a + 2]};
+        const double g[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+        double dot = 0.0;
+        for (size_t v : {a, b, c}) dot += g[0] * n[v] + g[1] * n[v + 1] + g[2] * n[v + 2];
+        flipped += dot <= 0.0;
+      }
+      EXPECT_EQ(flipped, 0u) << mesh.name;
+      for (size_t v = 0; v < n.size(); v += 3) {
+        ASSERT_NEAR(n[v] * n[v] + n[v + 1] * n[v + 1] + n[v + 2] * n[v + 2], 1.0, 1e-4) << mesh.name;
+      }
+    }
+  }
+}
+
 TEST_P(SceneTest, DeclaresExactlyTheExtensionsItUses) {
   const tinygltf::Model model = load(GetParam().name);
   const std::set<std::string> declared(model.extensionsUsed.begin(), model.extensionsUsed.end());
