@@ -48,7 +48,7 @@ void write_file_atomically(const std::string& path, const std::function<void(con
 void write_exr(const std::string& path, const Image& image);  // half=false: full 32-bit float
 void write_exr(const std::string& path, const std::vector<Layer>& layers);
 std::vector<Layer> read_exr_layers(const std::string& path);
-// The named layer, or with "" the unprefixed channels (falling back to the first layer).
+// The named layer, or with "" the unprefixed channels (else a layer named "final", else the first).
 Image read_exr(const std::string& path, const std::string& layer = "");
 
 // 8-bit PNG of display values already in [0,1] display (sRGB-encoded) space; clamps; NaN -> 0.

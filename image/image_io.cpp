@@ -119,7 +119,11 @@ Image read_exr(const std::string& path, const std::string& layer) {
   std::vector<Layer> layers = read_exr_layers(path);
   for (Layer& l : layers)
     if (l.name == layer) return std::move(l.image);
-  if (!layer.empty()) {
+  if (layer.empty()) {
+    // A pxf buffers.exr has no unnamed layer: its "final" layer is what a reader wants.
+    for (Layer& l : layers)
+      if (l.name == "final") return std::move(l.image);
+  } else {
     std::string names;
     for (const Layer& l : layers) names += (names.empty() ? "" : ", ") + (l.name.empty() ? "<default>" : l.name);
     throw Error(path + ": no layer '" + layer + "' (layers: " + names + ")");

@@ -1,0 +1,65 @@
+#include "app/options.h"
+
+#include <cstdio>
+
+#include "gl/context.h"
+#include "pathtracer/pathtracer.h"
+
+namespace pxf {
+
+void add_scene_options(CommandLine& cli, SceneOptions& o, bool headless) {
+  cli.option("--scene", &o.scene, "NAME|FILE.gltf", "built-in scene name, a .gltf/.glb file, or 'list' (default cornell)");
+  cli.option("--env", &o.env, "FILE.exr", "equirectangular environment map replacing the scene's");
+  cli.option("--env-strength", &o.env_strength, "environment radiance scale", 0.0f, 1e6f);
+  cli.size_option("--size", &o.width, &o.height, "image size (default: the scene's, else 512x512)");
+  if (headless)
+    cli.choice("--gl", &o.gl, {"auto", "osmesa", "egl"}, "headless GL back end (auto: OSMesa, else EGL)");
+  else
+    cli.choice("--gl", &o.gl, {"auto", "window", "osmesa", "egl"}, "GL back end (auto: a window when a display exists)");
+}
+
+void add_preview_options(CommandLine& cli, PreviewOptions& o) {
+  PreviewSettings& s = o.settings;
+  cli.option("--threshold", &s.threshold, "blend threshold t on perceived variance (default 0.001)", 0.0f, 1e6f);
+  cli.option("--sigma-s", &s.filter.sigma_s, "spatial sigma in pixels (default 8)", 0.1f, kMaxFilterRadius / 3.0f);
+  cli.option("--sigma-c", &s.filter.sigma_c, "range color sigma, linear RGB (default 0.02)", 1e-6f, 1e6f);
+  cli.option("--sigma-d", &s.filter.sigma_d, "range depth sigma, scene units (default 2)", 1e-6f, 1e6f);
+  cli.choice("--filter", &o.filter, filter_option_names(), "filter variant (default bilateral-depth)");
+  cli.choice("--schedule", &o.schedule, filter_schedule_names(),
+             "when the filter runs: pow2 = at power-of-two sample counts and the last frame (default)");
+  cli.option("--seed", &o.seed, "random seed", 0, 2147483647);
+  cli.option("--threads", &s.trace.threads, "path-tracing threads (0 = all cores)", 0, 1024);
+  cli.option("--max-vertices", &s.trace.max_vertices, "maximum path length in vertices, camera and light included", 2, 1024);
+  cli.option("--rr-start", &s.trace.rr_start_vertex, "Russian roulette from this vertex on", 2, 1024);
+  cli.flag("--all-hv", &o.all_hv, "put every contribution into the HV buffer (environment-lit scenes)");
+  cli.option("--key", &s.tonemap.key, "Reinhard key a (default 0.18)", 1e-4f, 100.0f);
+  cli.option("--white", &s.tonemap.white, "Reinhard white point (0 = none)", 0.0f, 1e9f);
+}
+
+bool print_scene_list_if_asked(const SceneOptions& options) {
+  if (options.scene != "list") return false;
+  for (const BuiltinScene& s : builtin_scenes()) std::printf("%-10s %s\n", s.name.c_str(), s.description.c_str());
+  return true;
+}
+
+void finish_preview_options(PreviewOptions& o) {
+  set_filter_option(o.settings, o.filter);
+  o.settings.schedule = parse_filter_schedule(o.schedule);
+  o.settings.trace.seed = static_cast<uint64_t>(o.seed);
+  o.settings.trace.all_hv = o.all_hv;
+  o.settings.filter.t = o.settings.threshold;
+}
+
+Scene load_scene_for(SceneOptions& options, PreviewOptions& preview, const CommandLine& cli) {
+  Scene scene = load_scene(options.scene, options.env, options.env_strength);
+  for (const std::string& w : scene.warnings) std::fprintf(stderr, "pxf: warning: %s\n", w.c_str());
+  if (options.width == 0) {
+    options.width = scene.defaults.width > 0 ? scene.defaults.width : 512;
+    options.height = scene.defaults.height > 0 ? scene.defaults.height : 512;
+  }
+  if (!cli.given("--all-hv") && scene.defaults.all_hv) preview.all_hv = true;
+  finish_preview_options(preview);
+  return scene;
+}
+
+}  // namespace pxf

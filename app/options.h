@@ -1,0 +1,37 @@
+// Options shared by `pxf render`, `pxf bench` and `pxf explore`: one declaration, one meaning.
+#pragma once
+#include <string>
+
+#include "app/cli.h"
+#include "app/preview.h"
+#include "pathtracer/scene.h"
+
+namespace pxf {
+
+struct SceneOptions {
+  std::string scene = "cornell";  // built-in name or glTF path; "list" prints the built-ins
+  std::string env;                // equirect EXR replacing the scene's environment
+  float env_strength = 1.0f;
+  int width = 0, height = 0;      // 0 = the scene's default, else 512x512
+  std::string gl = "auto";
+};
+
+struct PreviewOptions {
+  PreviewSettings settings;
+  std::string filter = "bilateral-depth";
+  std::string schedule = "pow2";
+  int seed = 1;
+  bool all_hv = false;
+};
+
+void add_scene_options(CommandLine& cli, SceneOptions& options, bool headless);
+void add_preview_options(CommandLine& cli, PreviewOptions& options);
+
+// Prints the built-in scenes when options.scene == "list" (returns true: nothing else to do).
+bool print_scene_list_if_asked(const SceneOptions& options);
+// Loads the scene, applies its render defaults (size, all_hv unless given on the command line).
+Scene load_scene_for(SceneOptions& options, PreviewOptions& preview, const CommandLine& cli);
+// Resolves the names of PreviewOptions into its settings.
+void finish_preview_options(PreviewOptions& options);
+
+}  // namespace pxf

@@ -1,0 +1,207 @@
+#include "app/preview.h"
+
+#include <chrono>
+
+namespace pxf {
+
+namespace {
+double ms_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+bool same_trace_params(const TraceParams& a, const TraceParams& b) {
+  return a.max_vertices == b.max_vertices && a.rr_start_vertex == b.rr_start_vertex && a.all_hv == b.all_hv &&
+         a.seed == b.seed && a.threads == b.threads;
+}
+
+bool same_filter_params(const PreviewSettings& a, const PreviewSettings& b) {
+  return a.filter_enabled == b.filter_enabled && a.filter.kind == b.filter.kind && a.filter.sigma_s == b.filter.sigma_s &&
+         a.filter.sigma_c == b.filter.sigma_c && a.filter.sigma_d == b.filter.sigma_d &&
+         a.filter.skip_case2 == b.filter.skip_case2 && a.threshold == b.threshold;
+}
+}  // namespace
+
+std::vector<std::string> filter_option_names() {
+  std::vector<std::string> names = filter_kind_names();
+  names.push_back("none");
+  return names;
+}
+
+void set_filter_option(PreviewSettings& settings, const std::string& name) {
+  settings.filter_enabled = name != "none";
+  if (settings.filter_enabled) settings.filter.kind = parse_filter_kind(name);
+}
+
+std::string filter_option_name(const PreviewSettings& settings) {
+  return settings.filter_enabled ? filter_kind_name(settings.filter.kind) : "none";
+}
+
+StageTimes& StageTimes::operator+=(const StageTimes& o) {
+  path_tracing += o.path_tracing;
+  upload += o.upload;
+  range += o.range;
+  filter += o.filter;
+  blend += o.blend;
+  tonemap += o.tonemap;
+  return *this;
+}
+
+Preview::Preview(const Scene& scene, const PreviewSettings& settings, int width, int height)
+    : width_(width),
+      height_(height),
+      settings_(settings),
+      renderer_(std::make_unique<ProgressiveRenderer>(scene, settings.trace, width, height)),
+      inputs_(width, height),
+      range_(width, height),
+      filter_(width, height),
+      blend_(width, height),
+      tonemap_(width, height),
+      variance_(static_cast<size_t>(width) * height, kVarUnknown) {
+  settings_.filter.t = settings_.threshold;
+  range_.set_settings(settings_.range);
+  range_.set_scene(scene);
+  range_.set_camera(renderer_->camera());
+}
+
+Preview::~Preview() = default;
+
+void Preview::reset() {
+  renderer_->reset();
+  schedule_ = ScheduleState{};
+  have_filtered_ = false;
+  uploaded_ = false;
+  filtered_samples_ = -1;
+  case_counts_ = {};
+}
+
+void Preview::set_camera(const Camera& camera) {
+  renderer_->set_camera(camera);
+  range_.set_camera(camera);
+  reset();
+}
+
+void Preview::set_settings(const PreviewSettings& settings) {
+  const bool retrace = !same_trace_params(settings.trace, settings_.trace);
+  const bool refilter = !same_filter_params(settings, settings_);
+  settings_ = settings;
+  settings_.filter.t = settings_.threshold;
+  range_.set_settings(settings_.range);
+  if (retrace) {
+    renderer_->set_params(settings_.trace);
+    reset();
+    return;
+  }
+  if (refilter) {
+    // The samples stay valid: filter them again with the new parameters (or drop L_f).
+    schedule_.all_pixels_case2 = false;
+    have_filtered_ = false;
+    if (settings_.filter_enabled && samples() > 0 && !schedule_.hv_empty) run_filter();
+  }
+  if (samples() > 0) redisplay();
+}
+
+void Preview::upload() {
+  if (uploaded_) return;
+  const auto start = std::chrono::steady_clock::now();
+  const Accumulation& acc = renderer_->accumulation();
+  for (size_t i = 0; i < variance_.size(); ++i) variance_[i] = acc.variance_of_mean(i);
+  inputs_.upload(&acc.lv_mean[0].x, &acc.hv_mean[0].x, variance_.data(), acc.samples.data());
+  last_.upload += ms_since(start);
+  uploaded_ = true;
+}
+
+void Preview::converge_range() {
+  const auto start = std::chrono::steady_clock::now();
+  const auto tracer = [this](const std::vector<uint32_t>& pixels, glm::vec2 jitter) {
+    return renderer_->trace_specular_chains(pixels, jitter);
+  };
+  while (range_.step(tracer)) {
+  }
+  last_.range += ms_since(start);
+}
+
+void Preview::run_filter() {
+  converge_range();
+  upload();
+  filter_.run(inputs_, range_.guide(), settings_.filter);
+  last_.filter += filter_.last_ms();
+  ++filter_runs_;
+  filtered_samples_ = samples();
+  have_filtered_ = true;
+  // Every pixel skipped = every pixel already in case 2: the filter is not needed any more.
+  if (settings_.filter.skip_case2 && filter_.filtered_pixels() == 0) schedule_.all_pixels_case2 = true;
+}
+
+void Preview::update_hv_empty() {
+  if (!schedule_.hv_empty) return;  // once there is HV light it stays
+  for (const glm::vec3& v : renderer_->accumulation().hv_mean)
+    if (v.x != 0.0f || v.y != 0.0f || v.z != 0.0f) {
+      schedule_.hv_empty = false;
+      return;
+    }
+}
+
+void Preview::blend_and_tonemap() {
+  upload();
+  blend_.run(inputs_, have_filtered_ ? &filter_ : nullptr, BlendParams{settings_.threshold});
+  last_.blend += blend_.last_ms();
+  tonemap_.run(blend_.output(), settings_.tonemap);
+  last_.tonemap += tonemap_.last_ms();
+  case_counts_ = blend_.case_counts();
+}
+
+void Preview::redisplay() { blend_and_tonemap(); }
+
+void Preview::add_frame(bool last_frame, bool display) {
+  last_ = StageTimes{};
+  const auto start = std::chrono::steady_clock::now();
+  renderer_->add_frame();
+  last_.path_tracing = ms_since(start);
+  uploaded_ = false;
+
+  update_hv_empty();
+  schedule_.have_filtered = have_filtered_;
+  if (last_frame) {
+    finish_passes();
+  } else {
+    if (settings_.filter_enabled && filter_due(settings_.schedule, samples(), false, schedule_)) run_filter();
+    if (display) blend_and_tonemap();
+  }
+  total_ += last_;
+}
+
+void Preview::finish_passes() {
+  if (settings_.filter_enabled && filtered_samples_ != samples() &&
+      filter_due(settings_.schedule, samples(), true, schedule_))
+    run_filter();
+  blend_and_tonemap();
+}
+
+void Preview::finish() {
+  last_ = StageTimes{};
+  finish_passes();
+  total_ += last_;
+}
+
+Image Preview::display_image() const { return tonemap_.display_image(); }
+Image Preview::final_image() const { return blend_.final_image(); }
+
+std::vector<Layer> Preview::buffers() {
+  converge_range();
+  upload();
+  std::vector<Layer> layers;
+  layers.push_back({"final", blend_.final_image()});
+  layers.push_back({"lv", inputs_.lv_image()});
+  layers.push_back({"hv", inputs_.hv_image()});
+  layers.push_back({"hv_filtered", have_filtered_ ? filter_.filtered_image() : inputs_.hv_image()});
+  layers.push_back({"var_u", inputs_.var_image()});
+  layers.push_back({"var_f", have_filtered_ ? filter_.variance_image() : Image::gray(width_, height_)});
+  layers.push_back({"blend", blend_.s_image()});
+  layers.push_back({"case", blend_.case_image()});
+  layers.push_back({"range_color", range_.range_color_image()});
+  layers.push_back({"depth", range_.depth_image()});
+  layers.push_back({"samples", renderer_->samples_image()});
+  return layers;
+}
+
+}  // namespace pxf

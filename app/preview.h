@@ -1,0 +1,119 @@
+// The preview core shared by `pxf render`, `pxf explore` and `pxf bench`: the progressive path
+// tracer plus the GL passes (range, filter, blend, tone map) on the schedule of SPEC 3.5.
+// Requires a current GL context (gl/context.h) for its whole life.
+// Usage:
+//   Preview preview(scene, settings, w, h);
+//   for (int i = 0; i < spp; ++i) preview.add_frame(/*last_frame=*/i + 1 == spp, /*display=*/...);
+//   preview.display_image(); preview.buffers();   // tone-mapped image; every buffer as EXR layers
+#pragma once
+#include <array>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "app/schedule.h"
+#include "gl/blend_pass.h"
+#include "gl/filter_pass.h"
+#include "gl/inputs.h"
+#include "gl/preview_params.h"
+#include "gl/range_pass.h"
+#include "gl/tonemap_pass.h"
+#include "image/image.h"
+#include "pathtracer/pathtracer.h"
+
+namespace pxf {
+
+struct PreviewSettings {
+  TraceParams trace;
+  float threshold = 0.001f;  // t: allowed perceived (relative) variance
+  bool filter_enabled = true;  // false = plain path tracing (--filter none)
+  FilterParams filter;         // kind and sigmas; filter.t is kept equal to threshold
+  FilterSchedule schedule = FilterSchedule::PowersOfTwo;
+  TonemapParams tonemap;
+  RangeSettings range;
+};
+
+// Filter variant names of the command line and the UI: the GL variants plus "none".
+std::vector<std::string> filter_option_names();
+// Applies a filter option name ("none" disables filtering).
+void set_filter_option(PreviewSettings& settings, const std::string& name);
+std::string filter_option_name(const PreviewSettings& settings);
+
+// Milliseconds per stage (SPEC 4).
+struct StageTimes {
+  double path_tracing = 0, upload = 0, range = 0, filter = 0, blend = 0, tonemap = 0;
+  double total() const { return path_tracing + upload + range + filter + blend + tonemap; }
+  StageTimes& operator+=(const StageTimes& o);
+};
+
+class Preview {
+ public:
+  Preview(const Scene& scene, const PreviewSettings& settings, int width, int height);
+  ~Preview();
+
+  // Traces one path per pixel, then runs the passes that are due. `display`: also blend and tone
+  // map (the explorer displays every frame; a headless render only its last one).
+  void add_frame(bool last_frame = false, bool display = true);
+  // Ends a capture (also an interrupted one): the last-frame filter run if due, blend, tone map.
+  void finish();
+  // Changes settings. Path-tracing changes reset the accumulation; filter, threshold and display
+  // changes apply at once to the current samples (re-filtering if a filtered image exists).
+  void set_settings(const PreviewSettings& settings);
+  void set_camera(const Camera& camera);  // resets
+  void reset();
+  // Blend and tone map the current state (e.g. after a display-only change).
+  void redisplay();
+
+  int width() const { return width_; }
+  int height() const { return height_; }
+  int samples() const { return renderer_->frames(); }
+  const PreviewSettings& settings() const { return settings_; }
+  const ProgressiveRenderer& renderer() const { return *renderer_; }
+  const StageTimes& last_times() const { return last_; }
+  const StageTimes& total_times() const { return total_; }
+  int filter_runs() const { return filter_runs_; }
+  bool filter_stopped() const { return schedule_.all_pixels_case2; }
+  // Pixels per BlendCase (gl/preview_params.h) of the last displayed frame.
+  const std::array<uint32_t, kBlendCaseCount>& case_counts() const { return case_counts_; }
+
+  // GPU results for the explorer's views.
+  const PreviewInputs& inputs() const { return inputs_; }
+  const RangePass& range() const { return range_; }
+  const FilterPass& filter() const { return filter_; }
+  const BlendPass& blend() const { return blend_; }
+  const TonemapPass& tonemap() const { return tonemap_; }
+  bool has_filtered() const { return have_filtered_; }
+
+  Image display_image() const;        // tone-mapped sRGB "R,G,B" in [0,1]
+  Image final_image() const;          // linear radiance after the blend
+  // Every buffer as EXR layers: final, lv, hv, hv_filtered, var_u, var_f, blend, case,
+  // range_color, depth, samples. Runs the range pass first if it has not converged yet.
+  std::vector<Layer> buffers();
+
+ private:
+  void upload();
+  void run_filter();
+  void converge_range();
+  void update_hv_empty();
+  void blend_and_tonemap();
+  void finish_passes();
+
+  int width_, height_;
+  PreviewSettings settings_;
+  std::unique_ptr<ProgressiveRenderer> renderer_;
+  PreviewInputs inputs_;
+  RangePass range_;
+  FilterPass filter_;
+  BlendPass blend_;
+  TonemapPass tonemap_;
+  std::vector<float> variance_;  // staging for Var[L_u]
+  ScheduleState schedule_;
+  bool have_filtered_ = false;
+  bool uploaded_ = false;  // inputs hold the current samples
+  int filter_runs_ = 0;
+  int filtered_samples_ = -1;  // sample count of the newest L_f
+  StageTimes last_, total_;
+  std::array<uint32_t, kBlendCaseCount> case_counts_{};
+};
+
+}  // namespace pxf

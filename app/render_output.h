@@ -1,0 +1,30 @@
+// What `pxf render` (and the explorer's capture) writes: final.png, final.exr, buffers.exr and
+// stats.json in an output folder. Every file is written atomically.
+#pragma once
+#include <optional>
+#include <string>
+
+#include "app/preview.h"
+#include "app/options.h"
+#include "image/image.h"
+
+namespace pxf {
+
+struct RenderReport {
+  const SceneOptions* scene = nullptr;
+  const PreviewOptions* preview = nullptr;
+  double wall_ms = 0;
+  bool interrupted = false;
+  std::string gl_backend, gl_renderer;
+  std::string reference_path;  // optional: NRMSE of the final and the unfiltered image against it
+  std::optional<ImageMetrics> final_vs_reference, unfiltered_vs_reference;  // filled by the writer
+};
+
+// The unfiltered image L_lv + L_u (what plain path tracing shows), from the preview's buffers.
+Image unfiltered_image(const std::vector<Layer>& buffers);
+const Image& layer_image(const std::vector<Layer>& buffers, const std::string& name);
+
+// Writes DIR/final.png, DIR/final.exr, DIR/buffers.exr, DIR/stats.json; creates DIR.
+void write_render_outputs(const std::string& dir, Preview& preview, RenderReport& report);
+
+}  // namespace pxf
