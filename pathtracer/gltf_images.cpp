@@ -20,6 +20,7 @@ bool decode_image(const unsigned char* bytes, size_t size, DecodedImage& out) {
   size_t n = 0;
   if (stbi_is_hdr_from_memory(bytes, len)) {
     float* data = stbi_loadf_from_memory(bytes, len, &w, &h, &c, 0);
+    out.bits = 32;
     if (data) {
       n = static_cast<size_t>(w) * h * c;
       out.values.assign(data, data + n);
@@ -27,6 +28,7 @@ bool decode_image(const unsigned char* bytes, size_t size, DecodedImage& out) {
     }
   } else if (stbi_is_16_bit_from_memory(bytes, len)) {
     stbi_us* data = stbi_load_16_from_memory(bytes, len, &w, &h, &c, 0);
+    out.bits = 16;
     if (data) {
       n = static_cast<size_t>(w) * h * c;
       out.values.resize(n);
@@ -44,7 +46,7 @@ bool decode_image(const unsigned char* bytes, size_t size, DecodedImage& out) {
   }
   if (n == 0 || c < 1 || c > 4) {
     const char* reason = stbi_failure_reason();
-    out.values.clear();
+    out = DecodedImage{};
     out.failure = reason ? reason : "unsupported image format";
     return false;
   }

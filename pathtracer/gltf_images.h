@@ -14,6 +14,7 @@ namespace pxf::gltf {
 
 struct DecodedImage {
   int width = 0, height = 0, channels = 0;
+  int bits = 8;               // 8, 16 or 32 (HDR float)
   std::vector<float> values;  // as stored, 8/16-bit scaled to [0,1], HDR as linear floats
   bool decoded = false;
   std::string failure;        // why decoding failed (empty when decoded)

@@ -77,6 +77,12 @@ glm::vec3 vec3_or(const std::vector<double>& v, glm::vec3 fallback) {
   return {finite_or(v[0], fallback.x), finite_or(v[1], fallback.y), finite_or(v[2], fallback.z)};
 }
 
+// value[key], or a null value when `value` is not an object (tinygltf asserts on that).
+const tinygltf::Value& member(const tinygltf::Value& value, const std::string& key) {
+  static const tinygltf::Value null_value;
+  return value.IsObject() ? value.Get(key) : null_value;
+}
+
 double number_or(const tinygltf::Value& value, double fallback) {
   return value.IsNumber() ? value.GetNumberAsDouble() : fallback;
 }
@@ -188,7 +194,10 @@ class GltfLoader {
       fail(std::string("invalid glTF: ") + e.what());
     }
     if (!ok) fail(first_line(err.empty() ? warn_text : err));
-    for (const std::string& line : lines_of(warn_text)) warn(line);
+    // tinygltf's image warnings ("File not found", "Failed to load external 'uri' for image[0]") are
+    // replaced by our single line per texture, which says which material loses what.
+    for (const std::string& line : lines_of(warn_text))
+      if (line.find("image[") == std::string::npos && line.find("File not found") == std::string::npos) warn(line);
   }
 
   void check_extensions() {
@@ -220,7 +229,7 @@ class GltfLoader {
     if (!value.IsObject()) return view;
     view.index = static_cast<int>(number_or(value.Get("index"), -1));
     view.texcoord = static_cast<int>(number_or(value.Get("texCoord"), 0));
-    const tinygltf::Value& ext = value.Get("extensions").Get("KHR_texture_transform");
+    const tinygltf::Value& ext = member(member(value, "extensions"), "KHR_texture_transform");
     if (ext.IsObject()) view.transform = &ext;
     return view;
   }
@@ -309,10 +318,16 @@ class GltfLoader {
     size_t texel_count = static_cast<size_t>(decoded.width) * decoded.height;
     out.texels.resize(texel_count);
     int c = decoded.channels;
-    // Decoding sRGB per 8/16-bit value is the bulk of texture load time; a table would help
-    // 8-bit images, but linear_from_srgb is already fast enough for our asset sizes.
+    // The sRGB curve per texel dominates texture load time; 8-bit images (values k/255) use a table.
+    static const std::vector<float> srgb_table = [] {
+      std::vector<float> table(256);
+      for (int k = 0; k < 256; ++k) table[k] = linear_from_srgb(k / 255.0f);
+      return table;
+    }();
+    bool use_table = srgb && decoded.bits == 8;
     auto color = [&](float v) {
       float x = std::isfinite(v) ? std::max(v, 0.0f) : 0.0f;
+      if (use_table) return srgb_table[std::min(255, static_cast<int>(x * 255.0f + 0.5f))];
       return srgb ? linear_from_srgb(x) : x;
     };
     for (size_t i = 0; i < texel_count; ++i) {
@@ -632,7 +647,7 @@ class GltfLoader {
 
   void read_scene_defaults() {
     if (scene_index_ < 0) return;
-    const tinygltf::Value& pxf = model_.scenes[scene_index_].extras.Get("pxf");
+    const tinygltf::Value& pxf = member(model_.scenes[scene_index_].extras, "pxf");
     if (!pxf.IsObject()) return;
     const tinygltf::Value& all_hv = pxf.Get("all_hv");
     if (all_hv.IsBool()) scene_.defaults.all_hv = all_hv.Get<bool>();
