@@ -7,7 +7,7 @@
 namespace pxf {
 
 const std::vector<std::string>& filter_kind_names() {
-  static const std::vector<std::string> names = {"bilateral-depth", "bilateral"};
+  static const std::vector<std::string> names = {"bilateral-depth", "bilateral", "separable"};
   return names;
 }
 const char* filter_kind_name(FilterKind kind) { return filter_kind_names()[static_cast<int>(kind)].c_str(); }
@@ -15,7 +15,7 @@ FilterKind parse_filter_kind(const std::string& name) {
   const auto& names = filter_kind_names();
   for (size_t i = 0; i < names.size(); ++i)
     if (names[i] == name) return static_cast<FilterKind>(i);
-  throw Error("unknown filter '" + name + "' (expected bilateral-depth or bilateral)");
+  throw Error("unknown filter '" + name + "' (expected bilateral-depth, bilateral or separable)");
 }
 
 namespace {
@@ -69,18 +69,23 @@ BlendDecision blend_decision(float u, float f, float t) {
   return {std::clamp(s, 0.0f, 1.0f), kCaseMixed};
 }
 
-FilterOutput cpu_filter(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
-                        const Image& depth, const FilterParams& p) {
+namespace {
+
+// One bilateral pass over `signal` (rgb) with variance `signal_var`, kernel extent (ex, ey) times
+// the radius; skipping (final pass only) looks at the unfiltered hv / var_u.
+FilterOutput filter_once(const Image& signal, const Image& signal_var, const Image& hv, const Image& var_u,
+                         const Image& lv, const Image& range_color, const Image& depth, const FilterParams& p,
+                         int ex, int ey, bool final_pass) {
   const int w = hv.width, h = hv.height;
   FilterOutput out{Image::rgb(w, h), Image::gray(w, h)};
   const int radius = std::min(kMaxFilterRadius, static_cast<int>(std::ceil(3.0f * std::max(p.sigma_s, 0.0f))));
   const float ks = inv_two_sigma2(p.sigma_s), kc = inv_two_sigma2(p.sigma_c);
-  const float kd = p.kind == FilterKind::BilateralDepth ? inv_two_sigma2(p.sigma_d) : 0.0f;
+  const float kd = p.kind != FilterKind::Bilateral ? inv_two_sigma2(p.sigma_d) : 0.0f;
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
       Px lu = rgb_at(hv, x, y);
       float v = clean_var(var_u.at(x, y, 0));
-      if (p.skip_case2 && v >= 0.0f) {
+      if (final_pass && p.skip_case2 && v >= 0.0f) {
         Px l = rgb_at(lv, x, y);
         float lb = std::max(lum(lu.c) + lum(l.c), 0.0f);
         if (relative_variance(v, lb) <= std::max(p.t, 0.0f)) {
@@ -92,8 +97,8 @@ FilterOutput cpu_filter(const Image& hv, const Image& var_u, const Image& lv, co
       Px rp = rgb_at(range_color, x, y);
       float dp = clean(depth.at(x, y, 0));
       double sw = 0, swl[3] = {0, 0, 0}, sw2v = 0, sw2u = 0, swk = 0, swv = 0;
-      for (int qy = std::max(0, y - radius); qy <= std::min(h - 1, y + radius); ++qy)
-        for (int qx = std::max(0, x - radius); qx <= std::min(w - 1, x + radius); ++qx) {
+      for (int qy = std::max(0, y - radius * ey); qy <= std::min(h - 1, y + radius * ey); ++qy)
+        for (int qx = std::max(0, x - radius * ex); qx <= std::min(w - 1, x + radius * ex); ++qx) {
           Px rq = rgb_at(range_color, qx, qy);
           float dq = clean(depth.at(qx, qy, 0));
           double dc2 = 0;
@@ -101,8 +106,8 @@ FilterOutput cpu_filter(const Image& hv, const Image& var_u, const Image& lv, co
           double dd = double(dp) - dq;
           double e = double((qx - x) * (qx - x) + (qy - y) * (qy - y)) * ks + dc2 * kc + dd * dd * kd;
           double wq = std::exp(-e);
-          Px lq = rgb_at(hv, qx, qy);
-          float vq = clean_var(var_u.at(qx, qy, 0));
+          Px lq = rgb_at(signal, qx, qy);
+          float vq = clean_var(signal_var.at(qx, qy, 0));
           sw += wq;
           for (int c = 0; c < 3; ++c) swl[c] += wq * lq.c[c];
           if (vq >= 0.0f) {
@@ -120,6 +125,15 @@ FilterOutput cpu_filter(const Image& hv, const Image& var_u, const Image& lv, co
           swk > 0 ? static_cast<float>((sw2v + sw2u * (swv / swk)) / (sw * sw)) : kVarUnknown;
     }
   return out;
+}
+
+}  // namespace
+
+FilterOutput cpu_filter(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
+                        const Image& depth, const FilterParams& p) {
+  if (p.kind != FilterKind::Separable) return filter_once(hv, var_u, hv, var_u, lv, range_color, depth, p, 1, 1, true);
+  FilterOutput rows = filter_once(hv, var_u, hv, var_u, lv, range_color, depth, p, 1, 0, false);
+  return filter_once(rows.filtered, rows.variance, hv, var_u, lv, range_color, depth, p, 0, 1, true);
 }
 
 BlendOutput cpu_blend(const Image& lv, const Image& hv, const Image& var_u, const FilterOutput* filtered,

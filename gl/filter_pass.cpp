@@ -27,7 +27,7 @@ void FilterPass::run(const PreviewInputs& inputs, const Texture2D& guide, const 
   program_.set("radius", radius);
   program_.set("k_s", inv_two_sigma2(p.sigma_s));
   program_.set("k_c", inv_two_sigma2(p.sigma_c));
-  program_.set("k_d", p.kind == FilterKind::BilateralDepth ? inv_two_sigma2(p.sigma_d) : 0.0f);
+  program_.set("k_d", p.kind != FilterKind::Bilateral ? inv_two_sigma2(p.sigma_d) : 0.0f);
   program_.set("skip_case2", p.skip_case2 ? 1 : 0);
   program_.set("t", p.t);
   const uint32_t zero = 0;
@@ -37,6 +37,23 @@ void FilterPass::run(const PreviewInputs& inputs, const Texture2D& guide, const 
   inputs.lv().bind(1);
   guide.bind(2);
   program_.use();
+  if (p.kind == FilterKind::Separable) {
+    if (!rows_.valid()) {
+      rows_ = Texture2D(width_, height_, TextureFormat::RGBA32F);
+      rows_fbo_.attach(0, rows_);
+      rows_fbo_.check("filter pass (rows)");
+    }
+    program_.set("extent", glm::ivec2(1, 0));
+    program_.set("final_pass", 0);
+    inputs.hv().bind(3);
+    quad_.draw(rows_fbo_, width_, height_);
+    program_.set("extent", glm::ivec2(0, 1));
+    rows_.bind(3);
+  } else {
+    program_.set("extent", glm::ivec2(1, 1));
+    inputs.hv().bind(3);
+  }
+  program_.set("final_pass", 1);
   quad_.draw(fbo_, width_, height_);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
   timer_.end();

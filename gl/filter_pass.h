@@ -1,4 +1,4 @@
-// Cross bilateral filter pass (SPEC 3.3): L_f and Var[L_f] from the HV buffer, guided by the
+// Cross bilateral filter pass (SPEC 3.3; FilterKind picks the variant): L_f and Var[L_f] from the HV buffer, guided by the
 // range buffer (color + distance). Runs on a schedule; the output texture persists between runs.
 // Usage:
 //   FilterPass filter(w, h);
@@ -37,6 +37,8 @@ class FilterPass {
   Texture2D output_;
   Framebuffer fbo_;
   Buffer counter_;
+  Texture2D rows_;      // separable: output of the horizontal pass (allocated on first use)
+  Framebuffer rows_fbo_;
   FullscreenPass quad_;
   StageTimer timer_;
   int runs_ = 0;

@@ -110,7 +110,9 @@ INSTANTIATE_TEST_SUITE_P(Variants, FilterVsCpu,
                                            std::make_tuple(FilterKind::BilateralDepth, true, 8.0f),
                                            std::make_tuple(FilterKind::Bilateral, false, 8.0f),
                                            std::make_tuple(FilterKind::Bilateral, true, 2.5f),
-                                           std::make_tuple(FilterKind::BilateralDepth, false, 0.0f)));
+                                           std::make_tuple(FilterKind::BilateralDepth, false, 0.0f),
+                                           std::make_tuple(FilterKind::Separable, false, 8.0f),
+                                           std::make_tuple(FilterKind::Separable, true, 3.0f)));
 
 TEST(FilterVsCpu, EdgesArePreserved) {
   // A step in range color with constant HV on each side: the filter must not mix the sides.

@@ -7,9 +7,11 @@
 namespace pxf {
 
 // Cross bilateral filter variants: "bilateral-depth" (SPEC default: spatial x color x depth) and
-// "bilateral" (spatial x color, no depth term). Both are the exact (non-separable) kernel.
-enum class FilterKind { BilateralDepth, Bilateral };
-const std::vector<std::string>& filter_kind_names();  // "bilateral-depth", "bilateral"
+// "bilateral" (spatial x color, no depth term) are the exact square kernel; "separable" is the
+// bilateral-depth weight applied as a horizontal then a vertical 1D pass (an approximation of
+// the 2D kernel, about 2r+1 times cheaper; its Var[L_f] is exact for what it computes).
+enum class FilterKind { BilateralDepth, Bilateral, Separable };
+const std::vector<std::string>& filter_kind_names();  // "bilateral-depth", "bilateral", "separable"
 const char* filter_kind_name(FilterKind kind);
 FilterKind parse_filter_kind(const std::string& name);  // throws pxf::Error listing the names
 

@@ -1,11 +1,16 @@
 #version 450 core
 // Cross bilateral filter (SPEC 3.3) of the HV buffer guided by the range buffer, with the variance
 // of the result: L_f = sum w L_u / sum w, Var[L_f] = sum w^2 Var[L_u] / (sum w)^2.
+// extent (1,1): the full square kernel; (1,0) then (0,1): the separable variant's two 1D passes
+// (the second filters the first's output, whose rows are independent, so its variance is exact).
 #include "common.glsl"
 
 layout(binding = 0) uniform sampler2D hv_tex;     // rgb L_u, a Var[L_u] (kVarUnknown: n < 2)
 layout(binding = 1) uniform sampler2D lv_tex;     // rgb L_lv (only for skipping)
 layout(binding = 2) uniform sampler2D guide_tex;  // rgb range color, a distance
+layout(binding = 3) uniform sampler2D signal_tex; // what is filtered: hv_tex, or the first 1D pass
+uniform ivec2 extent;
+uniform int final_pass;  // skipping and counting happen in the final pass only
 uniform int radius;
 uniform float k_s;   // 1 / (2 sigma_s^2)
 uniform float k_c;   // 1 / (2 sigma_c^2)
@@ -22,20 +27,20 @@ void main() {
   vec4 hv_p = texelFetch(hv_tex, p, 0);
   vec3 lu_p = clean(hv_p.rgb);
   float v_p = clean_var(hv_p.a);
-  if (skip_case2 != 0 && v_p >= 0.0) {
+  if (final_pass != 0 && skip_case2 != 0 && v_p >= 0.0) {
     float lb = max(luminance(lu_p) + luminance(clean(texelFetch(lv_tex, p, 0).rgb)), 0.0);
     if (relative_variance(v_p, lb) <= max(t, 0.0)) {
       out_filtered = vec4(lu_p, kVarSkipped);
       return;
     }
   }
-  atomicAdd(filtered_pixels, 1u);
+  if (final_pass != 0) atomicAdd(filtered_pixels, 1u);
   vec4 g_p = texelFetch(guide_tex, p, 0);
   vec3 r_p = clean(g_p.rgb);
   float d_p = clean(g_p.a);
   float sw = 0.0, sw2v = 0.0, sw2u = 0.0, swk = 0.0, swv = 0.0;
   vec3 swl = vec3(0.0);
-  ivec2 lo = max(p - radius, ivec2(0)), hi = min(p + radius, size - 1);
+  ivec2 lo = max(p - radius * extent, ivec2(0)), hi = min(p + radius * extent, size - 1);
   for (int qy = lo.y; qy <= hi.y; ++qy) {
     float dy2 = float((qy - p.y) * (qy - p.y));
     for (int qx = lo.x; qx <= hi.x; ++qx) {
@@ -45,7 +50,7 @@ void main() {
       float dd = d_p - clean(g_q.a);
       float e = (float((qx - p.x) * (qx - p.x)) + dy2) * k_s + dot(dr, dr) * k_c + dd * dd * k_d;
       float w = exp(-e);
-      vec4 hv_q = texelFetch(hv_tex, q, 0);
+      vec4 hv_q = texelFetch(signal_tex, q, 0);
       float v_q = clean_var(hv_q.a);
       sw += w;
       swl += w * clean(hv_q.rgb);

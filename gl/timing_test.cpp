@@ -1,0 +1,70 @@
+// Per-pass timings at 512x512 (run explicitly: gl_tests --gtest_also_run_disabled_tests
+// --gtest_filter='*Timing*'). Not part of the default run: it takes seconds on llvmpipe.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <random>
+#include "gl/blend_pass.h"
+#include "gl/filter_pass.h"
+#include "gl/inputs.h"
+#include "gl/range_pass.h"
+#include "gl/test_util.h"
+#include "gl/tonemap_pass.h"
+
+namespace pxf {
+namespace {
+
+TEST(Timing, DISABLED_Passes512) {
+  GlContext& ctx = test::osmesa_context();
+  const int w = 512, h = 512;
+  std::printf("GL: %s / %s (%s)\n", ctx.gl_version().c_str(), ctx.gl_renderer().c_str(), ctx.backend_name());
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<float> u01(0.0f, 1.0f);
+  std::vector<float> lv(w * h * 3), hv(w * h * 3), var(w * h);
+  for (float& v : lv) v = 0.2f * u01(rng);
+  for (float& v : hv) v = u01(rng);
+  for (float& v : var) v = 0.05f * u01(rng);
+  PreviewInputs inputs(w, h);
+  for (int i = 0; i < 3; ++i) inputs.upload(lv.data(), hv.data(), var.data());
+  std::printf("upload (lv + hv/var): %.2f ms\n", inputs.last_upload_ms());
+
+  RangePass range(w, h);
+  Scene scene;
+  try {
+    scene = load_scene("cornell");
+  } catch (const std::exception& e) {
+    std::printf("no cornell scene (%s)\n", e.what());
+  }
+  range.set_scene(scene);
+  double range_total = 0;
+  while (range.step()) range_total += range.last_ms();
+  std::printf("range pass: %d frames, %.2f ms per frame, %.1f ms total\n", range.frames(),
+              range_total / range.frames(), range_total);
+
+  FilterPass filter(w, h);
+  for (FilterKind kind : {FilterKind::BilateralDepth, FilterKind::Bilateral, FilterKind::Separable}) {
+    for (bool skip : {false, true}) {
+      FilterParams p;
+      p.kind = kind;
+      p.skip_case2 = skip;
+      p.t = 0.05f;
+      filter.run(inputs, range.guide(), p);
+      std::printf("filter %s sigma_s=8 skip=%d: %.1f ms (%u of %d pixels filtered)\n", filter_kind_name(kind), skip,
+                  filter.last_ms(), filter.filtered_pixels(), w * h);
+    }
+  }
+  BlendPass blend(w, h);
+  TonemapPass tonemap(w, h);
+  for (int i = 0; i < 3; ++i) {
+    blend.run(inputs, &filter, {0.01f});
+    tonemap.run(blend.output(), {});
+  }
+  std::printf("blend: %.2f ms\ntone map: %.2f ms\n", blend.last_ms(), tonemap.last_ms());
+  StageTimer t;
+  t.begin();
+  Image a = blend.final_image(), b = tonemap.display_image(), c = filter.filtered_image();
+  std::printf("read-back of 3 images: %.2f ms\n", t.end());
+}
+
+}  // namespace
+}  // namespace pxf
