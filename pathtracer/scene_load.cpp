@@ -87,6 +87,12 @@ double number_or(const tinygltf::Value& value, double fallback) {
   return value.IsNumber() ? value.GetNumberAsDouble() : fallback;
 }
 
+// An integer-valued property; `fallback` when absent, not a number or outside int range.
+int int_or(const tinygltf::Value& value, int fallback) {
+  double v = number_or(value, fallback);
+  return std::isfinite(v) && v >= -2147483648.0 && v <= 2147483647.0 ? static_cast<int>(v) : fallback;
+}
+
 glm::vec3 value_vec3_or(const tinygltf::Value& value, glm::vec3 fallback) {
   if (!value.IsArray() || value.ArrayLen() < 3) return fallback;
   glm::vec3 out;
@@ -99,12 +105,16 @@ const tinygltf::Value* find_extension(const tinygltf::ExtensionMap& extensions, 
   return it != extensions.end() && it->second.IsObject() ? &it->second : nullptr;
 }
 
-// First non-empty line of a (possibly multi-line) tinygltf message.
+// First non-empty line of a (possibly multi-line) tinygltf message, cut short: tinygltf quotes
+// whole data URIs in some messages.
 std::string first_line(const std::string& text) {
   std::istringstream in(text);
   std::string line;
   while (std::getline(in, line))
-    if (line.find_first_not_of(" \t\r") != std::string::npos) return line;
+    if (line.find_first_not_of(" \t\r") != std::string::npos) {
+      if (!line.empty() && line.back() == '\r') line.pop_back();
+      return line.size() > 160 ? line.substr(0, 160) + "..." : line;
+    }
   return "unknown error";
 }
 
@@ -227,8 +237,8 @@ class GltfLoader {
   static TextureInfoView info_of(const tinygltf::Value& value) {
     TextureInfoView view;
     if (!value.IsObject()) return view;
-    view.index = static_cast<int>(number_or(value.Get("index"), -1));
-    view.texcoord = static_cast<int>(number_or(value.Get("texCoord"), 0));
+    view.index = int_or(value.Get("index"), -1);
+    view.texcoord = int_or(value.Get("texCoord"), 0);
     const tinygltf::Value& ext = member(member(value, "extensions"), "KHR_texture_transform");
     if (ext.IsObject()) view.transform = &ext;
     return view;
@@ -251,7 +261,7 @@ class GltfLoader {
         scale = {finite_or(number_or(s.Get(0), 1), 1), finite_or(number_or(s.Get(1), 1), 1)};
       float rotation = finite_or(number_or(t.Get("rotation"), 0), 0);
       ref.transform = texture_transform_matrix(offset, rotation, scale);
-      if (t.Get("texCoord").IsNumber()) ref.texcoord = t.Get("texCoord").GetNumberAsInt();
+      if (t.Get("texCoord").IsNumber()) ref.texcoord = int_or(t.Get("texCoord"), -1);
     }
     if (ref.texcoord != 0 && ref.texcoord != 1) {
       warn("material '" + material + "' " + slot + " uses TEXCOORD_" + std::to_string(ref.texcoord) +
@@ -432,7 +442,7 @@ class GltfLoader {
     else if (node.mesh < -1) fail("node " + std::to_string(index) + " mesh index out of range");
     if (node.camera >= 0) add_camera(node.camera, world);
     if (const tinygltf::Value* ext = find_extension(node.extensions, "KHR_lights_punctual"))
-      add_light(static_cast<int>(number_or(ext->Get("light"), -1)), world);
+      add_light(int_or(ext->Get("light"), -1), world);
     for (int child : node.children) visit_node(child, world, on_path);
     on_path[index] = false;
   }
