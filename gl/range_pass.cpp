@@ -214,6 +214,7 @@ void RangePass::apply_specular_chains(const std::vector<uint32_t>& pixels, const
 }
 
 void RangePass::end_frame() {
+  if (frames_ == 0) last_change_ = 1.0f;
   const int next = 1 - current_;  // ping-pong: never sample the texture being written
   accumulate_.set("count", frames_ + 1);
   frame_color_.bind(0);
@@ -223,8 +224,11 @@ void RangePass::end_frame() {
   quad_.draw(accum_fbo_[next], width_, height_);
   current_ = next;
   ++frames_;
-  reduction_.run(change_, 0);
-  last_change_ = reduction_.read_sum() / (static_cast<float>(width_) * height_);
+  // The change is only needed once min_frames are in (its GPU reduction costs about a raster).
+  if (frames_ >= settings_.min_frames) {
+    reduction_.run(change_, 0);
+    last_change_ = reduction_.read_sum() / (static_cast<float>(width_) * height_);
+  }
   converged_ = frames_ >= settings_.max_frames || (frames_ >= settings_.min_frames && last_change_ < settings_.tolerance);
   timer_.end();
   check_gl_error("range pass");

@@ -26,7 +26,7 @@ namespace pxf {
 struct RangeSettings {
   int max_frames = 32;      // frame cap of the accumulation
   int min_frames = 8;        // so that the jitter sequence's mean is near the pixel center
-  float tolerance = 2e-4f;  // mean over pixels of the per-frame change (color, relative distance)
+  float tolerance = 5e-4f;  // (decays about as 1/frames where there are edges)  // mean over pixels of the per-frame change (color, relative distance)
 };
 
 class RangePass {

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <cstdlib>
+#include <string>
 #include <random>
 #include "gl/blend_pass.h"
 #include "gl/filter_pass.h"
@@ -38,11 +40,31 @@ TEST(Timing, DISABLED_Passes512) {
   range.set_scene(scene);
   double range_total = 0;
   while (range.step()) range_total += range.last_ms();
-  std::printf("range pass: %d frames, %.2f ms per frame, %.1f ms total\n", range.frames(),
-              range_total / range.frames(), range_total);
+  std::printf("range pass: %d frames, %.2f ms per frame, %.1f ms total (last change %g)\n", range.frames(),
+              range_total / range.frames(), range_total, range.last_change());
+  {
+    range.invalidate();
+    StageTimer raster, accumulate;
+    raster.begin();
+    range.begin_frame();
+    raster.end();
+    accumulate.begin();
+    range.end_frame();
+    accumulate.end();
+    std::printf("  raster %.2f ms, accumulate + convergence %.2f ms\n", raster.last_ms(), accumulate.last_ms());
+    GpuReduction reduction;
+    StageTimer rt;
+    rt.begin();
+    reduction.run(range.guide(), 0);
+    float sum = reduction.read_sum();
+    rt.end();
+    std::printf("  reduction alone %.2f ms (sum %g)\n", rt.last_ms(), sum);
+  }
 
   FilterPass filter(w, h);
+  const char* only = std::getenv("PXF_TIMING_FILTER");  // e.g. "separable" to skip the slow ones
   for (FilterKind kind : {FilterKind::BilateralDepth, FilterKind::Bilateral, FilterKind::Separable}) {
+    if (only && std::string(only) != filter_kind_name(kind)) continue;
     for (bool skip : {false, true}) {
       FilterParams p;
       p.kind = kind;
