@@ -35,8 +35,9 @@ class GlContext {
   virtual void present() {}  // swap buffers for a window; no-op headless
   virtual GlBackend backend() const = 0;
   const char* backend_name() const { return gl_backend_name(backend()); }
-  std::string gl_version() const;   // GL_VERSION of this context (makes no context current)
-  std::string gl_renderer() const;  // GL_RENDERER
+  // GL_VERSION / GL_RENDERER of the current context (call after make_current()).
+  std::string gl_version() const;
+  std::string gl_renderer() const;
   virtual GlProc get_proc_address(const char* name) const = 0;
   virtual void* native_window() const { return nullptr; }  // GLFWwindow* for the window back end
   virtual bool should_close() const { return false; }

@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <cstdlib>
+
 #include "gl/context.h"
 #include "gl/gl.h"
 #include "gl/resources.h"
@@ -76,6 +78,19 @@ TEST(GlContext, AutoWithoutWindowIsHeadless) {
   EXPECT_NE(ctx->backend(), GlBackend::Window);
   draw_and_check_pattern();
   ctx.reset();
+  test::osmesa_context();
+}
+
+TEST(GlContext, WindowWithoutDisplayIsAOneLineError) {
+  if (std::getenv("DISPLAY") || std::getenv("WAYLAND_DISPLAY")) GTEST_SKIP() << "a display exists";
+  try {
+    create_gl_context(GlBackend::Window);
+    FAIL() << "created a window without a display";
+  } catch (const Error& e) {
+    std::string m = e.what();
+    EXPECT_EQ(m.rfind("window: ", 0), 0u) << m;
+    EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+  }
   test::osmesa_context();
 }
 
