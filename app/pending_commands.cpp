@@ -3,5 +3,4 @@
 #include "image/image.h"
 namespace pxf {
 int run_bench(const Args&) { throw Error("bench is not built yet"); }
-int run_explore(const Args&) { throw Error("explore is not built yet"); }
 }  // namespace pxf

@@ -83,6 +83,8 @@ class Preview {
   const BlendPass& blend() const { return blend_; }
   const TonemapPass& tonemap() const { return tonemap_; }
   bool has_filtered() const { return have_filtered_; }
+  // Runs the range pass until it has converged (the explorer's range views need it while no filter runs).
+  void converge_range_buffer() { converge_range(); }
 
   Image display_image() const;        // tone-mapped sRGB "R,G,B" in [0,1]
   Image final_image() const;          // linear radiance after the blend

@@ -1,0 +1,30 @@
+// pxf explore: command line of the Dear ImGui explorer (issue 6); the window is app/explorer.cpp.
+#include "app/commands.h"
+#include "app/explorer.h"
+#include "app/explorer_views.h"
+
+namespace pxf {
+
+int run_explore(const Args& args) {
+  ExploreOptions o;
+  CommandLine cli("explore", "[options]",
+                  "Interactive explorer: a window that renders progressively with pixel filtering. Every buffer\n"
+                  "viewable (keys 1-0), split view, pixel inspector, live parameters, camera (drag: orbit,\n"
+                  "right drag: pan, wheel: zoom, WASD/QE: fly, R: reset), capture (P) into --out DIR with the\n"
+                  "same files as `pxf render`. Drop a .gltf/.glb onto the window to load it.");
+  add_scene_options(cli, o.scene, /*headless=*/false);
+  add_preview_options(cli, o.preview);
+  cli.choice("--view", &o.view, buffer_view_names(), "initial buffer view (default final)");
+  cli.option("--spp", &o.spp, "stop path tracing at this many samples per pixel (default: never)", 0, 1 << 24);
+  cli.option("--zoom", &o.zoom, "display zoom of the image (default: fit the window)", 0, 16);
+  cli.option("--out", &o.out, "DIR", "capture folder (default out)");
+  cli.option("--frames", &o.frames, "quit after N displayed frames (testing)", 0, 1 << 30);
+  cli.option("--screenshot", &o.screenshot, "FILE.png", "save the whole window (UI included) before quitting");
+  cli.flag("--capture", &o.capture_on_exit, "capture into --out before quitting (with --frames)");
+  if (!cli.parse(args)) return 0;
+  if (print_scene_list_if_asked(o.scene)) return 0;
+  o.all_hv_given = cli.given("--all-hv");
+  return run_explorer(o);
+}
+
+}  // namespace pxf

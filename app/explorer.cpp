@@ -1,0 +1,660 @@
+#include "app/explorer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <deque>
+#include <memory>
+#include <vector>
+
+#include "app/explorer_camera.h"
+#include "app/explorer_views.h"
+#include "app/preview.h"
+#include "app/render_output.h"
+#include "gl/context.h"
+#include "gl/gl.h"
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+#include <imgui.h>
+#include <imgui_stdlib.h>
+#include <backends/imgui_impl_glfw.h>
+#include <backends/imgui_impl_opengl3.h>
+
+namespace pxf {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+constexpr float kPanelWidth = 430.0f;
+constexpr double kTraceBudgetMs = 30.0;  // path tracing per displayed frame when it is fast
+constexpr int kMaxFramesPerDisplay = 32;
+constexpr size_t kPlotLength = 600;
+constexpr float kDividerGrabPixels = 6.0f;
+
+// Scene files dropped onto the window since the last frame (GLFW calls back from glfwPollEvents).
+std::vector<std::string> g_dropped_paths;
+void on_drop(GLFWwindow*, int count, const char** paths) {
+  for (int i = 0; i < count; ++i) g_dropped_paths.emplace_back(paths[i]);
+}
+
+double ms_between(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double, std::milli>(b - a).count();
+}
+
+// One texel of a GPU texture as RGBA floats (a 16-byte read-back; missing channels read 0, alpha 1).
+glm::vec4 read_texel(const Texture2D& texture, int x, int y) {
+  glm::vec4 v(0.0f);
+  glGetTextureSubImage(texture.id(), 0, x, y, 0, 1, 1, 1, GL_RGBA, GL_FLOAT, sizeof(v), &v.x);
+  return v;
+}
+
+float luminance(const glm::vec4& c) { return pxf::luminance(c.r, c.g, c.b); }
+
+// The default framebuffer (window plus UI) as an sRGB PNG-ready image, top row first.
+Image read_window(int width, int height) {
+  std::vector<unsigned char> rgba(static_cast<size_t>(width) * height * 4);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+  glReadBuffer(GL_BACK);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
+  Image image = Image::rgb(width, height);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x)
+      for (int c = 0; c < 3; ++c)  // GL rows go bottom-up
+        image.at(x, y, c) = rgba[(static_cast<size_t>(height - 1 - y) * width + x) * 4 + c] / 255.0f;
+  return image;
+}
+
+// Everything the inspector shows of one pixel.
+struct PixelProbe {
+  int x = -1, y = -1;
+  glm::vec4 final_s, lv, hv_var, filtered_var, guide;
+  float case_code = 0;
+  uint32_t n = 0;
+  float background = 0, u = 0, f = 0;
+  bool has_filtered = false;
+};
+
+PixelProbe probe_pixel(const Preview& preview, int x, int y) {
+  PixelProbe p;
+  p.x = x;
+  p.y = y;
+  p.final_s = read_texel(preview.blend().output(), x, y);
+  p.lv = read_texel(preview.inputs().lv(), x, y);
+  p.hv_var = read_texel(preview.inputs().hv(), x, y);
+  p.has_filtered = preview.has_filtered();
+  p.filtered_var = p.has_filtered ? read_texel(preview.filter().output(), x, y) : p.hv_var;
+  p.guide = read_texel(preview.range().guide(), x, y);
+  p.case_code = read_texel(preview.blend().case_texture(), x, y).r;
+  p.n = preview.renderer().accumulation().samples[static_cast<size_t>(y) * preview.width() + x];
+  // SPEC 3.4: L_b = Y(L_f) + Y(L_lv); u and f relative to it (0 where the variance is unknown).
+  p.background = luminance(p.filtered_var) + luminance(p.lv);
+  const float b2 = p.background * p.background;
+  p.u = p.hv_var.a > 0 && b2 > 0 ? p.hv_var.a / b2 : 0.0f;
+  p.f = p.has_filtered && p.filtered_var.a > 0 && b2 > 0 ? p.filtered_var.a / b2 : 0.0f;
+  return p;
+}
+
+std::string variance_text(float v) {
+  char text[64];
+  if (v == kVarSkipped) return "skipped (case 2)";
+  if (v < 0) return "unknown";
+  std::snprintf(text, sizeof(text), "%.4g", v);
+  return text;
+}
+
+class Explorer {
+ public:
+  Explorer(ExploreOptions& options, GlContext& context)
+      : options_(options), context_(context), window_(static_cast<GLFWwindow*>(context.native_window())) {
+    settings_ = options_.preview.settings;
+    view_ = parse_buffer_view(options_.view);
+    out_dir_ = options_.out;
+    load(options_.scene.scene, /*first=*/true);
+    views_ = std::make_unique<ViewRenderer>(preview_->width(), preview_->height());
+    divider_ = 0.5f * width_;
+    init_imgui();
+  }
+  ~Explorer() {
+    ImGui_ImplOpenGL3_Shutdown();
+    ImGui_ImplGlfw_Shutdown();
+    ImGui::DestroyContext();
+  }
+
+  int run() {
+    started_ = Clock::now();
+    for (int frame = 0; !context_.should_close(); ++frame) {
+      glfwPollEvents();
+      load_dropped_scenes();
+      ImGui_ImplOpenGL3_NewFrame();
+      ImGui_ImplGlfw_NewFrame();
+      ImGui::NewFrame();
+      image_window();
+      panel();
+      handle_keys();
+      apply_changes();
+      trace();
+      render_views();
+      ImGui::Render();
+      draw_to_window();
+      const bool last = options_.frames > 0 && frame + 1 >= options_.frames;
+      if (last) finish_run();
+      context_.present();
+      if (last) break;
+    }
+    return 0;
+  }
+
+ private:
+  // --- scene ---------------------------------------------------------------------------------
+  void load(const std::string& path, bool first) {
+    try {
+      auto scene = std::make_unique<Scene>(load_scene(path, first ? options_.scene.env : "", options_.scene.env_strength));
+      for (const std::string& w : scene->warnings) std::fprintf(stderr, "pxf: warning: %s\n", w.c_str());
+      if (!options_.all_hv_given) settings_.trace.all_hv = scene->defaults.all_hv;
+      if (first) size_image(*scene);
+      auto preview = std::make_unique<Preview>(*scene, settings_, width_, height_);
+      controller_ = std::make_unique<CameraController>(scene->camera, scene_bounds(*scene));
+      preview_ = std::move(preview);  // the old preview goes before its scene
+      scene_ = std::move(scene);
+      options_.scene.scene = path;
+      scene_error_.clear();
+      history_.clear();
+    } catch (const Error& e) {
+      if (first) throw;
+      scene_error_ = e.what();  // keep the previous scene running
+      std::fprintf(stderr, "pxf explore: %s\n", e.what());
+    }
+  }
+
+  void size_image(const Scene& scene) {
+    width_ = options_.scene.width, height_ = options_.scene.height;
+    if (width_ == 0) {
+      width_ = scene.defaults.width > 0 ? scene.defaults.width : 512;
+      height_ = scene.defaults.height > 0 ? scene.defaults.height : 512;
+    }
+  }
+
+  void load_dropped_scenes() {
+    std::vector<std::string> paths;
+    paths.swap(g_dropped_paths);
+    for (const std::string& p : paths) load(p, false);
+  }
+
+  // --- ImGui set-up and window ---------------------------------------------------------------
+  void init_imgui() {
+    IMGUI_CHECKVERSION();
+    ImGui::CreateContext();
+    ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini in the working directory
+    ImGui::StyleColorsDark();
+    ImGui_ImplGlfw_InitForOpenGL(window_, true);
+    ImGui_ImplOpenGL3_Init("#version 450");
+    glfwSetDropCallback(window_, on_drop);
+  }
+
+  float zoom(float area_w, float area_h) const {
+    if (options_.zoom > 0) return static_cast<float>(options_.zoom);
+    const float fit = std::min(area_w / width_, area_h / height_);
+    return fit >= 1.0f ? std::floor(fit) : fit;  // integer magnification keeps pixels square
+  }
+
+  // The image at the top-left of the window, at an integer zoom when it fits.
+  void image_window() {
+    const ImGuiIO& io = ImGui::GetIO();
+    const float area_w = io.DisplaySize.x - kPanelWidth, area_h = io.DisplaySize.y;
+    ImGui::SetNextWindowPos(ImVec2(0, 0));
+    ImGui::SetNextWindowSize(ImVec2(area_w, area_h));
+    ImGui::PushStyleVar(ImGuiStyleVar_WindowPadding, ImVec2(0, 0));
+    ImGui::PushStyleVar(ImGuiStyleVar_WindowBorderSize, 0.0f);
+    ImGui::Begin("image", nullptr,
+                 ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoBringToFrontOnFocus |
+                     ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoScrollWithMouse);
+    scale_ = zoom(area_w, area_h);
+    const ImVec2 size(width_ * scale_, height_ * scale_);
+    const ImVec2 origin = ImGui::GetCursorScreenPos();
+    ImGui::InvisibleButton("canvas", size,
+                           ImGuiButtonFlags_MouseButtonLeft | ImGuiButtonFlags_MouseButtonRight |
+                               ImGuiButtonFlags_MouseButtonMiddle);
+    const bool hovered = ImGui::IsItemHovered(), active = ImGui::IsItemActive();
+    ImGui::GetWindowDrawList()->AddImage(texture_id(shown_texture()), origin,
+                                         ImVec2(origin.x + size.x, origin.y + size.y));
+    mouse_on_image(origin, hovered, active);
+    if (hovered && inspector_ && !active) inspector_tooltip(origin);
+    ImGui::End();
+    ImGui::PopStyleVar(2);
+  }
+
+  static ImTextureID texture_id(const Texture2D& t) { return reinterpret_cast<ImTextureID>(static_cast<intptr_t>(t.id())); }
+
+  const Texture2D& shown_texture() { return views_->shown(split_); }
+
+  void mouse_on_image(const ImVec2& origin, bool hovered, bool active) {
+    const ImGuiIO& io = ImGui::GetIO();
+    const float divider_screen = origin.x + divider_ * scale_;
+    if (split_ && hovered && ImGui::IsMouseClicked(ImGuiMouseButton_Left) &&
+        std::abs(io.MousePos.x - divider_screen) <= kDividerGrabPixels)
+      dragging_divider_ = true;
+    if (!ImGui::IsMouseDown(ImGuiMouseButton_Left)) dragging_divider_ = false;
+    if (dragging_divider_) {
+      divider_ = std::clamp((io.MousePos.x - origin.x) / scale_, 0.0f, static_cast<float>(width_));
+      return;
+    }
+    if (active && (io.MouseDelta.x != 0 || io.MouseDelta.y != 0)) {
+      if (ImGui::IsMouseDown(ImGuiMouseButton_Left)) controller_->orbit(io.MouseDelta.x, io.MouseDelta.y);
+      else controller_->pan(io.MouseDelta.x, io.MouseDelta.y, height_ * scale_);
+      camera_changed_ = true;
+    }
+    if (hovered && io.MouseWheel != 0) {
+      controller_->zoom(io.MouseWheel);
+      camera_changed_ = true;
+    }
+    dragging_camera_ = active;
+  }
+
+  // Magnifier (nearest-neighbour crop of the shown view) and every buffer's value at the cursor.
+  void inspector_tooltip(const ImVec2& origin) {
+    const ImGuiIO& io = ImGui::GetIO();
+    const int x = static_cast<int>((io.MousePos.x - origin.x) / scale_);
+    const int y = static_cast<int>((io.MousePos.y - origin.y) / scale_);
+    if (x < 0 || y < 0 || x >= width_ || y >= height_) return;
+    const PixelProbe p = probe_pixel(*preview_, x, y);
+    ImGui::BeginTooltip();
+    constexpr float kHalf = 8.0f;
+    const ImVec2 uv0((x - kHalf) / width_, (y - kHalf) / height_), uv1((x + kHalf + 1) / width_, (y + kHalf + 1) / height_);
+    const ImVec2 at = ImGui::GetCursorScreenPos();
+    ImGui::Image(texture_id(shown_texture()), ImVec2(153, 153), uv0, uv1);
+    const float cell = 153.0f / (2 * kHalf + 1);  // outline the pixel under the cursor
+    ImGui::GetWindowDrawList()->AddRect(ImVec2(at.x + kHalf * cell, at.y + kHalf * cell),
+                                        ImVec2(at.x + (kHalf + 1) * cell, at.y + (kHalf + 1) * cell), IM_COL32(255, 255, 255, 255));
+    ImGui::Text("pixel (%d, %d)   n = %u", p.x, p.y, p.n);
+    ImGui::Text("final     %.4g %.4g %.4g", p.final_s.r, p.final_s.g, p.final_s.b);
+    ImGui::Text("LV        %.4g %.4g %.4g", p.lv.r, p.lv.g, p.lv.b);
+    ImGui::Text("HV L_u    %.4g %.4g %.4g", p.hv_var.r, p.hv_var.g, p.hv_var.b);
+    if (p.has_filtered) ImGui::Text("HV L_f    %.4g %.4g %.4g", p.filtered_var.r, p.filtered_var.g, p.filtered_var.b);
+    else ImGui::TextDisabled("HV L_f    (filter has not run)");
+    ImGui::Text("Var[L_u]  %s", variance_text(p.hv_var.a).c_str());
+    ImGui::Text("Var[L_f]  %s", p.has_filtered ? variance_text(p.filtered_var.a).c_str() : "-");
+    ImGui::Text("L_b %.4g   u %.4g   f %.4g   t %.4g", p.background, p.u, p.f, settings_.threshold);
+    const int code = static_cast<int>(p.case_code + 0.5f);
+    ImGui::Text("s %.4f   case %s", p.final_s.a, code >= 0 && code < kBlendCaseCount ? case_styles()[code].label : "?");
+    ImGui::Text("range     %.3f %.3f %.3f   depth %.4g", p.guide.r, p.guide.g, p.guide.b, p.guide.a);
+    ImGui::EndTooltip();
+  }
+
+  // --- the panel ------------------------------------------------------------------------------
+  void panel() {
+    const ImGuiIO& io = ImGui::GetIO();
+    ImGui::SetNextWindowPos(ImVec2(io.DisplaySize.x - kPanelWidth, 0));
+    ImGui::SetNextWindowSize(ImVec2(kPanelWidth, io.DisplaySize.y));
+    ImGui::Begin("pxf explorer", nullptr, ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
+    ImGui::PushItemWidth(200);
+    status_section();
+    view_section();
+    comparison_section();
+    parameter_section();
+    camera_section();
+    capture_section();
+    scene_section();
+    ImGui::PopItemWidth();
+    ImGui::End();
+  }
+
+  void status_section() {
+    if (!ImGui::CollapsingHeader("Status", ImGuiTreeNodeFlags_DefaultOpen)) return;
+    const int pixels = width_ * height_;
+    ImGui::Text("%d spp%s   %dx%d   %.2f Mpaths/s", preview_->samples(),
+                options_.spp > 0 && preview_->samples() >= options_.spp ? " (done)" : (paused_ ? " (paused)" : ""),
+                width_, height_, paths_per_second_ / 1e6);
+    ImGui::Text("ms: trace %.1f/frame  range %.1f  filter %.1f", stage_ms_.path_tracing, stage_ms_.range,
+                preview_->filter().last_ms());
+    ImGui::Text("    blend %.2f  tone map %.2f   filter runs %d%s", stage_ms_.blend, stage_ms_.tonemap,
+                preview_->filter_runs(), preview_->filter_stopped() ? " (stopped: all case 2)" : "");
+    const auto& counts = preview_->case_counts();
+    ImGui::Text("cases  0: %.1f%%  1: %.1f%%  2: %.1f%%  3: %.1f%%  4: %.1f%%", 100.0 * counts[0] / pixels,
+                100.0 * counts[1] / pixels, 100.0 * counts[2] / pixels, 100.0 * counts[3] / pixels,
+                100.0 * counts[4] / pixels);
+    const std::vector<float> plot(history_.begin(), history_.end());
+    char overlay[64];
+    std::snprintf(overlay, sizeof(overlay), "pixels at s = 1: %.1f%%", plot.empty() ? 0.0 : 100.0 * plot.back());
+    ImGui::PlotLines("##s1", plot.data(), static_cast<int>(plot.size()), 0, overlay, 0.0f, 1.0f,
+                     ImVec2(kPanelWidth - 30, 60));
+    if (!scene_error_.empty()) ImGui::TextColored(ImVec4(1, 0.35f, 0.3f, 1), "%s", scene_error_.c_str());
+    if (!status_message_.empty()) ImGui::TextWrapped("%s", status_message_.c_str());
+  }
+
+  void view_section() {
+    if (!ImGui::CollapsingHeader("Buffer view (keys 1-0)", ImGuiTreeNodeFlags_DefaultOpen)) return;
+    ImGui::BeginChild("views", ImVec2(0, 11 * ImGui::GetTextLineHeightWithSpacing() + 4), true);
+    for (int i = 0; i < kBufferViewCount; ++i)
+      if (ImGui::Selectable(buffer_view_label(BufferView(i)), view_ == BufferView(i))) view_ = BufferView(i);
+    ImGui::EndChild();
+    legend(split_ ? split_left_ : view_);
+    if (split_ && split_right_ != split_left_) legend(split_right_);
+  }
+
+  void legend(BufferView view) {
+    if (view == BufferView::Case) {
+      const auto& counts = preview_->case_counts();
+      for (int c = 0; c < kBlendCaseCount; ++c) {
+        const CaseStyle& style = case_styles()[c];
+        ImGui::ColorButton(style.label, ImVec4(style.r, style.g, style.b, 1), ImGuiColorEditFlags_NoTooltip, ImVec2(14, 14));
+        ImGui::SameLine();
+        ImGui::Text("%-26s %5.1f%%", style.label, 100.0 * counts[c] / (width_ * height_));
+      }
+      return;
+    }
+    if (!is_scalar_view(view)) return;
+    ScalarScale& s = views_->scale(view);
+    ImGui::TextUnformatted(buffer_view_label(view) + 3);
+    const float w = kPanelWidth - 30;
+    ImGui::Image(texture_id(views_->legend(view)), ImVec2(w, 14));
+    const char* format = s.log ? "%.0e" : "%.3g";
+    char lo[32], mid[32], hi[32];
+    std::snprintf(lo, sizeof(lo), format, s.lo);
+    std::snprintf(mid, sizeof(mid), format, s.log ? std::sqrt(s.lo * s.hi) : 0.5f * (s.lo + s.hi));
+    std::snprintf(hi, sizeof(hi), format, s.hi);
+    ImGui::TextUnformatted(lo);
+    ImGui::SameLine(w * 0.5f - ImGui::CalcTextSize(mid).x * 0.5f);
+    ImGui::TextUnformatted(mid);
+    ImGui::SameLine(w - ImGui::CalcTextSize(hi).x);
+    ImGui::TextUnformatted(hi);
+    if (view == BufferView::VarU || view == BufferView::VarF)
+      ImGui::TextDisabled("log scale; dark gray: unknown (n < 2)%s", view == BufferView::VarF ? ", light: skipped" : "");
+    if (view == BufferView::Depth) ImGui::TextDisabled("scene units; black: no surface");
+    if (view == BufferView::Blend) return;
+    ImGui::PushID(static_cast<int>(view));
+    ImGui::Checkbox("auto range", &s.automatic);
+    if (!s.automatic) {
+      ImGui::SameLine();
+      ImGui::SetNextItemWidth(120);
+      ImGui::DragFloat("lo", &s.lo, s.log ? 0.0f : 0.01f * (s.hi - s.lo), 0, 0, "%.3g");
+      ImGui::SameLine();
+      ImGui::SetNextItemWidth(120);
+      ImGui::DragFloat("hi", &s.hi, s.log ? 0.0f : 0.01f * (s.hi - s.lo), 0, 0, "%.3g");
+      if (s.log) {  // decade steps
+        if (ImGui::SmallButton("lo /10")) s.lo /= 10;
+        ImGui::SameLine();
+        if (ImGui::SmallButton("lo x10")) s.lo = std::min(s.lo * 10, s.hi);
+        ImGui::SameLine();
+        if (ImGui::SmallButton("hi /10")) s.hi = std::max(s.hi / 10, s.lo);
+        ImGui::SameLine();
+        if (ImGui::SmallButton("hi x10")) s.hi *= 10;
+      }
+    }
+    ImGui::PopID();
+  }
+
+  void view_combo(const char* label, BufferView* view) {
+    int index = static_cast<int>(*view);
+    ImGui::Combo(label, &index, [](void*, int i, const char** text) { *text = buffer_view_label(BufferView(i)); return true; },
+                 nullptr, kBufferViewCount);
+    *view = BufferView(index);
+  }
+
+  void comparison_section() {
+    if (!ImGui::CollapsingHeader("Comparison", ImGuiTreeNodeFlags_DefaultOpen)) return;
+    ImGui::Checkbox("split view (drag the divider)", &split_);
+    if (split_) {
+      view_combo("left", &split_left_);
+      view_combo("right", &split_right_);
+      ImGui::SliderFloat("divider", &divider_, 0.0f, static_cast<float>(width_), "%.0f px");
+    }
+    if (ImGui::Button("filtered vs unfiltered")) {
+      split_ = true;
+      split_left_ = BufferView::Final;
+      split_right_ = BufferView::Unfiltered;
+    }
+    ImGui::SameLine();
+    ImGui::Checkbox("magnifier / inspector", &inspector_);
+  }
+
+  void parameter_section() {
+    if (!ImGui::CollapsingHeader("Parameters", ImGuiTreeNodeFlags_DefaultOpen)) return;
+    PreviewSettings& s = settings_;
+    bool changed = false;
+    changed |= ImGui::SliderFloat("threshold t", &s.threshold, 1e-5f, 1.0f, "%.2e", ImGuiSliderFlags_Logarithmic);
+    changed |= ImGui::SliderFloat("sigma s (px)", &s.filter.sigma_s, 0.5f, kMaxFilterRadius / 3.0f, "%.2f");
+    changed |= ImGui::SliderFloat("sigma c", &s.filter.sigma_c, 1e-4f, 10.0f, "%.3g", ImGuiSliderFlags_Logarithmic);
+    changed |= ImGui::SliderFloat("sigma d", &s.filter.sigma_d, 1e-3f, 1e3f, "%.3g", ImGuiSliderFlags_Logarithmic);
+    changed |= name_combo("filter", filter_option_names(), filter_option_name(s),
+                          [&](const std::string& n) { set_filter_option(s, n); });
+    changed |= name_combo("schedule", filter_schedule_names(), filter_schedule_names()[static_cast<int>(s.schedule)],
+                          [&](const std::string& n) { s.schedule = parse_filter_schedule(n); });
+    changed |= ImGui::SliderInt("path length", &s.trace.max_vertices, 2, 32);
+    changed |= ImGui::Checkbox("all HV", &s.trace.all_hv);
+    changed |= ImGui::SliderFloat("exposure key", &s.tonemap.key, 0.01f, 2.0f, "%.3f", ImGuiSliderFlags_Logarithmic);
+    ImGui::Checkbox("pause", &paused_);
+    ImGui::SameLine();
+    ImGui::SetNextItemWidth(120);
+    ImGui::InputInt("stop at spp", &options_.spp, 0);
+    options_.spp = std::max(options_.spp, 0);
+    settings_changed_ |= changed;
+  }
+
+  template <typename Apply>
+  static bool name_combo(const char* label, const std::vector<std::string>& names, const std::string& current, Apply apply) {
+    bool changed = false;
+    if (ImGui::BeginCombo(label, current.c_str())) {
+      for (const std::string& n : names)
+        if (ImGui::Selectable(n.c_str(), n == current) && n != current) {
+          apply(n);
+          changed = true;
+        }
+      ImGui::EndCombo();
+    }
+    return changed;
+  }
+
+  void camera_section() {
+    if (!ImGui::CollapsingHeader("Camera")) return;
+    ImGui::TextWrapped("left drag: orbit   right/middle drag: pan   wheel: zoom   WASD: fly, Q/E: down/up "
+                       "(Shift: faster)   R: reset");
+    if (ImGui::Button("reset camera (R)")) reset_camera();
+    ImGui::SameLine();
+    ImGui::Checkbox("skip filter while moving", &fast_while_moving_);
+  }
+
+  void capture_section() {
+    if (!ImGui::CollapsingHeader("Capture", ImGuiTreeNodeFlags_DefaultOpen)) return;
+    ImGui::InputText("folder", &out_dir_);
+    if (ImGui::Button("save view + buffers (P)")) capture();
+  }
+
+  void scene_section() {
+    if (!ImGui::CollapsingHeader("Scene")) return;
+    ImGui::TextWrapped("%s", options_.scene.scene.c_str());
+    ImGui::InputText("path", &scene_path_);
+    ImGui::SameLine();
+    if (ImGui::Button("load")) load(scene_path_, false);
+    ImGui::TextDisabled("or drop a .gltf/.glb onto the window");
+  }
+
+  // --- input and state ------------------------------------------------------------------------
+  void handle_keys() {
+    const ImGuiIO& io = ImGui::GetIO();
+    if (io.WantTextInput) return;
+    for (int digit = 0; digit <= 9; ++digit)
+      if (ImGui::IsKeyPressed(GLFW_KEY_0 + digit, false)) view_ = BufferView(buffer_view_of_digit(digit));
+    if (ImGui::IsKeyPressed(GLFW_KEY_R, false)) reset_camera();
+    if (ImGui::IsKeyPressed(GLFW_KEY_P, false)) capture();
+    glm::vec3 fly(0.0f);
+    if (ImGui::IsKeyDown(GLFW_KEY_W)) fly.z += 1;
+    if (ImGui::IsKeyDown(GLFW_KEY_S)) fly.z -= 1;
+    if (ImGui::IsKeyDown(GLFW_KEY_D)) fly.x += 1;
+    if (ImGui::IsKeyDown(GLFW_KEY_A)) fly.x -= 1;
+    if (ImGui::IsKeyDown(GLFW_KEY_E)) fly.y += 1;
+    if (ImGui::IsKeyDown(GLFW_KEY_Q)) fly.y -= 1;
+    if (fly != glm::vec3(0.0f)) {
+      controller_->fly(fly * (io.KeyShift ? 4.0f : 1.0f), std::min(io.DeltaTime, 0.1f));
+      camera_changed_ = true;
+    }
+    flying_ = fly != glm::vec3(0.0f);
+  }
+
+  void reset_camera() {
+    controller_->reset();
+    camera_changed_ = true;
+  }
+
+  // Camera moves reset the accumulation; while moving the filter is skipped so the preview keeps
+  // up, and it runs again on the current samples as soon as the camera rests.
+  void apply_changes() {
+    if (camera_changed_) preview_->set_camera(controller_->camera());
+    camera_changed_ = false;
+    const bool moving = fast_while_moving_ && (dragging_camera_ || flying_);
+    if (settings_changed_ || moving != applied_moving_) {
+      PreviewSettings effective = settings_;
+      if (moving) effective.filter_enabled = false;
+      preview_->set_settings(effective);
+      settings_changed_ = false;
+      applied_moving_ = moving;
+    }
+  }
+
+  bool spp_reached() const { return options_.spp > 0 && preview_->samples() >= options_.spp; }
+
+  // One path-traced frame per display frame, more while they fit in the time budget. At the
+  // --spp limit the capture is finished exactly like `pxf render` (last-frame filter run).
+  void trace() {
+    const int before = preview_->samples();
+    if (before < last_samples_) history_.clear();  // the accumulation was reset
+    if (paused_ || spp_reached()) {
+      if (!finished_ && spp_reached()) preview_->finish(), finished_ = true;
+      last_samples_ = preview_->samples();
+      return;
+    }
+    finished_ = false;
+    const double per_frame = std::max(stage_ms_.path_tracing, 0.1);
+    int frames = std::clamp(static_cast<int>(kTraceBudgetMs / per_frame), 1, kMaxFramesPerDisplay);
+    if (options_.spp > 0) frames = std::min(frames, options_.spp - before);
+    const auto start = Clock::now();
+    for (int i = 0; i < frames; ++i) {
+      const bool last = options_.spp > 0 && before + i + 1 == options_.spp;
+      preview_->add_frame(/*last_frame=*/last, /*display=*/i + 1 == frames);
+      finished_ = last;
+      average_stage_times(preview_->last_times());
+    }
+    const double ms = ms_between(start, Clock::now());
+    paths_per_second_ = 0.8 * paths_per_second_ + 0.2 * (frames * double(width_) * height_ / (ms / 1000.0));
+    const auto& counts = preview_->case_counts();
+    history_.push_back(float(counts[kCaseNoFiltered] + counts[kCaseUnfiltered]) / (width_ * height_));
+    if (history_.size() > kPlotLength) history_.pop_front();
+    last_samples_ = preview_->samples();
+  }
+
+  void average_stage_times(const StageTimes& t) {
+    const double a = 0.2;
+    stage_ms_.path_tracing = (1 - a) * stage_ms_.path_tracing + a * t.path_tracing;
+    stage_ms_.upload = (1 - a) * stage_ms_.upload + a * t.upload;
+    if (t.range > 0) stage_ms_.range = t.range;
+    stage_ms_.blend = (1 - a) * stage_ms_.blend + a * t.blend;
+    stage_ms_.tonemap = (1 - a) * stage_ms_.tonemap + a * t.tonemap;
+  }
+
+  void render_views() {
+    if (++auto_scale_counter_ % 8 == 1) {
+      views_->update_auto_scale(split_ ? split_left_ : view_, *preview_);
+      if (split_) views_->update_auto_scale(split_right_, *preview_);
+    }
+    if (split_) views_->show_split(split_left_, split_right_, divider_, *preview_);
+    else views_->show(view_, *preview_);
+  }
+
+  void draw_to_window() {
+    int w, h;
+    glfwGetFramebufferSize(window_, &w, &h);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glViewport(0, 0, w, h);
+    glClearColor(0.08f, 0.08f, 0.09f, 1.0f);
+    glClear(GL_COLOR_BUFFER_BIT);
+    ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+    window_width_ = w, window_height_ = h;
+  }
+
+  // --- capture ----------------------------------------------------------------------------------
+  void capture() {
+    try {
+      options_.preview.settings = settings_;
+      options_.preview.filter = filter_option_name(settings_);
+      options_.preview.schedule = filter_schedule_names()[static_cast<int>(settings_.schedule)];
+      options_.preview.all_hv = settings_.trace.all_hv;
+      options_.scene.width = width_, options_.scene.height = height_;
+      preview_->finish();  // like an interrupted `pxf render`: the last-frame filter run, blend, tone map
+      RenderReport report;
+      report.scene = &options_.scene;
+      report.preview = &options_.preview;
+      report.gl_backend = context_.backend_name();
+      report.gl_renderer = context_.gl_renderer();
+      report.wall_ms = ms_between(started_, Clock::now());
+      write_render_outputs(out_dir_, *preview_, report);
+      views_->show(view_, *preview_);
+      const std::string view_png = out_dir_ + "/view-" + buffer_view_names()[static_cast<int>(view_)] + ".png";
+      write_png(view_png, views_->shown(false).download({"R", "G", "B"}));
+      status_message_ = "saved " + view_png + ", final.png, final.exr, buffers.exr, stats.json in " + out_dir_;
+    } catch (const Error& e) {
+      status_message_ = std::string("capture failed: ") + e.what();
+    }
+    std::fprintf(stderr, "pxf explore: %s\n", status_message_.c_str());
+  }
+
+  void finish_run() {
+    if (options_.capture_on_exit) capture();
+    if (!options_.screenshot.empty()) {
+      write_png(options_.screenshot, read_window(window_width_, window_height_));
+      std::fprintf(stderr, "pxf explore: wrote %s\n", options_.screenshot.c_str());
+    }
+  }
+
+  ExploreOptions& options_;
+  GlContext& context_;
+  GLFWwindow* window_;
+  PreviewSettings settings_;
+  std::unique_ptr<Scene> scene_;
+  std::unique_ptr<Preview> preview_;
+  std::unique_ptr<CameraController> controller_;
+  std::unique_ptr<ViewRenderer> views_;
+  int width_ = 0, height_ = 0, window_width_ = 0, window_height_ = 0;
+  float scale_ = 1.0f;
+  BufferView view_ = BufferView::Final, split_left_ = BufferView::Final, split_right_ = BufferView::Unfiltered;
+  bool split_ = false, inspector_ = true, paused_ = false, finished_ = false;
+  float divider_ = 0.0f;
+  bool dragging_divider_ = false, dragging_camera_ = false, flying_ = false;
+  bool camera_changed_ = false, settings_changed_ = false, applied_moving_ = false, fast_while_moving_ = true;
+  StageTimes stage_ms_;
+  double paths_per_second_ = 0;
+  std::deque<float> history_;
+  int last_samples_ = 0, auto_scale_counter_ = 0;
+  std::string out_dir_, scene_path_, scene_error_, status_message_;
+  Clock::time_point started_;
+};
+
+// The window fits the image at 1:1 (at least) beside the panel, within a usual screen.
+GlContextOptions window_options(const ExploreOptions& o, int width, int height) {
+  GlContextOptions w;
+  w.want_window = true;
+  w.title = "pxf explore";
+  const int zoom = std::max(o.zoom, 1);
+  w.width = std::clamp(width * zoom, 480, 1600) + static_cast<int>(kPanelWidth);
+  w.height = std::clamp(height * zoom, 760, 1000);
+  w.vsync = o.frames == 0;  // tests run as fast as they can
+  return w;
+}
+
+}  // namespace
+
+int run_explorer(ExploreOptions& options) {
+  // The window size depends on the image size: known from --size, else a common default.
+  const int width = options.scene.width > 0 ? options.scene.width : 512;
+  const int height = options.scene.height > 0 ? options.scene.height : 512;
+  finish_preview_options(options.preview);
+  auto context = create_gl_context(parse_gl_backend(options.scene.gl), window_options(options, width, height));
+  if (!context->native_window())
+    throw Error(std::string("explore needs a window; the '") + context->backend_name() +
+                "' back end has none (is DISPLAY set? try --gl window)");
+  Explorer explorer(options, *context);
+  return explorer.run();
+}
+
+}  // namespace pxf

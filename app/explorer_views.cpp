@@ -1,0 +1,233 @@
+#include "app/explorer_views.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "gl/gl.h"
+
+namespace pxf {
+
+namespace {
+
+struct ViewInfo {
+  BufferView view;
+  const char* name;
+  const char* label;
+};
+
+const ViewInfo kViews[kBufferViewCount] = {
+    {BufferView::Final, "final", "1  final (tone-mapped)"},
+    {BufferView::Lv, "lv", "2  LV (low variance)"},
+    {BufferView::Hv, "hv", "3  HV unfiltered L_u"},
+    {BufferView::HvFiltered, "hv-filtered", "4  HV filtered L_f"},
+    {BufferView::RangeColor, "range", "5  range color"},
+    {BufferView::Depth, "depth", "6  depth (distance)"},
+    {BufferView::VarU, "var-u", "7  Var[L_u] (log)"},
+    {BufferView::VarF, "var-f", "8  Var[L_f] (log)"},
+    {BufferView::Blend, "blend", "9  blend factor s"},
+    {BufferView::Case, "case", "0  blend case"},
+    {BufferView::Unfiltered, "unfiltered", "   unfiltered L_lv + L_u"},
+};
+
+const std::array<CaseStyle, kBlendCaseCount> kCaseStyles = {{
+    {"0  no L_f yet (s = 1)", 0.35f, 0.35f, 0.35f},
+    {"1  filtered only (s = 0)", 0.90f, 0.20f, 0.15f},
+    {"2  unfiltered (s = 1)", 0.20f, 0.75f, 0.25f},
+    {"3  mixed (0 < s < 1)", 0.20f, 0.45f, 0.95f},
+    {"4  n < 2 (s = 0)", 0.85f, 0.30f, 0.85f},
+}};
+
+constexpr int kLegendWidth = 256;
+
+// The value at fraction q of the sorted values (q in [0,1]).
+float percentile(std::vector<float>& values, double q) {
+  const size_t k = std::min(values.size() - 1, static_cast<size_t>(q * (values.size() - 1)));
+  std::nth_element(values.begin(), values.begin() + k, values.end());
+  return values[k];
+}
+
+}  // namespace
+
+const std::vector<std::string>& buffer_view_names() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> n;
+    for (const ViewInfo& v : kViews) n.push_back(v.name);
+    return n;
+  }();
+  return names;
+}
+
+const char* buffer_view_label(BufferView view) { return kViews[static_cast<int>(view)].label; }
+
+BufferView parse_buffer_view(const std::string& name) {
+  for (const ViewInfo& v : kViews)
+    if (name == v.name) return v.view;
+  std::string list;
+  for (const ViewInfo& v : kViews) list += (list.empty() ? "" : ", ") + std::string(v.name);
+  throw Error("unknown view '" + name + "' (valid: " + list + ")");
+}
+
+int buffer_view_of_digit(int digit) {
+  if (digit < 0 || digit > 9) return -1;
+  return digit == 0 ? 9 : digit - 1;
+}
+
+bool is_scalar_view(BufferView v) {
+  return v == BufferView::VarU || v == BufferView::VarF || v == BufferView::Blend || v == BufferView::Depth;
+}
+
+const std::array<CaseStyle, kBlendCaseCount>& case_styles() { return kCaseStyles; }
+
+ViewRenderer::ViewRenderer(int width, int height)
+    : width_(width),
+      height_(height),
+      scalar_(Program::from_embedded("fullscreen.vert", "view_scalar.frag")),
+      case_(Program::from_embedded("fullscreen.vert", "view_case.frag")),
+      display_(Program::from_embedded("fullscreen.vert", "view_display.frag")),
+      split_(Program::from_embedded("fullscreen.vert", "view_split.frag")),
+      split_output_(width, height, TextureFormat::RGBA8),
+      legend_ramp_(kLegendWidth, 1, TextureFormat::R32F),
+      legend_output_(kLegendWidth, 1, TextureFormat::RGBA8),
+      hdr_tonemap_(width, height),
+      unfiltered_(width, height) {
+  for (int i = 0; i < 3; ++i) {
+    outputs_[i] = Texture2D(width, height, TextureFormat::RGBA8);
+    outputs_[i].set_filter(false);  // magnified views show pixels, not blur
+    output_fbos_[i].attach(0, outputs_[i]);
+    output_fbos_[i].check("explorer view");
+  }
+  split_output_.set_filter(false);
+  split_fbo_.attach(0, split_output_);
+  split_fbo_.check("explorer split view");
+  legend_output_.set_filter(true);
+  legend_fbo_.attach(0, legend_output_);
+  legend_fbo_.check("explorer legend");
+  scale(BufferView::Blend) = ScalarScale{0.0f, 1.0f, /*log=*/false, /*automatic=*/false};
+  scale(BufferView::Depth) = ScalarScale{0.0f, 10.0f, /*log=*/false, /*automatic=*/true};
+  scale(BufferView::VarU) = ScalarScale{1e-6f, 1.0f, /*log=*/true, /*automatic=*/true};
+  scale(BufferView::VarF) = ScalarScale{1e-6f, 1.0f, /*log=*/true, /*automatic=*/true};
+}
+
+void ViewRenderer::draw_scalar(const Texture2D& source, int channel, const ScalarScale& s, bool sentinels,
+                               float background, const Framebuffer& target, int width, int height) {
+  scalar_.set("channel", channel);
+  scalar_.set("log_scale", s.log ? 1 : 0);
+  scalar_.set("lo", s.lo);
+  scalar_.set("hi", s.hi);
+  scalar_.set("sentinels", sentinels ? 1 : 0);
+  scalar_.set("background", background);
+  source.bind(0);
+  scalar_.use();
+  quad_.draw(target, width, height);
+}
+
+void ViewRenderer::draw_display(const Texture2D& source, bool encode_srgb, int slot) {
+  display_.set("encode_srgb", encode_srgb ? 1 : 0);
+  source.bind(0);
+  display_.use();
+  quad_.draw(output_fbos_[slot], width_, height_);
+}
+
+void ViewRenderer::tonemap_like_final(const Texture2D& hdr, Preview& preview, int slot) {
+  // Same key and the final image's log-average: HDR buffers compare at the same exposure.
+  TonemapParams params = preview.settings().tonemap;
+  if (!(params.log_average > 0)) params.log_average = preview.tonemap().log_average();
+  hdr_tonemap_.run(hdr, params);
+  draw_display(hdr_tonemap_.output(), false, slot);
+}
+
+const Texture2D& ViewRenderer::render(BufferView view, Preview& preview, int slot) {
+  const Framebuffer& target = output_fbos_[slot];
+  const FilterPass* filter = preview.has_filtered() ? &preview.filter() : nullptr;
+  switch (view) {
+    case BufferView::Final: draw_display(preview.tonemap().output(), false, slot); break;
+    case BufferView::Lv: tonemap_like_final(preview.inputs().lv(), preview, slot); break;
+    case BufferView::Hv: tonemap_like_final(preview.inputs().hv(), preview, slot); break;
+    case BufferView::HvFiltered:  // without an L_f yet the blend uses L_u: show that
+      tonemap_like_final(filter ? filter->output() : preview.inputs().hv(), preview, slot);
+      break;
+    case BufferView::Unfiltered:
+      unfiltered_.run(preview.inputs(), static_cast<const FilterPass*>(nullptr), BlendParams{preview.settings().threshold});
+      tonemap_like_final(unfiltered_.output(), preview, slot);
+      break;
+    case BufferView::RangeColor:
+      preview.converge_range_buffer();
+      draw_display(preview.range().guide(), true, slot);
+      break;
+    case BufferView::Depth:
+      preview.converge_range_buffer();
+      draw_scalar(preview.range().guide(), 3, scale(view), false, kBackgroundDepth * 0.5f, target, width_, height_);
+      break;
+    case BufferView::VarU:
+      draw_scalar(preview.inputs().hv(), 3, scale(view), true, 0.0f, target, width_, height_);
+      break;
+    case BufferView::VarF:
+      if (filter) {
+        draw_scalar(filter->output(), 3, scale(view), true, 0.0f, target, width_, height_);
+      } else {  // no L_f: every Var[L_f] unknown (the sentinel's color)
+        const float unknown[4] = {0.25f, 0.25f, 0.25f, 1.0f};
+        glClearNamedFramebufferfv(target.id(), GL_COLOR, 0, unknown);
+      }
+      break;
+    case BufferView::Blend:
+      draw_scalar(preview.blend().output(), 3, scale(view), false, 0.0f, target, width_, height_);
+      break;
+    case BufferView::Case:
+      preview.blend().case_texture().bind(0);
+      case_.use();
+      quad_.draw(target, width_, height_);
+      break;
+  }
+  check_gl_error("explorer view");
+  return outputs_[slot];
+}
+
+const Texture2D& ViewRenderer::split(const Texture2D& left, const Texture2D& right, float divider) {
+  split_.set("divider", divider);
+  left.bind(0);
+  right.bind(1);
+  split_.use();
+  quad_.draw(split_fbo_, width_, height_);
+  check_gl_error("explorer split view");
+  return split_output_;
+}
+
+const Texture2D& ViewRenderer::legend(BufferView view) {
+  const ScalarScale& s = scale(view);
+  std::vector<float> ramp(kLegendWidth);
+  for (int i = 0; i < kLegendWidth; ++i) {
+    const float x = (i + 0.5f) / kLegendWidth;
+    ramp[i] = s.log ? std::pow(10.0f, std::log10(std::max(s.lo, 1e-30f)) * (1 - x) + std::log10(std::max(s.hi, 1e-30f)) * x)
+                    : s.lo + (s.hi - s.lo) * x;
+  }
+  legend_ramp_.upload(ramp.data(), 1);
+  draw_scalar(legend_ramp_, 0, s, false, 0.0f, legend_fbo_, kLegendWidth, 1);
+  return legend_output_;
+}
+
+void ViewRenderer::update_auto_scale(BufferView view, Preview& preview) {
+  ScalarScale& s = scale(view);
+  if (!s.automatic || !is_scalar_view(view) || view == BufferView::Blend) return;
+  Image source;
+  if (view == BufferView::VarU) source = preview.inputs().var_image();
+  else if (view == BufferView::VarF && preview.has_filtered()) source = preview.filter().variance_image();
+  else if (view == BufferView::Depth) source = preview.range().depth_image();
+  else return;
+  std::vector<float> values;
+  values.reserve(source.pixels.size());
+  for (float v : source.pixels) {
+    const bool usable = std::isfinite(v) && (view == BufferView::Depth ? v < kBackgroundDepth * 0.5f : v > 0.0f);
+    if (usable) values.push_back(v);
+  }
+  if (values.empty()) return;
+  if (view == BufferView::Depth) {
+    s.lo = percentile(values, 0.0);
+    s.hi = std::max(percentile(values, 1.0), s.lo + 1e-3f);
+  } else {  // a decade-aligned log range covering the middle 98%
+    s.lo = std::pow(10.0f, std::floor(std::log10(percentile(values, 0.01))));
+    s.hi = std::pow(10.0f, std::ceil(std::log10(percentile(values, 0.99))));
+    if (s.hi <= s.lo) s.hi = s.lo * 10.0f;
+  }
+}
+
+}  // namespace pxf
