@@ -221,8 +221,9 @@ void ViewRenderer::update_auto_scale(BufferView view, Preview& preview) {
   }
   if (values.empty()) return;
   if (view == BufferView::Depth) {
-    s.lo = percentile(values, 0.0);
-    s.hi = std::max(percentile(values, 1.0), s.lo + 1e-3f);
+    // Percentiles: antialiased silhouettes against the background average in huge distances.
+    s.lo = percentile(values, 0.01);
+    s.hi = std::max(percentile(values, 0.99), s.lo + 1e-3f);
   } else {  // a decade-aligned log range covering the middle 98%
     s.lo = std::pow(10.0f, std::floor(std::log10(percentile(values, 0.01))));
     s.hi = std::pow(10.0f, std::ceil(std::log10(percentile(values, 0.99))));
