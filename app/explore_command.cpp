@@ -1,4 +1,6 @@
 // pxf explore: command line of the Dear ImGui explorer (issue 6); the window is app/explorer.cpp.
+#include <cstdio>
+
 #include "app/commands.h"
 #include "app/explorer.h"
 #include "app/explorer_views.h"
@@ -15,6 +17,9 @@ int run_explore(const Args& args) {
   add_scene_options(cli, o.scene, /*headless=*/false);
   add_preview_options(cli, o.preview);
   cli.choice("--view", &o.view, buffer_view_names(), "initial buffer view (default final)");
+  std::string inspect;
+  cli.choice("--split", &o.split, buffer_view_names(), "split view: the --view buffer left, this one right");
+  cli.option("--inspect", &inspect, "X,Y", "open the pixel inspector at pixel X,Y");
   cli.option("--spp", &o.spp, "stop path tracing at this many samples per pixel (default: never)", 0, 1 << 24);
   cli.option("--zoom", &o.zoom, "display zoom of the image (default: fit the window)", 0, 16);
   cli.option("--out", &o.out, "DIR", "capture folder (default out)");
@@ -22,6 +27,8 @@ int run_explore(const Args& args) {
   cli.option("--screenshot", &o.screenshot, "FILE.png", "save the whole window (UI included) before quitting");
   cli.flag("--capture", &o.capture_on_exit, "capture into --out before quitting (with --frames)");
   if (!cli.parse(args)) return 0;
+  if (!inspect.empty() && std::sscanf(inspect.c_str(), "%d,%d", &o.inspect_x, &o.inspect_y) != 2)
+    throw UsageError("--inspect wants X,Y, got '" + inspect + "'");
   if (print_scene_list_if_asked(o.scene)) return 0;
   o.all_hv_given = cli.given("--all-hv");
   return run_explorer(o);

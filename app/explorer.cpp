@@ -111,6 +111,11 @@ class Explorer {
       : options_(options), context_(context), window_(static_cast<GLFWwindow*>(context.native_window())) {
     settings_ = options_.preview.settings;
     view_ = parse_buffer_view(options_.view);
+    if (!options_.split.empty()) {
+      split_ = true;
+      split_left_ = view_;
+      split_right_ = parse_buffer_view(options_.split);
+    }
     out_dir_ = options_.out;
     load(options_.scene.scene, /*first=*/true);
     views_ = std::make_unique<ViewRenderer>(preview_->width(), preview_->height());
@@ -221,7 +226,13 @@ class Explorer {
     ImGui::GetWindowDrawList()->AddImage(texture_id(shown_texture()), origin,
                                          ImVec2(origin.x + size.x, origin.y + size.y));
     mouse_on_image(origin, hovered, active);
-    if (hovered && inspector_ && !active) inspector_tooltip(origin);
+    if (hovered && inspector_ && !active) {
+      inspector_tooltip(static_cast<int>((io.MousePos.x - origin.x) / scale_),
+                        static_cast<int>((io.MousePos.y - origin.y) / scale_));
+    } else if (options_.inspect_x >= 0) {  // pinned from the command line
+      ImGui::SetNextWindowPos(ImVec2(origin.x + (options_.inspect_x + 1) * scale_ + 16, origin.y + options_.inspect_y * scale_));
+      inspector_tooltip(options_.inspect_x, options_.inspect_y);
+    }
     ImGui::End();
     ImGui::PopStyleVar(2);
   }
@@ -254,10 +265,7 @@ class Explorer {
   }
 
   // Magnifier (nearest-neighbour crop of the shown view) and every buffer's value at the cursor.
-  void inspector_tooltip(const ImVec2& origin) {
-    const ImGuiIO& io = ImGui::GetIO();
-    const int x = static_cast<int>((io.MousePos.x - origin.x) / scale_);
-    const int y = static_cast<int>((io.MousePos.y - origin.y) / scale_);
+  void inspector_tooltip(int x, int y) {
     if (x < 0 || y < 0 || x >= width_ || y >= height_) return;
     const PixelProbe p = probe_pixel(*preview_, x, y);
     ImGui::BeginTooltip();

@@ -20,6 +20,8 @@ struct ExploreOptions {
   int spp = 0;                // stop path tracing at this many samples (0 = never)
   int zoom = 0;               // display zoom of the image (0 = fit the window)
   bool capture_on_exit = false;
+  std::string split;          // split view: the --view buffer left, this one right ("" = no split)
+  int inspect_x = -1, inspect_y = -1;  // show the pixel inspector at this pixel (screenshots, tests)
 };
 
 // Opens the window and runs until it is closed (or options.frames have been shown). Throws
