@@ -1,0 +1,22 @@
+// Helpers of the integration tests: a headless GL context per test binary and small renders
+// through the same Preview core as `pxf render`.
+#pragma once
+#include <memory>
+#include <string>
+
+#include "app/preview.h"
+#include "gl/context.h"
+
+namespace pxf::test_support {
+
+// One OSMesa context for the whole test binary (created on first use, made current).
+GlContext& headless_context();
+
+// Renders `spp` frames of a built-in scene (or file) with `settings` and finishes the capture.
+std::unique_ptr<Preview> render_preview(const std::string& scene, int width, int height, int spp,
+                                        const PreviewSettings& settings);
+
+// Folder for files a failing test leaves behind for a person to look at.
+std::string failure_dir(const std::string& test_name);
+
+}  // namespace pxf::test_support
