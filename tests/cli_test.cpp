@@ -1,0 +1,167 @@
+// The pxf command line end to end (issue 2 item 6, issue 4 item 6): exit codes, one-line errors,
+// no partial output, Ctrl-C, and `pxf diff` on EXRs written by another writer.
+#include <gtest/gtest.h>
+
+#include <OpenEXR/ImfRgbaFile.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "image/image.h"
+
+namespace fs = std::filesystem;
+using namespace pxf;
+
+namespace {
+
+struct Result {
+  int code = -1;
+  std::string out, err;
+};
+
+std::string temp_dir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("pxf_cli_test_" + std::to_string(::getpid())) / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir.parent_path());
+  return dir.string();
+}
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+Result run(const std::string& args) {
+  const std::string base = temp_dir("io");
+  fs::create_directories(base);
+  const std::string cmd = std::string(PXF_EXECUTABLE) + " " + args + " >" + base + "/out 2>" + base + "/err";
+  const int status = std::system(cmd.c_str());
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(base + "/out"), slurp(base + "/err")};
+}
+
+size_t lines(const std::string& text) { return std::count(text.begin(), text.end(), '\n'); }
+
+void write_half_rgba(const std::string& path, const std::vector<float>& rgb, int w, int h) {
+  std::vector<Imf::Rgba> pixels(w * h);
+  for (int i = 0; i < w * h; ++i) pixels[i] = Imf::Rgba(rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2], 1.0f);
+  Imf::RgbaOutputFile file(path.c_str(), w, h, Imf::WRITE_RGBA);
+  file.setFrameBuffer(pixels.data(), 1, w);
+  file.writePixels(h);
+}
+
+}  // namespace
+
+TEST(Cli, UsageErrorsExitWithCode2AndOneLine) {
+  for (const char* args : {"", "bogus", "render --nope", "render --spp 0", "render --spp", "render --size 3",
+                           "render --threshold -1", "render --filter gauss", "render --gl window", "bench --budgets 4,x",
+                           "diff only-one.exr", "explore --sigma-s abc"}) {
+    const Result r = run(args);
+    EXPECT_EQ(r.code, 2) << args;
+    if (std::string(args).find(' ') != std::string::npos) EXPECT_EQ(lines(r.err), 1u) << args << ": " << r.err;
+  }
+}
+
+TEST(Cli, EveryCommandHasHelp) {
+  for (const char* command : {"render", "explore", "bench", "diff"}) {
+    const Result r = run(std::string(command) + " --help");
+    EXPECT_EQ(r.code, 0) << command;
+    EXPECT_NE(r.out.find("usage: pxf " + std::string(command)), std::string::npos) << command;
+  }
+  EXPECT_EQ(run("--help").code, 0);
+}
+
+TEST(Cli, SceneListPrintsTheBuiltins) {
+  const Result r = run("render --scene list");
+  EXPECT_EQ(r.code, 0);
+  for (const char* name : {"cornell", "atrium", "kitchen", "envmap"}) EXPECT_NE(r.out.find(name), std::string::npos);
+}
+
+TEST(Cli, BadSceneIsOneLineNamingTheFileAndWritesNothing) {
+  const std::string out = temp_dir("bad_scene");
+  const std::string scene = temp_dir("x") + "/broken.gltf";
+  fs::create_directories(fs::path(scene).parent_path());
+  std::ofstream(scene) << "{ \"asset\": { \"version\": \"2.0\" }, \"meshes\": [ {";  // malformed JSON
+  const Result r = run("render --scene " + scene + " --out " + out);
+  EXPECT_EQ(r.code, 1);
+  EXPECT_EQ(lines(r.err), 1u) << r.err;
+  EXPECT_NE(r.err.find("broken.gltf"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  const Result missing = run("render --scene /nonexistent/scene.gltf --out " + out);
+  EXPECT_EQ(missing.code, 1);
+  EXPECT_NE(missing.err.find("/nonexistent/scene.gltf"), std::string::npos) << missing.err;
+}
+
+TEST(Cli, RenderWritesEveryOutput) {
+  const std::string out = temp_dir("render");
+  const Result r = run("render --size 32x24 --spp 4 --quiet --out " + out);
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const char* file : {"final.png", "final.exr", "buffers.exr", "stats.json"}) EXPECT_TRUE(fs::exists(out + "/" + file));
+  std::vector<std::string> names;
+  for (const Layer& l : read_exr_layers(out + "/buffers.exr")) names.push_back(l.name);
+  for (const char* layer : {"final", "lv", "hv", "hv_filtered", "var_u", "var_f", "blend", "range_color", "depth"})
+    EXPECT_NE(std::find(names.begin(), names.end(), layer), names.end()) << layer;
+  const auto stats = nlohmann::json::parse(slurp(out + "/stats.json"));
+  EXPECT_EQ(stats["settings"]["spp"], 4);
+  EXPECT_EQ(stats["filter_runs"], 3);  // 1, 2, 4
+  for (const char* stage : {"path_tracing", "upload", "range", "filter", "blend", "tonemap"})
+    EXPECT_TRUE(stats["stage_ms_total"].contains(stage)) << stage;
+  EXPECT_GT(stats["paths_per_second"].get<double>(), 0.0);
+  // A reference render, then NRMSE against it.
+  const std::string ref = temp_dir("reference");
+  ASSERT_EQ(run("render --size 32x24 --spp 64 --filter none --seed 9 --quiet --out " + ref).code, 0);
+  const Result with_ref = run("render --size 32x24 --spp 4 --quiet --reference " + ref + "/final.exr --out " + out);
+  ASSERT_EQ(with_ref.code, 0) << with_ref.err;
+  const auto stats2 = nlohmann::json::parse(slurp(out + "/stats.json"));
+  EXPECT_GT(stats2["final_vs_reference"]["nrmse_percent"].get<double>(), 0.0);
+  EXPECT_GT(stats2["unfiltered_vs_reference"]["nrmse_percent"].get<double>(), 0.0);
+}
+
+TEST(Cli, CtrlCFinishesTheFrameAndWritesEverything) {
+  const std::string out = temp_dir("interrupted");
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    std::freopen("/dev/null", "w", stderr);
+    std::freopen("/dev/null", "w", stdout);
+    execl(PXF_EXECUTABLE, "pxf", "render", "--size", "48x48", "--spp", "1000000", "--quiet", "--out", out.c_str(),
+          static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  std::this_thread::sleep_for(std::chrono::seconds(3));
+  kill(pid, SIGINT);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 130);
+  for (const char* file : {"final.png", "final.exr", "buffers.exr", "stats.json"}) EXPECT_TRUE(fs::exists(out + "/" + file));
+  const auto stats = nlohmann::json::parse(slurp(out + "/stats.json"));
+  EXPECT_TRUE(stats["interrupted"].get<bool>());
+  EXPECT_GT(stats["settings"]["spp"].get<int>(), 0);
+  for (const auto& entry : fs::directory_iterator(out))
+    EXPECT_EQ(entry.path().string().find(".tmp-"), std::string::npos) << entry.path();
+}
+
+TEST(Cli, DiffReadsForeignHalfFloatExrsAndGetsTheNumbersRight) {
+  const std::string dir = temp_dir("diff");
+  fs::create_directories(dir);
+  // reference (1,2,3),(3,2,1); test (1,2,3),(4,2,0): RMSE sqrt(2/6), mean 2 -> NRMSE 28.8675 %
+  write_half_rgba(dir + "/ref.exr", {1, 2, 3, 3, 2, 1}, 2, 1);
+  write_half_rgba(dir + "/test.exr", {1, 2, 3, 4, 2, 0}, 2, 1);
+  const Result r = run("diff " + dir + "/test.exr " + dir + "/ref.exr");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("NRMSE 28.8675 %"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("max|diff| 1"), std::string::npos) << r.out;
+  EXPECT_EQ(run("diff " + dir + "/test.exr " + dir + "/ref.exr --max-nrmse 10").code, 1);
+  EXPECT_EQ(run("diff " + dir + "/test.exr " + dir + "/ref.exr --max-nrmse 30").code, 0);
+  const Result missing = run("diff " + dir + "/nope.exr " + dir + "/ref.exr");
+  EXPECT_EQ(missing.code, 1);
+  EXPECT_NE(missing.err.find("nope.exr"), std::string::npos);
+}
