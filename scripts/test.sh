@@ -1,15 +1,17 @@
 #!/usr/bin/env bash
 # Sets up and builds pxf, then runs the whole test suite with ctest. Afterwards it builds the
-# core libraries' unit tests with AddressSanitizer + UndefinedBehaviorSanitizer and runs them
-# (skip with PXF_SKIP_SANITIZERS=1).
+# core libraries' unit tests (image, pathtracer) with AddressSanitizer + UndefinedBehaviorSanitizer
+# in build-asan/ and runs them (skip with PXF_SKIP_SANITIZERS=1).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
 ctest --test-dir build --output-on-failure -j "$(nproc)" --timeout 600
 
 if [ "${PXF_SKIP_SANITIZERS:-0}" != "1" ]; then
-  echo "== unit tests under AddressSanitizer + UndefinedBehaviorSanitizer"
-  PXF_BUILD_DIR=build-asan scripts/setup.sh -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPXF_SANITIZE=ON >/dev/null
+  echo "== image and path tracer unit tests under AddressSanitizer + UndefinedBehaviorSanitizer"
+  [ -f build-asan/CMakeCache.txt ] ||
+    cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPXF_SANITIZE=ON >/dev/null
+  cmake --build build-asan -j "$(nproc)" --target image_tests pathtracer_tests
   ASAN_OPTIONS=detect_leaks=0 ctest --test-dir build-asan --output-on-failure -j "$(nproc)" --timeout 900 \
     -L 'image_tests|pathtracer_tests'
 fi
