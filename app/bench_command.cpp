@@ -21,16 +21,9 @@ namespace pxf {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
+using Clock = BenchClock;
+double ms_since(Clock::time_point start) { return elapsed_ms(start); }
+double median(std::vector<double> v) { return median_of(std::move(v)); }
 
 bool is_power_of_two(int n) { return n > 0 && (n & (n - 1)) == 0; }
 

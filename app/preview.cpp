@@ -1,13 +1,11 @@
 #include "app/preview.h"
 
-#include <chrono>
+#include "pathtracer/bench.h"
 
 namespace pxf {
 
 namespace {
-double ms_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-}
+double ms_since(BenchClock::time_point start) { return elapsed_ms(start); }
 
 bool same_trace_params(const TraceParams& a, const TraceParams& b) {
   return a.max_vertices == b.max_vertices && a.rr_start_vertex == b.rr_start_vertex && a.all_hv == b.all_hv &&
@@ -102,7 +100,7 @@ void Preview::set_settings(const PreviewSettings& settings) {
 
 void Preview::upload() {
   if (uploaded_) return;
-  const auto start = std::chrono::steady_clock::now();
+  const auto start = BenchClock::now();
   const Accumulation& acc = renderer_->accumulation();
   for (size_t i = 0; i < variance_.size(); ++i) variance_[i] = acc.variance_of_mean(i);
   inputs_.upload(&acc.lv_mean[0].x, &acc.hv_mean[0].x, variance_.data(), acc.samples.data());
@@ -111,7 +109,7 @@ void Preview::upload() {
 }
 
 void Preview::converge_range() {
-  const auto start = std::chrono::steady_clock::now();
+  const auto start = BenchClock::now();
   const auto tracer = [this](const std::vector<uint32_t>& pixels, glm::vec2 jitter) {
     return renderer_->trace_specular_chains(pixels, jitter);
   };
@@ -154,7 +152,7 @@ void Preview::redisplay() { blend_and_tonemap(); }
 
 void Preview::add_frame(bool last_frame, bool display) {
   last_ = StageTimes{};
-  const auto start = std::chrono::steady_clock::now();
+  const auto start = BenchClock::now();
   renderer_->add_frame();
   last_.path_tracing = ms_since(start);
   uploaded_ = false;

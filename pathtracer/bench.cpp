@@ -16,18 +16,17 @@
 #include "pathtracer/sampling.h"
 
 namespace pxf {
-namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double ms_since(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
-double median(std::vector<double> v) {
+double median_of(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   return v.empty() ? 0.0 : v[v.size() / 2];
 }
+
+namespace {
+
+using Clock = BenchClock;
+double ms_since(Clock::time_point start) { return elapsed_ms(start); }
+double median(std::vector<double> v) { return median_of(std::move(v)); }
 
 // Incoherent rays as a path tracer makes them: from first hits, cosine-distributed around the
 // shading normal (one per pixel), falling back to camera rays where the camera sees nothing.
