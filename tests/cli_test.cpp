@@ -124,6 +124,17 @@ TEST(Cli, RenderWritesEveryOutput) {
   EXPECT_GT(stats2["unfiltered_vs_reference"]["nrmse_percent"].get<double>(), 0.0);
 }
 
+TEST(Cli, NoFilterAndNoRangePassWhenTheHvBufferIsEmpty) {
+  // Three vertices (camera, surface, light): only direct light, all of it LV.
+  const std::string out = temp_dir("direct_only");
+  ASSERT_EQ(run("render --size 32x32 --spp 8 --max-vertices 3 --quiet --out " + out).code, 0);
+  const auto stats = nlohmann::json::parse(slurp(out + "/stats.json"));
+  EXPECT_EQ(stats["filter_runs"], 0);
+  EXPECT_EQ(stats["stage_ms_total"]["filter"].get<double>(), 0.0);
+  EXPECT_EQ(stats["stage_ms_total"]["range"].get<double>(), 0.0);
+  EXPECT_EQ(stats["blend_case_pixels"]["no_filtered"], 32 * 32);
+}
+
 TEST(Cli, CtrlCFinishesTheFrameAndWritesEverything) {
   const std::string out = temp_dir("interrupted");
   const pid_t pid = fork();
