@@ -427,3 +427,37 @@ TEST(MaterialMapping, EmissionIsOneSidedUnlessDoubleSided) {
 
 }  // namespace
 }  // namespace pxf
+
+// Figures for docs/scenes.md, not a pass/fail test (tests never assert wall time). Run with
+//   pathtracer_tests --gtest_also_run_disabled_tests --gtest_filter=SceneFigures.*
+#include <chrono>
+namespace pxf {
+namespace {
+TEST(SceneFigures, DISABLED_BuiltinLoadTimes) {
+  for (const BuiltinScene& builtin : builtin_scenes()) {
+    double best = 1e30;
+    Scene scene;
+    for (int i = 0; i < 3; ++i) {
+      auto t0 = std::chrono::steady_clock::now();
+      scene = load_scene(builtin.name);
+      best = std::min(best, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    }
+    size_t emissive_meshes = 0, emissive_triangles = 0;
+    for (const Mesh& mesh : scene.meshes)
+      if (scene.materials[mesh.material].is_emissive()) {
+        ++emissive_meshes;
+        emissive_triangles += mesh.triangles.size();
+      }
+    std::printf("%s: load %.1f ms (best of 3), %zu triangles, %zu meshes, %zu textures, %zu punctual lights, "
+                "%zu emissive meshes (%zu triangles), environment %s, %zu warnings\n",
+                builtin.name.c_str(), best, scene.triangle_count(), scene.meshes.size(), scene.textures.size(),
+                scene.lights.size(), emissive_meshes, emissive_triangles,
+                scene.environment ? "yes" : "no", scene.warnings.size());
+    for (const PunctualLight& l : scene.lights)
+      std::printf("  light '%s' type %d intensity %.3g\n", l.name.c_str(), static_cast<int>(l.type), l.intensity);
+    for (const std::string& w : scene.warnings) std::printf("  warning: %s\n", w.c_str());
+    EXPECT_GT(scene.triangle_count(), 0u);
+  }
+}
+}  // namespace
+}  // namespace pxf
