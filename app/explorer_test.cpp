@@ -1,6 +1,7 @@
 // Tests of `pxf explore` (issue 6): the camera controls and view names as units, and the whole
 // explorer in a window under Xvfb against a headless `pxf render` of the same settings.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdlib>
@@ -96,7 +97,8 @@ class ExplorerWindow : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     if (std::system("command -v xvfb-run > /dev/null 2>&1") != 0) return;
-    dir_ = std::filesystem::path(PXF_BINARY_DIR) / "app" / "explorer_test_out";
+    // One folder per process: ctest runs each test case in its own process, possibly at once.
+    dir_ = std::filesystem::path(PXF_BINARY_DIR) / "app" / ("explorer_test_out-" + std::to_string(::getpid()));
     std::filesystem::remove_all(dir_);
     std::filesystem::create_directories(dir_);
     const std::string d = dir_.string();
