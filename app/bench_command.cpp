@@ -22,8 +22,6 @@ namespace pxf {
 namespace {
 
 using Clock = BenchClock;
-double ms_since(Clock::time_point start) { return elapsed_ms(start); }
-double median(std::vector<double> v) { return median_of(std::move(v)); }
 
 bool is_power_of_two(int n) { return n > 0 && (n & (n - 1)) == 0; }
 
@@ -33,13 +31,6 @@ void write_text(const std::string& path, const std::string& text) {
     out << text;
     if (!out) throw Error(path + ": cannot write");
   });
-}
-
-Image unfiltered(const ProgressiveRenderer& r) {
-  Image sum = r.lv_image();
-  const Image hv = r.hv_image();
-  for (size_t i = 0; i < sum.pixels.size(); ++i) sum.pixels[i] += hv.pixels[i];
-  return sum;
 }
 
 struct BenchSetup {
@@ -66,11 +57,11 @@ Image obtain_reference(const BenchSetup& b, const std::string& given, int spp, c
   for (int i = 0; i < spp; ++i) {
     renderer.add_frame();
     if ((i + 1) % 256 == 0 || i + 1 == spp)
-      std::fprintf(stderr, "reference: %d/%d spp, %.0f s\n", i + 1, spp, ms_since(start) / 1000);
+      std::fprintf(stderr, "reference: %d/%d spp, %.0f s\n", i + 1, spp, elapsed_ms(start) / 1000);
   }
-  Image reference = unfiltered(renderer);
+  Image reference = renderer.unfiltered_image();
   write_exr(cache, reference);
-  std::printf("reference: wrote %s (%d spp, %.1f s)\n", cache.c_str(), spp, ms_since(start) / 1000);
+  std::printf("reference: wrote %s (%d spp, %.1f s)\n", cache.c_str(), spp, elapsed_ms(start) / 1000);
   return reference;
 }
 
@@ -89,7 +80,7 @@ FilteredRun run_filtered(const BenchSetup& b, int frames, const Image& reference
     preview.add_frame(i + 1 == frames, false);
     run.frames.push_back(preview.last_times());
   }
-  run.wall_ms = ms_since(start);
+  run.wall_ms = elapsed_ms(start);
   run.nrmse = compare_images(preview.final_image(), reference).nrmse_percent;
   run.filter_runs = preview.filter_runs();
   return run;
@@ -111,15 +102,13 @@ PlainRun run_plain(const BenchSetup& b, int min_frames, int max_frames, double s
   const auto start = Clock::now();
   for (int k = 1; k <= max_frames; ++k) {
     preview.add_frame(false, false);
-    const auto finish_start = Clock::now();
     preview.finish();  // blend + tone map of a displayed frame: what a viewer pays
-    const double wall = ms_since(start) - measuring_ms;
+    const double wall = elapsed_ms(start) - measuring_ms;
     run.wall_ms.push_back(wall);
-    (void)finish_start;
     if (k <= 64 || k % 8 == 0) {
       const auto m0 = Clock::now();
-      const double e = compare_images(unfiltered(preview.renderer()), reference).nrmse_percent;
-      measuring_ms += ms_since(m0);
+      const double e = compare_images(preview.renderer().unfiltered_image(), reference).nrmse_percent;
+      measuring_ms += elapsed_ms(m0);
       run.spp.push_back(k);
       run.nrmse.push_back(e);
       run.nrmse_wall_ms.push_back(wall);
@@ -146,14 +135,14 @@ EqualTimeRow run_equal_time(const BenchSetup& b, int budget_frames, double budge
     preview.add_frame(false, false);
     const double next = pt_ms + (is_power_of_two(k + 1) ? filter_ms : 0.0);
     const double finish = filter_ms + display_ms;
-    if (ms_since(start) + next + finish > budget_ms) break;
+    if (elapsed_ms(start) + next + finish > budget_ms) break;
   }
   preview.finish();
   EqualTimeRow row;
   row.budget_frames = budget_frames;
   row.budget_ms = budget_ms;
   row.filtered_frames = preview.samples();
-  row.filtered_ms = ms_since(start);
+  row.filtered_ms = elapsed_ms(start);
   row.filtered_nrmse = compare_images(preview.final_image(), reference).nrmse_percent;
   return row;
 }
@@ -263,7 +252,7 @@ int run_bench(const Args& args) {
     if (t.blend > 0) display.push_back(t.blend + t.tonemap);
   }
   write_text(out + "/stages.csv", stages_csv.str());
-  const double pt_ms = median(pt), filter_ms = median(filter_app), display_ms = median(display);
+  const double pt_ms = median_of(pt), filter_ms = median_of(filter_app), display_ms = median_of(display);
   const double range_ms = range.empty() ? 0 : range.front();
   std::printf("\n1. one scheduled filter application (median of %zu runs):\n", filter_app.size());
   std::printf("   path tracing frame %8.1f ms\n", pt_ms);

@@ -5,7 +5,6 @@
 namespace pxf {
 
 namespace {
-double ms_since(BenchClock::time_point start) { return elapsed_ms(start); }
 
 bool same_trace_params(const TraceParams& a, const TraceParams& b) {
   return a.max_vertices == b.max_vertices && a.rr_start_vertex == b.rr_start_vertex && a.all_hv == b.all_hv &&
@@ -104,22 +103,22 @@ void Preview::upload() {
   const Accumulation& acc = renderer_->accumulation();
   for (size_t i = 0; i < variance_.size(); ++i) variance_[i] = acc.variance_of_mean(i);
   inputs_.upload(&acc.lv_mean[0].x, &acc.hv_mean[0].x, variance_.data(), acc.samples.data());
-  last_.upload += ms_since(start);
+  last_.upload += elapsed_ms(start);
   uploaded_ = true;
 }
 
-void Preview::converge_range() {
+void Preview::converge_range_buffer() {
   const auto start = BenchClock::now();
   const auto tracer = [this](const std::vector<uint32_t>& pixels, glm::vec2 jitter) {
     return renderer_->trace_specular_chains(pixels, jitter);
   };
   while (range_.step(tracer)) {
   }
-  last_.range += ms_since(start);
+  last_.range += elapsed_ms(start);
 }
 
 void Preview::run_filter() {
-  converge_range();
+  converge_range_buffer();
   upload();
   filter_.run(inputs_, range_.guide(), settings_.filter);
   last_.filter += filter_.last_ms();
@@ -154,7 +153,7 @@ void Preview::add_frame(bool last_frame, bool display) {
   last_ = StageTimes{};
   const auto start = BenchClock::now();
   renderer_->add_frame();
-  last_.path_tracing = ms_since(start);
+  last_.path_tracing = elapsed_ms(start);
   uploaded_ = false;
 
   update_hv_empty();
@@ -185,7 +184,7 @@ Image Preview::display_image() const { return tonemap_.display_image(); }
 Image Preview::final_image() const { return blend_.final_image(); }
 
 std::vector<Layer> Preview::buffers() {
-  converge_range();
+  converge_range_buffer();
   upload();
   std::vector<Layer> layers;
   layers.push_back({"final", blend_.final_image()});

@@ -63,6 +63,8 @@ class Preview {
   void reset();
   // Blend and tone map the current state (e.g. after a display-only change).
   void redisplay();
+  // Runs the range pass until it has converged (the explorer's range views need it unfiltered too).
+  void converge_range_buffer();
 
   int width() const { return width_; }
   int height() const { return height_; }
@@ -84,7 +86,6 @@ class Preview {
   const TonemapPass& tonemap() const { return tonemap_; }
   bool has_filtered() const { return have_filtered_; }
   // Runs the range pass until it has converged (the explorer's range views need it while no filter runs).
-  void converge_range_buffer() { converge_range(); }
 
   Image display_image() const;        // tone-mapped sRGB "R,G,B" in [0,1]
   Image final_image() const;          // linear radiance after the blend
@@ -95,7 +96,6 @@ class Preview {
  private:
   void upload();
   void run_filter();
-  void converge_range();
   void update_hv_empty();
   void blend_and_tonemap();
   void finish_passes();

@@ -25,8 +25,6 @@ double median_of(std::vector<double> v) {
 namespace {
 
 using Clock = BenchClock;
-double ms_since(Clock::time_point start) { return elapsed_ms(start); }
-double median(std::vector<double> v) { return median_of(std::move(v)); }
 
 // Incoherent rays as a path tracer makes them: from first hits, cosine-distributed around the
 // shading normal (one per pixel), falling back to camera rays where the camera sees nothing.
@@ -60,7 +58,7 @@ double timed_parallel_ms(tbb::task_arena& arena, size_t count, const Body& body)
       for (size_t i = r.begin(); i != r.end(); ++i) body(i);
     });
   });
-  return ms_since(start);
+  return elapsed_ms(start);
 }
 
 }  // namespace
@@ -81,12 +79,12 @@ BenchResult run_benchmark(const Scene& scene, int width, int height, const Trace
     renderer.add_frame();
     frame_ms.push_back(renderer.stats().last_frame_ms);
   }
-  double total_s = ms_since(start) / 1000.0;
+  double total_s = elapsed_ms(start) / 1000.0;
   uint64_t paths = renderer.stats().paths - before.paths, rays = renderer.stats().rays - before.rays;
   result.paths_per_s = paths / total_s;
   result.rays_per_s = rays / total_s;
   result.rays_per_path = paths ? static_cast<double>(rays) / paths : 0.0;
-  result.median_frame_ms = median(frame_ms);
+  result.median_frame_ms = median_of(frame_ms);
 
   PathTracer tracer(renderer.scene());
   const Camera& camera = renderer.camera();
@@ -108,9 +106,9 @@ BenchResult run_benchmark(const Scene& scene, int width, int height, const Trace
       if (hit.valid() && tracer.geometry().surface_point(hit, ray).front_face) sink.fetch_add(0, std::memory_order_relaxed);
     }));
   }
-  result.embree_rays_per_s = rays_in.size() / (median(embree_ms) / 1000.0);
+  result.embree_rays_per_s = rays_in.size() / (median_of(embree_ms) / 1000.0);
   result.fraction_of_embree = result.rays_per_s / result.embree_rays_per_s;
-  result.primary_ray_ms = median(primary_ms);
+  result.primary_ray_ms = median_of(primary_ms);
   result.primary_fraction = result.primary_ray_ms / result.median_frame_ms;
   return result;
 }

@@ -85,6 +85,7 @@ class ProgressiveRenderer {
 
   Image lv_image() const;          // RGB
   Image hv_image() const;          // RGB
+  Image unfiltered_image() const;  // RGB L_lv + L_u: what plain path tracing shows
   Image variance_image() const;    // "Y": Var[L_u], 0 where unknown
   Image samples_image() const;     // "Y": n
   std::vector<float> variance_of_mean() const;  // Var[L_u] per pixel, -1 where n < 2

@@ -140,6 +140,13 @@ Image ProgressiveRenderer::variance_image() const {
   return image;
 }
 
+Image ProgressiveRenderer::unfiltered_image() const {
+  Image sum = lv_image();
+  const Image hv = hv_image();
+  for (size_t i = 0; i < sum.pixels.size(); ++i) sum.pixels[i] += hv.pixels[i];
+  return sum;
+}
+
 Image ProgressiveRenderer::samples_image() const {
   Image image = Image::gray(impl_->width, impl_->height);
   for (size_t i = 0; i < impl_->acc.samples.size(); ++i) image.pixels[i] = static_cast<float>(impl_->acc.samples[i]);
