@@ -109,6 +109,11 @@ TEST(BlendFactorShader, MatchesCpuOnGridAndBoundaries) {
   for (int c = 0; c < 3; ++c) filtered.at(3, r, c) = 0.0f;
   var.at(4, r, 0) = 1e30f, filtered.at(4, r, 3) = 1e-30f;
   for (int c = 0; c < 3; ++c) filtered.at(4, r, c) = 1e-30f;
+  // All samples equal (Var[L_u] = 0, n >= 2): u = (Y(L_f) / L_b)^2. Bright L_f, f = 0: u = 1.
+  var.at(5, r, 0) = 0.0f, filtered.at(5, r, 3) = 0.0f;
+  // ... all samples zero, L_f tiny against L_lv: u = (1e-3 / 1.001)^2, case 2 for t >= 1e-6.
+  var.at(6, r, 0) = 0.0f, filtered.at(6, r, 3) = 0.0f;
+  for (int c = 0; c < 3; ++c) hv.at(6, r, c) = 0.0f, lv.at(6, r, c) = 1.0f, filtered.at(6, r, c) = 1e-3f;
   PreviewInputs inputs(w, h);
   inputs.upload(lv, hv, var);
   Texture2D ftex(w, h, TextureFormat::RGBA32F);
@@ -120,7 +125,8 @@ TEST(BlendFactorShader, MatchesCpuOnGridAndBoundaries) {
     EXPECT_EQ(count_nonfinite(final_rgb), 0u);
     for (int y = 0; y < w; ++y)
       for (int x = 0; x < w; ++x) {
-        float u = mags[y], f = mags[x];
+        // L_b = Y(L_f) = 1 here; Var[L_u] = 0 means all samples equal: u = zero_variance_u(1, 1) = 1.
+        float u = mags[y] > 0.0f ? mags[y] : zero_variance_u(1.0f, 1.0f), f = mags[x];
         BlendDecision ref = blend_decision(u, f, t);
         BlendDecision gpu{s.at(x, y, 0), static_cast<int>(cases.at(x, y, 0))};
         check_decision(u, f, t, gpu);
@@ -135,6 +141,13 @@ TEST(BlendFactorShader, MatchesCpuOnGridAndBoundaries) {
     EXPECT_EQ(s.at(1, r, 0), 0.0f);
     EXPECT_EQ(s.at(2, r, 0), 0.0f);                        // L_b = 0 with noise: filtered only
     EXPECT_EQ(s.at(3, r, 0), 1.0f);                        // L_b = 0, no noise: case 2
+    EXPECT_NEAR(s.at(5, r, 0), std::min(1.0f, std::sqrt(t)), 1e-6f);  // g(s) = s^2 u = t
+    if (t >= 1e-6f) {
+      EXPECT_EQ(cases.at(6, r, 0), float(kCaseUnfiltered));
+    }
+    if (t == 0.0f) {
+      EXPECT_EQ(s.at(6, r, 0), 0.0f);
+    }
     for (float v : s.pixels) EXPECT_TRUE(v >= 0.0f && v <= 1.0f);
   }
 }

@@ -47,6 +47,13 @@ float relative_variance(float var, float lb) {
   return (var / lb) / lb;
 }
 
+float zero_variance_u(float y_f, float lb) {
+  if (!(y_f > 0.0f)) return 0.0f;
+  if (!(lb > 0.0f)) return kInf;
+  const float r = y_f / lb;
+  return r * r;
+}
+
 BlendDecision blend_decision(float u, float f, float t) {
   if (!(t >= 0.0f)) t = 0.0f;
   if (std::isnan(u)) u = kInf;
@@ -85,7 +92,7 @@ FilterOutput filter_once(const Image& signal, const Image& signal_var, const Ima
     for (int x = 0; x < w; ++x) {
       Px lu = rgb_at(hv, x, y);
       float v = clean_var(var_u.at(x, y, 0));
-      if (final_pass && p.skip_case2 && v >= 0.0f) {
+      if (final_pass && p.skip_case2 && v > 0.0f) {  // a zero variance is not trusted
         Px l = rgb_at(lv, x, y);
         float lb = std::max(lum(lu.c) + lum(l.c), 0.0f);
         if (relative_variance(v, lb) <= std::max(p.t, 0.0f)) {
@@ -110,7 +117,7 @@ FilterOutput filter_once(const Image& signal, const Image& signal_var, const Ima
           float vq = clean_var(signal_var.at(qx, qy, 0));
           sw += wq;
           for (int c = 0; c < 3; ++c) swl[c] += wq * lq.c[c];
-          if (vq >= 0.0f) {
+          if (vq > 0.0f) {
             sw2v += wq * wq * vq;
             swk += wq;
             swv += wq * vq;
@@ -120,7 +127,8 @@ FilterOutput filter_once(const Image& signal, const Image& signal_var, const Ima
         }
       // sw >= 1: the center pixel has weight exp(0).
       for (int c = 0; c < 3; ++c) out.filtered.at(x, y, c) = static_cast<float>(swl[c] / sw);
-      // Neighbours of unknown variance (n < 2) count with the kernel-weighted mean of the known ones.
+      // Neighbours of unknown variance (n < 2, or 0: all samples equal) count with the
+      // kernel-weighted mean of the known ones.
       out.variance.at(x, y, 0) =
           swk > 0 ? static_cast<float>((sw2v + sw2u * (swv / swk)) / (sw * sw)) : kVarUnknown;
     }
@@ -154,9 +162,10 @@ BlendOutput cpu_blend(const Image& lv, const Image& hv, const Image& var_u, cons
         } else if (vu < 0.0f) {
           d = {0.0f, kCaseUnknownVar};
         } else {
-          float vf = std::max(clean_var(vf_raw), 0.0f);  // unknown Var[L_f] (unreachable) reads as 0
+          float vf = std::max(clean_var(vf_raw), 0.0f);  // unknown Var[L_f] (no neighbour variance known) reads as 0
           float lb = std::max(lum(lf.c) + lum(l.c), 0.0f);
-          d = blend_decision(relative_variance(vu, lb), relative_variance(vf, lb), params.t);
+          float u = vu > 0.0f ? relative_variance(vu, lb) : zero_variance_u(lum(lf.c), lb);
+          d = blend_decision(u, relative_variance(vf, lb), params.t);
         }
       }
       for (int c = 0; c < 3; ++c)

@@ -1,6 +1,7 @@
 // Plain C++ implementation of the preview formulas (SPEC 3.3–3.5) on pxf::Image: the reference the
 // GL shaders are tested against, and the single CPU definition of the blend case logic.
-// Images: L_u/L_lv "R,G,B"; Var[L_u] one channel (kVarUnknown where n < 2); the range guide
+// Images: L_u/L_lv "R,G,B"; Var[L_u] one channel (kVarUnknown where n < 2; exactly 0 where all
+// n >= 2 samples were equal, which the filter and blend do not trust as low variance); the range guide
 // "R,G,B" + depth one channel. Every function sanitizes exactly like the shaders (non-finite
 // inputs read as 0, magnitudes clamped to kMaxInput), so outputs are always finite.
 #pragma once
@@ -20,6 +21,9 @@ BlendDecision blend_decision(float u, float f, float t);
 inline float blend_factor(float u, float f, float t) { return blend_decision(u, f, t).s; }
 // var / lb^2 without overflow in the intermediate: 0 when var <= 0, +inf when lb <= 0.
 float relative_variance(float var, float lb);
+// u of a pixel whose samples were all equal (Var[L_u] = 0, n >= 2): (Y(L_f) / L_b)^2, as if its
+// mean's variance were Y(L_f)^2 (a mean of L_f fits such samples as well as their own mean).
+float zero_variance_u(float y_f, float lb);
 
 struct FilterOutput {
   Image filtered;  // "R,G,B": L_f (L_u where skipped)

@@ -25,7 +25,7 @@ struct Scenario {
 };
 
 // Two range-color regions split by a diagonal, two depth regions split horizontally, noisy HV
-// with known and unknown (n < 2) variance, a few L_b = 0 pixels.
+// with known, unknown (n < 2) and zero (all samples equal) variance, a few L_b = 0 pixels.
 Scenario make_scenario(unsigned seed) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<float> u01(0.0f, 1.0f);
@@ -42,7 +42,8 @@ Scenario make_scenario(unsigned seed) {
       s.depth.at(x, y, 0) = (top ? 2.0f : 5.0f) + 0.3f * u01(rng);
       float r = u01(rng);
       s.var.at(x, y, 0) = r < 0.05f ? kVarUnknown : 0.002f * std::pow(10.0f, 3.0f * u01(rng));
-      if (r > 0.97f)  // black pixel: L_b = 0 unless the filter brings light
+      if (r > 0.93f) s.var.at(x, y, 0) = 0.0f;  // all samples equal (n >= 2): not trusted
+      if (r > 0.97f)  // all samples black: L_b = 0 unless the filter brings light
         for (int c = 0; c < 3; ++c) s.hv.at(x, y, c) = s.lv.at(x, y, c) = 0.0f;
     }
   return s;

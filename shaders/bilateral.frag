@@ -5,7 +5,7 @@
 // (the second filters the first's output, whose rows are independent, so its variance is exact).
 #include "common.glsl"
 
-layout(binding = 0) uniform sampler2D hv_tex;     // rgb L_u, a Var[L_u] (kVarUnknown: n < 2)
+layout(binding = 0) uniform sampler2D hv_tex;     // rgb L_u, a Var[L_u] (kVarUnknown: n < 2; 0: all samples equal)
 layout(binding = 1) uniform sampler2D lv_tex;     // rgb L_lv (only for skipping)
 layout(binding = 2) uniform sampler2D guide_tex;  // rgb range color, a distance
 layout(binding = 3) uniform sampler2D signal_tex; // what is filtered: hv_tex, or the first 1D pass
@@ -27,7 +27,8 @@ void main() {
   vec4 hv_p = texelFetch(hv_tex, p, 0);
   vec3 lu_p = clean(hv_p.rgb);
   float v_p = clean_var(hv_p.a);
-  if (final_pass != 0 && skip_case2 != 0 && v_p >= 0.0) {
+  // A zero variance (all samples equal) is not trusted: such a pixel is filtered (see blend.frag).
+  if (final_pass != 0 && skip_case2 != 0 && v_p > 0.0) {
     float lb = max(luminance(lu_p) + luminance(clean(texelFetch(lv_tex, p, 0).rgb)), 0.0);
     if (relative_variance(v_p, lb) <= max(t, 0.0)) {
       out_filtered = vec4(lu_p, kVarSkipped);
@@ -54,7 +55,7 @@ void main() {
       float v_q = clean_var(hv_q.a);
       sw += w;
       swl += w * clean(hv_q.rgb);
-      if (v_q >= 0.0) {
+      if (v_q > 0.0) {
         sw2v += w * w * v_q;
         swk += w;
         swv += w * v_q;
@@ -63,8 +64,8 @@ void main() {
       }
     }
   }
-  // sw >= 1 (the center's weight is exp(0)). Unknown neighbour variances (n < 2) count with the
-  // kernel-weighted mean of the known ones.
+  // sw >= 1 (the center's weight is exp(0)). Unknown neighbour variances (n < 2, or 0 because all
+  // samples were equal) count with the kernel-weighted mean of the known ones.
   float var_f = swk > 0.0 ? (sw2v + sw2u * (swv / swk)) / (sw * sw) : kVarUnknown;
   out_filtered = vec4(swl / sw, var_f);
 }

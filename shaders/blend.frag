@@ -33,7 +33,8 @@ void main() {
     } else {
       float vf = max(clean_var(fv.a), 0.0);
       float lb = max(luminance(lf) + luminance(lv), 0.0);
-      s = blend_factor(relative_variance(vu, lb), relative_variance(vf, lb), t, blend_case);
+      float u = vu > 0.0 ? relative_variance(vu, lb) : zero_variance_u(luminance(lf), lb);
+      s = blend_factor(u, relative_variance(vf, lb), t, blend_case);
     }
   }
   atomicAdd(case_counts[blend_case], 1u);

@@ -20,6 +20,17 @@ float relative_variance(float var, float lb) {
   return (var / lb) / lb;
 }
 
+// Perceived variance u of a pixel whose n >= 2 HV samples were all equal (sample variance exactly
+// 0, in practice all zero): that is no evidence of low variance, only that rare paths were missed.
+// A mean of L_f is as consistent with such samples as their own mean, so the variance of the mean
+// is taken as Y(L_f)^2: u = (Y(L_f) / L_b)^2. Zero where L_f is black (nothing to blend in).
+float zero_variance_u(float y_f, float lb) {
+  if (!(y_f > 0.0)) return 0.0;
+  if (!(lb > 0.0)) return kInf;
+  float r = y_f / lb;
+  return r * r;
+}
+
 // SPEC 3.4: case 2 (u <= t) first, case 1 (D < 0), else case 3. Same algorithm as
 // blend_decision() in gl/cpu_reference.cpp: D < 0 <=> t < H = u f / (u + f) = lo / (1 + lo / hi),
 // s = f / (u + f) + sqrt((t - H) / (u + f)), all without overflow or harmful underflow.
