@@ -140,7 +140,8 @@ void Preview::update_hv_empty() {
 
 void Preview::blend_and_tonemap() {
   upload();
-  blend_.run(inputs_, have_filtered_ ? &filter_ : nullptr, BlendParams{settings_.threshold});
+  blend_.run(inputs_, have_filtered_ ? &filter_ : nullptr, range_.guide(),
+             BlendParams{settings_.threshold, range_weights(settings_.filter)});
   last_.blend += blend_.last_ms();
   tonemap_.run(blend_.output(), settings_.tonemap);
   last_.tonemap += tonemap_.last_ms();

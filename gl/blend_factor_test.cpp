@@ -120,7 +120,7 @@ TEST(BlendFactorShader, MatchesCpuOnGridAndBoundaries) {
   ftex.upload(filtered);
   BlendPass blend(w, h);
   for (float t : thresholds()) {
-    blend.run(inputs, &ftex, {t});
+    blend.run(inputs, &ftex, nullptr, {t});
     Image s = blend.s_image(), cases = blend.case_image(), final_rgb = blend.final_image();
     EXPECT_EQ(count_nonfinite(final_rgb), 0u);
     for (int y = 0; y < w; ++y)
@@ -150,6 +150,53 @@ TEST(BlendFactorShader, MatchesCpuOnGridAndBoundaries) {
     }
     for (float v : s.pixels) EXPECT_TRUE(v >= 0.0f && v <= 1.0f);
   }
+}
+
+// 5x3: range color 0.5 for x <= 2, 0.1 for x >= 3 (an edge), equal depth.
+struct PoolingScene {
+  Image range = Image::rgb(5, 3), depth = Image::gray(5, 3, "Y", 2.0f), var = Image::gray(5, 3);
+  PoolingScene() {
+    for (int y = 0; y < 3; ++y)
+      for (int x = 0; x < 5; ++x) {
+        for (int c = 0; c < 3; ++c) range.at(x, y, c) = x <= 2 ? 0.5f : 0.1f;
+        var.at(x, y, 0) = x <= 2 ? 1e-2f : 1.0f;
+      }
+  }
+};
+
+TEST(PooledVariance, QuietPixelTakesTheMeanOfItsRangeNeighbours) {
+  PoolingScene p;
+  p.var.at(1, 1, 0) = 1e-6f;  // a pixel that missed the bright paths
+  const RangeWeights range = range_weights(FilterParams{});
+  EXPECT_NEAR(pooled_var_u(p.var, p.range, p.depth, 1, 1, range), (8 * 1e-2f + 1e-6f) / 9, 1e-8f);
+  // Across the range edge the noisier right side does not count: (2,1) keeps its own 1e-2.
+  EXPECT_FLOAT_EQ(pooled_var_u(p.var, p.range, p.depth, 2, 1, range), 1e-2f);
+  // Without a color term (k_c = 0) it would: the mean then includes the right side's 1.0.
+  EXPECT_GT(pooled_var_u(p.var, p.range, p.depth, 2, 1, RangeWeights{0.0f, 0.0f}), 0.2f);
+  // Own variance unknown (n < 2) stays unknown; zero (all samples equal) takes the neighbours'.
+  p.var.at(1, 1, 0) = kVarUnknown;
+  EXPECT_EQ(pooled_var_u(p.var, p.range, p.depth, 1, 1, range), kVarUnknown);
+  p.var.at(1, 1, 0) = 0.0f;
+  EXPECT_NEAR(pooled_var_u(p.var, p.range, p.depth, 1, 1, range), 1e-2f, 1e-8f);
+  // All samples equal and no neighbour variance known: 0 (the blend then uses zero_variance_u).
+  for (float& v : p.var.pixels) v = 0.0f;
+  EXPECT_EQ(pooled_var_u(p.var, p.range, p.depth, 1, 1, range), 0.0f);
+}
+
+TEST(PooledVariance, DarkSpeckleIsFilteredNotKept) {
+  PoolingScene p;
+  Image lv = Image::rgb(5, 3), hv = Image::rgb(5, 3, 1.0f);
+  FilterOutput filtered{Image::rgb(5, 3, 1.0f), Image::gray(5, 3, "Y", 1e-4f)};
+  for (int c = 0; c < 3; ++c) hv.at(1, 1, c) = 0.01f;  // few small samples: mean and variance tiny
+  p.var.at(1, 1, 0) = 1e-7f;
+  // Pooled u = (8e-2 + 1e-7) / 9 / L_b^2 with L_b = Y(L_f) = 1: above t = 0.005.
+  const BlendParams params{0.005f, range_weights(FilterParams{})};
+  BlendOutput own_only = cpu_blend(lv, hv, p.var, &filtered, params, nullptr, nullptr);
+  EXPECT_EQ(own_only.blend_case.at(1, 1, 0), float(kCaseUnfiltered));  // u = 1e-7: kept dark
+  BlendOutput pooled = cpu_blend(lv, hv, p.var, &filtered, params, &p.range, &p.depth);
+  EXPECT_NE(pooled.blend_case.at(1, 1, 0), float(kCaseUnfiltered));
+  // Case 3: s = (f + sqrt(D)) / (u + f) ~ 0.75, so L ~ 0.75 * 0.01 + 0.25 * 1 instead of 0.01.
+  EXPECT_NEAR(pooled.final_rgb.at(1, 1, 1), 0.26f, 0.02f);
 }
 
 }  // namespace

@@ -13,23 +13,30 @@ BlendPass::BlendPass(int width, int height)
   fbo_.check("blend pass");
 }
 
-void BlendPass::run(const PreviewInputs& inputs, const FilterPass* filtered, const BlendParams& params) {
-  run(inputs, filtered && filtered->has_output() ? &filtered->output() : nullptr, params);
+void BlendPass::run(const PreviewInputs& inputs, const FilterPass* filtered, const Texture2D& guide,
+                    const BlendParams& params) {
+  run(inputs, filtered && filtered->has_output() ? &filtered->output() : nullptr, &guide, params);
 }
 
-void BlendPass::run(const PreviewInputs& inputs, const Texture2D* filtered, const BlendParams& params) {
-  if (inputs.width() != width_ || inputs.height() != height_ ||
-      (filtered && (filtered->width() != width_ || filtered->height() != height_)))
+void BlendPass::run(const PreviewInputs& inputs, const Texture2D* filtered, const Texture2D* guide,
+                    const BlendParams& params) {
+  auto other_size = [&](const Texture2D* tex) { return tex && (tex->width() != width_ || tex->height() != height_); };
+  if (inputs.width() != width_ || inputs.height() != height_ || other_size(filtered) || other_size(guide))
     throw Error("blend pass: input size differs from the pass size");
   timer_.begin();
   program_.set("has_filtered", filtered ? 1 : 0);
+  program_.set("has_guide", guide ? 1 : 0);
+  program_.set("k_c", params.range.k_c);
+  program_.set("k_d", params.range.k_d);
   program_.set("t", params.t);
   const std::array<uint32_t, kBlendCaseCount> zeros{};
   counts_.upload(zeros.data(), sizeof zeros);
   counts_.bind_storage(0);
   inputs.hv().bind(0);
   inputs.lv().bind(1);
-  if (filtered) filtered->bind(2); else inputs.hv().bind(2);  // unused, but keep the unit valid
+  // Unused units still get a texture, so every sampler is valid.
+  if (filtered) filtered->bind(2); else inputs.hv().bind(2);
+  if (guide) guide->bind(3); else inputs.hv().bind(3);
   program_.use();
   quad_.draw(fbo_, width_, height_);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);

@@ -27,16 +27,21 @@ float clean(float v) { return std::isfinite(v) ? std::clamp(v, -kMaxInput, kMaxI
 // Variance channel: negative or non-finite = unknown.
 float clean_var(float v) { return (std::isfinite(v) && v >= 0.0f) ? std::min(v, kMaxInput) : kVarUnknown; }
 float lum(const float* c) { return luminance(c[0], c[1], c[2]); }
-float inv_two_sigma2(float sigma) {
-  float s = std::max(sigma, 1.0e-6f);
-  return 1.0f / (2.0f * s * s);
-}
 
 struct Px {
   float c[3];
 };
 Px rgb_at(const Image& im, int x, int y) {
   return {{clean(im.at(x, y, 0)), clean(im.at(x, y, 1)), clean(im.at(x, y, 2))}};
+}
+// The exponent of the range weight between pixels p and q (color and depth terms).
+double range_exponent(const Image& range_color, const Image& depth, int px, int py, int qx, int qy,
+                      const RangeWeights& range) {
+  Px rp = rgb_at(range_color, px, py), rq = rgb_at(range_color, qx, qy);
+  double dc2 = 0;
+  for (int c = 0; c < 3; ++c) dc2 += double(rp.c[c] - rq.c[c]) * (rp.c[c] - rq.c[c]);
+  double dd = double(clean(depth.at(px, py, 0))) - clean(depth.at(qx, qy, 0));
+  return dc2 * range.k_c + dd * dd * range.k_d;
 }
 
 }  // namespace
@@ -52,6 +57,22 @@ float zero_variance_u(float y_f, float lb) {
   if (!(lb > 0.0f)) return kInf;
   const float r = y_f / lb;
   return r * r;
+}
+
+float pooled_var_u(const Image& var_u, const Image& range_color, const Image& depth, int x, int y,
+                   const RangeWeights& range) {
+  const float own = clean_var(var_u.at(x, y, 0));
+  if (own < 0.0f) return kVarUnknown;
+  double sw = 0, swv = 0;
+  for (int qy = std::max(0, y - 1); qy <= std::min(var_u.height - 1, y + 1); ++qy)
+    for (int qx = std::max(0, x - 1); qx <= std::min(var_u.width - 1, x + 1); ++qx) {
+      const float v = clean_var(var_u.at(qx, qy, 0));
+      if (!(v > 0.0f)) continue;
+      const double w = std::exp(-range_exponent(range_color, depth, x, y, qx, qy, range));
+      sw += w;
+      swv += w * v;
+    }
+  return sw > 0 ? std::max(own, static_cast<float>(swv / sw)) : own;
 }
 
 BlendDecision blend_decision(float u, float f, float t) {
@@ -86,32 +107,26 @@ FilterOutput filter_once(const Image& signal, const Image& signal_var, const Ima
   const int w = hv.width, h = hv.height;
   FilterOutput out{Image::rgb(w, h), Image::gray(w, h)};
   const int radius = std::min(kMaxFilterRadius, static_cast<int>(std::ceil(3.0f * std::max(p.sigma_s, 0.0f))));
-  const float ks = inv_two_sigma2(p.sigma_s), kc = inv_two_sigma2(p.sigma_c);
-  const float kd = p.kind != FilterKind::Bilateral ? inv_two_sigma2(p.sigma_d) : 0.0f;
+  const float ks = inv_two_sigma2(p.sigma_s);
+  const RangeWeights range = range_weights(p);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
       Px lu = rgb_at(hv, x, y);
-      float v = clean_var(var_u.at(x, y, 0));
-      if (final_pass && p.skip_case2 && v > 0.0f) {  // a zero variance is not trusted
+      if (final_pass && p.skip_case2) {  // the blend's u with the unfiltered background
+        float v = pooled_var_u(var_u, range_color, depth, x, y, range);
         Px l = rgb_at(lv, x, y);
         float lb = std::max(lum(lu.c) + lum(l.c), 0.0f);
-        if (relative_variance(v, lb) <= std::max(p.t, 0.0f)) {
+        if (v > 0.0f && relative_variance(v, lb) <= std::max(p.t, 0.0f)) {  // a zero variance is not trusted
           for (int c = 0; c < 3; ++c) out.filtered.at(x, y, c) = lu.c[c];
           out.variance.at(x, y, 0) = kVarSkipped;
           continue;
         }
       }
-      Px rp = rgb_at(range_color, x, y);
-      float dp = clean(depth.at(x, y, 0));
       double sw = 0, swl[3] = {0, 0, 0}, sw2v = 0, sw2u = 0, swk = 0, swv = 0;
       for (int qy = std::max(0, y - radius * ey); qy <= std::min(h - 1, y + radius * ey); ++qy)
         for (int qx = std::max(0, x - radius * ex); qx <= std::min(w - 1, x + radius * ex); ++qx) {
-          Px rq = rgb_at(range_color, qx, qy);
-          float dq = clean(depth.at(qx, qy, 0));
-          double dc2 = 0;
-          for (int c = 0; c < 3; ++c) dc2 += double(rp.c[c] - rq.c[c]) * (rp.c[c] - rq.c[c]);
-          double dd = double(dp) - dq;
-          double e = double((qx - x) * (qx - x) + (qy - y) * (qy - y)) * ks + dc2 * kc + dd * dd * kd;
+          double e = double((qx - x) * (qx - x) + (qy - y) * (qy - y)) * ks +
+                     range_exponent(range_color, depth, x, y, qx, qy, range);
           double wq = std::exp(-e);
           Px lq = rgb_at(signal, qx, qy);
           float vq = clean_var(signal_var.at(qx, qy, 0));
@@ -145,7 +160,8 @@ FilterOutput cpu_filter(const Image& hv, const Image& var_u, const Image& lv, co
 }
 
 BlendOutput cpu_blend(const Image& lv, const Image& hv, const Image& var_u, const FilterOutput* filtered,
-                      const BlendParams& params) {
+                      const BlendParams& params, const Image* range_color, const Image* depth) {
+  const bool pool = range_color && depth;
   const int w = hv.width, h = hv.height;
   BlendOutput out{Image::rgb(w, h), Image::gray(w, h), Image::gray(w, h)};
   for (int y = 0; y < h; ++y)
@@ -164,6 +180,7 @@ BlendOutput cpu_blend(const Image& lv, const Image& hv, const Image& var_u, cons
         } else {
           float vf = std::max(clean_var(vf_raw), 0.0f);  // unknown Var[L_f] (no neighbour variance known) reads as 0
           float lb = std::max(lum(lf.c) + lum(l.c), 0.0f);
+          if (pool) vu = pooled_var_u(var_u, *range_color, *depth, x, y, params.range);
           float u = vu > 0.0f ? relative_variance(vu, lb) : zero_variance_u(lum(lf.c), lb);
           d = blend_decision(u, relative_variance(vf, lb), params.t);
         }

@@ -24,6 +24,12 @@ float relative_variance(float var, float lb);
 // u of a pixel whose samples were all equal (Var[L_u] = 0, n >= 2): (Y(L_f) / L_b)^2, as if its
 // mean's variance were Y(L_f)^2 (a mean of L_f fits such samples as well as their own mean).
 float zero_variance_u(float y_f, float lb);
+// Var[L_u] for the blend decision and the filter's skipping: max of the pixel's own variance and
+// the range-weighted mean of the known (> 0) variances of its 3x3 neighbourhood. kVarUnknown where
+// the own variance is unknown (n < 2); 0 where it is 0 and no neighbour's is known. Why: see
+// pooled_var_u in shaders/common.glsl.
+float pooled_var_u(const Image& var_u, const Image& range_color, const Image& depth, int x, int y,
+                   const RangeWeights& range);
 
 struct FilterOutput {
   Image filtered;  // "R,G,B": L_f (L_u where skipped)
@@ -37,9 +43,9 @@ struct BlendOutput {
   Image s;           // "Y"
   Image blend_case;  // "Y": BlendCase codes
 };
-// `filtered` empty = the filter never ran.
+// `filtered` empty = the filter never ran. range_color and depth both null: no variance pooling.
 BlendOutput cpu_blend(const Image& lv, const Image& hv, const Image& var_u, const FilterOutput* filtered,
-                      const BlendParams& params);
+                      const BlendParams& params, const Image* range_color, const Image* depth);
 
 double cpu_log_average(const Image& rgb, float delta);
 Image cpu_tonemap(const Image& rgb, const TonemapParams& params);  // "R,G,B" display values in [0,1]

@@ -5,12 +5,6 @@
 #include "gl/gl.h"
 
 namespace pxf {
-namespace {
-float inv_two_sigma2(float sigma) {
-  float s = std::max(sigma, 1.0e-6f);
-  return 1.0f / (2.0f * s * s);
-}
-}  // namespace
 
 FilterPass::FilterPass(int width, int height)
     : width_(width), height_(height), program_(Program::from_embedded("fullscreen.vert", "bilateral.frag")),
@@ -26,8 +20,9 @@ void FilterPass::run(const PreviewInputs& inputs, const Texture2D& guide, const 
   const int radius = std::min(kMaxFilterRadius, static_cast<int>(std::ceil(3.0f * std::max(p.sigma_s, 0.0f))));
   program_.set("radius", radius);
   program_.set("k_s", inv_two_sigma2(p.sigma_s));
-  program_.set("k_c", inv_two_sigma2(p.sigma_c));
-  program_.set("k_d", p.kind != FilterKind::Bilateral ? inv_two_sigma2(p.sigma_d) : 0.0f);
+  const RangeWeights range = range_weights(p);
+  program_.set("k_c", range.k_c);
+  program_.set("k_d", range.k_d);
   program_.set("skip_case2", p.skip_case2 ? 1 : 0);
   program_.set("t", p.t);
   const uint32_t zero = 0;

@@ -163,10 +163,13 @@ TEST(BlendVsCpu, MatchesReferenceWithFilteredInput) {
     }
     Texture2D filtered(W, H, TextureFormat::RGBA32F);
     filtered.upload(packed);
-    for (float t : {0.0f, 0.001f, 0.02f, 0.2f}) {
+    for (float t : {0.0f, 0.001f, 0.02f, 0.2f})
+      for (bool pool : {false, true}) {
+      SCOPED_TRACE(testing::Message() << "t=" << t << " pool=" << pool << " skip=" << skip);
       BlendPass blend(W, H);
-      blend.run(gpu.inputs, &filtered, {t});
-      BlendOutput ref = cpu_blend(s.lv, s.hv, s.var, &ref_f, {t});
+      BlendParams bp{t, range_weights(fp)};
+      blend.run(gpu.inputs, &filtered, pool ? &gpu.guide : nullptr, bp);
+      BlendOutput ref = cpu_blend(s.lv, s.hv, s.var, &ref_f, bp, pool ? &s.range : nullptr, pool ? &s.depth : nullptr);
       expect_close(blend.final_image(), ref.final_rgb, 1e-4f, 1e-6f, "final");
       expect_close(blend.s_image(), ref.s, 1e-4f, 1e-5f, "s");
       expect_close(blend.case_image(), ref.blend_case, 0.0f, 0.0f, "case");
@@ -188,8 +191,8 @@ TEST(BlendVsCpu, NoFilteredValueMeansUnfiltered) {
   Scenario s = make_scenario(5);
   GpuFixture gpu(s);
   BlendPass blend(W, H);
-  blend.run(gpu.inputs, static_cast<const FilterPass*>(nullptr), {0.01f});
-  BlendOutput ref = cpu_blend(s.lv, s.hv, s.var, nullptr, {0.01f});
+  blend.run(gpu.inputs, nullptr, gpu.guide, {0.01f});
+  BlendOutput ref = cpu_blend(s.lv, s.hv, s.var, nullptr, {0.01f}, &s.range, &s.depth);
   expect_close(blend.final_image(), ref.final_rgb, 1e-5f, 1e-7f, "final");
   EXPECT_EQ(blend.case_counts()[kCaseNoFiltered], uint32_t(W * H));
 }
@@ -204,10 +207,11 @@ TEST(FullChain, FilterBlendTonemapOnGpuMatchesCpu) {
   BlendPass blend(W, H);
   TonemapPass tonemap(W, H);
   filter.run(gpu.inputs, gpu.guide, fp);
-  blend.run(gpu.inputs, &filter, {fp.t});
+  const BlendParams bp{fp.t, range_weights(fp)};
+  blend.run(gpu.inputs, &filter, gpu.guide, bp);
   tonemap.run(blend.output(), {});
   FilterOutput rf = cpu_filter(s.hv, s.var, s.lv, s.range, s.depth, fp);
-  BlendOutput rb = cpu_blend(s.lv, s.hv, s.var, &rf, {fp.t});
+  BlendOutput rb = cpu_blend(s.lv, s.hv, s.var, &rf, bp, &s.range, &s.depth);
   expect_close(blend.final_image(), rb.final_rgb, 2e-4f, 1e-6f, "final");
   expect_close(tonemap.display_image(), cpu_tonemap(rb.final_rgb, {}), 2e-4f, 2e-5f, "display");
   for (const Image& im : {filter.filtered_image(), filter.variance_image(), blend.final_image(), blend.s_image(),

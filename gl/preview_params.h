@@ -1,6 +1,7 @@
 // Parameters and codes of the preview passes (SPEC 3.3–3.5), shared by the GL passes, the CPU
 // reference and the app. No GL here.
 #pragma once
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -28,6 +29,20 @@ struct FilterParams {
 };
 constexpr int kMaxFilterRadius = 64;
 
+// 1 / (2 sigma^2), sigma clamped away from 0.
+constexpr float inv_two_sigma2(float sigma) {
+  const float s = std::max(sigma, 1.0e-6f);
+  return 1.0f / (2.0f * s * s);
+}
+// The range weight exp(-|R(p)-R(q)|^2 k_c - (d(p)-d(q))^2 k_d) of a filter: k_d = 0 for the
+// color-only variant. The blend's variance pooling uses the same weights as the filter.
+struct RangeWeights {
+  float k_c = 0.0f, k_d = 0.0f;
+};
+constexpr RangeWeights range_weights(const FilterParams& p) {
+  return {inv_two_sigma2(p.sigma_c), p.kind != FilterKind::Bilateral ? inv_two_sigma2(p.sigma_d) : 0.0f};
+}
+
 // Sentinels of the variance channels (alpha of the HV and filtered textures).
 constexpr float kVarUnknown = -1.0f;  // n < 2 (Var[L_u]); no known neighbour variance (Var[L_f])
 constexpr float kVarSkipped = -2.0f;  // Var[L_f] of a pixel the filter skipped (case 2)
@@ -40,6 +55,8 @@ constexpr float kMaxInput = 1.0e30f;
 
 struct BlendParams {
   float t = 0.01f;  // perceived-variance threshold; sqrt(t) = allowed relative std. deviation
+  // Weights of the 3x3 variance pooling (see pooled_var_u in cpu_reference.h): the filter's.
+  RangeWeights range = range_weights(FilterParams{});
 };
 
 // Blend case per pixel (the "case" buffer). 1, 2, 3 are SPEC 3.4's cases.

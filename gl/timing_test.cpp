@@ -78,7 +78,7 @@ TEST(Timing, DISABLED_Passes512) {
   BlendPass blend(w, h);
   TonemapPass tonemap(w, h);
   for (int i = 0; i < 3; ++i) {
-    blend.run(inputs, &filter, {0.01f});
+    blend.run(inputs, &filter, range.guide(), {0.01f});
     tonemap.run(blend.output(), {});
   }
   std::printf("blend: %.2f ms\ntone map: %.2f ms\n", blend.last_ms(), tonemap.last_ms());

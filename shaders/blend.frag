@@ -5,7 +5,11 @@
 layout(binding = 0) uniform sampler2D hv_tex;        // rgb L_u, a Var[L_u]
 layout(binding = 1) uniform sampler2D lv_tex;        // rgb L_lv
 layout(binding = 2) uniform sampler2D filtered_tex;  // rgb L_f, a Var[L_f] (or a sentinel)
+layout(binding = 3) uniform sampler2D guide_tex;     // rgb range color, a distance (pooling)
 uniform int has_filtered;
+uniform int has_guide;  // 0: u from the pixel's own variance only
+uniform float k_c;      // range weights of the variance pooling (the filter's)
+uniform float k_d;
 uniform float t;
 
 layout(std430, binding = 0) buffer CaseCounts { uint case_counts[5]; };
@@ -33,6 +37,7 @@ void main() {
     } else {
       float vf = max(clean_var(fv.a), 0.0);
       float lb = max(luminance(lf) + luminance(lv), 0.0);
+      if (has_guide != 0) vu = pooled_var_u(hv_tex, guide_tex, p, k_c, k_d);
       float u = vu > 0.0 ? relative_variance(vu, lb) : zero_variance_u(luminance(lf), lb);
       s = blend_factor(u, relative_variance(vf, lb), t, blend_case);
     }

@@ -20,6 +20,39 @@ float relative_variance(float var, float lb) {
   return (var / lb) / lb;
 }
 
+// Range weight of the cross bilateral filter (guide: rgb range color, a distance).
+float range_weight(vec4 g_p, vec4 g_q, float k_c, float k_d) {
+  vec3 dr = clean(g_p.rgb) - clean(g_q.rgb);
+  float dd = clean(g_p.a) - clean(g_q.a);
+  return exp(-(dot(dr, dr) * k_c + dd * dd * k_d));
+}
+
+// Var[L_u] for the decisions of the blend and the filter's skipping (u of SPEC 3.4). A variance
+// estimated from few samples is itself noisy, and far more often too low than too high: path
+// contributions are heavy-tailed, and a pixel that missed the rare bright paths looks quiet (dark
+// speckles kept by case 2). So the decision uses the larger of the pixel's own variance and the
+// range-weighted mean of the known variances in its 3x3 neighbourhood (the filter's weights). Both
+// fall as 1/n, so the bias still vanishes. Returns kVarUnknown where n < 2, and 0 where all the
+// pixel's samples were equal and no neighbour variance is known. Mirrors cpu_reference.cpp.
+float pooled_var_u(sampler2D hv, sampler2D guide, ivec2 p, float k_c, float k_d) {
+  float own = clean_var(texelFetch(hv, p, 0).a);
+  if (own < 0.0) return kVarUnknown;
+  ivec2 size = textureSize(hv, 0);
+  vec4 g_p = texelFetch(guide, p, 0);
+  float sw = 0.0, swv = 0.0;
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx) {
+      ivec2 q = p + ivec2(dx, dy);
+      if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) continue;
+      float v = clean_var(texelFetch(hv, q, 0).a);
+      if (!(v > 0.0)) continue;  // unknown, or all samples equal: no evidence
+      float w = range_weight(g_p, texelFetch(guide, q, 0), k_c, k_d);
+      sw += w;
+      swv += w * v;
+    }
+  return sw > 0.0 ? max(own, swv / sw) : own;
+}
+
 // Perceived variance u of a pixel whose n >= 2 HV samples were all equal (sample variance exactly
 // 0, in practice all zero): that is no evidence of low variance, only that rare paths were missed.
 // A mean of L_f is as consistent with such samples as their own mean, so the variance of the mean
