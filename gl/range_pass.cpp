@@ -49,6 +49,7 @@ RangePass::RangePass(int width, int height)
     : width_(width), height_(height), raster_(Program::from_embedded("range.vert", "range.frag")),
       points_(Program::from_embedded("specular_points.vert", "specular_points.frag")),
       accumulate_(Program::from_embedded("fullscreen.vert", "range_accumulate.frag")),
+      background_(Program::from_embedded("fullscreen.vert", "range_background.frag")),
       frame_color_(width, height, TextureFormat::RGBA32F), frame_distance_(width, height, TextureFormat::R32F),
       frame_depth_(width, height, TextureFormat::Depth32F),
       guide_{Texture2D(width, height, TextureFormat::RGBA32F), Texture2D(width, height, TextureFormat::RGBA32F)},
@@ -87,6 +88,7 @@ void RangePass::set_scene(const Scene& scene) {
     tex.set_wrap(gl_wrap(t.wrap_s), gl_wrap(t.wrap_t));
     textures_.push_back(std::move(tex));
   }
+  upload_environment(scene);
   for (const Mesh& m : scene.meshes) {
     if (m.triangles.empty() || m.positions.empty()) continue;
     std::vector<Vertex> vertices(m.positions.size());
@@ -126,6 +128,31 @@ void RangePass::set_camera(const Camera& camera) {
 
 glm::vec2 RangePass::jitter() const { return raster_jitter(frames_); }
 
+void RangePass::upload_environment(const Scene& scene) {
+  environment_ = Texture2D();
+  environment_strength_ = 0.0f;
+  if (!scene.environment || !(scene.environment->strength > 0.0f)) return;
+  const Texture& image = scene.environment->image;
+  if (image.width <= 0 || image.height <= 0 || image.texels.size() < static_cast<size_t>(image.width) * image.height)
+    return;
+  environment_ = Texture2D(image.width, image.height, TextureFormat::RGBA32F);
+  environment_.upload(&image.texels[0].x, 4);
+  environment_.set_filter(true);  // bilinear, as the path tracer samples it
+  environment_.set_wrap(GL_REPEAT, GL_CLAMP_TO_EDGE);
+  environment_strength_ = scene.environment->strength;
+}
+
+void RangePass::draw_environment(const glm::mat4& view_projection) {
+  background_.set("inverse_view_projection", glm::inverse(view_projection));
+  background_.set("size", glm::vec2(width_, height_));
+  background_.set("strength", environment_strength_);
+  background_.set("background_distance", kBackgroundDepth);
+  environment_.bind(0);
+  background_.use();
+  glDisable(GL_DEPTH_TEST);
+  quad_.draw(frame_fbo_, width_, height_);
+}
+
 void RangePass::draw_scene(glm::vec2 jitter) {
   const glm::mat4 view_projection =
       camera_projection_matrix(camera_, width_, height_, jitter) * camera_view_matrix(camera_);
@@ -139,6 +166,9 @@ void RangePass::draw_scene(glm::vec2 jitter) {
   glClearNamedFramebufferfv(frame_fbo_.id(), GL_COLOR, 0, clear_color);
   glClearNamedFramebufferfv(frame_fbo_.id(), GL_COLOR, 1, clear_distance);
   glClearNamedFramebufferfv(frame_fbo_.id(), GL_DEPTH, 0, &clear_depth);
+  if (environment_.valid()) draw_environment(view_projection);
+  raster_.use();
+  frame_fbo_.bind(width_, height_);
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
   glDisable(GL_CULL_FACE);  // the path tracer hits both sides of every triangle
@@ -198,8 +228,7 @@ void RangePass::apply_specular_chains(const std::vector<uint32_t>& pixels, const
     d[0] = static_cast<float>(pixels[i] % width_);
     d[1] = static_cast<float>(pixels[i] / width_);
     const SpecularChainHit& h = hits[i];
-    glm::vec3 c = h.hit ? h.range_color : glm::vec3(0.0f);
-    d[2] = c.x, d[3] = c.y, d[4] = c.z;
+    d[2] = h.range_color.x, d[3] = h.range_color.y, d[4] = h.range_color.z;
     d[5] = h.hit ? h.distance : kBackgroundDepth;
   }
   point_buffer_.upload(data.data(), data.size() * sizeof(float));

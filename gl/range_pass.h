@@ -68,8 +68,10 @@ class RangePass {
  private:
   struct GpuMesh;
   void draw_scene(glm::vec2 jitter);
+  void upload_environment(const Scene& scene);
+  void draw_environment(const glm::mat4& view_projection);  // where camera rays escape
   int width_, height_;
-  Program raster_, points_, accumulate_;
+  Program raster_, points_, accumulate_, background_;
   Texture2D frame_color_, frame_distance_, frame_depth_, guide_[2], change_;
   Framebuffer frame_fbo_, accum_fbo_[2];
   FullscreenPass quad_;
@@ -77,6 +79,8 @@ class RangePass {
   std::vector<GpuMesh> meshes_;
   std::vector<Texture2D> textures_;
   Texture2D white_;
+  Texture2D environment_;  // equirect radiance; invalid when the scene has none
+  float environment_strength_ = 0.0f;
   std::vector<Material> materials_;
   bool has_specular_material_ = false;
   Camera camera_;

@@ -8,6 +8,8 @@
 #include "gl/range_pass.h"
 #include "gl/test_util.h"
 #include "pathtracer/camera.h"
+#include "pathtracer/lights.h"
+#include "pathtracer/texture.h"
 
 namespace pxf {
 namespace {
@@ -129,6 +131,39 @@ TEST(RangePass, AlphaMaskCutsOut) {
   run_to_convergence(range);
   Image depth = range.depth_image();
   for (float v : depth.pixels) ASSERT_EQ(v, kBackgroundDepth);
+}
+
+TEST(RangePass, EscapingRaysTakeTheCompressedEnvironment) {
+  test::osmesa_context();
+  Scene scene = quad_scene(-10, 0, -10, 10);  // left half of the view; the right half sees the sky
+  Environment env;  // radiance varies per texel (0.5 ... 63), so a wrong direction shows
+  env.image.width = 64;
+  env.image.height = 32;
+  for (int y = 0; y < 32; ++y)
+    for (int x = 0; x < 64; ++x) env.image.texels.push_back(glm::vec4(0.5f + x, 0.1f * (y + 1), 2.0f, 1.0f));
+  env.strength = 1.5f;
+  scene.environment = env;
+  RangePass range(W, H);
+  range.set_scene(scene);
+  run_to_convergence(range);
+  Image color = range.range_color_image(), depth = range.depth_image();
+  for (int y = 0; y < H; ++y)
+    for (int x = W / 2 + 2; x < W; ++x) {
+      glm::vec3 expected(0.0f);  // the average over the same jittered rays
+      for (int k = 0; k < range.frames(); ++k) {
+        glm::vec2 j = raster_jitter(k);
+        Ray ray = camera_ray(Camera{}, W, H, x + j.x, y + j.y);
+        expected += range_environment_color(glm::vec3(sample_texture(env.image, equirect_uv(ray.direction))) * 1.5f);
+      }
+      expected /= float(range.frames());
+      for (int c = 0; c < 3; ++c) ASSERT_NEAR(color.at(x, y, c), expected[c], 2e-3f) << x << "," << y << " " << c;
+      ASSERT_EQ(depth.at(x, y, 0), kBackgroundDepth);
+    }
+  // The quad still covers the left half.
+  glm::vec3 c;
+  float d;
+  expected_at(3, 5, c, d, range.frames());
+  EXPECT_NEAR(color.at(3, 5, 0), c.x, 1e-4f);
 }
 
 TEST(RangePass, SpecularPixelsTakeTheChainResult) {

@@ -130,7 +130,10 @@ SpecularChainHit PathTracer::trace_specular_chain(const Ray& camera_ray) const {
   Ray ray = camera_ray;
   for (int bounce = 0; bounce <= kMaxSpecularChainBounces; ++bounce) {
     Hit hit = geometry_.intersect(ray);
-    if (!hit.valid()) return result;
+    if (!hit.valid()) {
+      result.range_color = range_environment_color(tint * lights_.environment_radiance(ray.direction));
+      return result;
+    }
     SurfacePoint sp = geometry_.surface_point(hit, ray);
     result.distance += hit.t;
     const Material& material = *sp.material;

@@ -10,6 +10,8 @@
 
 #include "pathtracer/bsdf.h"
 #include "pathtracer/integrator.h"
+#include "pathtracer/lights.h"
+#include "pathtracer/texture.h"
 #include "pathtracer/shapes.h"
 
 namespace pxf {
@@ -269,6 +271,53 @@ TEST(Integrator, SpecularChainsReachTheFirstDiffuseSurface) {
   std::vector<SpecularChainHit> center = renderer.trace_specular_chains({static_cast<uint32_t>((size / 2 - 4) * size + size / 2)}, glm::vec2(0.5f));
   ASSERT_TRUE(center[0].hit);
   EXPECT_NEAR(center[0].range_color.x, 0.73f, 0.02f);
+}
+
+// An 8x4 environment whose radiance differs per texel, so a wrong direction shows.
+Environment gradient_environment() {
+  Environment env;
+  env.image.width = 8;
+  env.image.height = 4;
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 8; ++x) env.image.texels.push_back(glm::vec4(0.5f + x, 1.0f + 2.0f * y, 3.0f, 1.0f));
+  env.strength = 2.0f;
+  return env;
+}
+
+TEST(Integrator, EscapedSpecularChainTakesTheCompressedEnvironment) {
+  // A tinted mirror at z = -2 filling the view of the default camera (at the origin, looking -Z):
+  // every chain reflects back past the camera into the environment.
+  Scene scene;
+  Mesh m;
+  m.positions = {{-10, -10, -2}, {10, -10, -2}, {10, 10, -2}, {-10, 10, -2}};
+  m.normals.assign(4, glm::vec3(0, 0, 1));
+  m.triangles = {{0, 1, 2}, {0, 2, 3}};
+  scene.meshes.push_back(m);
+  Material mirror;
+  mirror.metallic = 1.0f;
+  mirror.roughness = 0.0f;
+  mirror.base_color = glm::vec4(0.9f, 0.5f, 0.25f, 1.0f);
+  scene.materials.push_back(mirror);
+  scene.environment = gradient_environment();
+  const int size = 16;
+  ProgressiveRenderer renderer(scene, TraceParams{}, size, size);
+  for (int x : {2, 8, 13}) {
+    const int y = x / 2 + 3;
+    std::vector<SpecularChainHit> hits =
+        renderer.trace_specular_chains({static_cast<uint32_t>(y * size + x)}, glm::vec2(0.5f));
+    ASSERT_EQ(hits.size(), 1u);
+    EXPECT_FALSE(hits[0].hit);
+    Ray ray = camera_ray(scene.camera, size, size, x + 0.5f, y + 0.5f);
+    glm::vec3 reflected = glm::reflect(ray.direction, glm::vec3(0, 0, 1));
+    glm::vec3 radiance = glm::vec3(sample_texture(scene.environment->image, equirect_uv(reflected))) * 2.0f;
+    glm::vec3 expected = range_environment_color(glm::vec3(0.9f, 0.5f, 0.25f) * radiance);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(hits[0].range_color[c], expected[c], 1e-5f) << x << " " << c;
+  }
+  // Without an environment an escaped chain is black.
+  scene.environment.reset();
+  scene.lights.push_back(PunctualLight{});  // keep the scene lit
+  ProgressiveRenderer dark(scene, TraceParams{}, size, size);
+  EXPECT_EQ(dark.trace_specular_chains({8 * size + 8}, glm::vec2(0.5f))[0].range_color, glm::vec3(0.0f));
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // Public API of the path tracer (SPEC 3.1): a progressive state with make/step/get functions in the
 // style of yocto_trace. No GL here; the GL passes read these buffers and upload them.
 #pragma once
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -33,11 +34,23 @@ inline glm::vec3 range_shading(glm::vec3 albedo, glm::vec3 normal, glm::vec3 to_
   return albedo * (0.2f + 0.8f * (c > 0.0f ? c : 0.0f));
 }
 
+// The range-buffer color where a ray escapes to the environment: its radiance compressed to
+// [0, 1) per channel by L / (1 + L), so that bright and dark parts of the environment (a softbox,
+// the backdrop) differ in range color and the filter does not mix them. The raster pass
+// (shaders/range_background.frag) computes the same for camera rays that miss the scene.
+inline glm::vec3 range_environment_color(glm::vec3 radiance) {
+  if (!std::isfinite(radiance.x) || !std::isfinite(radiance.y) || !std::isfinite(radiance.z)) return glm::vec3(0.0f);
+  glm::vec3 l = glm::max(radiance, glm::vec3(0.0f));
+  return l / (1.0f + l);
+}
+
 // Result of following a perfectly specular chain from the camera (SPEC 3.2).
 struct SpecularChainHit {
-  glm::vec3 range_color{0.0f};  // albedo x chain tint x range_shading at the first non-specular hit
-  float distance = 0.0f;        // total distance along the chain, scene units
-  bool hit = false;             // false: the chain escaped (range color = environment-free black)
+  // hit: albedo x chain tint x range_shading at the first non-specular hit; escaped:
+  // range_environment_color(chain tint x environment radiance), black without an environment.
+  glm::vec3 range_color{0.0f};
+  float distance = 0.0f;  // total distance along the chain, scene units (hit only)
+  bool hit = false;       // false: the chain escaped (the range pass uses the background distance)
 };
 
 // Per-pixel accumulations, row-major, top row first.
