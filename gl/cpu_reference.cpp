@@ -7,15 +7,35 @@
 namespace pxf {
 
 const std::vector<std::string>& filter_kind_names() {
-  static const std::vector<std::string> names = {"bilateral-depth", "bilateral", "separable"};
+  static const std::vector<std::string> names = {"bilateral-depth", "bilateral", "separable", "atrous"};
   return names;
 }
 const char* filter_kind_name(FilterKind kind) { return filter_kind_names()[static_cast<int>(kind)].c_str(); }
 FilterKind parse_filter_kind(const std::string& name) {
   const auto& names = filter_kind_names();
-  for (size_t i = 0; i < names.size(); ++i)
+  std::string expected;
+  for (size_t i = 0; i < names.size(); ++i) {
     if (names[i] == name) return static_cast<FilterKind>(i);
-  throw Error("unknown filter '" + name + "' (expected bilateral-depth, bilateral or separable)");
+    expected += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + names[i];
+  }
+  throw Error("unknown filter '" + name + "' (expected " + expected + ")");
+}
+
+// Pass i of the à-trous filter convolves with the B3 spline at hole spacing 2^i, whose variance is
+// 4^i px^2 per axis (the taps 1/16 [1 4 6 4 1] have variance 1 at spacing 1), and the variances
+// of successive convolutions add: k passes have (4^k - 1) / 3. Passes are added while that is
+// below the Gaussian's sigma_s^2 (sigma_s = 8: 4 passes, variance 85 = (9.2 px)^2, footprint
+// radius 30 px against the exact kernel's 24), as long as the footprint radius 2 (2^k - 1) of the
+// next count fits kMaxFilterRadius (at most 5 passes).
+int atrous_iterations(float sigma_s) {
+  const double target = double(sigma_s) * sigma_s;
+  int passes = 1;
+  double variance = 1.0;
+  while (variance < target && 2 * ((2 << passes) - 1) <= kMaxFilterRadius) {
+    variance += std::ldexp(1.0, 2 * passes);  // pass number `passes` (from 0) adds 4^passes
+    ++passes;
+  }
+  return passes;
 }
 
 namespace {
@@ -127,10 +147,107 @@ FilterOutput filter_once(const Image& signal, const Image& signal_var, const Ima
   return out;
 }
 
+// ---- Edge-avoiding à-trous (FilterKind::Atrous) ----
+
+// The B3-spline taps of the à-trous kernel; the 5x5 kernel h is their outer product (sum 1).
+constexpr float kB3[5] = {1.0f / 16, 4.0f / 16, 6.0f / 16, 4.0f / 16, 1.0f / 16};
+
+// A variance as the à-trous filter's evidence: unknown when negative or non-finite (n < 2), and
+// also when exactly 0: n >= 2 identical samples (typically all zero) are no evidence of low variance.
+float evidence_var(float v) {
+  const float known = clean_var(v);
+  return known > 0.0f ? known : kVarUnknown;
+}
+
+// Case 2 with the unfiltered background (FilterParams::skip_case2); unknown variance is never skipped.
+bool in_case2(const Px& lu, float var, const Px& lv, float t) {
+  if (var < 0.0f) return false;
+  const float lb = std::max(lum(lu.c) + lum(lv.c), 0.0f);
+  return relative_variance(var, lb) <= std::max(t, 0.0f);
+}
+
+// One pixel's kernel sums: L_f = sum w L / sum w, Var[L_f] = sum w^2 Var / (sum w)^2, where
+// neighbours of unknown variance count with the kernel-weighted mean of the known ones.
+struct KernelSums {
+  double w = 0, wl[3] = {0, 0, 0};
+  double w2_var_known = 0, w2_unknown = 0, w_known = 0, w_var_known = 0;
+
+  void add(double wq, const Px& l, float var) {
+    w += wq;
+    for (int c = 0; c < 3; ++c) wl[c] += wq * l.c[c];
+    if (var >= 0.0f) {
+      w2_var_known += wq * wq * var;
+      w_known += wq;
+      w_var_known += wq * var;
+    } else {
+      w2_unknown += wq * wq;
+    }
+  }
+  void write(FilterOutput& out, int x, int y) const {
+    for (int c = 0; c < 3; ++c) out.filtered.at(x, y, c) = static_cast<float>(wl[c] / w);
+    out.variance.at(x, y, 0) = w_known > 0
+                                   ? static_cast<float>((w2_var_known + w2_unknown * (w_var_known / w_known)) / (w * w))
+                                   : kVarUnknown;
+  }
+};
+
+// One à-trous pass over `signal` (rgb) with variance `signal_var`: the 5x5 taps at hole spacing
+// `step`, weighted by h x the range weights (color, depth), taps outside the image left out (the
+// sums are normalized). Skipping (final pass only) looks at the unfiltered hv / var_u.
+FilterOutput atrous_pass(const Image& signal, const Image& signal_var, const Image& hv, const Image& var_u,
+                         const Image& lv, const Image& range_color, const Image& depth, const FilterParams& p,
+                         int step, bool final_pass) {
+  const int w = hv.width, h = hv.height;
+  FilterOutput out{Image::rgb(w, h), Image::gray(w, h)};
+  const float kc = inv_two_sigma2(p.sigma_c), kd = inv_two_sigma2(p.sigma_d);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      if (final_pass && p.skip_case2) {
+        const Px lu = rgb_at(hv, x, y);
+        if (in_case2(lu, evidence_var(var_u.at(x, y, 0)), rgb_at(lv, x, y), p.t)) {
+          for (int c = 0; c < 3; ++c) out.filtered.at(x, y, c) = lu.c[c];
+          out.variance.at(x, y, 0) = kVarSkipped;
+          continue;
+        }
+      }
+      const Px rp = rgb_at(range_color, x, y);
+      const float dp = clean(depth.at(x, y, 0));
+      KernelSums sums;
+      for (int j = 0; j < 5; ++j)
+        for (int i = 0; i < 5; ++i) {
+          const int qx = x + (i - 2) * step, qy = y + (j - 2) * step;
+          if (qx < 0 || qx >= w || qy < 0 || qy >= h) continue;
+          const Px rq = rgb_at(range_color, qx, qy);
+          double dc2 = 0;
+          for (int c = 0; c < 3; ++c) dc2 += double(rp.c[c] - rq.c[c]) * (rp.c[c] - rq.c[c]);
+          const double dd = double(dp) - clean(depth.at(qx, qy, 0));
+          const double range_weight = std::exp(-(dc2 * kc + dd * dd * kd));
+          sums.add(double(kB3[i]) * kB3[j] * range_weight, rgb_at(signal, qx, qy), evidence_var(signal_var.at(qx, qy, 0)));
+        }
+      sums.write(out, x, y);  // sum w >= h(0,0) = 0.14: the center tap has range weight 1
+    }
+  return out;
+}
+
+// atrous_iterations(sigma_s) passes at spacing 1, 2, 4, ...; each pass is a linear filter of the
+// previous pass's output, and its Var[L_f] is propagated treating that output's pixels as
+// independent. They are not (neighbouring outputs share inputs, positively weighted), so from the
+// second pass on Var[L_f] is a lower bound of the true variance of what is computed
+// (gl/passes_test.cpp AtrousVariance measures by how much).
+FilterOutput cpu_atrous(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
+                        const Image& depth, const FilterParams& p) {
+  const int passes = atrous_iterations(p.sigma_s);
+  FilterOutput level{hv, var_u};
+  for (int i = 0; i < passes; ++i)
+    level = atrous_pass(level.filtered, level.variance, hv, var_u, lv, range_color, depth, p, 1 << i, i + 1 == passes);
+  return level;
+}
+
 }  // namespace
 
 FilterOutput cpu_filter(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
                         const Image& depth, const FilterParams& p) {
+  if (p.kind == FilterKind::Atrous) return cpu_atrous(hv, var_u, lv, range_color, depth, p);
   if (p.kind != FilterKind::Separable) return filter_once(hv, var_u, hv, var_u, lv, range_color, depth, p, 1, 1, true);
   FilterOutput rows = filter_once(hv, var_u, hv, var_u, lv, range_color, depth, p, 1, 0, false);
   return filter_once(rows.filtered, rows.variance, hv, var_u, lv, range_color, depth, p, 0, 1, true);

@@ -63,15 +63,15 @@ TEST(Timing, DISABLED_Passes512) {
 
   FilterPass filter(w, h);
   const char* only = std::getenv("PXF_TIMING_FILTER");  // e.g. "separable" to skip the slow ones
-  for (FilterKind kind : {FilterKind::BilateralDepth, FilterKind::Bilateral, FilterKind::Separable}) {
-    if (only && std::string(only) != filter_kind_name(kind)) continue;
+  for (const std::string& name : filter_kind_names()) {
+    if (only && std::string(only) != name) continue;
     for (bool skip : {false, true}) {
       FilterParams p;
-      p.kind = kind;
+      p.kind = parse_filter_kind(name);
       p.skip_case2 = skip;
       p.t = 0.05f;
       filter.run(inputs, range.guide(), p);
-      std::printf("filter %s sigma_s=8 skip=%d: %.1f ms (%u of %d pixels filtered)\n", filter_kind_name(kind), skip,
+      std::printf("filter %s sigma_s=8 skip=%d: %.1f ms (%u of %d pixels filtered)\n", name.c_str(), skip,
                   filter.last_ms(), filter.filtered_pixels(), w * h);
     }
   }

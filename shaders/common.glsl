@@ -40,3 +40,17 @@ float blend_factor(float u, float f, float t, out int blend_case) {
   blend_case = 3;
   return clamp(fh / (uh + fh) + sqrt(q), 0.0, 1.0);
 }
+
+// A variance as the à-trous filter's evidence: unknown when negative or non-finite (n < 2), and
+// also when exactly 0: n >= 2 identical samples (typically all zero) are no evidence of low variance.
+float evidence_var(float v) {
+  float known = clean_var(v);
+  return known > 0.0 ? known : kVarUnknown;
+}
+
+// Case 2 with the unfiltered background (FilterParams::skip_case2); unknown variance is never skipped.
+bool in_case2(vec3 lu, float var, vec3 lv, float t) {
+  if (var < 0.0) return false;
+  float lb = max(luminance(lu) + luminance(lv), 0.0);
+  return relative_variance(var, lb) <= max(t, 0.0);
+}
