@@ -233,7 +233,8 @@ FilterOutput atrous_pass(const Image& signal, const Image& signal_var, const Ima
 // previous pass's output, and its Var[L_f] is propagated treating that output's pixels as
 // independent. They are not (neighbouring outputs share inputs, positively weighted), so from the
 // second pass on Var[L_f] is a lower bound of the true variance of what is computed
-// (gl/passes_test.cpp AtrousVariance measures by how much).
+// (Atrous.WhiteNoiseVarianceShrinksBySumOfSquaredWeights in gl/passes_test.cpp measures by how
+// much: 28.8x below at sigma_s = 8).
 FilterOutput cpu_atrous(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
                         const Image& depth, const FilterParams& p) {
   const int passes = atrous_iterations(p.sigma_s);
