@@ -7,15 +7,71 @@
 namespace pxf {
 
 const std::vector<std::string>& filter_kind_names() {
-  static const std::vector<std::string> names = {"bilateral-depth", "bilateral", "separable"};
+  static const std::vector<std::string> names = {"bilateral-depth", "bilateral", "separable", "atrous"};
   return names;
 }
 const char* filter_kind_name(FilterKind kind) { return filter_kind_names()[static_cast<int>(kind)].c_str(); }
 FilterKind parse_filter_kind(const std::string& name) {
   const auto& names = filter_kind_names();
-  for (size_t i = 0; i < names.size(); ++i)
+  std::string expected;
+  for (size_t i = 0; i < names.size(); ++i) {
     if (names[i] == name) return static_cast<FilterKind>(i);
-  throw Error("unknown filter '" + name + "' (expected bilateral-depth, bilateral or separable)");
+    expected += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + names[i];
+  }
+  throw Error("unknown filter '" + name + "' (expected " + expected + ")");
+}
+
+// Pass i of the à-trous filter convolves with the B3 spline at hole spacing 2^i, whose variance is
+// 4^i px^2 per axis (the taps 1/16 [1 4 6 4 1] have variance 1 at spacing 1), and the variances
+// of successive convolutions add: k passes have (4^k - 1) / 3. Passes are added while that is
+// below the Gaussian's sigma_s^2 (sigma_s = 8: 4 passes, variance 85 = (9.2 px)^2, footprint
+// radius 30 px against the exact kernel's 24), as long as the footprint radius 2 (2^k - 1) of the
+// next count fits kMaxFilterRadius (at most 5 passes).
+int atrous_iterations(float sigma_s) {
+  const double target = double(sigma_s) * sigma_s;
+  int passes = 1;
+  double variance = 1.0;
+  while (variance < target && 2 * ((2 << passes) - 1) <= kMaxFilterRadius) {
+    variance += std::ldexp(1.0, 2 * passes);  // pass number `passes` (from 0) adds 4^passes
+    ++passes;
+  }
+  return passes;
+}
+
+namespace {
+
+// The B3-spline taps of the à-trous kernel; the 5x5 kernel h is their outer product (sum 1).
+constexpr float kB3[5] = {1.0f / 16, 4.0f / 16, 6.0f / 16, 4.0f / 16, 1.0f / 16};
+
+}  // namespace
+
+// After the first pass, neighbouring outputs share inputs, so propagating Var as if they were
+// independent underestimates it (28.8x at sigma_s = 8 for white noise). Where all range weights are
+// 1 the passes are plain convolutions with the separable kernel K_k = K_{k-1} * h_k (h_k: B3 taps
+// at spacing 2^k), whose exact white-noise variance is (sum K_k^2)^2; the factor is that over
+// (sum h^2)^2 times the previous pass's exact variance: 1, 2.73, 3.20, 3.31, 3.33. At range edges
+// the correlation is smaller, so the corrected variance errs on the high (safe) side there.
+float atrous_variance_correction(int pass) {
+  static const std::vector<float> factors = [] {
+    std::vector<float> out;
+    std::vector<double> kernel = {1.0};
+    double h2 = 0, previous = 1.0;
+    for (float b : kB3) h2 += double(b) * b;
+    for (int k = 0; 2 * ((2 << k) - 1) <= 2 * kMaxFilterRadius; ++k) {
+      const int step = 1 << k;
+      std::vector<double> next(kernel.size() + 4 * step, 0.0);
+      for (size_t i = 0; i < kernel.size(); ++i)
+        for (int j = 0; j < 5; ++j) next[i + j * step] += kernel[i] * kB3[j];
+      kernel = std::move(next);
+      double sum2 = 0;
+      for (double v : kernel) sum2 += v * v;
+      const double exact = sum2 * sum2;
+      out.push_back(static_cast<float>(exact / (previous * h2 * h2)));
+      previous = exact;
+    }
+    return out;
+  }();
+  return factors[std::clamp<size_t>(static_cast<size_t>(std::max(pass, 0)), 0, factors.size() - 1)];
 }
 
 namespace {
@@ -42,6 +98,46 @@ double range_exponent(const Image& range_color, const Image& depth, int px, int 
   for (int c = 0; c < 3; ++c) dc2 += double(rp.c[c] - rq.c[c]) * (rp.c[c] - rq.c[c]);
   double dd = double(clean(depth.at(px, py, 0))) - clean(depth.at(qx, qy, 0));
   return dc2 * range.k_c + dd * dd * range.k_d;
+}
+
+// One pixel's kernel sums: L_f = sum w L / sum w, Var[L_f] = sum w^2 Var / (sum w)^2. Neighbours
+// of unknown variance (n < 2, or 0: all samples equal, no evidence) count with the kernel-weighted
+// mean of the known ones.
+struct KernelSums {
+  double w = 0, wl[3] = {0, 0, 0};
+  double w2_var_known = 0, w2_unknown = 0, w_known = 0, w_var_known = 0;
+
+  void add(double wq, const Px& l, float var) {
+    w += wq;
+    for (int c = 0; c < 3; ++c) wl[c] += wq * l.c[c];
+    if (var > 0.0f) {
+      w2_var_known += wq * wq * var;
+      w_known += wq;
+      w_var_known += wq * var;
+    } else {
+      w2_unknown += wq * wq;
+    }
+  }
+  // w > 0: the center tap always has range weight 1.
+  void write(FilterOutput& out, int x, int y, float variance_factor = 1.0f) const {
+    for (int c = 0; c < 3; ++c) out.filtered.at(x, y, c) = static_cast<float>(wl[c] / w);
+    out.variance.at(x, y, 0) =
+        w_known > 0 ? static_cast<float>(variance_factor * (w2_var_known + w2_unknown * (w_var_known / w_known)) / (w * w))
+                    : kVarUnknown;
+  }
+};
+
+// The filter's case-2 skip (FilterParams::skip_case2, final pass only): the blend's u (pooled
+// variance) with the unfiltered background; a zero variance is not trusted. Writes the skip.
+bool skip_as_case2(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
+                   const Image& depth, const FilterParams& p, int x, int y, FilterOutput& out) {
+  const float v = pooled_var_u(var_u, range_color, depth, x, y, range_weights(p));
+  const Px lu = rgb_at(hv, x, y), l = rgb_at(lv, x, y);
+  const float lb = std::max(lum(lu.c) + lum(l.c), 0.0f);
+  if (!(v > 0.0f) || relative_variance(v, lb) > std::max(p.t, 0.0f)) return false;
+  for (int c = 0; c < 3; ++c) out.filtered.at(x, y, c) = lu.c[c];
+  out.variance.at(x, y, 0) = kVarSkipped;
+  return true;
 }
 
 }  // namespace
@@ -111,49 +207,65 @@ FilterOutput filter_once(const Image& signal, const Image& signal_var, const Ima
   const RangeWeights range = range_weights(p);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
-      Px lu = rgb_at(hv, x, y);
-      if (final_pass && p.skip_case2) {  // the blend's u with the unfiltered background
-        float v = pooled_var_u(var_u, range_color, depth, x, y, range);
-        Px l = rgb_at(lv, x, y);
-        float lb = std::max(lum(lu.c) + lum(l.c), 0.0f);
-        if (v > 0.0f && relative_variance(v, lb) <= std::max(p.t, 0.0f)) {  // a zero variance is not trusted
-          for (int c = 0; c < 3; ++c) out.filtered.at(x, y, c) = lu.c[c];
-          out.variance.at(x, y, 0) = kVarSkipped;
-          continue;
-        }
-      }
-      double sw = 0, swl[3] = {0, 0, 0}, sw2v = 0, sw2u = 0, swk = 0, swv = 0;
+      if (final_pass && p.skip_case2 && skip_as_case2(hv, var_u, lv, range_color, depth, p, x, y, out)) continue;
+      KernelSums sums;
       for (int qy = std::max(0, y - radius * ey); qy <= std::min(h - 1, y + radius * ey); ++qy)
         for (int qx = std::max(0, x - radius * ex); qx <= std::min(w - 1, x + radius * ex); ++qx) {
           double e = double((qx - x) * (qx - x) + (qy - y) * (qy - y)) * ks +
                      range_exponent(range_color, depth, x, y, qx, qy, range);
-          double wq = std::exp(-e);
-          Px lq = rgb_at(signal, qx, qy);
-          float vq = clean_var(signal_var.at(qx, qy, 0));
-          sw += wq;
-          for (int c = 0; c < 3; ++c) swl[c] += wq * lq.c[c];
-          if (vq > 0.0f) {
-            sw2v += wq * wq * vq;
-            swk += wq;
-            swv += wq * vq;
-          } else {
-            sw2u += wq * wq;
-          }
+          sums.add(std::exp(-e), rgb_at(signal, qx, qy), clean_var(signal_var.at(qx, qy, 0)));
         }
-      // sw >= 1: the center pixel has weight exp(0).
-      for (int c = 0; c < 3; ++c) out.filtered.at(x, y, c) = static_cast<float>(swl[c] / sw);
-      // Neighbours of unknown variance (n < 2, or 0: all samples equal) count with the
-      // kernel-weighted mean of the known ones.
-      out.variance.at(x, y, 0) =
-          swk > 0 ? static_cast<float>((sw2v + sw2u * (swv / swk)) / (sw * sw)) : kVarUnknown;
+      sums.write(out, x, y);
     }
   return out;
+}
+
+// ---- Edge-avoiding à-trous (FilterKind::Atrous) ----
+
+// One à-trous pass over `signal` (rgb) with variance `signal_var`: the 5x5 taps at hole spacing
+// `step`, weighted by h x the range weights (color, depth), taps outside the image left out (the
+// sums are normalized). Skipping (final pass only) looks at the unfiltered hv / var_u.
+FilterOutput atrous_pass(const Image& signal, const Image& signal_var, const Image& hv, const Image& var_u,
+                         const Image& lv, const Image& range_color, const Image& depth, const FilterParams& p,
+                         int step, float variance_factor, bool final_pass) {
+  const int w = hv.width, h = hv.height;
+  FilterOutput out{Image::rgb(w, h), Image::gray(w, h)};
+  const RangeWeights range = range_weights(p);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      if (final_pass && p.skip_case2 && skip_as_case2(hv, var_u, lv, range_color, depth, p, x, y, out)) continue;
+      KernelSums sums;
+      for (int j = 0; j < 5; ++j)
+        for (int i = 0; i < 5; ++i) {
+          const int qx = x + (i - 2) * step, qy = y + (j - 2) * step;
+          if (qx < 0 || qx >= w || qy < 0 || qy >= h) continue;
+          const double range_weight = std::exp(-range_exponent(range_color, depth, x, y, qx, qy, range));
+          sums.add(double(kB3[i]) * kB3[j] * range_weight, rgb_at(signal, qx, qy), clean_var(signal_var.at(qx, qy, 0)));
+        }
+      sums.write(out, x, y, variance_factor);  // sum w >= h(0,0) = 0.14: the center tap has range weight 1
+    }
+  return out;
+}
+
+// atrous_iterations(sigma_s) passes at spacing 1, 2, 4, ...; each pass is a linear filter of the
+// previous pass's output. Its Var[L_f] is propagated as if that output's pixels were independent
+// and then multiplied by atrous_variance_correction(pass), which makes it exact where all range
+// weights are 1 (Atrous.WhiteNoiseVarianceShrinksBySumOfSquaredWeights in gl/passes_test.cpp).
+FilterOutput cpu_atrous(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
+                        const Image& depth, const FilterParams& p) {
+  const int passes = atrous_iterations(p.sigma_s);
+  FilterOutput level{hv, var_u};
+  for (int i = 0; i < passes; ++i)
+    level = atrous_pass(level.filtered, level.variance, hv, var_u, lv, range_color, depth, p, 1 << i,
+                        atrous_variance_correction(i), i + 1 == passes);
+  return level;
 }
 
 }  // namespace
 
 FilterOutput cpu_filter(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
                         const Image& depth, const FilterParams& p) {
+  if (p.kind == FilterKind::Atrous) return cpu_atrous(hv, var_u, lv, range_color, depth, p);
   if (p.kind != FilterKind::Separable) return filter_once(hv, var_u, hv, var_u, lv, range_color, depth, p, 1, 1, true);
   FilterOutput rows = filter_once(hv, var_u, hv, var_u, lv, range_color, depth, p, 1, 0, false);
   return filter_once(rows.filtered, rows.variance, hv, var_u, lv, range_color, depth, p, 0, 1, true);

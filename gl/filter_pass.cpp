@@ -17,6 +17,23 @@ void FilterPass::run(const PreviewInputs& inputs, const Texture2D& guide, const 
   if (inputs.width() != width_ || inputs.height() != height_ || guide.width() != width_ || guide.height() != height_)
     throw Error("filter pass: input size differs from the pass size");
   timer_.begin();
+  const uint32_t zero = 0;
+  counter_.upload(&zero, sizeof zero);
+  counter_.bind_storage(0);
+  inputs.hv().bind(0);
+  inputs.lv().bind(1);
+  guide.bind(2);
+  if (p.kind == FilterKind::Atrous)
+    run_atrous(inputs, p);
+  else
+    run_bilateral(inputs, p);
+  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+  timer_.end();
+  ++runs_;
+  check_gl_error("filter pass");
+}
+
+void FilterPass::run_bilateral(const PreviewInputs& inputs, const FilterParams& p) {
   const int radius = std::min(kMaxFilterRadius, static_cast<int>(std::ceil(3.0f * std::max(p.sigma_s, 0.0f))));
   program_.set("radius", radius);
   program_.set("k_s", inv_two_sigma2(p.sigma_s));
@@ -25,35 +42,52 @@ void FilterPass::run(const PreviewInputs& inputs, const Texture2D& guide, const 
   program_.set("k_d", range.k_d);
   program_.set("skip_case2", p.skip_case2 ? 1 : 0);
   program_.set("t", p.t);
-  const uint32_t zero = 0;
-  counter_.upload(&zero, sizeof zero);
-  counter_.bind_storage(0);
-  inputs.hv().bind(0);
-  inputs.lv().bind(1);
-  guide.bind(2);
   program_.use();
   if (p.kind == FilterKind::Separable) {
-    if (!rows_.valid()) {
-      rows_ = Texture2D(width_, height_, TextureFormat::RGBA32F);
-      rows_fbo_.attach(0, rows_);
-      rows_fbo_.check("filter pass (rows)");
-    }
     program_.set("extent", glm::ivec2(1, 0));
     program_.set("final_pass", 0);
     inputs.hv().bind(3);
-    quad_.draw(rows_fbo_, width_, height_);
+    quad_.draw(scratch_target(0), width_, height_);
     program_.set("extent", glm::ivec2(0, 1));
-    rows_.bind(3);
+    scratch_[0].bind(3);
   } else {
     program_.set("extent", glm::ivec2(1, 1));
     inputs.hv().bind(3);
   }
   program_.set("final_pass", 1);
   quad_.draw(fbo_, width_, height_);
-  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
-  timer_.end();
-  ++runs_;
-  check_gl_error("filter pass");
+}
+
+// atrous_iterations(sigma_s) passes at hole spacing 1, 2, 4, ...: each reads the previous pass's
+// output (the first reads the HV buffer), the intermediate ones ping-pong between the scratch
+// textures, the last writes output_ (and alone skips case-2 pixels and counts).
+void FilterPass::run_atrous(const PreviewInputs& inputs, const FilterParams& p) {
+  if (!atrous_program_.id()) atrous_program_ = Program::from_embedded("fullscreen.vert", "atrous.frag");
+  const RangeWeights range = range_weights(p);
+  atrous_program_.set("k_c", range.k_c);
+  atrous_program_.set("k_d", range.k_d);
+  atrous_program_.set("skip_case2", p.skip_case2 ? 1 : 0);
+  atrous_program_.set("t", p.t);
+  atrous_program_.use();
+  const int passes = atrous_iterations(p.sigma_s);
+  inputs.hv().bind(3);
+  for (int i = 0; i < passes; ++i) {
+    const bool last = i + 1 == passes;
+    atrous_program_.set("step_px", 1 << i);
+    atrous_program_.set("variance_correction", atrous_variance_correction(i));
+    atrous_program_.set("final_pass", last ? 1 : 0);
+    quad_.draw(last ? fbo_ : scratch_target(i % 2), width_, height_);
+    if (!last) scratch_[i % 2].bind(3);
+  }
+}
+
+const Framebuffer& FilterPass::scratch_target(int index) {
+  if (!scratch_[index].valid()) {
+    scratch_[index] = Texture2D(width_, height_, TextureFormat::RGBA32F);
+    scratch_fbo_[index].attach(0, scratch_[index]);
+    scratch_fbo_[index].check("filter pass (scratch)");
+  }
+  return scratch_fbo_[index];
 }
 
 uint32_t FilterPass::filtered_pixels() const {

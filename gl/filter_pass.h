@@ -1,4 +1,5 @@
-// Cross bilateral filter pass (SPEC 3.3; FilterKind picks the variant): L_f and Var[L_f] from the HV buffer, guided by the
+// Cross bilateral filter pass (SPEC 3.3; FilterKind picks the variant: shaders/bilateral.frag, or
+// shaders/atrous.frag for the à-trous one): L_f and Var[L_f] from the HV buffer, guided by the
 // range buffer (color + distance). Runs on a schedule; the output texture persists between runs.
 // Usage:
 //   FilterPass filter(w, h);
@@ -32,13 +33,20 @@ class FilterPass {
   Image raw_variance_image() const;  // "Y" with the sentinels kept
 
  private:
+  void run_bilateral(const PreviewInputs& inputs, const FilterParams& params);
+  void run_atrous(const PreviewInputs& inputs, const FilterParams& params);
+  const Framebuffer& scratch_target(int index);  // allocates scratch_[index] on first use
+
   int width_, height_;
   Program program_;
+  Program atrous_program_;  // compiled on first use
   Texture2D output_;
   Framebuffer fbo_;
   Buffer counter_;
-  Texture2D rows_;      // separable: output of the horizontal pass (allocated on first use)
-  Framebuffer rows_fbo_;
+  // Intermediate results: the separable's horizontal pass (scratch_[0]); the à-trous passes
+  // before the last (ping-pong between the two).
+  Texture2D scratch_[2];
+  Framebuffer scratch_fbo_[2];
   FullscreenPass quad_;
   StageTimer timer_;
   int runs_ = 0;

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <random>
 #include "gl/blend_pass.h"
@@ -113,7 +114,167 @@ INSTANTIATE_TEST_SUITE_P(Variants, FilterVsCpu,
                                            std::make_tuple(FilterKind::Bilateral, true, 2.5f),
                                            std::make_tuple(FilterKind::BilateralDepth, false, 0.0f),
                                            std::make_tuple(FilterKind::Separable, false, 8.0f),
-                                           std::make_tuple(FilterKind::Separable, true, 3.0f)));
+                                           std::make_tuple(FilterKind::Separable, true, 3.0f),
+                                           std::make_tuple(FilterKind::Atrous, false, 8.0f),
+                                           std::make_tuple(FilterKind::Atrous, true, 8.0f),
+                                           std::make_tuple(FilterKind::Atrous, true, 2.5f),
+                                           std::make_tuple(FilterKind::Atrous, false, 0.0f),
+                                           std::make_tuple(FilterKind::Atrous, false, 21.0f)));
+
+TEST(FilterKinds, ConstantHvStaysConstant) {
+  // The weights are normalized, so a constant signal comes out unchanged whatever the range edges.
+  test::osmesa_context();
+  Scenario s = make_scenario(13);
+  for (float& v : s.hv.pixels) v = 0.7f;
+  GpuFixture gpu(s);
+  FilterPass filter(W, H);
+  for (const std::string& name : filter_kind_names()) {
+    FilterParams p;
+    p.kind = parse_filter_kind(name);
+    p.skip_case2 = false;
+    filter.run(gpu.inputs, gpu.guide, p);
+    Image f = filter.filtered_image();
+    size_t off = 0;
+    for (float v : f.pixels) off += std::abs(v - 0.7f) > 1e-5f;
+    EXPECT_EQ(off, 0u) << name;
+  }
+}
+
+TEST(Atrous, IterationsFollowSigmaS) {
+  // k passes have B3 variance (4^k - 1) / 3: 1, 5, 21, 85, 341; the first that reaches sigma_s^2,
+  // at least 1, at most 5 (footprint radius 62 <= kMaxFilterRadius).
+  EXPECT_EQ(atrous_iterations(0.0f), 1);
+  EXPECT_EQ(atrous_iterations(1.0f), 1);
+  EXPECT_EQ(atrous_iterations(1.5f), 2);
+  EXPECT_EQ(atrous_iterations(4.5f), 3);
+  EXPECT_EQ(atrous_iterations(4.6f), 4);
+  EXPECT_EQ(atrous_iterations(8.0f), 4);
+  EXPECT_EQ(atrous_iterations(kMaxFilterRadius / 3.0f), 5);
+  EXPECT_EQ(atrous_iterations(kInf), 5);
+  EXPECT_EQ(atrous_iterations(kNaN), 1);
+}
+
+TEST(Atrous, EdgesArePreserved) {
+  // A step in range color, and one in depth, with constant HV on each side: no mixing across.
+  test::osmesa_context();
+  Scenario s = make_scenario(3);
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      bool left = x < W / 2, top = y < H / 2;
+      for (int c = 0; c < 3; ++c) {
+        s.range.at(x, y, c) = left ? 0.8f : 0.1f;
+        s.hv.at(x, y, c) = (left ? 1.0f : 3.0f) * (top ? 1.0f : 2.0f);
+      }
+      s.depth.at(x, y, 0) = top ? 3.0f : 30.0f;
+      s.var.at(x, y, 0) = 0.5f;
+    }
+  GpuFixture gpu(s);
+  FilterPass filter(W, H);
+  FilterParams p;
+  p.kind = FilterKind::Atrous;
+  p.skip_case2 = false;
+  filter.run(gpu.inputs, gpu.guide, p);
+  Image f = filter.filtered_image();
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x)
+      EXPECT_NEAR(f.at(x, y, 0), (x < W / 2 ? 1.0f : 3.0f) * (y < H / 2 ? 1.0f : 2.0f), 1e-5f);
+}
+
+TEST(Atrous, ZeroVarianceIsNoEvidence) {
+  // Var[L_u] = 0 with n >= 2 (identical samples) is no evidence of low variance: as a neighbour it
+  // counts like kVarUnknown; the pixel itself is skipped only on its neighbours' (pooled) evidence,
+  // never when no neighbour variance is known.
+  test::osmesa_context();
+  Scenario s = make_scenario(17);
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x)
+      if ((x + 3 * y) % 7 == 0) s.var.at(x, y, 0) = 0.0f;
+  GpuFixture gpu(s);
+  FilterPass filter(W, H);
+  FilterParams p;
+  p.kind = FilterKind::Atrous;
+  p.t = 0.05f;
+  for (bool skip : {false, true}) {
+    p.skip_case2 = skip;
+    filter.run(gpu.inputs, gpu.guide, p);
+    FilterOutput ref = cpu_filter(s.hv, s.var, s.lv, s.range, s.depth, p);
+    expect_close(filter.filtered_image(), ref.filtered, 1e-4f, 1e-7f, "L_f");
+    expect_close(filter.raw_variance_image(), ref.variance, 1e-4f, 1e-12f, "Var[L_f]");
+  }
+  // Only zero variances: nothing is known, nothing is skipped.
+  for (float& v : s.var.pixels) v = 0.0f;
+  GpuFixture zeros(s);
+  filter.run(zeros.inputs, zeros.guide, p);
+  EXPECT_EQ(filter.filtered_pixels(), uint32_t(W * H));
+  for (float v : filter.raw_variance_image().pixels) EXPECT_EQ(v, kVarUnknown);
+}
+
+// The composite 1D kernel of `passes` à-trous passes on a flat guide: the B3 taps at spacing
+// 1, 2, 4, ... convolved with each other.
+std::vector<double> composite_b3_kernel(int passes) {
+  std::vector<double> kernel = {1.0};
+  for (int i = 0; i < passes; ++i) {
+    const int step = 1 << i;
+    const double b3[5] = {1 / 16.0, 4 / 16.0, 6 / 16.0, 4 / 16.0, 1 / 16.0};
+    std::vector<double> next(kernel.size() + 4 * step, 0.0);
+    for (size_t k = 0; k < kernel.size(); ++k)
+      for (int j = 0; j < 5; ++j) next[k + j * step] += kernel[k] * b3[j];
+    kernel = next;
+  }
+  return kernel;
+}
+
+TEST(Atrous, WhiteNoiseVarianceShrinksBySumOfSquaredWeights) {
+  // On a flat guide the à-trous filter is a fixed linear kernel W (the composite of the passes),
+  // so white noise of variance v comes out with variance v sum W^2 = v (sum_i c_i^2)^2 (c: the
+  // composite 1D kernel). One pass: W = h and the propagated Var[L_f] = v sum h^2 is exact. More
+  // passes: each pass's inputs are correlated; without atrous_variance_correction the propagated
+  // Var[L_f] would be (sum h^2)^passes, 28.8x too low at sigma_s = 8. With it, it is exact here.
+  test::osmesa_context();
+  constexpr int N = 192;
+  constexpr float kNoiseVar = 1.0f / 3.0f;  // uniform in [0, 2]
+  Image lv = Image::rgb(N, N), var = Image::gray(N, N, "Y", kNoiseVar), guide = Image::rgba(N, N, 0.5f);
+  PreviewInputs inputs(N, N);
+  Texture2D guide_tex(N, N, TextureFormat::RGBA32F);
+  guide_tex.upload(guide);
+  FilterPass filter(N, N);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> noise(0.0f, 2.0f);
+  for (float sigma_s : {1.0f, 8.0f}) {
+    FilterParams p;
+    p.kind = FilterKind::Atrous;
+    p.sigma_s = sigma_s;
+    p.skip_case2 = false;
+    const int passes = atrous_iterations(sigma_s);
+    const int margin = 2 * ((1 << passes) - 1);  // the footprint radius: no border effects inside
+    double sum_c2 = 0;
+    for (double c : composite_b3_kernel(passes)) sum_c2 += c * c;
+    const double expected = sum_c2 * sum_c2;
+    double sum_sq = 0;
+    size_t count = 0;
+    for (int realization = 0; realization < 12; ++realization) {
+      Image hv = Image::rgb(N, N);
+      for (float& v : hv.pixels) v = noise(rng);
+      inputs.upload(lv, hv, var);
+      filter.run(inputs, guide_tex, p);
+      Image f = filter.filtered_image();
+      for (int y = margin; y < N - margin; ++y)
+        for (int x = margin; x < N - margin; ++x, ++count) sum_sq += (f.at(x, y, 0) - 1.0) * (f.at(x, y, 0) - 1.0);
+    }
+    const double measured = sum_sq / count / kNoiseVar;
+    const double propagated = filter.raw_variance_image().at(N / 2, N / 2, 0) / kNoiseVar;
+    const double per_pass = std::pow(70.0 / 256.0, 2);  // sum h^2 of the 5x5 kernel: (sum b3^2)^2
+    const double uncorrected = std::pow(per_pass, passes);
+    std::printf("sigma_s %g, %d passes: white-noise variance x %.3g measured, x %.3g expected (sum W^2), "
+                "Var[L_f] x %.3g (uncorrected x %.3g)\n",
+                sigma_s, passes, measured, expected, propagated, uncorrected);
+    EXPECT_NEAR(measured / expected, 1.0, 0.15) << sigma_s;
+    EXPECT_NEAR(propagated / expected, 1.0, 1e-3) << sigma_s;
+    if (passes > 1) {
+      EXPECT_GT(expected / uncorrected, 20.0) << "the correction matters";
+    }
+  }
+}
 
 TEST(FilterVsCpu, EdgesArePreserved) {
   // A step in range color with constant HV on each side: the filter must not mix the sides.

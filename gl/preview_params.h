@@ -10,9 +10,14 @@ namespace pxf {
 // Cross bilateral filter variants: "bilateral-depth" (SPEC default: spatial x color x depth) and
 // "bilateral" (spatial x color, no depth term) are the exact square kernel; "separable" is the
 // bilateral-depth weight applied as a horizontal then a vertical 1D pass (an approximation of
-// the 2D kernel, about 2r+1 times cheaper; its Var[L_f] is exact for what it computes).
-enum class FilterKind { BilateralDepth, Bilateral, Separable };
-const std::vector<std::string>& filter_kind_names();  // "bilateral-depth", "bilateral", "separable"
+// the 2D kernel, about 2r+1 times cheaper; its Var[L_f] is exact for what it computes); "atrous"
+// is the edge-avoiding à-trous wavelet (Dammertz et al. 2010): atrous_iterations(sigma_s) passes of
+// a 5x5 B3-spline kernel with hole spacing 2^i, each tap weighted by the same color x depth range
+// weights (25 taps per pass; its Var[L_f] treats each pass's inputs as independent, see
+// gl/cpu_reference.cpp).
+enum class FilterKind { BilateralDepth, Bilateral, Separable, Atrous };
+// "bilateral-depth", "bilateral", "separable", "atrous"
+const std::vector<std::string>& filter_kind_names();
 const char* filter_kind_name(FilterKind kind);
 FilterKind parse_filter_kind(const std::string& name);  // throws pxf::Error listing the names
 
@@ -42,6 +47,13 @@ struct RangeWeights {
 constexpr RangeWeights range_weights(const FilterParams& p) {
   return {inv_two_sigma2(p.sigma_c), p.kind != FilterKind::Bilateral ? inv_two_sigma2(p.sigma_d) : 0.0f};
 }
+
+// Passes of the à-trous variant for sigma_s (rule in gl/cpu_reference.cpp), at least 1, and few
+// enough that its footprint radius 2 (2^k - 1) stays within kMaxFilterRadius.
+int atrous_iterations(float sigma_s);
+// Factor on the Var[L_f] that à-trous pass `pass` (from 0) propagates as if its input pixels were
+// independent, so that it is exact where the range weights are all 1 (see cpu_reference.cpp).
+float atrous_variance_correction(int pass);
 
 // Sentinels of the variance channels (alpha of the HV and filtered textures).
 constexpr float kVarUnknown = -1.0f;  // n < 2 (Var[L_u]); no known neighbour variance (Var[L_f])

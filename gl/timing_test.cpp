@@ -1,17 +1,22 @@
 // Per-pass timings at 512x512 (run explicitly: gl_tests --gtest_also_run_disabled_tests
-// --gtest_filter='*Timing*'). Not part of the default run: it takes seconds on llvmpipe.
+// --gtest_filter='*Timing*'; PXF_TIMING_FILTER=NAME,NAME,... times only those filter variants,
+// PXF_TIMING_ROUNDS=N reports medians of N rounds). Not part of the default run: it takes seconds
+// on llvmpipe.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
-#include <string>
 #include <random>
+#include <string>
+#include <vector>
 #include "gl/blend_pass.h"
 #include "gl/filter_pass.h"
 #include "gl/inputs.h"
 #include "gl/range_pass.h"
 #include "gl/test_util.h"
 #include "gl/tonemap_pass.h"
+#include "pathtracer/bench.h"
 
 namespace pxf {
 namespace {
@@ -62,19 +67,32 @@ TEST(Timing, DISABLED_Passes512) {
   }
 
   FilterPass filter(w, h);
-  const char* only = std::getenv("PXF_TIMING_FILTER");  // e.g. "separable" to skip the slow ones
-  for (FilterKind kind : {FilterKind::BilateralDepth, FilterKind::Bilateral, FilterKind::Separable}) {
-    if (only && std::string(only) != filter_kind_name(kind)) continue;
-    for (bool skip : {false, true}) {
-      FilterParams p;
-      p.kind = kind;
-      p.skip_case2 = skip;
-      p.t = 0.05f;
-      filter.run(inputs, range.guide(), p);
-      std::printf("filter %s sigma_s=8 skip=%d: %.1f ms (%u of %d pixels filtered)\n", filter_kind_name(kind), skip,
-                  filter.last_ms(), filter.filtered_pixels(), w * h);
-    }
-  }
+  const char* only = std::getenv("PXF_TIMING_FILTER");  // e.g. "separable,atrous" to skip the slow ones
+  const char* rounds_env = std::getenv("PXF_TIMING_ROUNDS");  // median over rounds (default 1)
+  const int rounds = rounds_env ? std::max(1, std::atoi(rounds_env)) : 1;
+  std::vector<std::string> kinds;
+  for (const std::string& name : filter_kind_names())
+    if (!only || ("," + std::string(only) + ",").find("," + name + ",") != std::string::npos) kinds.push_back(name);
+  // Rounds alternate the variants back to back (A B A B ...), so background load hits them alike.
+  // A first untimed run of each variant compiles its shader (llvmpipe also JITs at the first draw).
+  std::vector<std::vector<double>> ms(kinds.size() * 2);
+  std::vector<uint32_t> filtered(kinds.size() * 2);
+  for (int round = -1; round < rounds; ++round)
+    for (size_t k = 0; k < kinds.size(); ++k)
+      for (bool skip : {false, true}) {
+        FilterParams p;
+        p.kind = parse_filter_kind(kinds[k]);
+        p.skip_case2 = skip;
+        p.t = 0.05f;
+        filter.run(inputs, range.guide(), p);
+        if (round < 0) continue;
+        ms[2 * k + skip].push_back(filter.last_ms());
+        filtered[2 * k + skip] = filter.filtered_pixels();
+      }
+  for (size_t k = 0; k < kinds.size(); ++k)
+    for (bool skip : {false, true})
+      std::printf("filter %s sigma_s=8 skip=%d: %.1f ms (median of %d; %u of %d pixels filtered)\n", kinds[k].c_str(),
+                  skip, median_of(ms[2 * k + skip]), rounds, filtered[2 * k + skip], w * h);
   BlendPass blend(w, h);
   TonemapPass tonemap(w, h);
   for (int i = 0; i < 3; ++i) {

@@ -26,15 +26,9 @@ void main() {
   ivec2 size = textureSize(hv_tex, 0);
   vec4 hv_p = texelFetch(hv_tex, p, 0);
   vec3 lu_p = clean(hv_p.rgb);
-  if (final_pass != 0 && skip_case2 != 0) {
-    // The blend's u (pooled variance), with the unfiltered background. A zero variance (all
-    // samples equal, no neighbour known) is not trusted: such a pixel is filtered.
-    float v_p = pooled_var_u(hv_tex, guide_tex, p, k_c, k_d);
-    float lb = max(luminance(lu_p) + luminance(clean(texelFetch(lv_tex, p, 0).rgb)), 0.0);
-    if (v_p > 0.0 && relative_variance(v_p, lb) <= max(t, 0.0)) {
-      out_filtered = vec4(lu_p, kVarSkipped);
-      return;
-    }
+  if (final_pass != 0 && skip_case2 != 0 && skip_as_case2(hv_tex, lv_tex, guide_tex, p, k_c, k_d, t)) {
+    out_filtered = vec4(lu_p, kVarSkipped);
+    return;
   }
   if (final_pass != 0) atomicAdd(filtered_pixels, 1u);
   vec4 g_p = texelFetch(guide_tex, p, 0);

@@ -84,3 +84,12 @@ float blend_factor(float u, float f, float t, out int blend_case) {
   blend_case = 3;
   return clamp(fh / (uh + fh) + sqrt(q), 0.0, 1.0);
 }
+
+// The filter's case-2 skip (FilterParams::skip_case2, final pass only): the blend's u (pooled
+// variance) with the unfiltered background; a zero variance (all samples equal, no neighbour known)
+// is not trusted. Mirrors skip_as_case2() in gl/cpu_reference.cpp.
+bool skip_as_case2(sampler2D hv, sampler2D lv, sampler2D guide, ivec2 p, float k_c, float k_d, float t) {
+  float v = pooled_var_u(hv, guide, p, k_c, k_d);
+  float lb = max(luminance(clean(texelFetch(hv, p, 0).rgb)) + luminance(clean(texelFetch(lv, p, 0).rgb)), 0.0);
+  return v > 0.0 && relative_variance(v, lb) <= max(t, 0.0);
+}

@@ -1,0 +1,64 @@
+#version 450 core
+// One pass of the edge-avoiding à-trous wavelet filter (Dammertz et al. 2010; FilterKind::Atrous):
+// the 5x5 B3-spline kernel h at hole spacing `step_px` (1, 2, 4, ... over the passes), each tap
+// weighted by h x the range weights of the cross bilateral filter (color, depth; no spatial
+// Gaussian beyond h): L_f = sum w L / sum w, Var[L_f] = c_k sum w^2 Var / (sum w)^2 with the
+// correction c_k for the correlation between the previous pass's pixels (atrous_variance_correction).
+// Taps outside the image are left out.
+// Mirrors atrous_pass() in gl/cpu_reference.cpp.
+#include "common.glsl"
+
+layout(binding = 0) uniform sampler2D hv_tex;     // rgb L_u, a Var[L_u] (kVarUnknown: n < 2; 0: all samples equal)
+layout(binding = 1) uniform sampler2D lv_tex;     // rgb L_lv (only for skipping)
+layout(binding = 2) uniform sampler2D guide_tex;  // rgb range color, a distance
+layout(binding = 3) uniform sampler2D signal_tex; // what is filtered: hv_tex, or the previous pass
+uniform int step_px;
+uniform int final_pass;  // skipping and counting happen in the final pass only: later passes read every pixel
+uniform float k_c;  // 1 / (2 sigma_c^2)
+uniform float k_d;  // 1 / (2 sigma_d^2)
+uniform int skip_case2;
+uniform float t;
+uniform float variance_correction;  // atrous_variance_correction(pass)
+
+layout(std430, binding = 0) buffer Counter { uint filtered_pixels; };
+layout(location = 0) out vec4 out_filtered;  // rgb L_f, a Var[L_f] (kVarUnknown, kVarSkipped)
+
+const float kB3[5] = float[5](1.0 / 16.0, 4.0 / 16.0, 6.0 / 16.0, 4.0 / 16.0, 1.0 / 16.0);
+
+void main() {
+  ivec2 p = ivec2(gl_FragCoord.xy);
+  ivec2 size = textureSize(hv_tex, 0);
+  if (final_pass != 0 && skip_case2 != 0 && skip_as_case2(hv_tex, lv_tex, guide_tex, p, k_c, k_d, t)) {
+    out_filtered = vec4(clean(texelFetch(hv_tex, p, 0).rgb), kVarSkipped);
+    return;
+  }
+  if (final_pass != 0) atomicAdd(filtered_pixels, 1u);
+  vec4 g_p = texelFetch(guide_tex, p, 0);
+  float sw = 0.0, sw2v = 0.0, sw2u = 0.0, swk = 0.0, swv = 0.0;
+  vec3 swl = vec3(0.0);
+  for (int j = 0; j < 5; ++j) {
+    int qy = p.y + (j - 2) * step_px;
+    if (qy < 0 || qy >= size.y) continue;
+    for (int i = 0; i < 5; ++i) {
+      int qx = p.x + (i - 2) * step_px;
+      if (qx < 0 || qx >= size.x) continue;
+      ivec2 q = ivec2(qx, qy);
+      float w = kB3[i] * kB3[j] * range_weight(g_p, texelFetch(guide_tex, q, 0), k_c, k_d);
+      vec4 s_q = texelFetch(signal_tex, q, 0);
+      float v_q = clean_var(s_q.a);
+      sw += w;
+      swl += w * clean(s_q.rgb);
+      if (v_q > 0.0) {  // unknown (n < 2) or 0 (all samples equal): no evidence
+        sw2v += w * w * v_q;
+        swk += w;
+        swv += w * v_q;
+      } else {
+        sw2u += w * w;
+      }
+    }
+  }
+  // sw >= h(0,0) = 0.14 (the center's range weight is 1). Unknown neighbour variances count with
+  // the kernel-weighted mean of the known ones.
+  float var_f = swk > 0.0 ? variance_correction * (sw2v + sw2u * (swv / swk)) / (sw * sw) : kVarUnknown;
+  out_filtered = vec4(swl / sw, var_f);
+}
