@@ -45,12 +45,6 @@ void embree_error(void*, RTCError code, const char* message) {
 
 }  // namespace
 
-glm::vec3 offset_ray_origin(glm::vec3 position, glm::vec3 geometric_normal, glm::vec3 direction) {
-  float scale = std::max(std::max(std::abs(position.x), std::abs(position.y)), std::abs(position.z));
-  float eps = 1e-4f * (1.0f + scale);
-  return position + (glm::dot(direction, geometric_normal) >= 0.0f ? eps : -eps) * geometric_normal;
-}
-
 EmbreeScene::EmbreeScene(const Scene& scene) : scene_(scene) {
   device_ = rtcNewDevice(nullptr);
   if (!device_) throw Error("embree: cannot create a device (error " + std::to_string(rtcGetDeviceError(nullptr)) + ")");

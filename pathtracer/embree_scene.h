@@ -2,6 +2,8 @@
 // hit (face normal, interpolated attributes). Alpha MASK materials are cut out by Embree filter
 // functions, so every query (camera, continuation, shadow) sees the same holes.
 #pragma once
+#include <algorithm>
+#include <cmath>
 #include <limits>
 #include <memory>
 #include <vector>
@@ -80,7 +82,11 @@ class EmbreeScene {
 };
 
 // Moves a point off a surface to the side `direction` leaves to, scaled to the point's magnitude
-// so far-away geometry does not self-intersect.
-glm::vec3 offset_ray_origin(glm::vec3 position, glm::vec3 geometric_normal, glm::vec3 direction);
+// so far-away geometry does not self-intersect. Inline: every bounce and shadow ray calls it.
+inline glm::vec3 offset_ray_origin(glm::vec3 position, glm::vec3 geometric_normal, glm::vec3 direction) {
+  float scale = std::max(std::max(std::abs(position.x), std::abs(position.y)), std::abs(position.z));
+  float eps = 1e-4f * (1.0f + scale);
+  return position + (glm::dot(direction, geometric_normal) >= 0.0f ? eps : -eps) * geometric_normal;
+}
 
 }  // namespace pxf

@@ -93,6 +93,7 @@ void PathTracer::trace_pixels(const Camera& camera, int width, int height, const
 // Pixels first .. first + count - 1 (row-major in rect) of trace_pixels, in lockstep.
 void PathTracer::trace_batch(const Camera& camera, int width, int height, const PixelRect& rect, int first, int count,
                              uint32_t frame, const TraceParams& params, PathSample* out) const {
+  const CameraRays camera_rays(camera, width, height);
   Path paths[kBatchPaths];
   for (int i = 0; i < count; ++i) {
     const int x = rect.x0 + (first + i) % rect.width(), y = rect.y0 + (first + i) / rect.width();
@@ -101,7 +102,7 @@ void PathTracer::trace_batch(const Camera& camera, int width, int height, const 
     const glm::vec2 jitter = pixel_rng.next_2d();  // box filter: uniform in the pixel
     out[i] = PathSample{};
     Path& path = paths[i];
-    path.ray = camera_ray(camera, width, height, static_cast<float>(x) + jitter.x, static_cast<float>(y) + jitter.y);
+    path.ray = camera_rays(static_cast<float>(x) + jitter.x, static_cast<float>(y) + jitter.y);
     // A second stream for the path itself (the pixel stream's first draws went to the jitter).
     path.rng = Rng(params.seed ^ 0x5bd1e9955bd1e995ULL, pixel, frame);
     path.state = PathState{};
