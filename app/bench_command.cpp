@@ -177,10 +177,12 @@ int run_pathtracer_bench(const BenchSetup& b, int timed) {
   std::printf("%s\n", format_benchmark(r).c_str());
   std::ostringstream csv;
   csv << "width,height,threads,max_vertices,timed_frames,paths_per_s,rays_per_s,rays_per_path,median_frame_ms,"
-         "embree_rays_per_s,fraction_of_embree,primary_ray_ms,primary_fraction\n"
+         "embree_rays_per_s,fraction_of_embree,embree_stream_rays_per_s,fraction_of_embree_stream,primary_ray_ms,"
+         "primary_fraction\n"
       << r.width << "," << r.height << "," << r.threads << "," << r.max_vertices << "," << r.timed_frames << ","
       << r.paths_per_s << "," << r.rays_per_s << "," << r.rays_per_path << "," << r.median_frame_ms << ","
-      << r.embree_rays_per_s << "," << r.fraction_of_embree << "," << r.primary_ray_ms << "," << r.primary_fraction
+      << r.embree_rays_per_s << "," << r.fraction_of_embree << "," << r.embree_stream_rays_per_s << ","
+      << r.fraction_of_embree_stream << "," << r.primary_ray_ms << "," << r.primary_fraction
       << "\n";
   write_text(b.out + "/pathtracer.csv", csv.str());
   std::printf("wrote %s/pathtracer.csv\n", b.out.c_str());

@@ -14,16 +14,26 @@ float image_aspect(int width, int height) {
 
 }  // namespace
 
-Ray camera_ray(const Camera& camera, int width, int height, float px, float py) {
-  float tan_half = std::tan(0.5f * camera.yfov);
-  float ndc_x = 2.0f * px / static_cast<float>(width) - 1.0f;
-  float ndc_y = 1.0f - 2.0f * py / static_cast<float>(height);  // row 0 is the top row
-  glm::vec3 dir_camera(ndc_x * tan_half * image_aspect(width, height), ndc_y * tan_half, -1.0f);
-  glm::vec3 dir_world = glm::mat3(camera.camera_to_world) * dir_camera;
+CameraRays::CameraRays(const Camera& camera, int width, int height)
+    : basis_(glm::mat3(camera.camera_to_world)),
+      origin_(glm::vec3(camera.camera_to_world[3])),
+      tan_half_(std::tan(0.5f * camera.yfov)),
+      aspect_(image_aspect(width, height)),
+      width_(static_cast<float>(width)),
+      height_(static_cast<float>(height)) {}
+
+Ray CameraRays::operator()(float px, float py) const {
+  float ndc_x = 2.0f * px / width_ - 1.0f;
+  float ndc_y = 1.0f - 2.0f * py / height_;  // row 0 is the top row
+  glm::vec3 dir_camera(ndc_x * tan_half_ * aspect_, ndc_y * tan_half_, -1.0f);
   Ray ray;
-  ray.origin = glm::vec3(camera.camera_to_world[3]);
-  ray.direction = glm::normalize(dir_world);
+  ray.origin = origin_;
+  ray.direction = glm::normalize(basis_ * dir_camera);
   return ray;
+}
+
+Ray camera_ray(const Camera& camera, int width, int height, float px, float py) {
+  return CameraRays(camera, width, height)(px, py);
 }
 
 glm::mat4 camera_view_matrix(const Camera& camera) { return glm::inverse(camera.camera_to_world); }

@@ -15,6 +15,19 @@ struct Ray {
 // (width, height) = bottom-right. A pixel (x, y) with jitter j in [0,1)^2 uses (x + j.x, y + j.y).
 Ray camera_ray(const Camera& camera, int width, int height, float px, float py);
 
+// camera_ray for many rays of one image: the terms shared by all of them (tan, aspect, basis)
+// computed once. Gives exactly camera_ray's rays.
+class CameraRays {
+ public:
+  CameraRays(const Camera& camera, int width, int height);
+  Ray operator()(float px, float py) const;
+
+ private:
+  glm::mat3 basis_;
+  glm::vec3 origin_;
+  float tan_half_, aspect_, width_, height_;
+};
+
 // View and projection matrices for OpenGL that rasterize exactly what camera_ray traces, with the
 // whole image shifted by `jitter` pixels (jitter (0.5,0.5) = pixel centers; GL's window y is
 // flipped relative to image rows, the matrix accounts for it so that row 0 is the top row).

@@ -45,12 +45,6 @@ void embree_error(void*, RTCError code, const char* message) {
 
 }  // namespace
 
-glm::vec3 offset_ray_origin(glm::vec3 position, glm::vec3 geometric_normal, glm::vec3 direction) {
-  float scale = std::max(std::max(std::abs(position.x), std::abs(position.y)), std::abs(position.z));
-  float eps = 1e-4f * (1.0f + scale);
-  return position + (glm::dot(direction, geometric_normal) >= 0.0f ? eps : -eps) * geometric_normal;
-}
-
 EmbreeScene::EmbreeScene(const Scene& scene) : scene_(scene) {
   device_ = rtcNewDevice(nullptr);
   if (!device_) throw Error("embree: cannot create a device (error " + std::to_string(rtcGetDeviceError(nullptr)) + ")");
@@ -98,38 +92,12 @@ EmbreeScene::~EmbreeScene() {
   if (device_) rtcReleaseDevice(device_);
 }
 
-Hit EmbreeScene::intersect(const Ray& ray, float tmax) const {
-  RTCIntersectContext context;
-  rtcInitIntersectContext(&context);
-  RTCRayHit rh;
-  rh.ray.org_x = ray.origin.x;
-  rh.ray.org_y = ray.origin.y;
-  rh.ray.org_z = ray.origin.z;
-  rh.ray.dir_x = ray.direction.x;
-  rh.ray.dir_y = ray.direction.y;
-  rh.ray.dir_z = ray.direction.z;
-  rh.ray.tnear = 0.0f;
-  rh.ray.tfar = tmax;
-  rh.ray.time = 0.0f;
-  rh.ray.mask = 0xffffffffu;
-  rh.ray.id = 0;
-  rh.ray.flags = 0;
-  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-  rtcIntersect1(rtc_scene_, &context, &rh);
-  Hit hit;
-  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return hit;
-  hit.mesh = rh.hit.geomID;
-  hit.prim = rh.hit.primID;
-  hit.u = rh.hit.u;
-  hit.v = rh.hit.v;
-  hit.t = rh.ray.tfar;
-  return hit;
-}
+namespace {
 
-bool EmbreeScene::occluded(glm::vec3 origin, glm::vec3 direction, float tmax) const {
-  RTCIntersectContext context;
-  rtcInitIntersectContext(&context);
+// Rays go to Embree in chunks of this many (stack buffers; streams of 64 traced as fast as 256).
+constexpr size_t kStreamChunk = 64;
+
+RTCRay embree_ray(glm::vec3 origin, glm::vec3 direction, float tmax) {
   RTCRay r;
   r.org_x = origin.x;
   r.org_y = origin.y;
@@ -143,8 +111,77 @@ bool EmbreeScene::occluded(glm::vec3 origin, glm::vec3 direction, float tmax) co
   r.mask = 0xffffffffu;
   r.id = 0;
   r.flags = 0;
+  return r;
+}
+
+RTCRayHit embree_ray_hit(const Ray& ray, float tmax) {
+  RTCRayHit rh;
+  rh.ray = embree_ray(ray.origin, ray.direction, tmax);
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  return rh;
+}
+
+Hit hit_of(const RTCRayHit& rh) {
+  Hit hit;
+  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return hit;
+  hit.mesh = rh.hit.geomID;
+  hit.prim = rh.hit.primID;
+  hit.u = rh.hit.u;
+  hit.v = rh.hit.v;
+  hit.t = rh.ray.tfar;
+  return hit;
+}
+
+bool is_occluded(const RTCRay& r) { return r.tfar < 0.0f; }  // Embree sets tfar = -inf on occlusion
+
+RTCIntersectContext intersect_context(RayCoherence coherence) {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  context.flags = coherence == RayCoherence::Coherent ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT
+                                                      : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+  return context;
+}
+
+}  // namespace
+
+Hit EmbreeScene::intersect(const Ray& ray, float tmax) const {
+  RTCIntersectContext context = intersect_context(RayCoherence::Incoherent);
+  RTCRayHit rh = embree_ray_hit(ray, tmax);
+  rtcIntersect1(rtc_scene_, &context, &rh);
+  return hit_of(rh);
+}
+
+bool EmbreeScene::occluded(glm::vec3 origin, glm::vec3 direction, float tmax) const {
+  RTCIntersectContext context = intersect_context(RayCoherence::Incoherent);
+  RTCRay r = embree_ray(origin, direction, tmax);
   rtcOccluded1(rtc_scene_, &context, &r);
-  return r.tfar < 0.0f;  // Embree sets tfar = -inf on occlusion
+  return is_occluded(r);
+}
+
+void EmbreeScene::intersect(const Ray* rays, size_t count, RayCoherence coherence, Hit* hits) const {
+  RTCIntersectContext context = intersect_context(coherence);
+  RTCRayHit chunk[kStreamChunk];
+  for (size_t begin = 0; begin < count; begin += kStreamChunk) {
+    const size_t n = std::min(kStreamChunk, count - begin);
+    for (size_t i = 0; i < n; ++i) chunk[i] = embree_ray_hit(rays[begin + i], std::numeric_limits<float>::infinity());
+    rtcIntersect1M(rtc_scene_, &context, chunk, static_cast<unsigned>(n), sizeof(RTCRayHit));
+    for (size_t i = 0; i < n; ++i) hits[begin + i] = hit_of(chunk[i]);
+  }
+}
+
+void EmbreeScene::occluded(const ShadowRay* rays, size_t count, bool* occluded) const {
+  RTCIntersectContext context = intersect_context(RayCoherence::Incoherent);
+  RTCRay chunk[kStreamChunk];
+  for (size_t begin = 0; begin < count; begin += kStreamChunk) {
+    const size_t n = std::min(kStreamChunk, count - begin);
+    for (size_t i = 0; i < n; ++i) {
+      const ShadowRay& ray = rays[begin + i];
+      chunk[i] = embree_ray(ray.origin, ray.direction, ray.tmax);
+    }
+    rtcOccluded1M(rtc_scene_, &context, chunk, static_cast<unsigned>(n), sizeof(RTCRay));
+    for (size_t i = 0; i < n; ++i) occluded[begin + i] = is_occluded(chunk[i]);
+  }
 }
 
 float EmbreeScene::triangle_area(unsigned mesh, unsigned prim) const {

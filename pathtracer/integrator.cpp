@@ -10,6 +10,9 @@ namespace pxf {
 namespace {
 
 constexpr int kMaxSpecularChainBounces = 8;
+// Paths traced together; a 16 x 16 tile of the progressive renderer is one batch. The batch state
+// lives on the stack (about 45 KB).
+constexpr int kBatchPaths = 256;
 
 struct PathState {
   glm::vec3 throughput{1.0f};
@@ -30,6 +33,41 @@ void add_contribution(PathSample& out, glm::vec3 value, bool lv, bool all_hv) {
 
 }  // namespace
 
+// One path of a batch: its random stream, the ray it traces next, and what it has gathered.
+struct PathTracer::Path {
+  Rng rng;
+  Ray ray;
+  PathState state;
+  PathSample* out = nullptr;
+};
+
+// The next event estimation contributions of one vertex step of a batch, each waiting on its
+// shadow ray. Resolving them before the next step keeps every path's sum in the order of a path
+// traced alone (emission at vertex k, light at vertex k, emission at vertex k + 1, ...).
+struct PathTracer::ShadowQueue {
+  struct Pending {
+    PathSample* out;
+    glm::vec3 contribution;  // added when the shadow ray reaches the light
+    bool lv;
+  };
+  ShadowRay rays[kBatchPaths];
+  Pending pending[kBatchPaths];
+  bool occluded[kBatchPaths];
+  int count = 0;
+
+  void push(const ShadowRay& ray, const Pending& contribution) {
+    rays[count] = ray;
+    pending[count] = contribution;
+    ++count;
+  }
+  void resolve(const EmbreeScene& geometry, bool all_hv) {
+    geometry.occluded(rays, static_cast<size_t>(count), occluded);
+    for (int i = 0; i < count; ++i)
+      if (!occluded[i]) add_contribution(*pending[i].out, pending[i].contribution, pending[i].lv, all_hv);
+    count = 0;
+  }
+};
+
 bool PathSample::finite() const { return is_finite(lv) && is_finite(hv); }
 
 PathTracer::PathTracer(const Scene& scene) : geometry_(scene), lights_(scene) {
@@ -40,87 +78,126 @@ PathTracer::PathTracer(const Scene& scene) : geometry_(scene), lights_(scene) {
 
 PathSample PathTracer::trace_pixel(const Camera& camera, int width, int height, int x, int y, uint32_t frame,
                                    const TraceParams& params) const {
-  uint64_t pixel = static_cast<uint64_t>(y) * static_cast<uint64_t>(width) + static_cast<uint64_t>(x);
-  Rng rng(params.seed, pixel, frame);
-  glm::vec2 jitter = rng.next_2d();  // box filter: uniform in the pixel
-  Ray ray = camera_ray(camera, width, height, static_cast<float>(x) + jitter.x, static_cast<float>(y) + jitter.y);
-  return trace_ray(ray, pixel, frame, params);
+  PathSample out;
+  trace_pixels(camera, width, height, PixelRect{x, y, x + 1, y + 1}, frame, params, &out);
+  return out;
 }
 
-PathSample PathTracer::trace_ray(const Ray& camera_ray, uint64_t pixel_index, uint32_t frame,
-                                 const TraceParams& params) const {
-  // A second stream for the path itself (the pixel stream's first draws went to the jitter).
-  Rng rng(params.seed ^ 0x5bd1e9955bd1e995ULL, pixel_index, frame);
+void PathTracer::trace_pixels(const Camera& camera, int width, int height, const PixelRect& rect, uint32_t frame,
+                              const TraceParams& params, PathSample* out) const {
+  const int count = rect.count();
+  for (int first = 0; first < count; first += kBatchPaths)
+    trace_batch(camera, width, height, rect, first, std::min(kBatchPaths, count - first), frame, params, out + first);
+}
+
+// Pixels first .. first + count - 1 (row-major in rect) of trace_pixels, in lockstep.
+void PathTracer::trace_batch(const Camera& camera, int width, int height, const PixelRect& rect, int first, int count,
+                             uint32_t frame, const TraceParams& params, PathSample* out) const {
+  const CameraRays camera_rays(camera, width, height);
+  Path paths[kBatchPaths];
+  for (int i = 0; i < count; ++i) {
+    const int x = rect.x0 + (first + i) % rect.width(), y = rect.y0 + (first + i) / rect.width();
+    const uint64_t pixel = static_cast<uint64_t>(y) * static_cast<uint64_t>(width) + static_cast<uint64_t>(x);
+    Rng pixel_rng(params.seed, pixel, frame);
+    const glm::vec2 jitter = pixel_rng.next_2d();  // box filter: uniform in the pixel
+    out[i] = PathSample{};
+    Path& path = paths[i];
+    path.ray = camera_rays(static_cast<float>(x) + jitter.x, static_cast<float>(y) + jitter.y);
+    // A second stream for the path itself (the pixel stream's first draws went to the jitter).
+    path.rng = Rng(params.seed ^ 0x5bd1e9955bd1e995ULL, pixel, frame);
+    path.state = PathState{};
+    path.out = &out[i];
+  }
+  // live[k] is the k-th path still being traced; rays[k] and hits[k] are its ray and hit.
+  int live[kBatchPaths];
+  int live_count = count;
+  for (int i = 0; i < count; ++i) live[i] = i;
+  Ray rays[kBatchPaths];
+  Hit hits[kBatchPaths];
+  ShadowQueue shadows;
+  for (int vertex = 2; vertex <= params.max_vertices && live_count > 0; ++vertex) {
+    for (int k = 0; k < live_count; ++k) rays[k] = paths[live[k]].ray;
+    geometry_.intersect(rays, static_cast<size_t>(live_count),
+                        vertex == 2 ? RayCoherence::Coherent : RayCoherence::Incoherent, hits);
+    int still_live = 0;
+    for (int k = 0; k < live_count; ++k)
+      if (shade_vertex(paths[live[k]], hits[k], vertex, params, shadows)) live[still_live++] = live[k];
+    live_count = still_live;
+    shadows.resolve(geometry_, params.all_hv);
+  }
+}
+
+// Vertex `vertex` of a path at `hit`: the emission found there, next event estimation (queued on
+// `shadows`) and the BSDF sample that continues the path into path.ray. False: the path ends here.
+bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const TraceParams& params,
+                              ShadowQueue& shadows) const {
   const Scene& scene = geometry_.scene();
-  PathSample out;
-  PathState s;
-  Ray ray = camera_ray;
-  for (int vertex = 2; vertex <= params.max_vertices; ++vertex) {
-    Hit hit = geometry_.intersect(ray);
-    ++out.rays;
-    if (!hit.valid()) {  // the environment is the light vertex
-      if (lights_.has_environment()) {
-        float w = s.prev_delta ? 1.0f : power_heuristic(s.prev_pdf, lights_.pdf_environment(ray.direction));
-        add_contribution(out, s.throughput * lights_.environment_radiance(ray.direction) * w, emission_is_lv(s),
-                         params.all_hv);
-      }
-      break;
-    }
-    SurfacePoint sp = geometry_.surface_point(hit, ray);
-    const Material& material = *sp.material;
-    if (material.is_emissive() && (sp.front_face || material.double_sided)) {
-      float w = 1.0f;
-      if (!s.prev_delta)
-        w = power_heuristic(s.prev_pdf, lights_.pdf_triangle(hit.mesh, hit.prim, ray.origin, sp.position, sp.geometric_normal));
-      add_contribution(out, s.throughput * eval_emission(scene, material, sp.uv0, sp.uv1) * w, emission_is_lv(s),
+  PathState& s = path.state;
+  PathSample& out = *path.out;
+  Rng& rng = path.rng;
+  ++out.rays;
+  if (!hit.valid()) {  // the environment is the light vertex
+    if (lights_.has_environment()) {
+      float w = s.prev_delta ? 1.0f : power_heuristic(s.prev_pdf, lights_.pdf_environment(path.ray.direction));
+      add_contribution(out, s.throughput * lights_.environment_radiance(path.ray.direction) * w, emission_is_lv(s),
                        params.all_hv);
     }
-    if (vertex == params.max_vertices) break;  // no room for another vertex
+    return false;
+  }
+  SurfacePoint sp = geometry_.surface_point(hit, path.ray);
+  const Material& material = *sp.material;
+  if (material.is_emissive() && (sp.front_face || material.double_sided)) {
+    float w = 1.0f;
+    if (!s.prev_delta)
+      w = power_heuristic(s.prev_pdf,
+                          lights_.pdf_triangle(hit.mesh, hit.prim, path.ray.origin, sp.position, sp.geometric_normal));
+    add_contribution(out, s.throughput * eval_emission(scene, material, sp.uv0, sp.uv1) * w, emission_is_lv(s),
+                     params.all_hv);
+  }
+  if (vertex == params.max_vertices) return false;  // no room for another vertex
 
-    glm::vec3 wo = -ray.direction;
-    Bsdf bsdf(eval_material(scene, material, sp.uv0, sp.uv1, sp.color), sp.shading_normal, sp.geometric_normal, wo,
-              sp.front_face);
-    if (bsdf.is_black()) break;
+  glm::vec3 wo = -path.ray.direction;
+  Bsdf bsdf(eval_material(scene, material, sp.uv0, sp.uv1, sp.color), sp.shading_normal, sp.geometric_normal, wo,
+            sp.front_face);
+  if (bsdf.is_black()) return false;
 
-    // Next event estimation (the light vertex is vertex + 1 <= max_vertices).
-    float u_light = rng.next_float();
-    glm::vec2 u_light2 = rng.next_2d();
-    if (bsdf.has_nondelta()) {
-      LightSample ls;
-      if (lights_.sample(sp.position, u_light, u_light2, &ls)) {
-        float bsdf_pdf;
-        glm::vec3 f = bsdf.eval(ls.wi, &bsdf_pdf);
-        if (max_component(f) > 0.0f && max_component(ls.radiance) > 0.0f) {
-          glm::vec3 origin = offset_ray_origin(sp.position, sp.geometric_normal, ls.wi);
-          float tmax = std::isinf(ls.distance) ? ls.distance : ls.distance * (1.0f - 1e-3f);
-          ++out.rays;
-          if (!geometry_.occluded(origin, ls.wi, tmax)) {
-            float w = ls.delta ? 1.0f : power_heuristic(ls.pdf, bsdf_pdf);
-            add_contribution(out, s.throughput * f * ls.radiance * (w / ls.pdf), s.nonspecular == 0, params.all_hv);
-          }
-        }
+  // Next event estimation (the light vertex is vertex + 1 <= max_vertices).
+  float u_light = rng.next_float();
+  glm::vec2 u_light2 = rng.next_2d();
+  if (bsdf.has_nondelta()) {
+    LightSample ls;
+    if (lights_.sample(sp.position, u_light, u_light2, &ls)) {
+      float bsdf_pdf;
+      glm::vec3 f = bsdf.eval(ls.wi, &bsdf_pdf);
+      if (max_component(f) > 0.0f && max_component(ls.radiance) > 0.0f) {
+        glm::vec3 origin = offset_ray_origin(sp.position, sp.geometric_normal, ls.wi);
+        float tmax = std::isinf(ls.distance) ? ls.distance : ls.distance * (1.0f - 1e-3f);
+        ++out.rays;
+        float w = ls.delta ? 1.0f : power_heuristic(ls.pdf, bsdf_pdf);
+        shadows.push(ShadowRay{origin, ls.wi, tmax},
+                     {&out, s.throughput * f * ls.radiance * (w / ls.pdf), s.nonspecular == 0});
       }
     }
-
-    // Continue the path by sampling the BSDF.
-    float u_lobe = rng.next_float();
-    glm::vec2 u_dir = rng.next_2d();
-    float u_rr = rng.next_float();
-    BsdfSample bs;
-    if (!bsdf.sample(u_lobe, u_dir, &bs)) break;
-    s.throughput *= bs.weight;
-    if (!bs.delta) ++s.nonspecular;
-    s.prev_delta = bs.delta;
-    s.prev_pdf = bs.pdf;
-    if (vertex >= params.rr_start_vertex) {
-      float q = std::min(1.0f, max_component(s.throughput));
-      if (!(u_rr < q)) break;
-      s.throughput /= q;
-    }
-    ray.origin = offset_ray_origin(sp.position, sp.geometric_normal, bs.wi);
-    ray.direction = bs.wi;
   }
-  return out;
+
+  // Continue the path by sampling the BSDF.
+  float u_lobe = rng.next_float();
+  glm::vec2 u_dir = rng.next_2d();
+  float u_rr = rng.next_float();
+  BsdfSample bs;
+  if (!bsdf.sample(u_lobe, u_dir, &bs)) return false;
+  s.throughput *= bs.weight;
+  if (!bs.delta) ++s.nonspecular;
+  s.prev_delta = bs.delta;
+  s.prev_pdf = bs.pdf;
+  if (vertex >= params.rr_start_vertex) {
+    float q = std::min(1.0f, max_component(s.throughput));
+    if (!(u_rr < q)) return false;
+    s.throughput /= q;
+  }
+  path.ray.origin = offset_ray_origin(sp.position, sp.geometric_normal, bs.wi);
+  path.ray.direction = bs.wi;
+  return true;
 }
 
 SpecularChainHit PathTracer::trace_specular_chain(const Ray& camera_ray) const {

@@ -19,16 +19,27 @@ struct PathSample {
   bool finite() const;
 };
 
+// The pixels [x0, x1) x [y0, y1) of an image.
+struct PixelRect {
+  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+  int width() const { return x1 - x0; }
+  int count() const { return (x1 - x0) * (y1 - y0); }
+};
+
 class PathTracer {
  public:
   explicit PathTracer(const Scene& scene);
 
-  // The path of pixel (x, y) in frame `frame`; its random stream depends only on
-  // (params.seed, pixel, frame).
+  // One path for each pixel of `rect` in frame `frame`; out[i] is the i-th pixel in row-major
+  // order (rect.count() entries). The paths of a batch advance together, one vertex at a time, so
+  // each vertex's rays reach Embree as one stream. A path's random stream depends only on
+  // (params.seed, pixel, frame), and a stream answers each ray as a single-ray query would, so
+  // neither the rect nor the thread changes a pixel's value.
+  void trace_pixels(const Camera& camera, int width, int height, const PixelRect& rect, uint32_t frame,
+                    const TraceParams& params, PathSample* out) const;
+  // The path of pixel (x, y): trace_pixels on that pixel alone.
   PathSample trace_pixel(const Camera& camera, int width, int height, int x, int y, uint32_t frame,
                          const TraceParams& params) const;
-  // The path along a given camera ray (rng stream as for pixel `pixel_index`).
-  PathSample trace_ray(const Ray& camera_ray, uint64_t pixel_index, uint32_t frame, const TraceParams& params) const;
 
   SpecularChainHit trace_specular_chain(const Ray& camera_ray) const;
 
@@ -38,6 +49,12 @@ class PathTracer {
   const LightSampler& lights() const { return lights_; }
 
  private:
+  struct Path;
+  struct ShadowQueue;
+  void trace_batch(const Camera& camera, int width, int height, const PixelRect& rect, int first, int count,
+                   uint32_t frame, const TraceParams& params, PathSample* out) const;
+  bool shade_vertex(Path& path, const Hit& hit, int vertex, const TraceParams& params, ShadowQueue& shadows) const;
+
   EmbreeScene geometry_;
   LightSampler lights_;
   bool has_perfect_specular_ = false;

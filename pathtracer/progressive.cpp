@@ -49,18 +49,19 @@ struct ProgressiveRenderer::Impl {
       uint64_t tile_rays = 0, tile_paths = 0, tile_dropped = 0;
       for (int tile = range.begin(); tile != range.end(); ++tile) {
         int x0 = (tile % tiles_x) * kTileSize, y0 = (tile / tiles_x) * kTileSize;
-        int x1 = std::min(x0 + kTileSize, width), y1 = std::min(y0 + kTileSize, height);
-        for (int y = y0; y < y1; ++y) {
-          for (int x = x0; x < x1; ++x) {
-            PathSample sample = tracer->trace_pixel(camera, width, height, x, y, frame, params);
-            tile_rays += sample.rays;
-            ++tile_paths;
-            if (!sample.finite()) {  // LV and HV of a path are dropped together
-              ++tile_dropped;
-              continue;
-            }
-            accumulate_sample(acc, static_cast<size_t>(y) * width + x, sample.lv, sample.hv);
+        const PixelRect rect{x0, y0, std::min(x0 + kTileSize, width), std::min(y0 + kTileSize, height)};
+        PathSample samples[kTileSize * kTileSize];
+        tracer->trace_pixels(camera, width, height, rect, frame, params, samples);
+        for (int i = 0; i < rect.count(); ++i) {
+          const PathSample& sample = samples[i];
+          tile_rays += sample.rays;
+          ++tile_paths;
+          if (!sample.finite()) {  // LV and HV of a path are dropped together
+            ++tile_dropped;
+            continue;
           }
+          const int x = rect.x0 + i % rect.width(), y = rect.y0 + i / rect.width();
+          accumulate_sample(acc, static_cast<size_t>(y) * width + x, sample.lv, sample.hv);
         }
       }
       rays += tile_rays;

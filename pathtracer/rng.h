@@ -16,6 +16,7 @@ inline uint64_t mix64(uint64_t z) {
 // PCG32 (O'Neill, XSH-RR), seeded by hashing (seed, pixel, frame). Draw k of a path is dimension k.
 class Rng {
  public:
+  Rng() = default;  // a placeholder: assign a seeded stream before drawing
   Rng(uint64_t seed, uint64_t pixel, uint64_t frame) {
     uint64_t key = mix64(seed * 0x9e3779b97f4a7c15ULL + mix64(pixel + 0x632be59bd9b4e019ULL));
     key = mix64(key ^ mix64(frame + 0x85ebca6b2e4f1b3bULL));
@@ -42,8 +43,8 @@ class Rng {
   }
 
  private:
-  uint64_t state_;
-  uint64_t increment_;
+  uint64_t state_ = 0;
+  uint64_t increment_ = 1;
 };
 
 }  // namespace pxf

@@ -67,12 +67,6 @@ glm::vec2 texture_uv(const TextureRef& ref, glm::vec2 uv0, glm::vec2 uv1) {
   return glm::vec2(t);
 }
 
-glm::vec4 eval_texture(const Scene& scene, const TextureRef& ref, glm::vec2 uv0, glm::vec2 uv1,
-                       glm::vec4 fallback) {
-  if (!ref.valid() || ref.texture >= static_cast<int>(scene.textures.size())) return fallback;
-  return sample_texture(scene.textures[ref.texture], texture_uv(ref, uv0, uv1));
-}
-
 glm::mat3 texture_transform_matrix(glm::vec2 offset, float rotation, glm::vec2 scale) {
   // glm is column-major: mat3(col0, col1, col2).
   glm::mat3 translation(1, 0, 0, 0, 1, 0, offset.x, offset.y, 1);

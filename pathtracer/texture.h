@@ -16,9 +16,13 @@ glm::vec4 sample_texture(const Texture& texture, glm::vec2 uv);
 glm::vec2 texture_uv(const TextureRef& ref, glm::vec2 uv0, glm::vec2 uv1);
 
 // sample_texture(scene.textures[ref.texture], texture_uv(ref, uv0, uv1)), or `fallback` when the
-// reference is unset or out of range.
-glm::vec4 eval_texture(const Scene& scene, const TextureRef& ref, glm::vec2 uv0, glm::vec2 uv1,
-                       glm::vec4 fallback = glm::vec4(1.0f));
+// reference is unset or out of range. Inline: most material slots have no texture, and this is
+// called for each of them at every path vertex.
+inline glm::vec4 eval_texture(const Scene& scene, const TextureRef& ref, glm::vec2 uv0, glm::vec2 uv1,
+                              glm::vec4 fallback = glm::vec4(1.0f)) {
+  if (!ref.valid() || ref.texture >= static_cast<int>(scene.textures.size())) return fallback;
+  return sample_texture(scene.textures[ref.texture], texture_uv(ref, uv0, uv1));
+}
 
 // The 3x3 matrix of KHR_texture_transform: T(offset) * R(rotation) * S(scale), as the extension
 // defines it (rotation counter-clockwise in UV space, radians).
