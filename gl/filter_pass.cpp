@@ -33,15 +33,22 @@ void FilterPass::run(const PreviewInputs& inputs, const Texture2D& guide, const 
   check_gl_error("filter pass");
 }
 
+namespace {
+// The uniforms every variant's shader shares: range weights and the case-2 skip.
+void set_range_and_skip(Program& program, const FilterParams& p) {
+  const RangeWeights range = range_weights(p);
+  program.set("k_c", range.k_c);
+  program.set("k_d", range.k_d);
+  program.set("skip_case2", p.skip_case2 ? 1 : 0);
+  program.set("t", p.t);
+}
+}  // namespace
+
 void FilterPass::run_bilateral(const PreviewInputs& inputs, const FilterParams& p) {
   const int radius = std::min(kMaxFilterRadius, static_cast<int>(std::ceil(3.0f * std::max(p.sigma_s, 0.0f))));
   program_.set("radius", radius);
   program_.set("k_s", inv_two_sigma2(p.sigma_s));
-  const RangeWeights range = range_weights(p);
-  program_.set("k_c", range.k_c);
-  program_.set("k_d", range.k_d);
-  program_.set("skip_case2", p.skip_case2 ? 1 : 0);
-  program_.set("t", p.t);
+  set_range_and_skip(program_, p);
   program_.use();
   if (p.kind == FilterKind::Separable) {
     program_.set("extent", glm::ivec2(1, 0));
@@ -63,11 +70,7 @@ void FilterPass::run_bilateral(const PreviewInputs& inputs, const FilterParams& 
 // textures, the last writes output_ (and alone skips case-2 pixels and counts).
 void FilterPass::run_atrous(const PreviewInputs& inputs, const FilterParams& p) {
   if (!atrous_program_.id()) atrous_program_ = Program::from_embedded("fullscreen.vert", "atrous.frag");
-  const RangeWeights range = range_weights(p);
-  atrous_program_.set("k_c", range.k_c);
-  atrous_program_.set("k_d", range.k_d);
-  atrous_program_.set("skip_case2", p.skip_case2 ? 1 : 0);
-  atrous_program_.set("t", p.t);
+  set_range_and_skip(atrous_program_, p);
   atrous_program_.use();
   const int passes = atrous_iterations(p.sigma_s);
   inputs.hv().bind(3);

@@ -158,8 +158,6 @@ void RangePass::draw_scene(glm::vec2 jitter) {
       camera_projection_matrix(camera_, width_, height_, jitter) * camera_view_matrix(camera_);
   raster_.set("view_projection", view_projection);
   raster_.set("camera_position", glm::vec3(camera_.camera_to_world[3]));
-  raster_.use();
-  frame_fbo_.bind(width_, height_);
   const float clear_color[4] = {0, 0, 0, 0};
   const float clear_distance[4] = {kBackgroundDepth, 0, 0, 0};
   const float clear_depth = 1.0f;
