@@ -89,4 +89,20 @@ inline glm::vec3 offset_ray_origin(glm::vec3 position, glm::vec3 geometric_norma
   return position + (glm::dot(direction, geometric_normal) >= 0.0f ? eps : -eps) * geometric_normal;
 }
 
+// A shadow ray between two surface points (pbrt's SpawnRayTo): both ends are moved off their
+// surfaces towards each other, and the direction and distance are those between the moved ends.
+// Aiming from an offset origin at the un-offset target instead ends the ray just beyond the
+// target's plane; at grazing angles it then crosses that plane before tmax, and an emitter near
+// the shading point shadows itself. to_normal = 0 for a target on no surface (a point light).
+inline ShadowRay shadow_ray_between(glm::vec3 from, glm::vec3 from_normal, glm::vec3 to, glm::vec3 to_normal) {
+  const glm::vec3 d = to - from;
+  const glm::vec3 origin = offset_ray_origin(from, from_normal, d);
+  const glm::vec3 target = offset_ray_origin(to, to_normal, -d);
+  const glm::vec3 span = target - origin;
+  const float distance = glm::length(span);
+  if (!(distance > 0.0f)) return ShadowRay{origin, glm::vec3(0.0f), 0.0f};  // nothing to test
+  constexpr float kShadowEpsilon = 1e-4f;  // stop short of the target by this fraction
+  return ShadowRay{origin, span / distance, distance * (1.0f - kShadowEpsilon)};
+}
+
 }  // namespace pxf

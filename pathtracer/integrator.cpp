@@ -19,6 +19,7 @@ struct PathState {
   int nonspecular = 0;     // non-delta interactions so far
   bool prev_delta = true;  // the last interaction was a delta lobe (or the camera)
   float prev_pdf = 0.0f;   // solid-angle pdf of the last non-delta BSDF sample
+  glm::vec3 prev_position{0.0f};  // the surface point the ray left (un-offset: the light pdf's origin)
 };
 
 // The path so far is E S* (emission here is E S* L), or E S* D with the D just before (E S* D L).
@@ -150,7 +151,7 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
     float w = 1.0f;
     if (!s.prev_delta)
       w = power_heuristic(s.prev_pdf,
-                          lights_.pdf_triangle(hit.mesh, hit.prim, path.ray.origin, sp.position, sp.geometric_normal));
+                          lights_.pdf_triangle(hit.mesh, hit.prim, s.prev_position, sp.position, sp.geometric_normal));
     add_contribution(out, s.throughput * eval_emission(scene, material, sp.uv0, sp.uv1) * w, emission_is_lv(s),
                      params.all_hv);
   }
@@ -170,11 +171,12 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
       float bsdf_pdf;
       glm::vec3 f = bsdf.eval(ls.wi, &bsdf_pdf);
       if (max_component(f) > 0.0f && max_component(ls.radiance) > 0.0f) {
-        glm::vec3 origin = offset_ray_origin(sp.position, sp.geometric_normal, ls.wi);
-        float tmax = std::isinf(ls.distance) ? ls.distance : ls.distance * (1.0f - 1e-3f);
+        ShadowRay ray = std::isinf(ls.distance)
+                            ? ShadowRay{offset_ray_origin(sp.position, sp.geometric_normal, ls.wi), ls.wi, ls.distance}
+                            : shadow_ray_between(sp.position, sp.geometric_normal, ls.point, ls.normal);
         ++out.rays;
         float w = ls.delta ? 1.0f : power_heuristic(ls.pdf, bsdf_pdf);
-        shadows.push(ShadowRay{origin, ls.wi, tmax},
+        shadows.push(ray,
                      {&out, s.throughput * f * ls.radiance * (w / ls.pdf), s.nonspecular == 0});
       }
     }
@@ -195,6 +197,7 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
     if (!(u_rr < q)) return false;
     s.throughput /= q;
   }
+  s.prev_position = sp.position;
   path.ray.origin = offset_ray_origin(sp.position, sp.geometric_normal, bs.wi);
   path.ray.direction = bs.wi;
   return true;

@@ -219,6 +219,7 @@ bool LightSampler::sample_punctual(glm::vec3 position, float u_select, LightSamp
   float dist = std::sqrt(dist2);
   out->wi = d / dist;
   out->distance = dist;
+  out->point = light.position;  // no surface: out->normal stays 0, so shadow rays aim at it unoffset
   float falloff = range_window(dist, light.range) / dist2;
   if (light.type == PunctualLight::Type::Spot) falloff *= spot_attenuation(light, -out->wi);
   out->radiance = power * falloff;

@@ -17,7 +17,7 @@ struct LightSample {
   glm::vec3 radiance{0.0f};  // emitted radiance towards the shading point (delta: intensity / d^2)
   float pdf = 0.0f;          // solid-angle pdf incl. selection (delta: selection probability)
   bool delta = false;
-  glm::vec3 point{0.0f}, normal{0.0f};  // the sampled point on a triangle (area lights)
+  glm::vec3 point{0.0f}, normal{0.0f};  // the sampled point (finite distance); normal 0 off surfaces
 };
 
 // Direction <-> equirect coordinates (scene.h convention).
