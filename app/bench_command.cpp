@@ -15,6 +15,7 @@
 #include "app/plot.h"
 #include "app/preview.h"
 #include "gl/context.h"
+#include "image/metrics.h"
 #include "pathtracer/bench.h"
 
 namespace pxf {
@@ -31,6 +32,25 @@ void write_text(const std::string& path, const std::string& text) {
     out << text;
     if (!out) throw Error(path + ": cannot write");
   });
+}
+
+// The error figures of one bench row, one call per row: HDR NRMSE, and on the images tone-mapped
+// with the reference's key and log-average, display NRMSE and mean LDR-FLIP (image/metrics.h).
+struct RowError {
+  double hdr_nrmse = 0, display_nrmse = 0, flip = 0;
+};
+RowError row_error(const Image& test, const Image& reference) {
+  const DisplayMetrics m = compare_display(test, reference);
+  return {m.hdr.nrmse_percent, m.display_nrmse_percent, m.flip_mean};
+}
+// CSV columns beside the HDR NRMSE ones: "<prefix>display_nrmse_percent,<prefix>flip".
+std::string display_csv_header(const std::string& prefix) {
+  return prefix + "display_nrmse_percent," + prefix + "flip";
+}
+std::string display_csv(const RowError& e) {
+  std::ostringstream s;
+  s << e.display_nrmse << "," << e.flip;
+  return s.str();
 }
 
 struct BenchSetup {
@@ -90,6 +110,7 @@ struct PlainRun {
   std::vector<double> wall_ms;  // after k+1 frames (display of the last frame included)
   std::vector<int> spp;         // where NRMSE was measured
   std::vector<double> nrmse;
+  std::vector<RowError> errors;  // beside nrmse: display NRMSE and FLIP too
   std::vector<double> nrmse_wall_ms;
 };
 
@@ -107,10 +128,12 @@ PlainRun run_plain(const BenchSetup& b, int min_frames, int max_frames, double s
     run.wall_ms.push_back(wall);
     if (k <= 64 || k % 8 == 0) {
       const auto m0 = Clock::now();
-      const double e = compare_images(preview.renderer().unfiltered_image(), reference).nrmse_percent;
+      const RowError error = row_error(preview.renderer().unfiltered_image(), reference);
+      const double e = error.hdr_nrmse;
       measuring_ms += elapsed_ms(m0);
       run.spp.push_back(k);
       run.nrmse.push_back(e);
+      run.errors.push_back(error);
       run.nrmse_wall_ms.push_back(wall);
       if (k >= min_frames && e <= stop_nrmse) break;
     }
@@ -123,6 +146,7 @@ struct EqualTimeRow {
   double budget_ms = 0, plain_nrmse = 0;
   int filtered_frames = 0;
   double filtered_ms = 0, filtered_nrmse = 0;
+  RowError plain_error, filtered_error;
 };
 
 // A filtered capture that stops adding frames when the next one (with its scheduled filter run)
@@ -146,7 +170,8 @@ EqualTimeRow run_equal_time(const BenchSetup& b, int budget_frames, double budge
   row.budget_ms = budget_ms;
   row.filtered_frames = preview.samples();
   row.filtered_ms = elapsed_ms(start);
-  row.filtered_nrmse = compare_images(preview.final_image(), reference).nrmse_percent;
+  row.filtered_error = row_error(preview.final_image(), reference);
+  row.filtered_nrmse = row.filtered_error.hdr_nrmse;
   return row;
 }
 
@@ -205,7 +230,8 @@ int run_bench(const Args& args) {
                   "  1. per-stage times of one scheduled filter application, in ms and in path-tracing frames;\n"
                   "  2. the relative overhead of filtering over --frames frames;\n"
                   "  3. NRMSE to the reference of unfiltered vs filtered images at equal wall time, at budgets of\n"
-                  "     --budgets unfiltered frames;\n"
+                  "     --budgets unfiltered frames, in HDR and on display values (both tone-mapped with the\n"
+                  "     reference's key and log-average), with the mean LDR-FLIP of the display images;\n"
                   "  4. the spp at which unfiltered path tracing reaches the NRMSE of the filtered image at --frames.\n"
                   "The reference (--reference-spp plain path tracing) is cached in --out. Writes CSV and SVG plots.\n"
                   "--pathtracer instead measures paths/s, rays/s and the raw Embree incoherent-ray rate.");
@@ -278,21 +304,28 @@ int run_bench(const Args& args) {
 
   // 3. Equal time.
   std::printf("\n3. NRMSE to the reference at equal wall time:\n");
-  std::printf("   budget  time ms  unfiltered NRMSE | filtered spp  time ms  NRMSE   ratio\n");
+  std::printf("   budget  time ms  unfiltered NRMSE | filtered spp  time ms  NRMSE   ratio"
+              " | display NRMSE unf / filt (ratio)  FLIP unf / filt\n");
   std::ostringstream eq_csv;
-  eq_csv << "budget_frames,budget_ms,unfiltered_nrmse_percent,filtered_spp,filtered_ms,filtered_nrmse_percent\n";
+  eq_csv << "budget_frames,budget_ms,unfiltered_nrmse_percent,filtered_spp,filtered_ms,filtered_nrmse_percent,"
+         << display_csv_header("unfiltered_") << "," << display_csv_header("filtered_") << "\n";
   PlotSeries filtered_points{"filtered (equal time)", {}, {}, true};
   for (int budget : budgets) {
     const double budget_ms = plain.wall_ms[budget - 1];
     double plain_nrmse = 0;
+    RowError plain_error;
     for (size_t i = 0; i < plain.spp.size(); ++i)
-      if (plain.spp[i] == budget) plain_nrmse = plain.nrmse[i];
+      if (plain.spp[i] == budget) plain_nrmse = plain.nrmse[i], plain_error = plain.errors[i];
     EqualTimeRow row = run_equal_time(b, budget, budget_ms, pt_ms, filter_ms, display_ms, reference);
     row.plain_nrmse = plain_nrmse;
-    std::printf("   %6d %8.0f  %14.3f %%  | %12d %8.0f  %6.3f %%  %5.2fx\n", budget, budget_ms, plain_nrmse,
-                row.filtered_frames, row.filtered_ms, row.filtered_nrmse, plain_nrmse / row.filtered_nrmse);
+    row.plain_error = plain_error;
+    std::printf("   %6d %8.0f  %14.3f %%  | %12d %8.0f  %6.3f %%  %5.2fx | %7.3f %% / %7.3f %% (%.2fx)  %.4f / %.4f\n",
+                budget, budget_ms, plain_nrmse, row.filtered_frames, row.filtered_ms, row.filtered_nrmse,
+                plain_nrmse / row.filtered_nrmse, plain_error.display_nrmse, row.filtered_error.display_nrmse,
+                row.filtered_error.display_nrmse / plain_error.display_nrmse, plain_error.flip, row.filtered_error.flip);
     eq_csv << budget << "," << budget_ms << "," << plain_nrmse << "," << row.filtered_frames << ","
-           << row.filtered_ms << "," << row.filtered_nrmse << "\n";
+           << row.filtered_ms << "," << row.filtered_nrmse << "," << display_csv(plain_error) << ","
+           << display_csv(row.filtered_error) << "\n";
     filtered_points.x.push_back(row.filtered_ms / 1000);
     filtered_points.y.push_back(row.filtered_nrmse);
   }
@@ -306,10 +339,11 @@ int run_bench(const Args& args) {
     std::printf("more than %d spp (%.3f %% there)\n", plain.spp.back(), plain.nrmse.back());
 
   std::ostringstream conv_csv;
-  conv_csv << "spp,wall_ms,unfiltered_nrmse_percent\n";
+  conv_csv << "spp,wall_ms,unfiltered_nrmse_percent," << display_csv_header("unfiltered_") << "\n";
   PlotSeries plain_curve{"unfiltered", {}, {}, false};
   for (size_t i = 0; i < plain.spp.size(); ++i) {
-    conv_csv << plain.spp[i] << "," << plain.nrmse_wall_ms[i] << "," << plain.nrmse[i] << "\n";
+    conv_csv << plain.spp[i] << "," << plain.nrmse_wall_ms[i] << "," << plain.nrmse[i] << ","
+             << display_csv(plain.errors[i]) << "\n";
     plain_curve.x.push_back(plain.nrmse_wall_ms[i] / 1000);
     plain_curve.y.push_back(plain.nrmse[i]);
   }

@@ -1,23 +1,69 @@
-// pxf diff: image metrics between two images (SPEC section 4), the same code the tests use.
+// pxf diff: image metrics between two images (SPEC section 4), the same code the tests use:
+// HDR metrics, then display-space NRMSE and LDR-FLIP, each also with the emitters masked out.
 #include <cstdio>
+#include <optional>
 
 #include "app/cli.h"
 #include "app/commands.h"
 #include "image/image.h"
+#include "image/metrics.h"
 
 namespace pxf {
 
+namespace {
+bool has_rgb(const Image& image) {
+  for (const char* c : {"R", "G", "B"})
+    if (image.channel_index(c) < 0) return false;
+  return true;
+}
+
+bool has_layer(const std::vector<Layer>& layers, const std::string& name) {
+  for (const Layer& l : layers)
+    if (l.name == name) return true;
+  return false;
+}
+
+// The emitter mask: --mask FILE's "emitter" layer, else the reference's own when it is a
+// buffers.exr that has one (said on stdout), else none.
+std::optional<Image> emitter_mask(const std::string& mask_path, const std::string& reference_path) {
+  if (!mask_path.empty()) return read_exr(mask_path, "emitter");
+  if (!has_layer(read_exr_layers(reference_path), "emitter")) return std::nullopt;
+  std::printf("mask: the emitter layer of %s\n", reference_path.c_str());
+  return read_exr(reference_path, "emitter");
+}
+
+size_t masked_pixels(const Image& mask) {
+  size_t n = 0;
+  for (size_t p = 0; p < mask.pixel_count(); ++p) n += mask.pixels[p * mask.channels.size()] > 0;
+  return n;
+}
+
+void print_display(const char* label, const DisplayMetrics& m) {
+  std::printf("%s: HDR NRMSE %.4f %%  display NRMSE %.4f %%  FLIP %.6f\n", label, m.hdr.nrmse_percent,
+              m.display_nrmse_percent, m.flip_mean);
+}
+}  // namespace
+
 int run_diff(const Args& args) {
-  std::string test_path, reference_path, layer, reference_layer;
-  double max_nrmse = -1;
+  std::string test_path, reference_path, layer, reference_layer, mask_path;
+  double max_nrmse = -1, max_flip = -1;
+  DisplayMetricOptions display;
   CommandLine cli("diff", "TEST.exr REFERENCE.exr [options]",
                   "Prints NRMSE (% of the reference mean), RMSE, relative MSE, max |difference| and the\n"
-                  "NaN/Inf count of TEST against REFERENCE over their shared color channels.");
+                  "NaN/Inf count of TEST against REFERENCE over their shared color channels. For RGB images\n"
+                  "also the display-space NRMSE (both tone-mapped with the reference's Reinhard key and\n"
+                  "log-average luminance, compared as sRGB values) and the mean LDR-FLIP of those display\n"
+                  "images, each again with the emitters masked out when a mask is known.");
   cli.positional("TEST.exr", &test_path, "image to judge (EXR)");
   cli.positional("REFERENCE.exr", &reference_path, "reference image (EXR)");
   cli.option("--layer", &layer, "NAME", "layer of TEST to compare (default: the unnamed layer, else the first)");
   cli.option("--reference-layer", &reference_layer, "NAME", "layer of REFERENCE (default: same as --layer)");
-  cli.option("--max-nrmse", &max_nrmse, "exit with code 1 when NRMSE (%) is above this", 0.0, 1e9);
+  cli.option("--mask", &mask_path, "FILE.exr",
+             "leave out pixels whose 'emitter' layer is > 0 (default: REFERENCE's own emitter layer, if any)");
+  cli.option("--key", &display.key, "Reinhard key of the display tone map", 1e-4f, 100.0f);
+  cli.option("--ppd", &display.pixels_per_degree, "FLIP's pixels per degree of visual angle", 1.0, 1000.0);
+  cli.option("--max-nrmse", &max_nrmse, "exit with code 1 when the HDR NRMSE (%) is above this", 0.0, 1e9);
+  cli.option("--max-flip", &max_flip, "exit with code 1 when the mean FLIP (all pixels) is above this", 0.0, 1.0);
   if (!cli.parse(args)) return 0;
   if (!cli.given("--reference-layer")) reference_layer = layer;
 
@@ -25,12 +71,40 @@ int run_diff(const Args& args) {
   const Image reference = read_exr(reference_path, reference_layer);
   const ImageMetrics m = compare_images(test, reference);
   std::printf("%s\n", format_metrics(m).c_str());
+  if (m.reference_nonfinite > 0) {
+    std::fprintf(stderr, "pxf diff: %s has %zu non-finite samples; it cannot serve as a reference\n",
+                 reference_path.c_str(), m.reference_nonfinite);
+    return 1;
+  }
   if (m.nan_count + m.inf_count > 0) {
     std::fprintf(stderr, "pxf diff: %s has %zu non-finite samples\n", test_path.c_str(), m.nan_count + m.inf_count);
     return 1;
   }
+  double flip = -1;
+  if (has_rgb(test) && has_rgb(reference)) {
+    const std::optional<Image> mask = emitter_mask(mask_path, reference_path);
+    const DisplayMetrics all = compare_display(test, reference, nullptr, display);
+    print_display("all pixels", all);
+    flip = all.flip_mean;
+    if (mask) {
+      const DisplayMetrics masked = compare_display(test, reference, &*mask, display);
+      char label[64];
+      std::snprintf(label, sizeof label, "emitters masked (%zu pixels)", masked_pixels(*mask));
+      print_display(label, masked);
+    }
+  } else {
+    std::printf("display metrics: skipped, the images have no R,G,B channels\n");
+  }
   if (max_nrmse >= 0 && m.nrmse_percent > max_nrmse) {
     std::fprintf(stderr, "pxf diff: NRMSE %.4f %% is above --max-nrmse %.4f %%\n", m.nrmse_percent, max_nrmse);
+    return 1;
+  }
+  if (max_flip >= 0 && flip < 0) {
+    std::fprintf(stderr, "pxf diff: --max-flip needs R,G,B images\n");
+    return 1;
+  }
+  if (max_flip >= 0 && flip > max_flip) {
+    std::fprintf(stderr, "pxf diff: FLIP %.6f is above --max-flip %.6f\n", flip, max_flip);
     return 1;
   }
   return 0;

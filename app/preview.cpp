@@ -199,6 +199,7 @@ std::vector<Layer> Preview::buffers() {
   layers.push_back({"range_color", range_.range_color_image()});
   layers.push_back({"depth", range_.depth_image()});
   layers.push_back({"samples", renderer_->samples_image()});
+  layers.push_back({"emitter", renderer_->emitter_coverage_image()});
   return layers;
 }
 

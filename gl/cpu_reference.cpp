@@ -305,36 +305,8 @@ BlendOutput cpu_blend(const Image& lv, const Image& hv, const Image& var_u, cons
   return out;
 }
 
-namespace {
-float sanitize_display(float v) { return std::isfinite(v) ? std::clamp(v, 0.0f, kMaxInput) : 0.0f; }
-}  // namespace
+double cpu_log_average(const Image& rgb, float delta) { return log_average_luminance(rgb, delta); }
 
-double cpu_log_average(const Image& rgb, float delta) {
-  double sum = 0;
-  for (int y = 0; y < rgb.height; ++y)
-    for (int x = 0; x < rgb.width; ++x) {
-      float c[3] = {sanitize_display(rgb.at(x, y, 0)), sanitize_display(rgb.at(x, y, 1)),
-                    sanitize_display(rgb.at(x, y, 2))};
-      sum += std::log(double(delta) + lum(c));
-    }
-  return std::exp(sum / std::max<size_t>(rgb.pixel_count(), 1));
-}
-
-Image cpu_tonemap(const Image& rgb, const TonemapParams& p) {
-  Image out = Image::rgb(rgb.width, rgb.height);
-  double lavg = p.log_average > 0 ? p.log_average : cpu_log_average(rgb, p.delta);
-  float k = static_cast<float>(p.key / std::max(lavg, 1e-30));
-  for (int y = 0; y < rgb.height; ++y)
-    for (int x = 0; x < rgb.width; ++x) {
-      float c[3] = {sanitize_display(rgb.at(x, y, 0)), sanitize_display(rgb.at(x, y, 1)),
-                    sanitize_display(rgb.at(x, y, 2))};
-      float lm = k * lum(c);
-      // Ld / Y without dividing by Y: k (1 + Lm / white^2) / (1 + Lm).
-      float burn = p.white > 0 ? 1.0f + lm / (p.white * p.white) : 1.0f;
-      float scale = k * burn / (1.0f + lm);
-      for (int i = 0; i < 3; ++i) out.at(x, y, i) = srgb_from_linear(std::clamp(c[i] * scale, 0.0f, 1.0f));
-    }
-  return out;
-}
+Image cpu_tonemap(const Image& rgb, const TonemapParams& p) { return tonemap_reinhard(rgb, p); }
 
 }  // namespace pxf

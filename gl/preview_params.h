@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "image/tonemap.h"
+
 namespace pxf {
 
 // Cross bilateral filter variants: "bilateral-depth" (SPEC default: spatial x color x depth) and
@@ -63,7 +65,7 @@ constexpr float kVarSkipped = -2.0f;  // Var[L_f] of a pixel the filter skipped 
 constexpr float kBackgroundDepth = 1.0e4f;
 
 // Inputs larger than this are clamped, so that sums of a whole kernel stay finite in float.
-constexpr float kMaxInput = 1.0e30f;
+constexpr float kMaxInput = kMaxTonemapInput;
 
 struct BlendParams {
   float t = 0.01f;  // perceived-variance threshold; sqrt(t) = allowed relative std. deviation
@@ -81,11 +83,6 @@ enum BlendCase : int {
 };
 constexpr int kBlendCaseCount = 5;
 
-struct TonemapParams {
-  float key = 0.18f;         // Reinhard's key a
-  float white = 0.0f;        // white point in key-scaled luminance; 0 = none (L/(1+L))
-  float log_average = 0.0f;  // > 0: use this log-average luminance instead of the image's
-  float delta = 1.0e-4f;     // log-average offset: exp(mean(log(delta + Y)))
-};
+// TonemapParams: image/tonemap.h (the tone map formula lives there).
 
 }  // namespace pxf

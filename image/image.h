@@ -72,10 +72,12 @@ struct ImageMetrics {
   size_t nan_count = 0;  // samples of the test image (not pixels) that are NaN
   size_t inf_count = 0;  // ... or +-Inf
   size_t samples = 0;    // compared finite samples
+  size_t reference_nonfinite = 0;  // samples of the reference that are NaN or +-Inf (skipped)
 };
-// Compares the channels the two images share by name, ignoring "A". Throws pxf::Error on a size
-// mismatch or when they share no channel.
-ImageMetrics compare_images(const Image& test, const Image& reference);
+// Compares the channels the two images share by name, ignoring "A". With a mask (channel 0, same
+// size), pixels whose mask is > 0 are left out. Throws pxf::Error on a size mismatch, when they
+// share no channel, or when the reference has no finite sample to compare against.
+ImageMetrics compare_images(const Image& test, const Image& reference, const Image* mask = nullptr);
 size_t count_nonfinite(const Image& image);
 std::string format_metrics(const ImageMetrics& m);
 

@@ -2,7 +2,10 @@
 #include <cmath>
 #include <cstdio>
 
+#include "image/flip.h"
 #include "image/image.h"
+#include "image/metrics.h"
+#include "image/tonemap.h"
 
 namespace pxf {
 
@@ -16,6 +19,15 @@ std::vector<std::pair<int, int>> shared_channels(const Image& test, const Image&
   }
   return pairs;
 }
+void check_same_size(const Image& a, const Image& b, const char* what) {
+  if (a.width != b.width || a.height != b.height)
+    throw Error(std::string(what) + " sizes differ: " + std::to_string(a.width) + "x" + std::to_string(a.height) +
+                " vs " + std::to_string(b.width) + "x" + std::to_string(b.height));
+}
+
+bool masked_out(const Image* mask, size_t pixel) {
+  return mask && mask->pixels[pixel * mask->channels.size()] > 0;  // NaN in a mask keeps the pixel
+}
 }  // namespace
 
 size_t count_nonfinite(const Image& image) {
@@ -24,10 +36,12 @@ size_t count_nonfinite(const Image& image) {
   return count;
 }
 
-ImageMetrics compare_images(const Image& test, const Image& reference) {
-  if (test.width != reference.width || test.height != reference.height)
-    throw Error("image sizes differ: " + std::to_string(test.width) + "x" + std::to_string(test.height) + " vs " +
-                std::to_string(reference.width) + "x" + std::to_string(reference.height));
+ImageMetrics compare_images(const Image& test, const Image& reference, const Image* mask) {
+  check_same_size(test, reference, "image");
+  if (mask) {
+    check_same_size(*mask, reference, "mask and image");
+    if (mask->channels.empty()) throw Error("the mask has no channel");
+  }
   const auto pairs = shared_channels(test, reference);
   if (pairs.empty()) throw Error("the images share no color channel");
 
@@ -35,11 +49,15 @@ ImageMetrics compare_images(const Image& test, const Image& reference) {
   double sum_sq = 0, sum_rel = 0, sum_ref = 0;
   const size_t tn = test.channels.size(), rn = reference.channels.size();
   for (size_t p = 0; p < reference.pixel_count(); ++p) {
+    if (masked_out(mask, p)) continue;
     for (auto [t, r] : pairs) {
       const double tv = test.pixels[p * tn + t], rv = reference.pixels[p * rn + r];
       if (std::isnan(tv)) { ++m.nan_count; continue; }
       if (std::isinf(tv)) { ++m.inf_count; continue; }
-      if (!std::isfinite(rv)) continue;  // a broken reference sample says nothing about the test
+      if (!std::isfinite(rv)) {  // a broken reference sample says nothing about the test
+        ++m.reference_nonfinite;
+        continue;
+      }
       const double d = tv - rv;
       sum_sq += d * d;
       sum_rel += d * d / (rv * rv + 1e-2);
@@ -48,6 +66,9 @@ ImageMetrics compare_images(const Image& test, const Image& reference) {
       ++m.samples;
     }
   }
+  if (m.samples == 0 && m.reference_nonfinite > 0)
+    throw Error("the reference has no finite sample to compare against (" + std::to_string(m.reference_nonfinite) +
+                " NaN/Inf)");
   if (m.samples == 0) return m;
   const double n = static_cast<double>(m.samples);
   m.rmse = std::sqrt(sum_sq / n);
@@ -64,6 +85,37 @@ std::string format_metrics(const ImageMetrics& m) {
                 m.nrmse_percent, m.rmse, m.rel_mse, m.max_abs_diff, m.reference_mean, m.nan_count, m.inf_count,
                 m.samples);
   return line;
+}
+
+namespace {
+double masked_mean(const Image& values, const Image* mask) {
+  double sum = 0;
+  size_t n = 0;
+  for (size_t p = 0; p < values.pixel_count(); ++p) {
+    if (masked_out(mask, p)) continue;
+    sum += values.pixels[p];
+    ++n;
+  }
+  return n ? sum / n : 0.0;
+}
+}  // namespace
+
+DisplayImages tonemap_like_reference(const Image& test, const Image& reference, float key) {
+  TonemapParams params;
+  params.key = key;
+  params.log_average = static_cast<float>(log_average_luminance(reference, params.delta));
+  return {tonemap_reinhard(test, params), tonemap_reinhard(reference, params)};
+}
+
+DisplayMetrics compare_display(const Image& test, const Image& reference, const Image* mask,
+                               const DisplayMetricOptions& options) {
+  DisplayMetrics m;
+  m.hdr = compare_images(test, reference, mask);
+  const Image test_rgb = test.select({"R", "G", "B"}), reference_rgb = reference.select({"R", "G", "B"});
+  const DisplayImages display = tonemap_like_reference(test_rgb, reference_rgb, options.key);
+  m.display_nrmse_percent = compare_images(display.test, display.reference, mask).nrmse_percent;
+  m.flip_mean = masked_mean(flip_error_map(display.test, display.reference, options.pixels_per_degree), mask);
+  return m;
 }
 
 }  // namespace pxf

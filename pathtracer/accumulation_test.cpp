@@ -87,5 +87,40 @@ TEST(Accumulation, RendererBuffersResetAndImages) {
   EXPECT_EQ(renderer.stats().paths, 0u);
 }
 
+// Camera at the origin looking down -z at z = -1: left half an emitter facing the camera
+// (or away from it), right half a grey wall. On a 9-pixel-wide image the seam x = 0 runs
+// through the middle of column 4.
+Scene half_emitter_scene(bool emitter_faces_camera) {
+  Scene scene;
+  scene.source = "test:half-emitter";
+  scene.materials = {make_diffuse(glm::vec3(0.5f)), make_emitter(glm::vec3(4.0f))};
+  const glm::vec3 up(0, 20, 0), right(20, 0, 0);
+  if (emitter_faces_camera)
+    scene.meshes.push_back(make_quad(glm::vec3(-20, -10, -1), right, up, 1));  // normal +z
+  else
+    scene.meshes.push_back(make_quad(glm::vec3(-20, -10, -1), up, right, 1));  // normal -z
+  scene.meshes.push_back(make_quad(glm::vec3(0, -10, -1), right, up, 0));
+  scene.camera = look_at_camera(glm::vec3(0), glm::vec3(0, 0, -1), glm::vec3(0, 1, 0), 0.8f);
+  return scene;
+}
+
+TEST(Accumulation, EmitterCoverageIsTheFractionOfCameraRaysSeeingAnEmitter) {
+  TraceParams params;
+  params.threads = 2;
+  const Scene scene = half_emitter_scene(true);
+  ProgressiveRenderer renderer(scene, params, 9, 4);
+  const Image coverage = renderer.emitter_coverage_image();
+  ASSERT_EQ(coverage.channels, std::vector<std::string>{"Y"});
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 9; ++x) {
+      const float expected = x < 4 ? 1.0f : (x == 4 ? 0.5f : 0.0f);  // 2 of the 2x2 rays at the seam
+      EXPECT_EQ(coverage.at(x, y, 0), expected) << x << "," << y;
+    }
+  // An emitter seen from its back emits nothing toward the camera: not in the mask.
+  const Scene back = half_emitter_scene(false);
+  ProgressiveRenderer back_renderer(back, params, 9, 4);
+  for (float v : back_renderer.emitter_coverage_image().pixels) EXPECT_EQ(v, 0.0f);
+}
+
 }  // namespace
 }  // namespace pxf

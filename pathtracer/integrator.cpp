@@ -22,6 +22,11 @@ struct PathState {
   glm::vec3 prev_position{0.0f};  // the surface point the ray left (un-offset: the light pdf's origin)
 };
 
+// Emission leaves a surface toward the ray only on its front face, unless it is double-sided.
+bool emission_visible(const Material& material, const SurfacePoint& sp) {
+  return material.is_emissive() && (sp.front_face || material.double_sided);
+}
+
 // The path so far is E S* (emission here is E S* L), or E S* D with the D just before (E S* D L).
 bool emission_is_lv(const PathState& s) { return s.nonspecular == 0 || (s.nonspecular == 1 && !s.prev_delta); }
 
@@ -147,7 +152,7 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
   }
   SurfacePoint sp = geometry_.surface_point(hit, path.ray);
   const Material& material = *sp.material;
-  if (material.is_emissive() && (sp.front_face || material.double_sided)) {
+  if (emission_visible(material, sp)) {
     float w = 1.0f;
     if (!s.prev_delta)
       w = power_heuristic(s.prev_pdf,
@@ -201,6 +206,13 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
   path.ray.origin = offset_ray_origin(sp.position, sp.geometric_normal, bs.wi);
   path.ray.direction = bs.wi;
   return true;
+}
+
+bool PathTracer::first_hit_is_emissive(const Ray& camera_ray) const {
+  const Hit hit = geometry_.intersect(camera_ray);
+  if (!hit.valid()) return false;
+  const SurfacePoint sp = geometry_.surface_point(hit, camera_ray);
+  return emission_visible(*sp.material, sp);
 }
 
 SpecularChainHit PathTracer::trace_specular_chain(const Ray& camera_ray) const {

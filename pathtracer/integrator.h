@@ -42,6 +42,8 @@ class PathTracer {
                          const TraceParams& params) const;
 
   SpecularChainHit trace_specular_chain(const Ray& camera_ray) const;
+  // The ray's first surface emits toward it (the emission the path tracer adds at vertex 1).
+  bool first_hit_is_emissive(const Ray& camera_ray) const;
 
   bool dark() const { return lights_.empty(); }
   bool has_perfect_specular() const { return has_perfect_specular_; }

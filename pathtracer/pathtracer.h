@@ -102,6 +102,11 @@ class ProgressiveRenderer {
   Image variance_image() const;    // "Y": Var[L_u], 0 where unknown
   Image samples_image() const;     // "Y": n
   std::vector<float> variance_of_mean() const;  // Var[L_u] per pixel, -1 where n < 2
+  // "Y": the fraction of each pixel's camera rays whose first visible surface is emissive, from
+  // kEmitterRaysPerSide^2 stratified rays per pixel traced on demand (once per output, not per
+  // frame). Lets metrics leave the light sources out.
+  Image emitter_coverage_image() const;
+  static constexpr int kEmitterRaysPerSide = 2;
 
   // True when a perfectly specular surface is directly visible somewhere (cheap check by the
   // caller's raster flag is preferred; this is what the renderer knows from its materials).

@@ -154,6 +154,24 @@ Image ProgressiveRenderer::samples_image() const {
   return image;
 }
 
+Image ProgressiveRenderer::emitter_coverage_image() const {
+  const int w = impl_->width, h = impl_->height, n = kEmitterRaysPerSide;
+  Image image = Image::gray(w, h);
+  auto trace_rows = [&](const tbb::blocked_range<int>& rows) {
+    for (int y = rows.begin(); y != rows.end(); ++y)
+      for (int x = 0; x < w; ++x) {
+        int emissive = 0;
+        for (int j = 0; j < n; ++j)
+          for (int i = 0; i < n; ++i)
+            emissive += impl_->tracer->first_hit_is_emissive(
+                camera_ray(impl_->camera, w, h, x + (i + 0.5f) / n, y + (j + 0.5f) / n));
+        image.at(x, y, 0) = static_cast<float>(emissive) / (n * n);
+      }
+  };
+  impl_->arena->execute([&] { tbb::parallel_for(tbb::blocked_range<int>(0, h, 8), trace_rows); });
+  return image;
+}
+
 std::vector<float> ProgressiveRenderer::variance_of_mean() const {
   std::vector<float> v(impl_->acc.samples.size());
   for (size_t i = 0; i < v.size(); ++i) v[i] = impl_->acc.variance_of_mean(i);

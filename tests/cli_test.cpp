@@ -9,6 +9,7 @@
 
 #include <array>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -106,7 +107,8 @@ TEST(Cli, RenderWritesEveryOutput) {
   for (const char* file : {"final.png", "final.exr", "buffers.exr", "stats.json"}) EXPECT_TRUE(fs::exists(out + "/" + file));
   std::vector<std::string> names;
   for (const Layer& l : read_exr_layers(out + "/buffers.exr")) names.push_back(l.name);
-  for (const char* layer : {"final", "lv", "hv", "hv_filtered", "var_u", "var_f", "blend", "range_color", "depth"})
+  for (const char* layer :
+       {"final", "lv", "hv", "hv_filtered", "var_u", "var_f", "blend", "range_color", "depth", "emitter"})
     EXPECT_NE(std::find(names.begin(), names.end(), layer), names.end()) << layer;
   const auto stats = nlohmann::json::parse(slurp(out + "/stats.json"));
   EXPECT_EQ(stats["settings"]["spp"], 4);
@@ -175,4 +177,62 @@ TEST(Cli, DiffReadsForeignHalfFloatExrsAndGetsTheNumbersRight) {
   const Result missing = run("diff " + dir + "/nope.exr " + dir + "/ref.exr");
   EXPECT_EQ(missing.code, 1);
   EXPECT_NE(missing.err.find("nope.exr"), std::string::npos);
+}
+
+// Issue 12 item 9: a reference without finite values is an error, never NRMSE 0 and exit 0.
+TEST(Cli, DiffRejectsANonFiniteReference) {
+  const std::string dir = temp_dir("diff_nan");
+  fs::create_directories(dir);
+  write_half_rgba(dir + "/ref.exr", std::vector<float>(6, NAN), 2, 1);
+  write_half_rgba(dir + "/test.exr", {1, 2, 3, 4, 2, 0}, 2, 1);
+  const Result r = run("diff " + dir + "/test.exr " + dir + "/ref.exr --max-nrmse 1");
+  EXPECT_EQ(r.code, 1) << r.out;
+  EXPECT_EQ(lines(r.err), 1u) << r.err;
+  EXPECT_NE(r.err.find("ref.exr"), std::string::npos) << r.err;
+  write_half_rgba(dir + "/partly.exr", {1, 2, NAN, 3, 2, 1}, 2, 1);
+  EXPECT_EQ(run("diff " + dir + "/test.exr " + dir + "/partly.exr").code, 1);
+}
+
+namespace {
+// The number after `label` on the line starting with `line_start` in `text`; NaN when absent.
+double number_after(const std::string& text, const std::string& line_start, const std::string& label) {
+  const size_t line = text.find(line_start);
+  if (line == std::string::npos) return NAN;
+  const size_t end = text.find('\n', line);
+  const size_t at = text.find(label, line);
+  if (at == std::string::npos || at > end) return NAN;
+  return std::stod(text.substr(at + label.size()));
+}
+}  // namespace
+
+// Display NRMSE and FLIP beside HDR NRMSE, with the emitters masked through the reference
+// buffers.exr's own emitter layer or --mask; --max-flip gates like --max-nrmse.
+TEST(Cli, DiffReportsDisplayMetricsWithAndWithoutEmitters) {
+  const std::string test = temp_dir("diff_test"), ref = temp_dir("diff_ref");
+  ASSERT_EQ(run("render --size 48x36 --spp 4 --quiet --out " + test).code, 0);
+  ASSERT_EQ(run("render --size 48x36 --spp 64 --filter none --seed 9 --quiet --out " + ref).code, 0);
+  const Result r = run("diff " + test + "/final.exr " + ref + "/buffers.exr");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("mask: the emitter layer of " + ref + "/buffers.exr"), std::string::npos) << r.out;
+  const double flip = number_after(r.out, "all pixels:", "FLIP ");
+  const double display = number_after(r.out, "all pixels:", "display NRMSE ");
+  const double masked_hdr = number_after(r.out, "emitters masked", "HDR NRMSE ");
+  const double hdr = number_after(r.out, "all pixels:", "HDR NRMSE ");
+  EXPECT_GT(flip, 0.0) << r.out;
+  EXPECT_LT(flip, 0.5) << r.out;
+  EXPECT_GT(display, 0.0) << r.out;
+  EXPECT_GT(masked_hdr, 0.0) << r.out;
+  EXPECT_NE(masked_hdr, hdr) << r.out;  // the ceiling light is in view of the default camera
+  EXPECT_GT(number_after(r.out, "emitters masked", "masked ("), 0.0) << r.out;
+  // --mask names the file explicitly; one without an emitter layer is a clear error.
+  const Result explicit_mask = run("diff " + test + "/final.exr " + ref + "/final.exr --mask " + test + "/buffers.exr");
+  EXPECT_EQ(explicit_mask.code, 0) << explicit_mask.err;
+  EXPECT_NE(explicit_mask.out.find("emitters masked"), std::string::npos) << explicit_mask.out;
+  const Result no_layer = run("diff " + test + "/final.exr " + ref + "/final.exr --mask " + ref + "/final.exr");
+  EXPECT_EQ(no_layer.code, 1);
+  EXPECT_NE(no_layer.err.find("emitter"), std::string::npos) << no_layer.err;
+  // --max-flip
+  EXPECT_EQ(run("diff " + test + "/final.exr " + ref + "/final.exr --max-flip " + std::to_string(flip * 0.5)).code, 1);
+  EXPECT_EQ(run("diff " + test + "/final.exr " + ref + "/final.exr --max-flip " + std::to_string(flip * 2)).code, 0);
+  EXPECT_EQ(run("diff " + ref + "/final.exr " + ref + "/final.exr --max-flip 0").code, 0);
 }

@@ -1,0 +1,76 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "image/flip.h"
+#include "image/metrics.h"
+#include "image/tonemap.h"
+
+using namespace pxf;
+
+namespace {
+Image gradient(int w, int h, float scale) {
+  Image im = Image::rgb(w, h);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < 3; ++c) im.at(x, y, c) = scale * (0.1f + 0.05f * x + 0.02f * y + 0.1f * c);
+  return im;
+}
+}  // namespace
+
+TEST(MaskedMetrics, MaskedPixelsAreLeftOut) {
+  Image ref = Image::rgb(2, 1, 1.0f), test = Image::rgb(2, 1, 1.0f);
+  for (int c = 0; c < 3; ++c) test.at(1, 0, c) = 5.0f;  // wrong only at the masked pixel
+  Image mask = Image::gray(2, 1, "emitter");
+  mask.at(1, 0, 0) = 0.25f;
+  EXPECT_GT(compare_images(test, ref).rmse, 1.0);
+  const ImageMetrics m = compare_images(test, ref, &mask);
+  EXPECT_EQ(m.samples, 3u);
+  EXPECT_EQ(m.rmse, 0.0);
+  EXPECT_THROW(compare_images(test, ref, &static_cast<const Image&>(Image::gray(3, 1))), Error);
+}
+
+// A reference without one finite sample cannot judge anything: an error, not NRMSE 0.
+TEST(MaskedMetrics, AllNonFiniteReferenceIsAnError) {
+  EXPECT_THROW(compare_images(Image::rgb(3, 2, 1.0f), Image::rgb(3, 2, NAN)), Error);
+  EXPECT_THROW(compare_images(Image::rgb(3, 2, 1.0f), Image::rgb(3, 2, INFINITY)), Error);
+  Image partly = Image::rgb(3, 2, 1.0f);
+  partly.at(0, 0, 0) = NAN;
+  EXPECT_EQ(compare_images(Image::rgb(3, 2, 1.0f), partly).reference_nonfinite, 1u);
+}
+
+// The display NRMSE is the NRMSE of both images through the product's tone map with the
+// reference's log-average luminance, so a test twice as bright shows its error on screen.
+TEST(DisplayMetrics, UsesTheReferencesToneMap) {
+  const Image ref = gradient(16, 8, 1.0f), brighter = gradient(16, 8, 2.0f);
+  TonemapParams p;
+  p.log_average = static_cast<float>(log_average_luminance(ref, p.delta));
+  const double expected = compare_images(tonemap_reinhard(brighter, p), tonemap_reinhard(ref, p)).nrmse_percent;
+  const DisplayMetrics m = compare_display(brighter, ref);
+  EXPECT_NEAR(m.display_nrmse_percent, expected, 1e-9);
+  EXPECT_GT(m.display_nrmse_percent, 5.0);  // tone-mapping each with its own average would hide it
+  EXPECT_EQ(m.hdr.nrmse_percent, compare_images(brighter, ref).nrmse_percent);
+  EXPECT_GT(m.flip_mean, 0.0);
+  const DisplayMetrics same = compare_display(ref, ref);
+  EXPECT_EQ(same.display_nrmse_percent, 0.0);
+  EXPECT_EQ(same.flip_mean, 0.0);
+}
+
+// The masked FLIP mean averages the FLIP map over the kept pixels only.
+TEST(DisplayMetrics, MaskAppliesToEveryMetric) {
+  const Image ref = gradient(24, 24, 1.0f);
+  Image test = ref;
+  for (int c = 0; c < 3; ++c) test.at(2, 2, c) = 50.0f;  // a "light" that differs
+  Image mask = Image::gray(24, 24, "emitter");
+  mask.at(2, 2, 0) = 1.0f;
+  const DisplayMetrics all = compare_display(test, ref), masked = compare_display(test, ref, &mask);
+  EXPECT_GT(all.hdr.nrmse_percent, 10 * masked.hdr.nrmse_percent);
+  EXPECT_EQ(masked.hdr.rmse, 0.0);
+  EXPECT_EQ(masked.display_nrmse_percent, 0.0);
+  const DisplayImages d = tonemap_like_reference(test, ref);
+  const Image flip = flip_error_map(d.test, d.reference);
+  double sum = 0;
+  for (size_t p = 0; p < flip.pixels.size(); ++p) sum += p == 2 * 24 + 2 ? 0.0 : flip.pixels[p];
+  EXPECT_NEAR(masked.flip_mean, sum / (flip.pixels.size() - 1), 1e-9);
+  EXPECT_LT(masked.flip_mean, all.flip_mean);
+}
