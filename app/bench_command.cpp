@@ -16,6 +16,8 @@
 #include "app/preview.h"
 #include "gl/context.h"
 #include "image/metrics.h"
+#include "gl/cpu_reference.h"
+#include "gl/filter_pass.h"
 #include "pathtracer/bench.h"
 
 namespace pxf {
@@ -61,11 +63,17 @@ struct BenchSetup {
 };
 
 // The reference: a high-spp plain path tracing (independent seed), cached in the output folder.
-Image obtain_reference(const BenchSetup& b, const std::string& given, int spp, const std::string& scene_name) {
-  if (!given.empty()) return read_exr(given);
+// `layer` "hv": its HV buffer alone (for the variant table; read from layer hv of a given file,
+// e.g. the buffers.exr of `pxf render --filter none`), else what plain path tracing shows.
+Image obtain_reference(const BenchSetup& b, const std::string& given, int spp, const std::string& scene_name,
+                       const std::string& layer = "") {
+  if (!given.empty()) return read_exr(given, layer);
   const std::string base = std::filesystem::path(scene_name).stem().string();
-  const std::string cache = b.out + "/reference_" + base + "_" + std::to_string(b.width) + "x" +
-                            std::to_string(b.height) + "_" + std::to_string(spp) + "spp.exr";
+  const auto cache_name = [&](const std::string& prefix) {
+    return b.out + "/" + prefix + base + "_" + std::to_string(b.width) + "x" + std::to_string(b.height) + "_" +
+           std::to_string(spp) + "spp.exr";
+  };
+  const std::string cache = cache_name(layer == "hv" ? "reference_hv_" : "reference_");
   if (std::filesystem::exists(cache)) {
     std::printf("reference: %s (cached)\n", cache.c_str());
     return read_exr(cache);
@@ -79,10 +87,10 @@ Image obtain_reference(const BenchSetup& b, const std::string& given, int spp, c
     if ((i + 1) % 256 == 0 || i + 1 == spp)
       std::fprintf(stderr, "reference: %d/%d spp, %.0f s\n", i + 1, spp, elapsed_ms(start) / 1000);
   }
-  Image reference = renderer.unfiltered_image();
-  write_exr(cache, reference);
+  write_exr(cache_name("reference_"), renderer.unfiltered_image());  // both cached: one render serves both
+  write_exr(cache_name("reference_hv_"), renderer.hv_image());
   std::printf("reference: wrote %s (%d spp, %.1f s)\n", cache.c_str(), spp, elapsed_ms(start) / 1000);
-  return reference;
+  return read_exr(cache);
 }
 
 struct FilteredRun {
@@ -187,17 +195,18 @@ double spp_to_match(const PlainRun& run, double target) {
   return 0;
 }
 
-std::vector<int> parse_budgets(const std::string& text) {
-  std::vector<int> budgets;
+// A comma-separated list of counts in [1, 65536] (empty: none).
+std::vector<int> parse_counts(const std::string& option, const std::string& text) {
+  std::vector<int> counts;
   std::stringstream in(text);
   std::string item;
   while (std::getline(in, item, ',')) {
     char* end = nullptr;
     const long v = std::strtol(item.c_str(), &end, 10);
-    if (item.empty() || *end || v < 1 || v > 1 << 16) throw UsageError("--budgets: '" + item + "' is not a frame count");
-    budgets.push_back(static_cast<int>(v));
+    if (item.empty() || *end || v < 1 || v > 1 << 16) throw UsageError(option + ": '" + item + "' is not a count");
+    counts.push_back(static_cast<int>(v));
   }
-  return budgets;
+  return counts;
 }
 
 int run_pathtracer_bench(const BenchSetup& b, int timed) {
@@ -217,12 +226,94 @@ int run_pathtracer_bench(const BenchSetup& b, int timed) {
   return 0;
 }
 
+// The variant table (the thesis' Fig. 3.8): every filter variant applied to the same 4-spp HV
+// buffer with the same converged range buffer: ms per application (median of `rounds` after one
+// warm-up, the variants alternating so background load hits them alike), that in path-tracing
+// frames (median of one frame per round, traced in the same run), and HV-only NRMSE against the
+// reference's HV. Writes variants.csv, variants.svg and variant_<name>.png (the filtered HV,
+// tone-mapped with the reference HV's log-average so they compare at one exposure).
+// `extra_taps`: additional rows "subsampled-N" with N taps (to choose kSubsampledTaps).
+int run_variant_bench(const BenchSetup& b, const Image& reference_hv, int spp, int rounds,
+                      const std::vector<int>& extra_taps) {
+  Preview preview(b.scene, b.filtered, b.width, b.height);
+  if (reference_hv.width != b.width || reference_hv.height != b.height) throw Error("reference size differs from --size");
+  double upload_ms = 0;  // of the inputs, before each filter run: the same for every variant
+  for (int i = 0; i < spp; ++i) {
+    preview.add_frame(i + 1 == spp, false);  // the last frame filters: uploads, converges the range buffer
+    if (preview.last_times().upload > 0) upload_ms = preview.last_times().upload;
+  }
+  const Image hv = preview.inputs().hv_image();
+  ProgressiveRenderer timing_tracer(b.scene, b.plain.trace, b.width, b.height);
+  std::vector<std::string> names = filter_kind_names();
+  std::vector<FilterParams> params;
+  for (const std::string& name : names) {
+    params.push_back(b.filtered.filter);
+    params.back().kind = parse_filter_kind(name);
+  }
+  for (int taps : extra_taps) {
+    names.push_back("subsampled-" + std::to_string(taps));
+    params.push_back(b.filtered.filter);
+    params.back().kind = FilterKind::Subsampled;
+    params.back().subsampled_taps = taps;
+  }
+  for (FilterParams& p : params) p.t = b.filtered.threshold;
+  FilterPass filter(b.width, b.height);
+  std::vector<std::vector<double>> ms(names.size());
+  std::vector<double> pt_ms;
+  std::vector<Image> filtered(names.size());
+  std::vector<uint32_t> filtered_pixels(names.size());
+  for (int round = -1; round < rounds; ++round) {
+    const auto start = Clock::now();
+    timing_tracer.add_frame();
+    pt_ms.push_back(elapsed_ms(start));
+    for (size_t k = 0; k < names.size(); ++k) {
+      filter.run(preview.inputs(), preview.range().guide(), params[k]);
+      if (round >= 0) ms[k].push_back(filter.last_ms());
+      if (round == 0) filtered[k] = filter.filtered_image(), filtered_pixels[k] = filter.filtered_pixels();
+    }
+  }
+  const double frame_ms = median_of(pt_ms);
+  TonemapParams tonemap;
+  tonemap.log_average = static_cast<float>(cpu_log_average(reference_hv, tonemap.delta));
+  write_png(b.out + "/variant_reference_hv.png", cpu_tonemap(reference_hv, tonemap));
+  write_png(b.out + "/variant_unfiltered_hv.png", cpu_tonemap(hv, tonemap));
+  const double unfiltered_nrmse = compare_images(hv, reference_hv).nrmse_percent;
+  std::printf("\nvariants at %d spp (HV only, against the reference's HV; path-tracing frame %.1f ms, median of %zu;"
+              " upload %.1f ms, the same for all):\n",
+              spp, frame_ms, pt_ms.size(), upload_ms);
+  std::printf("   %-16s %9s %9s %10s %10s %9s\n", "variant", "filter ms", "+upload", "PT frames", "NRMSE %", "filtered");
+  std::printf("   %-16s %9s %9s %10s %10.2f\n", "unfiltered", "-", "-", "-", unfiltered_nrmse);
+  std::ostringstream csv;
+  csv << "variant,filter_ms,upload_ms,application_ms,pt_frame_ms,pt_frames,hv_nrmse_percent,filtered_pixels\n";
+  csv << "unfiltered,0,0,0," << frame_ms << ",0," << unfiltered_nrmse << ",0\n";
+  std::vector<PlotSeries> points;
+  for (size_t k = 0; k < names.size(); ++k) {
+    const double filter_ms = median_of(ms[k]), application_ms = filter_ms + upload_ms;
+    const double nrmse = compare_images(filtered[k], reference_hv).nrmse_percent;
+    std::printf("   %-16s %9.1f %9.1f %10.2f %10.2f %9u\n", names[k].c_str(), filter_ms, application_ms,
+                application_ms / frame_ms, nrmse, filtered_pixels[k]);
+    csv << names[k] << "," << filter_ms << "," << upload_ms << "," << application_ms << "," << frame_ms << ","
+        << application_ms / frame_ms << "," << nrmse << "," << filtered_pixels[k] << "\n";
+    points.push_back({names[k], {application_ms / frame_ms}, {nrmse}, true});
+    write_png(b.out + "/variant_" + names[k] + ".png", cpu_tonemap(filtered[k], tonemap));
+  }
+  write_text(b.out + "/variants.csv", csv.str());
+  write_svg_plot(b.out + "/variants.svg",
+                 {"Filter variants at " + std::to_string(spp) + " spp: HV-only NRMSE vs cost", "PT frames per application",
+                  "HV NRMSE (%)", true, false},
+                 points);
+  std::printf("\nwrote %s/variants.csv, variants.svg, variant_<name>.png\n", b.out.c_str());
+  return 0;
+}
+
 }  // namespace
 
 int run_bench(const Args& args) {
   SceneOptions scene_options;
   PreviewOptions preview_options;
-  bool pathtracer = false;
+  bool pathtracer = false, variants = false;
+  int variant_spp = 4, variant_rounds = 5;
+  std::string extra_taps_text;
   std::string reference_path, out = "bench-out", budgets_text = "4,16,64";
   int reference_spp = 4096, frames = 32, max_spp = 1024, timed = 20;
   CommandLine cli("bench", "[options]",
@@ -234,10 +325,17 @@ int run_bench(const Args& args) {
                   "     reference's key and log-average), with the mean LDR-FLIP of the display images;\n"
                   "  4. the spp at which unfiltered path tracing reaches the NRMSE of the filtered image at --frames.\n"
                   "The reference (--reference-spp plain path tracing) is cached in --out. Writes CSV and SVG plots.\n"
-                  "--pathtracer instead measures paths/s, rays/s and the raw Embree incoherent-ray rate.");
+                  "--pathtracer instead measures paths/s, rays/s and the raw Embree incoherent-ray rate.\n"
+                  "--variants instead tabulates every filter variant on one --variant-spp HV buffer: ms per\n"
+                  "application, path-tracing frames, HV-only NRMSE against the reference's HV (layer hv of\n"
+                  "--reference, e.g. buffers.exr of `pxf render --filter none`; default: rendered and cached).");
   add_scene_options(cli, scene_options, /*headless=*/true);
   add_preview_options(cli, preview_options);
   cli.flag("--pathtracer", &pathtracer, "path tracer throughput only");
+  cli.flag("--variants", &variants, "the filter variant table (time vs HV-only NRMSE)");
+  cli.option("--variant-spp", &variant_spp, "spp of the --variants HV buffer (default 4)", 1, 1 << 16);
+  cli.option("--variant-rounds", &variant_rounds, "timed rounds of --variants (default 5, after a warm-up)", 1, 1000);
+  cli.option("--subsampled-taps", &extra_taps_text, "LIST", "--variants: also the subsampled variant with these tap counts");
   cli.option("--timed-frames", &timed, "timed frames of --pathtracer (after 3 warm-up frames)", 1, 100000);
   cli.option("--reference", &reference_path, "REF.exr", "reference image (default: render and cache one)");
   cli.option("--reference-spp", &reference_spp, "samples of the rendered reference (default 4096)", 1, 1 << 20);
@@ -247,7 +345,8 @@ int run_bench(const Args& args) {
   cli.option("--out", &out, "DIR", "folder for CSV, plots and the cached reference (default bench-out)");
   if (!cli.parse(args)) return 0;
   if (print_scene_list_if_asked(scene_options)) return 0;
-  const std::vector<int> budgets = parse_budgets(budgets_text);
+  const std::vector<int> budgets = parse_counts("--budgets", budgets_text);
+  const std::vector<int> extra_taps = parse_counts("--subsampled-taps", extra_taps_text);
 
   BenchSetup b;
   b.scene = load_scene_for(scene_options, preview_options, cli);
@@ -266,6 +365,9 @@ int run_bench(const Args& args) {
               scene_options.scene.c_str(), b.width, b.height, b.filtered.threshold,
               filter_option_name(b.filtered).c_str(), b.filtered.filter.sigma_s, b.filtered.filter.sigma_c,
               b.filtered.filter.sigma_d, context->backend_name(), context->gl_renderer().c_str());
+  if (variants)
+    return run_variant_bench(b, obtain_reference(b, reference_path, reference_spp, scene_options.scene, "hv"),
+                             variant_spp, variant_rounds, extra_taps);
   const Image reference = obtain_reference(b, reference_path, reference_spp, scene_options.scene);
   if (reference.width != b.width || reference.height != b.height) throw Error("reference size differs from --size");
 

@@ -2,12 +2,17 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
+#include <map>
+#include <mutex>
+#include <utility>
 
 namespace pxf {
 
 const std::vector<std::string>& filter_kind_names() {
-  static const std::vector<std::string> names = {"bilateral-depth", "bilateral", "separable", "atrous"};
+  static const std::vector<std::string> names = {"bilateral-depth", "bilateral", "separable", "atrous",
+                                                         "subsampled"};
   return names;
 }
 const char* filter_kind_name(FilterKind kind) { return filter_kind_names()[static_cast<int>(kind)].c_str(); }
@@ -72,6 +77,115 @@ float atrous_variance_correction(int pass) {
     return out;
   }();
   return factors[std::clamp<size_t>(static_cast<size_t>(std::max(pass, 0)), 0, factors.size() - 1)];
+}
+
+// ---- The subsampled variant's taps ----
+
+namespace {
+
+// A small deterministic generator (the table must not depend on the standard library's
+// distributions, which differ between implementations): splitmix64, uniform in [0, 1).
+struct TapRng {
+  uint64_t state;
+  double uniform() {
+    uint64_t z = (state += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return double((z ^ (z >> 31)) >> 11) * 0x1.0p-53;
+  }
+};
+
+struct Point {
+  double x, y;
+};
+
+// `count` points of unit-sigma Gaussian density truncated at radius 3, the first at the origin,
+// spread as a Poisson disk whose spacing follows the density: two points a, b are at least
+// alpha (r(a) + r(b)) / 2 apart, r(p) = 1 / sqrt(count g(p)) the mean spacing where count points
+// have density g. Dart throwing; alpha shrinks when darts keep failing, so it always finishes.
+std::vector<Point> poisson_gaussian_pattern(int count) {
+  const double kPi = 3.14159265358979323846;
+  auto spacing = [count, kPi](const Point& p) {
+    const double g = std::exp(-0.5 * (p.x * p.x + p.y * p.y)) / (2 * kPi);
+    return 1.0 / std::sqrt(count * g);
+  };
+  std::vector<Point> points = {{0.0, 0.0}};
+  TapRng rng{0x5eed5eedull + static_cast<uint64_t>(count)};
+  double alpha = 0.9;
+  int failures = 0;
+  while (static_cast<int>(points.size()) < count) {
+    // Box-Muller, truncated at 3 sigma like the exact kernel's radius.
+    const double radius = std::sqrt(-2.0 * std::log(1.0 - rng.uniform())), angle = 2 * kPi * rng.uniform();
+    if (radius > 3.0) continue;
+    const Point c{radius * std::cos(angle), radius * std::sin(angle)};
+    const double rc = spacing(c);
+    bool ok = true;
+    for (const Point& a : points) {
+      const double min_d = alpha * 0.5 * (rc + spacing(a));
+      if ((a.x - c.x) * (a.x - c.x) + (a.y - c.y) * (a.y - c.y) < min_d * min_d) {
+        ok = false;
+        break;
+      }
+    }
+    if (ok) {
+      points.push_back(c);
+      failures = 0;
+    } else if (++failures > 2000) {
+      alpha *= 0.95;
+      failures = 0;
+    }
+  }
+  return points;
+}
+
+const std::vector<Point>& cached_pattern(int count) {
+  static std::mutex mutex;
+  static std::map<int, std::vector<Point>> patterns;
+  std::lock_guard<std::mutex> lock(mutex);
+  auto it = patterns.find(count);
+  if (it == patterns.end()) it = patterns.emplace(count, poisson_gaussian_pattern(count)).first;
+  return it->second;
+}
+
+}  // namespace
+
+// The unit pattern scaled by sigma_s, rotated by 2 pi r / kSubsampledRotations for each r, rounded
+// to whole pixels; taps that round to the same pixel are merged (their count is the weight factor,
+// so Var[L_f] = sum w^2 Var stays exact). sigma_s 0 or invalid: the centre alone.
+SubsampledTapTable subsampled_tap_table(float sigma_s, int taps) {
+  taps = std::clamp(taps, 1, 1024);
+  const double sigma = std::isfinite(sigma_s) && sigma_s > 0 ? std::min<double>(sigma_s, kMaxFilterRadius / 3.0) : 0.0;
+  const std::vector<Point>& pattern = cached_pattern(taps);
+  std::vector<std::vector<SubsampledTap>> rotations(kSubsampledRotations);
+  SubsampledTapTable table;
+  for (int r = 0; r < kSubsampledRotations; ++r) {
+    const double angle = 2 * 3.14159265358979323846 * r / kSubsampledRotations;
+    const double c = std::cos(angle), s = std::sin(angle);
+    std::map<std::pair<int, int>, int> counts;
+    for (const Point& p : pattern) {
+      const int dx = static_cast<int>(std::lround(sigma * (c * p.x - s * p.y)));
+      const int dy = static_cast<int>(std::lround(sigma * (s * p.x + c * p.y)));
+      ++counts[{std::clamp(dx, -kMaxFilterRadius, kMaxFilterRadius), std::clamp(dy, -kMaxFilterRadius, kMaxFilterRadius)}];
+    }
+    for (const auto& [offset, n] : counts) rotations[r].push_back({offset.first, offset.second, n, 0});
+    table.per_rotation = std::max(table.per_rotation, static_cast<int>(rotations[r].size()));
+  }
+  for (auto& list : rotations) {
+    list.resize(table.per_rotation);  // padded with count 0
+    table.taps.insert(table.taps.end(), list.begin(), list.end());
+  }
+  return table;
+}
+
+// An integer hash of the pixel (the "lowbias32" finalizer), the same in shaders/subsampled.frag.
+int subsampled_rotation(int x, int y) {
+  uint32_t h = static_cast<uint32_t>(x) * 0x8da6b343u ^ static_cast<uint32_t>(y) * 0xd8163841u;
+  h ^= h >> 16;
+  h *= 0x7feb352du;
+  h ^= h >> 15;
+  h *= 0x846ca68bu;
+  h ^= h >> 16;
+  return static_cast<int>(h % kSubsampledRotations);
 }
 
 namespace {
@@ -261,11 +375,39 @@ FilterOutput cpu_atrous(const Image& hv, const Image& var_u, const Image& lv, co
   return level;
 }
 
+// ---- Subsampled (FilterKind::Subsampled) ----
+
+// The bilateral-depth kernel at the pixel's rotation of the tap table only: each tap weighted by
+// its count x the range weights (the spatial weight is in the tap density), taps outside the image
+// left out. Mirrors shaders/subsampled.frag.
+FilterOutput cpu_subsampled(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
+                            const Image& depth, const FilterParams& p) {
+  const int w = hv.width, h = hv.height;
+  FilterOutput out{Image::rgb(w, h), Image::gray(w, h)};
+  const RangeWeights range = range_weights(p);
+  const SubsampledTapTable table = subsampled_tap_table(p.sigma_s, p.subsampled_taps > 0 ? p.subsampled_taps : kSubsampledTaps);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      if (p.skip_case2 && skip_as_case2(hv, var_u, lv, range_color, depth, p, x, y, out)) continue;
+      KernelSums sums;
+      const SubsampledTap* taps = &table.taps[static_cast<size_t>(subsampled_rotation(x, y)) * table.per_rotation];
+      for (int i = 0; i < table.per_rotation && taps[i].count > 0; ++i) {
+        const int qx = x + taps[i].dx, qy = y + taps[i].dy;
+        if (qx < 0 || qx >= w || qy < 0 || qy >= h) continue;
+        const double weight = taps[i].count * std::exp(-range_exponent(range_color, depth, x, y, qx, qy, range));
+        sums.add(weight, rgb_at(hv, qx, qy), clean_var(var_u.at(qx, qy, 0)));
+      }
+      sums.write(out, x, y);  // sum w >= 1: the centre tap is in every rotation
+    }
+  return out;
+}
+
 }  // namespace
 
 FilterOutput cpu_filter(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
                         const Image& depth, const FilterParams& p) {
   if (p.kind == FilterKind::Atrous) return cpu_atrous(hv, var_u, lv, range_color, depth, p);
+  if (p.kind == FilterKind::Subsampled) return cpu_subsampled(hv, var_u, lv, range_color, depth, p);
   if (p.kind != FilterKind::Separable) return filter_once(hv, var_u, hv, var_u, lv, range_color, depth, p, 1, 1, true);
   FilterOutput rows = filter_once(hv, var_u, hv, var_u, lv, range_color, depth, p, 1, 0, false);
   return filter_once(rows.filtered, rows.variance, hv, var_u, lv, range_color, depth, p, 0, 1, true);

@@ -25,6 +25,8 @@ void FilterPass::run(const PreviewInputs& inputs, const Texture2D& guide, const 
   guide.bind(2);
   if (p.kind == FilterKind::Atrous)
     run_atrous(inputs, p);
+  else if (p.kind == FilterKind::Subsampled)
+    run_subsampled(p);
   else
     run_bilateral(inputs, p);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
@@ -82,6 +84,25 @@ void FilterPass::run_atrous(const PreviewInputs& inputs, const FilterParams& p) 
     quad_.draw(last ? fbo_ : scratch_target(i % 2), width_, height_);
     if (!last) scratch_[i % 2].bind(3);
   }
+}
+
+// One pass over the tap table of (sigma_s, taps), uploaded again only when those change.
+void FilterPass::run_subsampled(const FilterParams& p) {
+  if (!subsampled_program_.id()) subsampled_program_ = Program::from_embedded("fullscreen.vert", "subsampled.frag");
+  const int taps = p.subsampled_taps > 0 ? p.subsampled_taps : kSubsampledTaps;
+  const SubsampledTapTable table = subsampled_tap_table(p.sigma_s, taps);
+  if (subsampled_key_ != std::make_pair(p.sigma_s, taps) || !subsampled_taps_.id()) {
+    const size_t bytes = table.taps.size() * sizeof(SubsampledTap);
+    if (!subsampled_taps_.id()) subsampled_taps_ = Buffer(bytes);
+    subsampled_taps_.upload(table.taps.data(), bytes);
+    subsampled_key_ = {p.sigma_s, taps};
+  }
+  subsampled_taps_.bind_storage(1);
+  set_range_and_skip(subsampled_program_, p);
+  subsampled_program_.set("taps_per_rotation", table.per_rotation);
+  subsampled_program_.set("rotations", kSubsampledRotations);
+  subsampled_program_.use();
+  quad_.draw(fbo_, width_, height_);
 }
 
 const Framebuffer& FilterPass::scratch_target(int index) {

@@ -1,5 +1,5 @@
-// Cross bilateral filter pass (SPEC 3.3; FilterKind picks the variant: shaders/bilateral.frag, or
-// shaders/atrous.frag for the à-trous one): L_f and Var[L_f] from the HV buffer, guided by the
+// Cross bilateral filter pass (SPEC 3.3; FilterKind picks the variant: shaders/bilateral.frag,
+// shaders/atrous.frag for the à-trous one, shaders/subsampled.frag for the subsampled one): L_f and Var[L_f] from the HV buffer, guided by the
 // range buffer (color + distance). Runs on a schedule; the output texture persists between runs.
 // Usage:
 //   FilterPass filter(w, h);
@@ -9,6 +9,7 @@
 // Pixels in case 2 (u <= t with the unfiltered background) are skipped: L_f = L_u there and
 // Var[L_f] = kVarSkipped, the blend then uses s = 1 (see FilterParams::skip_case2).
 #pragma once
+#include <utility>
 #include "gl/inputs.h"
 #include "gl/preview_params.h"
 #include "gl/resources.h"
@@ -35,11 +36,15 @@ class FilterPass {
  private:
   void run_bilateral(const PreviewInputs& inputs, const FilterParams& params);
   void run_atrous(const PreviewInputs& inputs, const FilterParams& params);
+  void run_subsampled(const FilterParams& params);
   const Framebuffer& scratch_target(int index);  // allocates scratch_[index] on first use
 
   int width_, height_;
   Program program_;
   Program atrous_program_;  // compiled on first use
+  Program subsampled_program_;  // compiled on first use
+  Buffer subsampled_taps_;      // subsampled_tap_table() of the last run's sigma_s and tap count
+  std::pair<float, int> subsampled_key_{-1.0f, 0};
   Texture2D output_;
   Framebuffer fbo_;
   Buffer counter_;

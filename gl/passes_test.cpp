@@ -119,7 +119,12 @@ INSTANTIATE_TEST_SUITE_P(Variants, FilterVsCpu,
                                            std::make_tuple(FilterKind::Atrous, true, 8.0f),
                                            std::make_tuple(FilterKind::Atrous, true, 2.5f),
                                            std::make_tuple(FilterKind::Atrous, false, 0.0f),
-                                           std::make_tuple(FilterKind::Atrous, false, 21.0f)));
+                                           std::make_tuple(FilterKind::Atrous, false, 21.0f),
+                                           std::make_tuple(FilterKind::Subsampled, false, 8.0f),
+                                           std::make_tuple(FilterKind::Subsampled, true, 8.0f),
+                                           std::make_tuple(FilterKind::Subsampled, true, 2.5f),
+                                           std::make_tuple(FilterKind::Subsampled, false, 0.0f),
+                                           std::make_tuple(FilterKind::Subsampled, false, 21.0f)));
 
 TEST(FilterKinds, ConstantHvStaysConstant) {
   // The weights are normalized, so a constant signal comes out unchanged whatever the range edges.
@@ -274,6 +279,130 @@ TEST(Atrous, WhiteNoiseVarianceShrinksBySumOfSquaredWeights) {
       EXPECT_GT(expected / uncorrected, 20.0) << "the correction matters";
     }
   }
+}
+
+TEST(Subsampled, TapTableFollowsTheSpatialGaussian) {
+  // Every rotation holds kSubsampledTaps taps in all (counts), the centre among them, within the
+  // exact kernel's radius 3 sigma_s; their mean squared distance is that of the Gaussian truncated
+  // at 3 sigma_s, 2 sigma_s^2 (1 - 4.5 e^-4.5 / (1 - e^-4.5)) = 1.90 sigma_s^2, apart from the
+  // centre; and the rotations differ.
+  const float sigma = 8.0f;
+  const SubsampledTapTable table = subsampled_tap_table(sigma, kSubsampledTaps);
+  ASSERT_EQ(table.taps.size(), size_t(table.per_rotation) * kSubsampledRotations);
+  double r2_sum = 0;
+  int r2_count = 0, differing = 0;
+  for (int r = 0; r < kSubsampledRotations; ++r) {
+    int total = 0, centre = 0;
+    for (int i = 0; i < table.per_rotation; ++i) {
+      const SubsampledTap& tap = table.taps[size_t(r) * table.per_rotation + i];
+      total += tap.count;
+      if (tap.count == 0) continue;
+      EXPECT_LE(tap.dx * tap.dx + tap.dy * tap.dy, std::pow(3 * sigma + 1, 2));
+      if (tap.dx == 0 && tap.dy == 0) {
+        centre = tap.count;
+        continue;
+      }
+      r2_sum += tap.count * double(tap.dx * tap.dx + tap.dy * tap.dy);
+      r2_count += tap.count;
+      if (r > 0 && (tap.dx != table.taps[i].dx || tap.dy != table.taps[i].dy)) ++differing;
+    }
+    EXPECT_EQ(total, kSubsampledTaps) << r;
+    EXPECT_GE(centre, 1) << r;
+  }
+  EXPECT_NEAR(r2_sum / r2_count / (sigma * sigma), 1.90, 0.3);
+  EXPECT_GT(differing, 0);
+  // No spatial extent: the centre alone, every tap merged into it.
+  const SubsampledTapTable none = subsampled_tap_table(0.0f, kSubsampledTaps);
+  EXPECT_EQ(none.per_rotation, 1);
+  EXPECT_EQ(none.taps[0].count, kSubsampledTaps);
+  EXPECT_EQ(subsampled_tap_table(kNaN, 5).taps[0].count, 5);
+}
+
+TEST(Subsampled, RotationsCoverTheTableEvenly) {
+  std::vector<int> hits(kSubsampledRotations, 0);
+  for (int y = 0; y < 256; ++y)
+    for (int x = 0; x < 256; ++x) ++hits[subsampled_rotation(x, y)];
+  const double expected = 256.0 * 256.0 / kSubsampledRotations;
+  for (int h : hits) EXPECT_NEAR(h, expected, 5 * std::sqrt(expected));
+}
+
+TEST(Subsampled, WhiteNoiseVarianceIsExactForTheWeightsUsed) {
+  // On a flat guide each pixel's output is a fixed linear combination of its taps (count-weighted),
+  // so white noise of variance v comes out with variance v sum c^2 / (sum c)^2 per pixel, which is
+  // the propagated Var[L_f] if duplicates are merged (a tap counted twice contributes 4 v, not 2 v).
+  // Checked as the mean of (L_f - 1)^2 / Var[L_f] over pixels and realizations, which must be 1.
+  test::osmesa_context();
+  constexpr int N = 96;
+  constexpr float kNoiseVar = 1.0f / 3.0f;  // uniform in [0, 2]
+  Image lv = Image::rgb(N, N), var = Image::gray(N, N, "Y", kNoiseVar), guide = Image::rgba(N, N, 0.5f);
+  PreviewInputs inputs(N, N);
+  Texture2D guide_tex(N, N, TextureFormat::RGBA32F);
+  guide_tex.upload(guide);
+  FilterPass filter(N, N);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> noise(0.0f, 2.0f);
+  for (float sigma_s : {1.5f, 8.0f}) {
+    FilterParams p;
+    p.kind = FilterKind::Subsampled;
+    p.sigma_s = sigma_s;
+    p.skip_case2 = false;
+    double ratio_sum = 0, independent_sum = 0;
+    size_t count = 0;
+    for (int realization = 0; realization < 12; ++realization) {
+      Image hv = Image::rgb(N, N);
+      for (float& v : hv.pixels) v = noise(rng);
+      inputs.upload(lv, hv, var);
+      filter.run(inputs, guide_tex, p);
+      const Image f = filter.filtered_image(), vf = filter.raw_variance_image();
+      const SubsampledTapTable table = subsampled_tap_table(sigma_s, kSubsampledTaps);
+      for (int y = 0; y < N; ++y)
+        for (int x = 0; x < N; ++x, ++count) {
+          ASSERT_GT(vf.at(x, y, 0), 0.0f);
+          const double e2 = (f.at(x, y, 0) - 1.0) * (f.at(x, y, 0) - 1.0);
+          ratio_sum += e2 / vf.at(x, y, 0);
+          // What unmerged duplicates would claim: v sum over taps of 1 / (sum taps)^2 = v / n_in.
+          double n_in = 0;
+          const SubsampledTap* taps = &table.taps[size_t(subsampled_rotation(x, y)) * table.per_rotation];
+          for (int i = 0; i < table.per_rotation; ++i) {
+            const int qx = x + taps[i].dx, qy = y + taps[i].dy;
+            if (qx >= 0 && qx < N && qy >= 0 && qy < N) n_in += taps[i].count;
+          }
+          independent_sum += e2 / (kNoiseVar / n_in);
+        }
+    }
+    const double ratio = ratio_sum / count, independent = independent_sum / count;
+    std::printf("sigma_s %g: measured / propagated Var[L_f] = %.3f; / (v / taps) = %.3f\n", sigma_s, ratio, independent);
+    EXPECT_NEAR(ratio, 1.0, 0.05) << sigma_s;
+    if (sigma_s < 2.0f) {
+      EXPECT_GT(independent, 1.3) << "duplicates merged matter at small sigma_s";
+    }
+  }
+}
+
+TEST(Subsampled, EdgesArePreserved) {
+  // A step in range color, and one in depth, with constant HV on each side: no mixing across.
+  test::osmesa_context();
+  Scenario s = make_scenario(3);
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      bool left = x < W / 2, top = y < H / 2;
+      for (int c = 0; c < 3; ++c) {
+        s.range.at(x, y, c) = left ? 0.8f : 0.1f;
+        s.hv.at(x, y, c) = (left ? 1.0f : 3.0f) * (top ? 1.0f : 2.0f);
+      }
+      s.depth.at(x, y, 0) = top ? 3.0f : 30.0f;
+      s.var.at(x, y, 0) = 0.5f;
+    }
+  GpuFixture gpu(s);
+  FilterPass filter(W, H);
+  FilterParams p;
+  p.kind = FilterKind::Subsampled;
+  p.skip_case2 = false;
+  filter.run(gpu.inputs, gpu.guide, p);
+  Image f = filter.filtered_image();
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x)
+      EXPECT_NEAR(f.at(x, y, 0), (x < W / 2 ? 1.0f : 3.0f) * (y < H / 2 ? 1.0f : 2.0f), 1e-5f);
 }
 
 TEST(FilterVsCpu, EdgesArePreserved) {

@@ -16,9 +16,12 @@ namespace pxf {
 // is the edge-avoiding à-trous wavelet (Dammertz et al. 2010): atrous_iterations(sigma_s) passes of
 // a 5x5 B3-spline kernel with hole spacing 2^i, each tap weighted by the same color x depth range
 // weights (25 taps per pass; its Var[L_f] treats each pass's inputs as independent, see
-// gl/cpu_reference.cpp).
-enum class FilterKind { BilateralDepth, Bilateral, Separable, Atrous };
-// "bilateral-depth", "bilateral", "separable", "atrous"
+// gl/cpu_reference.cpp); "subsampled" is the bilateral-depth kernel evaluated at subsampled_taps()
+// only: Poisson-disk offsets drawn from the spatial Gaussian (the tap density carries the spatial
+// weight), rotated per pixel (Banterle et al. 2012), each weighted by the color x depth range
+// weights; its Var[L_f] is exact for the weights it uses.
+enum class FilterKind { BilateralDepth, Bilateral, Separable, Atrous, Subsampled };
+// "bilateral-depth", "bilateral", "separable", "atrous", "subsampled"
 const std::vector<std::string>& filter_kind_names();
 const char* filter_kind_name(FilterKind kind);
 FilterKind parse_filter_kind(const std::string& name);  // throws pxf::Error listing the names
@@ -33,8 +36,29 @@ struct FilterParams {
   // pixel gets L_f = L_u and Var[L_f] = kVarSkipped, and the blend uses s = 1 there.
   bool skip_case2 = true;
   float t = 0.01f;  // the blend threshold (only used for skipping)
+  int subsampled_taps = 0;  // taps of the subsampled variant, the centre included; 0 = kSubsampledTaps
 };
 constexpr int kMaxFilterRadius = 64;
+
+// The subsampled variant's taps per pixel, the centre included: chosen by measurement of time
+// against HV-only NRMSE at 4 spp (docs/filter-subsampled.md).
+constexpr int kSubsampledTaps = 32;
+// Rotations of the tap pattern; each pixel uses rotation subsampled_rotation(x, y).
+constexpr int kSubsampledRotations = 64;
+// One entry of the tap table: the pixel offset and how many of the pattern's taps rounded to it
+// (its weight factor); count 0 pads a rotation's list to the common length.
+struct SubsampledTap {
+  int dx = 0, dy = 0, count = 0, unused = 0;  // 16 bytes: an ivec4 in the shader's std430 buffer
+};
+// The table of all rotations: rotation r's taps are taps[r * per_rotation, (r + 1) * per_rotation).
+// The one definition used by the GL pass (uploaded as a buffer) and the CPU reference.
+struct SubsampledTapTable {
+  int per_rotation = 0;
+  std::vector<SubsampledTap> taps;
+};
+SubsampledTapTable subsampled_tap_table(float sigma_s, int taps);
+// The pattern rotation of pixel (x, y): an integer hash, identical in shaders/subsampled.frag.
+int subsampled_rotation(int x, int y);
 
 // 1 / (2 sigma^2), sigma clamped away from 0.
 constexpr float inv_two_sigma2(float sigma) {

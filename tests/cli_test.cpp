@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
+#include "gl/preview_params.h"
 #include "image/image.h"
 
 namespace fs = std::filesystem;
@@ -63,6 +64,7 @@ void write_half_rgba(const std::string& path, const std::vector<float>& rgb, int
 TEST(Cli, UsageErrorsExitWithCode2AndOneLine) {
   for (const char* args : {"", "bogus", "render --nope", "render --spp 0", "render --spp", "render --size 3",
                            "render --threshold -1", "render --filter gauss", "render --gl window", "bench --budgets 4,x",
+                           "bench --variants --subsampled-taps 0",
                            "diff only-one.exr", "explore --sigma-s abc"}) {
     const Result r = run(args);
     EXPECT_EQ(r.code, 2) << args;
@@ -124,6 +126,24 @@ TEST(Cli, RenderWritesEveryOutput) {
   const auto stats2 = nlohmann::json::parse(slurp(out + "/stats.json"));
   EXPECT_GT(stats2["final_vs_reference"]["nrmse_percent"].get<double>(), 0.0);
   EXPECT_GT(stats2["unfiltered_vs_reference"]["nrmse_percent"].get<double>(), 0.0);
+}
+
+TEST(Cli, BenchVariantsTabulatesEveryFilterVariant) {
+  // The reference's HV from the buffers.exr of an unfiltered render; a row and an image per variant.
+  const std::string ref = temp_dir("variants_reference"), out = temp_dir("variants");
+  ASSERT_EQ(run("render --size 24x16 --spp 32 --filter none --seed 9 --quiet --out " + ref).code, 0);
+  const Result r = run("bench --variants --size 24x16 --variant-rounds 1 --subsampled-taps 8 --reference " + ref +
+                       "/buffers.exr --out " + out);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string csv = slurp(out + "/variants.csv");
+  std::vector<std::string> rows = filter_kind_names();
+  rows.push_back("subsampled-8");
+  for (const std::string& name : rows) {
+    EXPECT_NE(csv.find("\n" + name + ","), std::string::npos) << name;
+    EXPECT_TRUE(fs::exists(out + "/variant_" + name + ".png")) << name;
+  }
+  EXPECT_EQ(lines(csv), rows.size() + 2);  // the header and the unfiltered row
+  EXPECT_TRUE(fs::exists(out + "/variants.svg"));
 }
 
 TEST(Cli, NoFilterAndNoRangePassWhenTheHvBufferIsEmpty) {

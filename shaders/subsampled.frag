@@ -1,0 +1,71 @@
+#version 450 core
+// Spatially subsampled cross bilateral filter (FilterKind::Subsampled; Banterle et al. 2012): the
+// bilateral-depth kernel evaluated at a few taps only, Poisson-disk offsets drawn from the spatial
+// Gaussian (so the spatial weight is carried by the tap density) and rotated per pixel by a hash
+// of the pixel. Each tap is weighted by its count (taps that rounded to the same pixel are merged)
+// x the color x depth range weights: L_f = sum w L_u / sum w, Var[L_f] = sum w^2 Var / (sum w)^2,
+// exact for the weights used. The tap table comes from subsampled_tap_table() in
+// gl/cpu_reference.cpp, which cpu_subsampled() there uses too. Taps outside the image are left out.
+#include "common.glsl"
+
+layout(binding = 0) uniform sampler2D hv_tex;     // rgb L_u, a Var[L_u] (kVarUnknown: n < 2; 0: all samples equal)
+layout(binding = 1) uniform sampler2D lv_tex;     // rgb L_lv (only for skipping)
+layout(binding = 2) uniform sampler2D guide_tex;  // rgb range color, a distance
+uniform int taps_per_rotation;
+uniform int rotations;
+uniform float k_c;  // 1 / (2 sigma_c^2)
+uniform float k_d;  // 1 / (2 sigma_d^2)
+uniform int skip_case2;
+uniform float t;
+
+layout(std430, binding = 0) buffer Counter { uint filtered_pixels; };
+// Rotation r's taps at [r * taps_per_rotation, ...): xy the offset, z the count (0 = padding).
+layout(std430, binding = 1) readonly buffer Taps { ivec4 taps[]; };
+layout(location = 0) out vec4 out_filtered;  // rgb L_f, a Var[L_f] (kVarUnknown, kVarSkipped)
+
+// subsampled_rotation() in gl/cpu_reference.cpp.
+int rotation_of(ivec2 p) {
+  uint h = uint(p.x) * 0x8da6b343u ^ uint(p.y) * 0xd8163841u;
+  h ^= h >> 16;
+  h *= 0x7feb352du;
+  h ^= h >> 15;
+  h *= 0x846ca68bu;
+  h ^= h >> 16;
+  return int(h % uint(rotations));
+}
+
+void main() {
+  ivec2 p = ivec2(gl_FragCoord.xy);
+  ivec2 size = textureSize(hv_tex, 0);
+  if (skip_case2 != 0 && skip_as_case2(hv_tex, lv_tex, guide_tex, p, k_c, k_d, t)) {
+    out_filtered = vec4(clean(texelFetch(hv_tex, p, 0).rgb), kVarSkipped);
+    return;
+  }
+  atomicAdd(filtered_pixels, 1u);
+  vec4 g_p = texelFetch(guide_tex, p, 0);
+  float sw = 0.0, sw2v = 0.0, sw2u = 0.0, swk = 0.0, swv = 0.0;
+  vec3 swl = vec3(0.0);
+  int first = rotation_of(p) * taps_per_rotation;
+  for (int i = 0; i < taps_per_rotation; ++i) {
+    ivec4 tap = taps[first + i];
+    if (tap.z == 0) break;
+    ivec2 q = p + tap.xy;
+    if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) continue;
+    float w = float(tap.z) * range_weight(g_p, texelFetch(guide_tex, q, 0), k_c, k_d);
+    vec4 hv_q = texelFetch(hv_tex, q, 0);
+    float v_q = clean_var(hv_q.a);
+    sw += w;
+    swl += w * clean(hv_q.rgb);
+    if (v_q > 0.0) {  // unknown (n < 2) or 0 (all samples equal): no evidence
+      sw2v += w * w * v_q;
+      swk += w;
+      swv += w * v_q;
+    } else {
+      sw2u += w * w;
+    }
+  }
+  // sw >= 1: the centre tap is in every rotation with range weight 1. Unknown neighbour variances
+  // count with the kernel-weighted mean of the known ones.
+  float var_f = swk > 0.0 ? (sw2v + sw2u * (swv / swk)) / (sw * sw) : kVarUnknown;
+  out_filtered = vec4(swl / sw, var_f);
+}
