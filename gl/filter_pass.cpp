@@ -25,6 +25,8 @@ void FilterPass::run(const PreviewInputs& inputs, const Texture2D& guide, const 
   guide.bind(2);
   if (p.kind == FilterKind::Atrous)
     run_atrous(inputs, p);
+  else if (p.kind == FilterKind::Grid)
+    run_grid(p);
   else
     run_bilateral(inputs, p);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
@@ -82,6 +84,11 @@ void FilterPass::run_atrous(const PreviewInputs& inputs, const FilterParams& p) 
     quad_.draw(last ? fbo_ : scratch_target(i % 2), width_, height_);
     if (!last) scratch_[i % 2].bind(3);
   }
+}
+
+void FilterPass::run_grid(const FilterParams& p) {
+  if (!grid_) grid_ = std::make_unique<GridFilter>(width_, height_);
+  grid_->run(p, fbo_);
 }
 
 const Framebuffer& FilterPass::scratch_target(int index) {

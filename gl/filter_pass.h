@@ -9,6 +9,8 @@
 // Pixels in case 2 (u <= t with the unfiltered background) are skipped: L_f = L_u there and
 // Var[L_f] = kVarSkipped, the blend then uses s = 1 (see FilterParams::skip_case2).
 #pragma once
+#include <memory>
+#include "gl/grid_filter.h"
 #include "gl/inputs.h"
 #include "gl/preview_params.h"
 #include "gl/resources.h"
@@ -35,6 +37,7 @@ class FilterPass {
  private:
   void run_bilateral(const PreviewInputs& inputs, const FilterParams& params);
   void run_atrous(const PreviewInputs& inputs, const FilterParams& params);
+  void run_grid(const FilterParams& params);
   const Framebuffer& scratch_target(int index);  // allocates scratch_[index] on first use
 
   int width_, height_;
@@ -48,6 +51,7 @@ class FilterPass {
   Texture2D scratch_[2];
   Framebuffer scratch_fbo_[2];
   FullscreenPass quad_;
+  std::unique_ptr<GridFilter> grid_;  // created on first use
   StageTimer timer_;
   int runs_ = 0;
 };

@@ -14,9 +14,10 @@ namespace pxf {
 // is the edge-avoiding à-trous wavelet (Dammertz et al. 2010): atrous_iterations(sigma_s) passes of
 // a 5x5 B3-spline kernel with hole spacing 2^i, each tap weighted by the same color x depth range
 // weights (25 taps per pass; its Var[L_f] treats each pass's inputs as independent, see
-// gl/cpu_reference.cpp).
-enum class FilterKind { BilateralDepth, Bilateral, Separable, Atrous };
-// "bilateral-depth", "bilateral", "separable", "atrous"
+// gl/cpu_reference.cpp); "grid" is the bilateral grid (Chen et al. 2007) on the range color's
+// luminance (gl/grid_layout.h).
+enum class FilterKind { BilateralDepth, Bilateral, Separable, Atrous, Grid };
+// "bilateral-depth", "bilateral", "separable", "atrous", "grid"
 const std::vector<std::string>& filter_kind_names();
 const char* filter_kind_name(FilterKind kind);
 FilterKind parse_filter_kind(const std::string& name);  // throws pxf::Error listing the names
