@@ -26,7 +26,8 @@ void GridFilter::run(const FilterParams& p, const Framebuffer& target) {
   bounds_buffer_.bind_storage(4);
 
   bounds_.use();
-  glDispatchCompute((width_ + 15) / 16, (height_ + 15) / 16, 1);
+  const int strips = (width_ + 63) / 64 * height_;  // 64-pixel row strips (grid_bounds.comp)
+  glDispatchCompute((strips + 63) / 64, 1, 1);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
 
   splat_.set("grid_xy", grid_xy);
@@ -42,7 +43,7 @@ void GridFilter::run(const FilterParams& p, const Framebuffer& target) {
   blur_.set("grid_z_cells", layout_.nz);
   blur_.use();
   const GLuint groups = static_cast<GLuint>((layout_.cells() + 63) / 64);
-  for (int axis = 0; axis < 3; ++axis) {
+  for (int axis = 0; axis < 2; ++axis) {  // z was blurred in the splat
     blur_.set("axis", axis);
     grid_[axis % 2].bind_storage(1);
     grid_[1 - axis % 2].bind_storage(2);
@@ -59,7 +60,7 @@ void GridFilter::run(const FilterParams& p, const Framebuffer& target) {
   slice_.set("skip_case2", p.skip_case2 ? 1 : 0);
   slice_.set("t", p.t);
   slice_.use();
-  grid_[1].bind_storage(1);
+  grid_[0].bind_storage(1);
   quad_.draw(target, width_, height_);
 }
 

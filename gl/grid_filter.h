@@ -1,7 +1,7 @@
 // Bilateral-grid variant of the filter pass (FilterKind::Grid; Chen, Paris and Durand 2007), run
 // by FilterPass. Four GL steps, all a real GPU runs unchanged: the guide luminance's bounds
 // (shaders/grid_bounds.comp), the splat of L_u and its variance into a coarse 3D grid
-// (grid_splat.comp), a separable blur of the grid (grid_blur.comp, three dispatches) and the
+// (grid_splat.comp, which also blurs along z), the blur along x and y (grid_blur.comp) and the
 // per-pixel trilinear slice with the case-2 skip (grid_slice.frag), which writes FilterPass's
 // output. Layout and the variance it computes: gl/grid_layout.h, gl/grid_reference.cpp.
 #pragma once
@@ -24,7 +24,7 @@ class GridFilter {
   int width_, height_;
   Program bounds_, splat_, blur_, slice_;
   Buffer bounds_buffer_;
-  Buffer grid_[2];  // ping-pong: splat into 0, blur x -> 1, y -> 0, z -> 1, slice from 1
+  Buffer grid_[2];  // ping-pong: splat (and blur z) into 0, blur x -> 1, y -> 0, slice from 0
   GridLayout layout_;
   FullscreenPass quad_;
 };

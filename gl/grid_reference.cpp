@@ -43,6 +43,11 @@ float grid_z(const Grid& g, float y) {
   return std::clamp((y - g.y_min) / g.cell_z, 0.0f, float(kGridRangeCells - 1));
 }
 
+// c += w x (value sums), w^2 x (squared-weight sums b.xy).
+void add_weighted(Cell& c, const Cell& src, float w) {
+  for (int m = 0; m < 8; ++m) c[m] += (m == 4 || m == 5 ? w * w : w) * src[m];
+}
+
 Grid splat(const Image& hv, const Image& var_u, const Image& range_color, const FilterParams& p) {
   Grid g;
   g.layout = grid_layout(hv.width, hv.height, p);
@@ -59,16 +64,17 @@ Grid splat(const Image& hv, const Image& var_u, const Image& range_color, const 
   for (int y = 0; y < hv.height; ++y)
     for (int x = 0; x < hv.width; ++x) {
       const int k = std::clamp(nearest_cell(grid_z(g, guide_luminance(range_color, x, y))), 0, kGridRangeCells - 1);
-      Cell& c = g.cells[g.index(nearest_cell(float(x) * inv_cell_s), nearest_cell(float(y) * inv_cell_s), k)];
-      for (int ch = 0; ch < 3; ++ch) c[ch] += clean(hv.at(x, y, ch));
-      c[3] += 1.0f;
       const float var = clean_var(var_u.at(x, y, 0));
-      if (var > 0.0f) {
-        c[4] += var;
-        c[6] += 1.0f;
-        c[7] += var;
-      } else {
-        c[5] += 1.0f;
+      const Cell pixel = var > 0.0f ? Cell{clean(hv.at(x, y, 0)), clean(hv.at(x, y, 1)), clean(hv.at(x, y, 2)), 1.0f,
+                                           var, 0.0f, 1.0f, var}
+                                    : Cell{clean(hv.at(x, y, 0)), clean(hv.at(x, y, 1)), clean(hv.at(x, y, 2)), 1.0f,
+                                           0.0f, 1.0f, 0.0f, 0.0f};
+      // The z pass of the blur, per pixel (as grid_splat.comp does).
+      for (int t = 0; t < 5; ++t) {
+        const int q = k + t - 2;
+        if (q < 0 || q >= kGridRangeCells) continue;
+        Cell& c = g.cells[g.index(nearest_cell(float(x) * inv_cell_s), nearest_cell(float(y) * inv_cell_s), q)];
+        add_weighted(c, pixel, kGridBlurTaps[t]);
       }
     }
   return g;
@@ -88,9 +94,7 @@ void blur(Grid& g, int axis) {
           int q[3] = {i, j, k};
           q[axis] = c[axis] + t - 2;
           if (q[axis] < 0 || q[axis] >= n[axis]) continue;
-          const Cell& src = g.cells[g.index(q[0], q[1], q[2])];
-          const float w = kGridBlurTaps[t];
-          for (int m = 0; m < 8; ++m) sum[m] += (m == 4 || m == 5 ? w * w : w) * src[m];
+          add_weighted(sum, g.cells[g.index(q[0], q[1], q[2])], kGridBlurTaps[t]);
         }
         out[g.index(i, j, k)] = sum;
       }
@@ -111,7 +115,7 @@ void slice(const Grid& g, int x, int y, float luminance_y, FilterOutput& out) {
       for (int dx = 0; dx < 2; ++dx) {
         const float w = (dx ? frac[0] : 1.0f - frac[0]) * (dy ? frac[1] : 1.0f - frac[1]) * (dz ? frac[2] : 1.0f - frac[2]);
         const Cell& c = g.cells[g.index(c0[0] + dx, c0[1] + dy, c0[2] + dz)];
-        for (int m = 0; m < 8; ++m) sum[m] += (m == 4 || m == 5 ? w * w : w) * c[m];
+        add_weighted(sum, c, w);
       }
   // sum[3] > 0: the pixel's own nearest cell is a corner with weight >= 1/2 per axis.
   for (int ch = 0; ch < 3; ++ch) out.filtered.at(x, y, ch) = sum[ch] / sum[3];
@@ -125,7 +129,7 @@ void slice(const Grid& g, int x, int y, float luminance_y, FilterOutput& out) {
 FilterOutput cpu_grid_filter(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
                              const Image& depth, const FilterParams& p) {
   Grid g = splat(hv, var_u, range_color, p);
-  for (int axis = 0; axis < 3; ++axis) blur(g, axis);
+  for (int axis = 0; axis < 2; ++axis) blur(g, axis);  // z: in the splat
   FilterOutput out{Image::rgb(hv.width, hv.height), Image::gray(hv.width, hv.height)};
   for (int y = 0; y < hv.height; ++y)
     for (int x = 0; x < hv.width; ++x) {

@@ -1,5 +1,5 @@
 #version 450 core
-// Bilateral grid, step 3: blur along one axis (x, y or z, one dispatch each) with the B3-spline
+// Bilateral grid, step 3: blur along one axis (x or y, one dispatch each; z is blurred in the splat) with the B3-spline
 // taps g = 1/16 [1 4 6 4 1]; taps outside the grid are left out. The value sums (a, and the
 // linear sums b.zw) take g, the squared-weight sums (b.xy) take g^2: the variance of a linear
 // combination of independent cells. Mirrors blur() in gl/grid_reference.cpp.

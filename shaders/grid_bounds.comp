@@ -1,31 +1,27 @@
 #version 450 core
 // Bilateral grid, step 1: the min and max of the guide's luminance over the image (the z range of
-// the grid). Each 16x16 group reduces its tile in shared memory, then one atomic per group.
+// the grid). Each invocation scans a strip of 64 pixels of one row, then two atomics (a
+// shared-memory tree with barriers costs several times more on llvmpipe).
 #include "common.glsl"
 #include "grid_common.glsl"
-layout(local_size_x = 16, local_size_y = 16) in;
+layout(local_size_x = 64) in;
 
 layout(binding = 2) uniform sampler2D guide_tex;
-
-shared float lo[256];
-shared float hi[256];
+const int kStrip = 64;
 
 void main() {
-  uint i = gl_LocalInvocationIndex;
-  ivec2 p = ivec2(gl_GlobalInvocationID.xy);
-  bool inside = all(lessThan(p, textureSize(guide_tex, 0)));
-  float y = inside ? guide_luminance(texelFetch(guide_tex, p, 0)) : 0.0;
-  lo[i] = inside ? y : 3.0e38;
-  hi[i] = y;
-  barrier();
-  for (uint half_size = 128u; half_size > 0u; half_size >>= 1) {
-    if (i < half_size) {
-      lo[i] = min(lo[i], lo[i + half_size]);
-      hi[i] = max(hi[i], hi[i + half_size]);
-    }
-    barrier();
+  ivec2 size = textureSize(guide_tex, 0);
+  int strips_per_row = (size.x + kStrip - 1) / kStrip;
+  int strip = int(gl_GlobalInvocationID.x);
+  int y = strip / strips_per_row;
+  if (y >= size.y) return;
+  int x0 = (strip % strips_per_row) * kStrip;
+  float lo = 3.0e38, hi = 0.0;
+  for (int x = x0; x < min(x0 + kStrip, size.x); ++x) {
+    float l = guide_luminance(texelFetch(guide_tex, ivec2(x, y), 0));
+    lo = min(lo, l);
+    hi = max(hi, l);
   }
-  if (i != 0u) return;
-  atomicMin(y_min_bits, floatBitsToUint(lo[0]));
-  atomicMax(y_max_bits, floatBitsToUint(hi[0]));
+  atomicMin(y_min_bits, floatBitsToUint(lo));
+  atomicMax(y_max_bits, floatBitsToUint(hi));
 }

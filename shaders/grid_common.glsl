@@ -15,5 +15,8 @@ float grid_z(float y, float sigma_c) {
   return clamp((y - y_min) / cell_z, 0.0, float(kGridRangeCells - 1));
 }
 
+// The grid blur's taps (kGridBlurTaps in gl/grid_layout.h).
+const float kGridBlurTaps[5] = float[5](1.0 / 16.0, 4.0 / 16.0, 6.0 / 16.0, 4.0 / 16.0, 1.0 / 16.0);
+
 // Nearest cell of a grid coordinate (cell centers at integers).
 int nearest_cell(float u) { return int(floor(u + 0.5)); }

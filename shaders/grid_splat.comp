@@ -2,7 +2,9 @@
 // Bilateral grid, step 2: splat. One invocation per spatial cell (i, j) gathers the pixels whose
 // nearest cell it is (scan order, so the sums match the CPU reference) into its column of
 // kGridRangeCells range cells, each pixel into its nearest range cell with weight 1 (homogeneous
-// coordinates). Per cell, two vec4:
+// coordinates), and at once blurred along z: the pixel goes into range cells k - 2 .. k + 2 with the
+// blur taps g (g^2 for the squared-weight sums), which is the z pass of the separable blur done
+// per pixel instead of per cell (far fewer operations: most cells are empty). Per cell, two vec4:
 //   a = (sum L_u, count)
 //   b = (sum Var over known variances, count of unknown ones, count of known ones, sum Var known)
 // i.e. the sums sum w^2 Var, sum w^2 (unknown), sum w (known), sum w Var (known) of the exact
@@ -40,8 +42,15 @@ void main() {
       int k = clamp(nearest_cell(grid_z(guide_luminance(texelFetch(guide_tex, p, 0)), sigma_c)), 0, kGridRangeCells - 1);
       vec4 hv = texelFetch(hv_tex, p, 0);
       float var = clean_var(hv.a);
-      acc_a[k] += vec4(clean(hv.rgb), 1.0);
-      acc_b[k] += var > 0.0 ? vec4(var, 0.0, 1.0, var) : vec4(0.0, 1.0, 0.0, 0.0);
+      vec4 a = vec4(clean(hv.rgb), 1.0);
+      vec4 b = var > 0.0 ? vec4(var, 0.0, 1.0, var) : vec4(0.0, 1.0, 0.0, 0.0);
+      for (int t = 0; t < 5; ++t) {
+        int q = k + t - 2;
+        if (q < 0 || q >= kGridRangeCells) continue;
+        float g = kGridBlurTaps[t];
+        acc_a[q] += g * a;
+        acc_b[q] += vec4(g * g, g * g, g, g) * b;
+      }
     }
   }
   for (int k = 0; k < kGridRangeCells; ++k) {
