@@ -7,12 +7,13 @@
 #include <map>
 #include <mutex>
 #include <utility>
+#include "gl/grid_reference.h"
 
 namespace pxf {
 
 const std::vector<std::string>& filter_kind_names() {
   static const std::vector<std::string> names = {"bilateral-depth", "bilateral", "separable", "atrous",
-                                                         "subsampled"};
+                                                         "subsampled", "grid"};
   return names;
 }
 const char* filter_kind_name(FilterKind kind) { return filter_kind_names()[static_cast<int>(kind)].c_str(); }
@@ -192,10 +193,13 @@ namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
-// The shaders' sanitize(): non-finite -> 0, magnitude clamped.
+}  // namespace
+
 float clean(float v) { return std::isfinite(v) ? std::clamp(v, -kMaxInput, kMaxInput) : 0.0f; }
-// Variance channel: negative or non-finite = unknown.
 float clean_var(float v) { return (std::isfinite(v) && v >= 0.0f) ? std::min(v, kMaxInput) : kVarUnknown; }
+
+namespace {
+
 float lum(const float* c) { return luminance(c[0], c[1], c[2]); }
 
 struct Px {
@@ -241,8 +245,8 @@ struct KernelSums {
   }
 };
 
-// The filter's case-2 skip (FilterParams::skip_case2, final pass only): the blend's u (pooled
-// variance) with the unfiltered background; a zero variance is not trusted. Writes the skip.
+}  // namespace
+
 bool skip_as_case2(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
                    const Image& depth, const FilterParams& p, int x, int y, FilterOutput& out) {
   const float v = pooled_var_u(var_u, range_color, depth, x, y, range_weights(p));
@@ -253,8 +257,6 @@ bool skip_as_case2(const Image& hv, const Image& var_u, const Image& lv, const I
   out.variance.at(x, y, 0) = kVarSkipped;
   return true;
 }
-
-}  // namespace
 
 float relative_variance(float var, float lb) {
   if (!(var > 0.0f)) return 0.0f;
@@ -408,6 +410,7 @@ FilterOutput cpu_filter(const Image& hv, const Image& var_u, const Image& lv, co
                         const Image& depth, const FilterParams& p) {
   if (p.kind == FilterKind::Atrous) return cpu_atrous(hv, var_u, lv, range_color, depth, p);
   if (p.kind == FilterKind::Subsampled) return cpu_subsampled(hv, var_u, lv, range_color, depth, p);
+  if (p.kind == FilterKind::Grid) return cpu_grid_filter(hv, var_u, lv, range_color, depth, p);
   if (p.kind != FilterKind::Separable) return filter_once(hv, var_u, hv, var_u, lv, range_color, depth, p, 1, 1, true);
   FilterOutput rows = filter_once(hv, var_u, hv, var_u, lv, range_color, depth, p, 1, 0, false);
   return filter_once(rows.filtered, rows.variance, hv, var_u, lv, range_color, depth, p, 0, 1, true);

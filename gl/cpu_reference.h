@@ -38,6 +38,16 @@ struct FilterOutput {
 FilterOutput cpu_filter(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
                         const Image& depth, const FilterParams& params);
 
+// The shaders' clean(): non-finite -> 0, magnitude clamped to kMaxInput; clean_var(): negative or
+// non-finite variance -> kVarUnknown. For the variants' references in other files.
+float clean(float v);
+float clean_var(float v);
+// The filter's case-2 skip (FilterParams::skip_case2, final pass only): the blend's u (pooled
+// variance) with the unfiltered background; a zero variance is not trusted. Writes the skip
+// (L_f = L_u, Var = kVarSkipped) into `out` and returns true where the pixel is skipped.
+bool skip_as_case2(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
+                   const Image& depth, const FilterParams& p, int x, int y, FilterOutput& out);
+
 struct BlendOutput {
   Image final_rgb;   // "R,G,B"
   Image s;           // "Y"

@@ -27,6 +27,8 @@ void FilterPass::run(const PreviewInputs& inputs, const Texture2D& guide, const 
     run_atrous(inputs, p);
   else if (p.kind == FilterKind::Subsampled)
     run_subsampled(p);
+  else if (p.kind == FilterKind::Grid)
+    run_grid(p);
   else
     run_bilateral(inputs, p);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
@@ -103,6 +105,11 @@ void FilterPass::run_subsampled(const FilterParams& p) {
   subsampled_program_.set("rotations", kSubsampledRotations);
   subsampled_program_.use();
   quad_.draw(fbo_, width_, height_);
+}
+
+void FilterPass::run_grid(const FilterParams& p) {
+  if (!grid_) grid_ = std::make_unique<GridFilter>(width_, height_);
+  grid_->run(p, fbo_);
 }
 
 const Framebuffer& FilterPass::scratch_target(int index) {

@@ -10,6 +10,8 @@
 // Var[L_f] = kVarSkipped, the blend then uses s = 1 (see FilterParams::skip_case2).
 #pragma once
 #include <utility>
+#include <memory>
+#include "gl/grid_filter.h"
 #include "gl/inputs.h"
 #include "gl/preview_params.h"
 #include "gl/resources.h"
@@ -37,6 +39,7 @@ class FilterPass {
   void run_bilateral(const PreviewInputs& inputs, const FilterParams& params);
   void run_atrous(const PreviewInputs& inputs, const FilterParams& params);
   void run_subsampled(const FilterParams& params);
+  void run_grid(const FilterParams& params);
   const Framebuffer& scratch_target(int index);  // allocates scratch_[index] on first use
 
   int width_, height_;
@@ -53,6 +56,7 @@ class FilterPass {
   Texture2D scratch_[2];
   Framebuffer scratch_fbo_[2];
   FullscreenPass quad_;
+  std::unique_ptr<GridFilter> grid_;  // created on first use
   StageTimer timer_;
   int runs_ = 0;
 };

@@ -124,7 +124,11 @@ INSTANTIATE_TEST_SUITE_P(Variants, FilterVsCpu,
                                            std::make_tuple(FilterKind::Subsampled, true, 8.0f),
                                            std::make_tuple(FilterKind::Subsampled, true, 2.5f),
                                            std::make_tuple(FilterKind::Subsampled, false, 0.0f),
-                                           std::make_tuple(FilterKind::Subsampled, false, 21.0f)));
+                                           std::make_tuple(FilterKind::Subsampled, false, 21.0f),
+                                           std::make_tuple(FilterKind::Grid, false, 8.0f),
+                                           std::make_tuple(FilterKind::Grid, true, 8.0f),
+                                           std::make_tuple(FilterKind::Grid, false, 0.0f),
+                                           std::make_tuple(FilterKind::Grid, true, 21.0f)));
 
 TEST(FilterKinds, ConstantHvStaysConstant) {
   // The weights are normalized, so a constant signal comes out unchanged whatever the range edges.

@@ -19,9 +19,10 @@ namespace pxf {
 // gl/cpu_reference.cpp); "subsampled" is the bilateral-depth kernel evaluated at subsampled_taps()
 // only: Poisson-disk offsets drawn from the spatial Gaussian (the tap density carries the spatial
 // weight), rotated per pixel (Banterle et al. 2012), each weighted by the color x depth range
-// weights; its Var[L_f] is exact for the weights it uses.
-enum class FilterKind { BilateralDepth, Bilateral, Separable, Atrous, Subsampled };
-// "bilateral-depth", "bilateral", "separable", "atrous", "subsampled"
+// weights; its Var[L_f] is exact for the weights it uses. "grid" is the bilateral grid (Chen et al.
+// 2007) on the range color's luminance (gl/grid_layout.h).
+enum class FilterKind { BilateralDepth, Bilateral, Separable, Atrous, Subsampled, Grid };
+// "bilateral-depth", "bilateral", "separable", "atrous", "subsampled", "grid"
 const std::vector<std::string>& filter_kind_names();
 const char* filter_kind_name(FilterKind kind);
 FilterKind parse_filter_kind(const std::string& name);  // throws pxf::Error listing the names

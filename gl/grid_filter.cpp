@@ -1,0 +1,67 @@
+#include "gl/grid_filter.h"
+
+#include "gl/gl.h"
+
+namespace pxf {
+
+GridFilter::GridFilter(int width, int height)
+    : width_(width), height_(height), bounds_(Program::from_embedded_compute("grid_bounds.comp")),
+      splat_(Program::from_embedded_compute("grid_splat.comp")),
+      blur_(Program::from_embedded_compute("grid_blur.comp")),
+      slice_(Program::from_embedded("fullscreen.vert", "grid_slice.frag")), bounds_buffer_(2 * sizeof(uint32_t)) {}
+
+void GridFilter::resize_grid(const GridLayout& layout) {
+  const size_t bytes = layout.cells() * 2 * 4 * sizeof(float);
+  if (grid_[0].size() < bytes)
+    for (Buffer& b : grid_) b = Buffer(bytes);
+  layout_ = layout;
+}
+
+void GridFilter::run(const FilterParams& p, const Framebuffer& target) {
+  resize_grid(grid_layout(width_, height_, p));
+  const glm::ivec2 grid_xy(layout_.nx, layout_.ny);
+  const float inv_cell_s = 1.0f / layout_.cell_s;
+  const uint32_t initial_bounds[2] = {0x7f7fffffu, 0u};  // FLT_MAX, +0
+  bounds_buffer_.upload(initial_bounds, sizeof initial_bounds);
+  bounds_buffer_.bind_storage(4);
+
+  bounds_.use();
+  const int strips = (width_ + 63) / 64 * height_;  // 64-pixel row strips (grid_bounds.comp)
+  glDispatchCompute((strips + 63) / 64, 1, 1);
+  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+
+  splat_.set("grid_xy", grid_xy);
+  splat_.set("cell_s", layout_.cell_s);
+  splat_.set("inv_cell_s", inv_cell_s);
+  splat_.set("sigma_c", p.sigma_c);
+  splat_.use();
+  grid_[0].bind_storage(1);
+  glDispatchCompute((layout_.nx + 7) / 8, (layout_.ny + 7) / 8, 1);
+  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+
+  blur_.set("grid_xy", grid_xy);
+  blur_.set("grid_z_cells", layout_.nz);
+  blur_.use();
+  const GLuint groups = static_cast<GLuint>((layout_.cells() + 63) / 64);
+  for (int axis = 0; axis < 2; ++axis) {  // z was blurred in the splat
+    blur_.set("axis", axis);
+    grid_[axis % 2].bind_storage(1);
+    grid_[1 - axis % 2].bind_storage(2);
+    glDispatchCompute(groups, 1, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+  }
+
+  const RangeWeights range = range_weights(p);
+  slice_.set("grid_xy", grid_xy);
+  slice_.set("inv_cell_s", inv_cell_s);
+  slice_.set("sigma_c", p.sigma_c);
+  slice_.set("k_c", range.k_c);
+  slice_.set("k_d", range.k_d);
+  slice_.set("skip_case2", p.skip_case2 ? 1 : 0);
+  slice_.set("t", p.t);
+  slice_.use();
+  grid_[0].bind_storage(1);
+  quad_.draw(target, width_, height_);
+}
+
+}  // namespace pxf

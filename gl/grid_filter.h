@@ -1,0 +1,32 @@
+// Bilateral-grid variant of the filter pass (FilterKind::Grid; Chen, Paris and Durand 2007), run
+// by FilterPass. Four GL steps, all a real GPU runs unchanged: the guide luminance's bounds
+// (shaders/grid_bounds.comp), the splat of L_u and its variance into a coarse 3D grid
+// (grid_splat.comp, which also blurs along z), the blur along x and y (grid_blur.comp) and the
+// per-pixel trilinear slice with the case-2 skip (grid_slice.frag), which writes FilterPass's
+// output. Layout and the variance it computes: gl/grid_layout.h, gl/grid_reference.cpp.
+#pragma once
+#include "gl/grid_layout.h"
+#include "gl/inputs.h"
+#include "gl/resources.h"
+
+namespace pxf {
+
+class GridFilter {
+ public:
+  GridFilter(int width, int height);
+  // Expects FilterPass's bindings: HV at texture unit 0, LV at 1, the guide at 2, the filtered-pixel
+  // counter at storage binding 0. Draws rgb L_f, a Var[L_f] into `target`.
+  void run(const FilterParams& params, const Framebuffer& target);
+
+ private:
+  void resize_grid(const GridLayout& layout);
+
+  int width_, height_;
+  Program bounds_, splat_, blur_, slice_;
+  Buffer bounds_buffer_;
+  Buffer grid_[2];  // ping-pong: splat (and blur z) into 0, blur x -> 1, y -> 0, slice from 0
+  GridLayout layout_;
+  FullscreenPass quad_;
+};
+
+}  // namespace pxf

@@ -1,0 +1,66 @@
+// Cell layout of the bilateral-grid filter (FilterKind::Grid; Chen, Paris and Durand 2007), shared
+// by the GL pass (gl/grid_filter.cpp, shaders/grid_*.comp, shaders/grid_slice.frag) and its CPU
+// reference (gl/grid_reference.cpp). No GL here.
+//
+// The grid is 3D: pixel x, pixel y and one range coordinate z, the luminance Y of the range
+// color. Cell centers sit at integer grid coordinates: pixel (x, y) of luminance Y lies at
+// (x / cell_s, y / cell_s, (Y - Y_min) / cell_z). Why luminance alone: a 4D grid (adding the
+// distance) or a 5D one (RGB) multiplies the cells to blur and the corners to slice (16 or 32
+// instead of 8) and would not fit the budget on llvmpipe. What it gives up against the exact
+// RGB + depth weight: two neighbouring surfaces whose range colors have the same luminance (a
+// chroma edge) or that lie at different distances with the same luminance are mixed. In the range
+// buffer the luminance already carries the shading term (0.2 + 0.8 n.v), so most geometric
+// edges (a change of normal) still separate.
+#pragma once
+#include <algorithm>
+#include <cmath>
+#include "gl/preview_params.h"
+
+namespace pxf {
+
+// Range cells along z. The range color's luminance spans [0, 1] (albedo x shading), i.e. 50 cells
+// at the default sigma_c = 0.02; a wider span stretches the cells (cell_z grows) instead of
+// growing the grid, which widens the range kernel proportionally.
+constexpr int kGridRangeCells = 48;
+// Spatial cells are sigma_s pixels wide, but at least this: below it the grid would have more cells
+// than the image has pixels, and the exact kernel is cheap anyway.
+constexpr float kGridMinCellPx = 4.0f;
+
+struct GridLayout {
+  int nx = 2, ny = 2, nz = kGridRangeCells;
+  float cell_s = kGridMinCellPx;  // pixels per spatial cell
+  size_t cells() const { return size_t(nx) * ny * nz; }
+};
+
+// Cells 0 .. floor((W-1)/cell_s) + 1 in x: every pixel's coordinate u lies in [0, nx - 1) so
+// that the slice's corners floor(u) and floor(u) + 1 both exist (same in y).
+inline GridLayout grid_layout(int width, int height, const FilterParams& p) {
+  GridLayout g;
+  g.cell_s = std::max(p.sigma_s, kGridMinCellPx);
+  g.nx = static_cast<int>(std::floor(float(std::max(width, 1) - 1) / g.cell_s)) + 2;
+  g.ny = static_cast<int>(std::floor(float(std::max(height, 1) - 1) / g.cell_s)) + 2;
+  return g;
+}
+
+// Range cell size from the guide's luminance span [y_min, y_max]: sigma_c, stretched so that the
+// span fits the kGridRangeCells cells (z in [0, nz - 1]).
+inline float grid_cell_z(float y_min, float y_max, float sigma_c) {
+  return std::max(std::max(sigma_c, 1.0e-6f), (y_max - y_min) / float(kGridRangeCells - 1));
+}
+
+// The grid blur, along each axis in turn: the B3-spline taps 1/16 [1 4 6 4 1] (a standard deviation
+// of one cell, as Chen et al. blur with a Gaussian of one cell). Taps outside the grid are left out.
+constexpr float kGridBlurTaps[5] = {1.0f / 16, 4.0f / 16, 6.0f / 16, 4.0f / 16, 1.0f / 16};
+
+// Var[L_f] correction for the interpolation along one spatial axis at fraction a (see
+// grid_reference.cpp): the two interpolated cells are correlated (the blur spreads each pixel into
+// both), which the squared interpolation weights ignore. With G0 = sum g^2 and G1 = sum g(k) g(k+1)
+// of the blur taps, the exact variance over uniformly occupied cells is (a0^2 + a1^2) G0 + 2 a0 a1 G1
+// against (a0^2 + a1^2) G0 propagated.
+inline float grid_interpolation_correction(float a) {
+  constexpr float g0 = 70.0f / 256.0f, g1 = 56.0f / 256.0f;
+  const float b = 1.0f - a;
+  return 1.0f + 2.0f * a * b * g1 / (g0 * (a * a + b * b));
+}
+
+}  // namespace pxf

@@ -1,0 +1,57 @@
+#version 450 core
+// Bilateral grid, step 4: slice. Each pixel interpolates the blurred grid trilinearly at its own
+// (x / cell_s, y / cell_s, z): the value sums with the weights a, the squared-weight sums with a^2.
+// L_f = sum a / sum count; Var[L_f] = c(a_x) c(a_y) (sum w^2 Var + sum w^2 (unknown) x mean known
+// Var) / (sum w)^2, c = grid_interpolation_correction (gl/grid_layout.h) for the correlation of
+// the interpolated cells along the spatial axes. Case-2 pixels are skipped as in the other variants.
+// Mirrors slice() in gl/grid_reference.cpp.
+#include "common.glsl"
+#include "grid_common.glsl"
+
+layout(binding = 0) uniform sampler2D hv_tex;     // rgb L_u, a Var[L_u]
+layout(binding = 1) uniform sampler2D lv_tex;     // rgb L_lv (only for skipping)
+layout(binding = 2) uniform sampler2D guide_tex;  // rgb range color, a distance
+layout(std430, binding = 1) readonly buffer Grid { vec4 cells[]; };
+layout(std430, binding = 0) buffer Counter { uint filtered_pixels; };
+uniform ivec2 grid_xy;
+uniform float inv_cell_s;
+uniform float sigma_c;
+uniform float k_c;  // 1 / (2 sigma_c^2), for skipping
+uniform float k_d;  // 1 / (2 sigma_d^2), for skipping
+uniform int skip_case2;
+uniform float t;
+
+layout(location = 0) out vec4 out_filtered;  // rgb L_f, a Var[L_f] (kVarUnknown, kVarSkipped)
+
+float interpolation_correction(float a) {
+  const float g0 = 70.0 / 256.0, g1 = 56.0 / 256.0;
+  float b = 1.0 - a;
+  return 1.0 + 2.0 * a * b * g1 / (g0 * (a * a + b * b));
+}
+
+void main() {
+  ivec2 p = ivec2(gl_FragCoord.xy);
+  if (skip_case2 != 0 && skip_as_case2(hv_tex, lv_tex, guide_tex, p, k_c, k_d, t)) {
+    out_filtered = vec4(clean(texelFetch(hv_tex, p, 0).rgb), kVarSkipped);
+    return;
+  }
+  atomicAdd(filtered_pixels, 1u);
+  precise vec2 uv = vec2(p) * inv_cell_s;
+  float z = grid_z(guide_luminance(texelFetch(guide_tex, p, 0)), sigma_c);
+  ivec3 c0 = ivec3(ivec2(floor(uv)), min(int(floor(z)), kGridRangeCells - 2));
+  vec3 frac = clamp(vec3(uv, z) - vec3(c0), 0.0, 1.0);
+  vec4 a = vec4(0.0), b = vec4(0.0);
+  for (int dz = 0; dz < 2; ++dz)
+    for (int dy = 0; dy < 2; ++dy)
+      for (int dx = 0; dx < 2; ++dx) {
+        float w = (dx == 1 ? frac.x : 1.0 - frac.x) * (dy == 1 ? frac.y : 1.0 - frac.y) *
+                  (dz == 1 ? frac.z : 1.0 - frac.z);
+        int cell = ((c0.z + dz) * grid_xy.y + c0.y + dy) * grid_xy.x + c0.x + dx;
+        a += w * cells[2 * cell];
+        b += vec4(w * w, w * w, w, w) * cells[2 * cell + 1];
+      }
+  // a.w > 0: the pixel's own nearest cell is a corner with interpolation weight >= 1/2 per axis.
+  float correction = interpolation_correction(frac.x) * interpolation_correction(frac.y);
+  float var_f = b.z > 0.0 ? correction * (b.x + b.y * (b.w / b.z)) / (a.w * a.w) : kVarUnknown;
+  out_filtered = vec4(a.rgb / a.w, var_f);
+}
