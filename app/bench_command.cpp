@@ -23,8 +23,6 @@ namespace {
 
 using Clock = BenchClock;
 
-bool is_power_of_two(int n) { return n > 0 && (n & (n - 1)) == 0; }
-
 void write_text(const std::string& path, const std::string& text) {
   write_file_atomically(path, [&](const std::string& tmp) {
     std::ofstream out(tmp);
@@ -118,36 +116,60 @@ PlainRun run_plain(const BenchSetup& b, int min_frames, int max_frames, double s
   return run;
 }
 
-struct EqualTimeRow {
-  int budget_frames = 0;
-  double budget_ms = 0, plain_nrmse = 0;
-  int filtered_frames = 0;
-  double filtered_ms = 0, filtered_nrmse = 0;
+// One job under `--time` (the render command's machinery): frames while the next one, its due
+// passes and the finish fit the budget, then the finish. One row of the equal-time table; columns
+// are added per row.
+struct TimedRun {
+  int spp = 0;
+  double used_ms = 0;
+  int filter_runs = 0;
+  StageTimes times;
+  ImageMetrics metrics;
 };
 
-// A filtered capture that stops adding frames when the next one (with its scheduled filter run)
-// and the final filter + blend would exceed the budget; the actual wall time is reported.
-EqualTimeRow run_equal_time(const BenchSetup& b, int budget_frames, double budget_ms, double pt_ms,
-                            double filter_ms, double display_ms, const Image& reference) {
-  Preview preview(b.scene, b.filtered, b.width, b.height);
+TimedRun run_timed(const BenchSetup& b, const PreviewSettings& settings, double budget_ms, const Image& reference) {
   const auto start = Clock::now();
-  for (int k = 1;; ++k) {
-    preview.add_frame(false, false);
-    // Frame k + 1 on a power of two runs the filter anyway, and then it is also the last frame's
-    // filter run: finish() adds none. Otherwise finish() filters once more.
-    const bool scheduled = is_power_of_two(k + 1);
-    const double next = pt_ms + (scheduled ? filter_ms : 0.0);
-    const double finish = (scheduled ? 0.0 : filter_ms) + display_ms;
-    if (elapsed_ms(start) + next + finish > budget_ms) break;
+  Preview preview(b.scene, settings, b.width, b.height);
+  for (int i = 0;; ++i) {
+    if (i > 0 && !next_frame_fits(preview.predict_next_frame(budget_ms, elapsed_ms(start)))) break;
+    preview.add_frame(false, /*display=*/i == 0);  // the first display measures the finish's
   }
   preview.finish();
+  TimedRun run;
+  run.used_ms = elapsed_ms(start);
+  run.spp = preview.samples();
+  run.filter_runs = preview.filter_runs();
+  run.times = preview.total_times();
+  run.metrics = compare_images(preview.final_image(), reference);
+  return run;
+}
+
+struct EqualTimeRow {
+  int budget_frames = 0;
+  double budget_ms = 0;
+  TimedRun filtered, plain;
+};
+
+EqualTimeRow run_equal_time(const BenchSetup& b, int budget_frames, double pt_ms, const Image& reference) {
   EqualTimeRow row;
   row.budget_frames = budget_frames;
-  row.budget_ms = budget_ms;
-  row.filtered_frames = preview.samples();
-  row.filtered_ms = elapsed_ms(start);
-  row.filtered_nrmse = compare_images(preview.final_image(), reference).nrmse_percent;
+  row.budget_ms = budget_frames * pt_ms;
+  row.plain = run_timed(b, b.plain, row.budget_ms, reference);
+  row.filtered = run_timed(b, b.filtered, row.budget_ms, reference);
   return row;
+}
+
+const char* kEqualTimeCsvHeader =
+    "budget_frames,budget_ms,unfiltered_spp,unfiltered_ms,unfiltered_nrmse_percent,filtered_spp,filtered_ms,"
+    "filtered_filter_runs,filtered_nrmse_percent,filtered_outside_tracing_share\n";
+
+std::string equal_time_csv_row(const EqualTimeRow& r) {
+  std::ostringstream line;
+  line << r.budget_frames << "," << r.budget_ms << "," << r.plain.spp << "," << r.plain.used_ms << ","
+       << r.plain.metrics.nrmse_percent << "," << r.filtered.spp << "," << r.filtered.used_ms << ","
+       << r.filtered.filter_runs << "," << r.filtered.metrics.nrmse_percent << ","
+       << share_outside_tracing(r.filtered.times, r.filtered.used_ms) << "\n";
+  return line.str();
 }
 
 // The spp at which plain path tracing reaches `target` NRMSE (log-log interpolation); 0 = never.
@@ -198,14 +220,14 @@ int run_bench(const Args& args) {
   SceneOptions scene_options;
   PreviewOptions preview_options;
   bool pathtracer = false;
-  std::string reference_path, out = "bench-out", budgets_text = "4,16,64";
-  int reference_spp = 4096, frames = 32, max_spp = 1024, timed = 20;
+  std::string reference_path, out = "bench-out", budgets_text = "8,32,128,256";
+  int reference_spp = 2048, frames = 32, max_spp = 1024, timed = 20;
   CommandLine cli("bench", "[options]",
                   "Run time against error on one scene (default cornell, 512x512, default settings):\n"
                   "  1. per-stage times of one scheduled filter application, in ms and in path-tracing frames;\n"
                   "  2. the relative overhead of filtering over --frames frames;\n"
-                  "  3. NRMSE to the reference of unfiltered vs filtered images at equal wall time, at budgets of\n"
-                  "     --budgets unfiltered frames;\n"
+                  "  3. NRMSE to the reference of unfiltered vs filtered images at equal wall time of the whole job\n"
+                  "     (the --time machinery), at budgets of --budgets median path-tracing frames;\n"
                   "  4. the spp at which unfiltered path tracing reaches the NRMSE of the filtered image at --frames.\n"
                   "The reference (--reference-spp plain path tracing) is cached in --out. Writes CSV and SVG plots.\n"
                   "--pathtracer instead measures paths/s, rays/s and the raw Embree incoherent-ray rate.");
@@ -214,9 +236,9 @@ int run_bench(const Args& args) {
   cli.flag("--pathtracer", &pathtracer, "path tracer throughput only");
   cli.option("--timed-frames", &timed, "timed frames of --pathtracer (after 3 warm-up frames)", 1, 100000);
   cli.option("--reference", &reference_path, "REF.exr", "reference image (default: render and cache one)");
-  cli.option("--reference-spp", &reference_spp, "samples of the rendered reference (default 4096)", 1, 1 << 20);
+  cli.option("--reference-spp", &reference_spp, "samples of the rendered reference (default 2048)", 1, 1 << 20);
   cli.option("--frames", &frames, "frames of the filtered run (default 32)", 1, 1 << 16);
-  cli.option("--budgets", &budgets_text, "LIST", "equal-time budgets in unfiltered frames (default 4,16,64)");
+  cli.option("--budgets", &budgets_text, "LIST", "equal-time budgets in median path-tracing frames (default 8,32,128,256)");
   cli.option("--max-spp", &max_spp, "most unfiltered spp tried to match the filtered NRMSE (default 1024)", 1, 1 << 20);
   cli.option("--out", &out, "DIR", "folder for CSV, plots and the cached reference (default bench-out)");
   if (!cli.parse(args)) return 0;
@@ -268,33 +290,31 @@ int run_bench(const Args& args) {
               (filter_ms + range_ms) / pt_ms);
 
   // 2 + 4. The unfiltered run: overhead and convergence.
-  const int max_budget = *std::max_element(budgets.begin(), budgets.end());
-  const PlainRun plain = run_plain(b, std::max({frames, max_budget, 64}), std::max({max_spp, max_budget, frames}),
+  const PlainRun plain = run_plain(b, std::max(frames, 64), std::max(max_spp, frames),
                                    filtered.nrmse, reference);
   const double plain_frames_ms = plain.wall_ms[frames - 1];
   std::printf("\n2. overhead of filtering over %d frames: %.0f ms filtered vs %.0f ms unfiltered = %+.1f %% (%d filter runs)\n",
               frames, filtered.wall_ms, plain_frames_ms, 100.0 * (filtered.wall_ms / plain_frames_ms - 1.0),
               filtered.filter_runs);
 
-  // 3. Equal time.
-  std::printf("\n3. NRMSE to the reference at equal wall time:\n");
-  std::printf("   budget  time ms  unfiltered NRMSE | filtered spp  time ms  NRMSE   ratio\n");
+  // 3. Equal time: both runs under the same --time budget of N median path-tracing frames.
+  std::printf("\n3. HDR NRMSE to the reference at equal wall time of the whole job (--time = N PT frames):\n");
+  std::printf("   budget  time ms | unfiltered spp  used ms  NRMSE   | filtered spp  used ms  NRMSE    ratio\n");
   std::ostringstream eq_csv;
-  eq_csv << "budget_frames,budget_ms,unfiltered_nrmse_percent,filtered_spp,filtered_ms,filtered_nrmse_percent\n";
-  PlotSeries filtered_points{"filtered (equal time)", {}, {}, true};
+  eq_csv << kEqualTimeCsvHeader;
+  PlotSeries filtered_points{"filtered (--time)", {}, {}, true};
+  PlotSeries plain_points{"unfiltered (--time)", {}, {}, true};
   for (int budget : budgets) {
-    const double budget_ms = plain.wall_ms[budget - 1];
-    double plain_nrmse = 0;
-    for (size_t i = 0; i < plain.spp.size(); ++i)
-      if (plain.spp[i] == budget) plain_nrmse = plain.nrmse[i];
-    EqualTimeRow row = run_equal_time(b, budget, budget_ms, pt_ms, filter_ms, display_ms, reference);
-    row.plain_nrmse = plain_nrmse;
-    std::printf("   %6d %8.0f  %14.3f %%  | %12d %8.0f  %6.3f %%  %5.2fx\n", budget, budget_ms, plain_nrmse,
-                row.filtered_frames, row.filtered_ms, row.filtered_nrmse, plain_nrmse / row.filtered_nrmse);
-    eq_csv << budget << "," << budget_ms << "," << plain_nrmse << "," << row.filtered_frames << ","
-           << row.filtered_ms << "," << row.filtered_nrmse << "\n";
-    filtered_points.x.push_back(row.filtered_ms / 1000);
-    filtered_points.y.push_back(row.filtered_nrmse);
+    const EqualTimeRow row = run_equal_time(b, budget, pt_ms, reference);
+    std::printf("   %6d %8.0f | %14d %8.0f  %6.3f %% | %12d %8.0f  %6.3f %%  %5.2fx\n", budget, row.budget_ms,
+                row.plain.spp, row.plain.used_ms, row.plain.metrics.nrmse_percent, row.filtered.spp,
+                row.filtered.used_ms, row.filtered.metrics.nrmse_percent,
+                row.plain.metrics.nrmse_percent / row.filtered.metrics.nrmse_percent);
+    eq_csv << equal_time_csv_row(row);
+    filtered_points.x.push_back(row.filtered.used_ms / 1000);
+    filtered_points.y.push_back(row.filtered.metrics.nrmse_percent);
+    plain_points.x.push_back(row.plain.used_ms / 1000);
+    plain_points.y.push_back(row.plain.metrics.nrmse_percent);
   }
   write_text(out + "/equal_time.csv", eq_csv.str());
 
@@ -317,7 +337,7 @@ int run_bench(const Args& args) {
   PlotSeries filtered_end{"filtered " + std::to_string(frames) + " spp", {filtered.wall_ms / 1000}, {filtered.nrmse}, true};
   write_svg_plot(out + "/nrmse_vs_time.svg",
                  {"NRMSE vs wall time: " + scene_options.scene, "wall time (s)", "NRMSE (%)", true, true},
-                 {plain_curve, filtered_points, filtered_end});
+                 {plain_curve, plain_points, filtered_points, filtered_end});
   std::printf("\nwrote %s/stages.csv, equal_time.csv, convergence.csv, nrmse_vs_time.svg\n", out.c_str());
   return 0;
 }
