@@ -68,8 +68,7 @@ int run_render(const Args& args) {
   cli.option("--spp", &spp, "samples (path-traced frames) per pixel (default 64; unbounded with --time alone)", 1,
              1 << 24);
   cli.option("--time", &time_s,
-             "wall-clock budget in seconds for the whole job (loading, tracing, passes, finish); with --spp too,\n"
-             "whichever comes first",
+             "wall-clock budget in seconds of the whole job (load, trace, passes, finish); with --spp: first wins",
              0.001, 1e7);
   add_preview_options(cli, preview_options);
   cli.option("--reference", &reference, "REF.exr", "report NRMSE of the final and the unfiltered image against it");
