@@ -197,6 +197,82 @@ std::vector<int> parse_budgets(const std::string& text) {
   return budgets;
 }
 
+// One scene's row of the per-stage table (thesis Table 3.2): medians over `frames` frames of the
+// scheduled run, and the overhead of the filtered run over the unfiltered one.
+struct StageRow {
+  std::string scene;
+  int width = 0, height = 0, filter_runs = 0;
+  double pt_ms = 0, filter_ms = 0, range_ms = 0, display_ms = 0, filtered_ms = 0, plain_ms = 0;
+  double overhead() const { return plain_ms > 0 ? filtered_ms / plain_ms - 1.0 : 0.0; }
+};
+
+StageRow measure_stages(const BenchSetup& b, const std::string& scene_name, int frames) {
+  Preview filtered(b.scene, b.filtered, b.width, b.height);
+  std::vector<double> pt, filter_app, display;
+  StageRow row;
+  const auto start = Clock::now();
+  for (int i = 0; i < frames; ++i) {
+    filtered.add_frame(i + 1 == frames, false);
+    const StageTimes& t = filtered.last_times();
+    pt.push_back(t.path_tracing);
+    if (t.filter > 0) filter_app.push_back(t.filter + t.upload);
+    if (t.blend > 0) display.push_back(t.blend + t.tonemap);
+    row.range_ms += t.range;
+  }
+  row.filtered_ms = elapsed_ms(start);
+  Preview plain(b.scene, b.plain, b.width, b.height);
+  const auto plain_start = Clock::now();
+  for (int i = 0; i < frames; ++i) plain.add_frame(i + 1 == frames, false);
+  row.plain_ms = elapsed_ms(plain_start);
+  row.scene = scene_name;
+  row.width = b.width;
+  row.height = b.height;
+  row.filter_runs = filtered.filter_runs();
+  row.pt_ms = median_of(pt);
+  row.filter_ms = median_of(filter_app);
+  row.display_ms = median_of(display);
+  return row;
+}
+
+int run_stage_table(SceneOptions scene_options, PreviewOptions preview_options, const CommandLine& cli, int frames,
+                    const std::string& out) {
+  std::printf("per-stage ms over %d frames (scheduled filter runs), every built-in scene:\n", frames);
+  std::printf("   %-10s %9s %8s %9s %8s %8s %5s %9s\n", "scene", "size", "PT ms", "filter", "range", "display",
+              "runs", "overhead");
+  std::ostringstream csv;
+  csv << "scene,width,height,frames,path_tracing_ms,filter_ms,range_ms,blend_tonemap_ms,filter_runs,filtered_ms,"
+         "unfiltered_ms,overhead_percent\n";
+  PlotSeries overhead{"overhead over " + std::to_string(frames) + " frames", {}, {}, true};
+  for (const BuiltinScene& builtin : builtin_scenes()) {
+    SceneOptions so = scene_options;
+    so.scene = builtin.name;
+    if (!cli.given("--size")) so.width = so.height = 0;  // each scene's own default size
+    PreviewOptions po = preview_options;
+    BenchSetup b;
+    b.scene = load_scene_for(so, po, cli);
+    b.width = so.width;
+    b.height = so.height;
+    b.filtered = po.settings;
+    b.plain = b.filtered;
+    b.plain.filter_enabled = false;
+    const StageRow r = measure_stages(b, builtin.name, frames);
+    std::printf("   %-10s %4dx%-4d %8.1f %9.1f %8.1f %8.1f %5d %+8.1f %%\n", r.scene.c_str(), r.width, r.height,
+                r.pt_ms, r.filter_ms, r.range_ms, r.display_ms, r.filter_runs, 100.0 * r.overhead());
+    csv << r.scene << "," << r.width << "," << r.height << "," << frames << "," << r.pt_ms << "," << r.filter_ms << ","
+        << r.range_ms << "," << r.display_ms << "," << r.filter_runs << "," << r.filtered_ms << "," << r.plain_ms
+        << "," << 100.0 * r.overhead() << "\n";
+    overhead.x.push_back(static_cast<double>(overhead.x.size() + 1));
+    overhead.y.push_back(100.0 * r.overhead());
+  }
+  write_text(out + "/stage_table.csv", csv.str());
+  write_svg_plot(out + "/stage_overhead.svg",
+                 {"filtering overhead per built-in scene (x: scene number, order of --scene list)", "scene",
+                  "overhead (%)", false, false},
+                 {overhead});
+  std::printf("wrote %s/stage_table.csv, %s/stage_overhead.svg\n", out.c_str(), out.c_str());
+  return 0;
+}
+
 int run_pathtracer_bench(const BenchSetup& b, int timed) {
   const BenchResult r = run_benchmark(b.scene, b.width, b.height, b.plain.trace, 3, timed);
   std::printf("%s\n", format_benchmark(r).c_str());
@@ -219,7 +295,7 @@ int run_pathtracer_bench(const BenchSetup& b, int timed) {
 int run_bench(const Args& args) {
   SceneOptions scene_options;
   PreviewOptions preview_options;
-  bool pathtracer = false;
+  bool pathtracer = false, stage_table = false;
   std::string reference_path, out = "bench-out", budgets_text = "8,32,128,256";
   int reference_spp = 2048, frames = 32, max_spp = 1024, timed = 20;
   CommandLine cli("bench", "[options]",
@@ -234,6 +310,8 @@ int run_bench(const Args& args) {
   add_scene_options(cli, scene_options, /*headless=*/true);
   add_preview_options(cli, preview_options);
   cli.flag("--pathtracer", &pathtracer, "path tracer throughput only");
+  cli.flag("--stage-table", &stage_table,
+           "per-stage ms and overhead over --frames frames for every built-in scene (no reference)");
   cli.option("--timed-frames", &timed, "timed frames of --pathtracer (after 3 warm-up frames)", 1, 100000);
   cli.option("--reference", &reference_path, "REF.exr", "reference image (default: render and cache one)");
   cli.option("--reference-spp", &reference_spp, "samples of the rendered reference (default 2048)", 1, 1 << 20);
@@ -244,6 +322,13 @@ int run_bench(const Args& args) {
   if (!cli.parse(args)) return 0;
   if (print_scene_list_if_asked(scene_options)) return 0;
   const std::vector<int> budgets = parse_budgets(budgets_text);
+  if (stage_table) {
+    std::filesystem::create_directories(out);
+    finish_preview_options(preview_options);
+    if (!preview_options.settings.filter_enabled) throw UsageError("--filter none: nothing to compare against");
+    auto context = create_gl_context(parse_gl_backend(scene_options.gl));
+    return run_stage_table(scene_options, preview_options, cli, frames, out);
+  }
 
   BenchSetup b;
   b.scene = load_scene_for(scene_options, preview_options, cli);
