@@ -26,8 +26,6 @@ namespace {
 
 using Clock = BenchClock;
 
-bool is_power_of_two(int n) { return n > 0 && (n & (n - 1)) == 0; }
-
 void write_text(const std::string& path, const std::string& text) {
   write_file_atomically(path, [&](const std::string& tmp) {
     std::ofstream out(tmp);
@@ -149,38 +147,62 @@ PlainRun run_plain(const BenchSetup& b, int min_frames, int max_frames, double s
   return run;
 }
 
-struct EqualTimeRow {
-  int budget_frames = 0;
-  double budget_ms = 0, plain_nrmse = 0;
-  int filtered_frames = 0;
-  double filtered_ms = 0, filtered_nrmse = 0;
-  RowError plain_error, filtered_error;
+// One job under `--time` (the render command's machinery): frames while the next one, its due
+// passes and the finish fit the budget, then the finish. One row of the equal-time table; columns
+// are added per row.
+struct TimedRun {
+  int spp = 0;
+  double used_ms = 0;
+  int filter_runs = 0;
+  StageTimes times;
+  RowError error;  // HDR NRMSE, display NRMSE, FLIP
 };
 
-// A filtered capture that stops adding frames when the next one (with its scheduled filter run)
-// and the final filter + blend would exceed the budget; the actual wall time is reported.
-EqualTimeRow run_equal_time(const BenchSetup& b, int budget_frames, double budget_ms, double pt_ms,
-                            double filter_ms, double display_ms, const Image& reference) {
-  Preview preview(b.scene, b.filtered, b.width, b.height);
+TimedRun run_timed(const BenchSetup& b, const PreviewSettings& settings, double budget_ms, const Image& reference) {
   const auto start = Clock::now();
-  for (int k = 1;; ++k) {
-    preview.add_frame(false, false);
-    // Frame k + 1 on a power of two runs the filter anyway, and then it is also the last frame's
-    // filter run: finish() adds none. Otherwise finish() filters once more.
-    const bool scheduled = is_power_of_two(k + 1);
-    const double next = pt_ms + (scheduled ? filter_ms : 0.0);
-    const double finish = (scheduled ? 0.0 : filter_ms) + display_ms;
-    if (elapsed_ms(start) + next + finish > budget_ms) break;
+  Preview preview(b.scene, settings, b.width, b.height);
+  for (int i = 0;; ++i) {
+    if (i > 0 && !next_frame_fits(preview.predict_next_frame(budget_ms, elapsed_ms(start)))) break;
+    preview.add_frame(false, /*display=*/i == 0);  // the first display measures the finish's
   }
   preview.finish();
+  TimedRun run;
+  run.used_ms = elapsed_ms(start);
+  run.spp = preview.samples();
+  run.filter_runs = preview.filter_runs();
+  run.times = preview.total_times();
+  run.error = row_error(preview.final_image(), reference);
+  return run;
+}
+
+struct EqualTimeRow {
+  int budget_frames = 0;
+  double budget_ms = 0;
+  TimedRun filtered, plain;
+};
+
+EqualTimeRow run_equal_time(const BenchSetup& b, int budget_frames, double pt_ms, const Image& reference) {
   EqualTimeRow row;
   row.budget_frames = budget_frames;
-  row.budget_ms = budget_ms;
-  row.filtered_frames = preview.samples();
-  row.filtered_ms = elapsed_ms(start);
-  row.filtered_error = row_error(preview.final_image(), reference);
-  row.filtered_nrmse = row.filtered_error.hdr_nrmse;
+  row.budget_ms = budget_frames * pt_ms;
+  row.plain = run_timed(b, b.plain, row.budget_ms, reference);
+  row.filtered = run_timed(b, b.filtered, row.budget_ms, reference);
   return row;
+}
+
+const char* kEqualTimeCsvHeader =
+    "budget_frames,budget_ms,unfiltered_spp,unfiltered_ms,unfiltered_nrmse_percent,filtered_spp,filtered_ms,"
+    "filtered_filter_runs,filtered_nrmse_percent,filtered_outside_tracing_share,unfiltered_display_nrmse_percent,"
+    "unfiltered_flip,filtered_display_nrmse_percent,filtered_flip\n";
+
+std::string equal_time_csv_row(const EqualTimeRow& r) {
+  std::ostringstream line;
+  line << r.budget_frames << "," << r.budget_ms << "," << r.plain.spp << "," << r.plain.used_ms << ","
+       << r.plain.error.hdr_nrmse << "," << r.filtered.spp << "," << r.filtered.used_ms << ","
+       << r.filtered.filter_runs << "," << r.filtered.error.hdr_nrmse << ","
+       << share_outside_tracing(r.filtered.times, r.filtered.used_ms) << "," << display_csv(r.plain.error) << ","
+       << display_csv(r.filtered.error) << "\n";
+  return line.str();
 }
 
 // The spp at which plain path tracing reaches `target` NRMSE (log-log interpolation); 0 = never.
@@ -207,6 +229,82 @@ std::vector<int> parse_counts(const std::string& option, const std::string& text
     counts.push_back(static_cast<int>(v));
   }
   return counts;
+}
+
+// One scene's row of the per-stage table (thesis Table 3.2): medians over `frames` frames of the
+// scheduled run, and the overhead of the filtered run over the unfiltered one.
+struct StageRow {
+  std::string scene;
+  int width = 0, height = 0, filter_runs = 0;
+  double pt_ms = 0, filter_ms = 0, range_ms = 0, display_ms = 0, filtered_ms = 0, plain_ms = 0;
+  double overhead() const { return plain_ms > 0 ? filtered_ms / plain_ms - 1.0 : 0.0; }
+};
+
+StageRow measure_stages(const BenchSetup& b, const std::string& scene_name, int frames) {
+  Preview filtered(b.scene, b.filtered, b.width, b.height);
+  std::vector<double> pt, filter_app, display;
+  StageRow row;
+  const auto start = Clock::now();
+  for (int i = 0; i < frames; ++i) {
+    filtered.add_frame(i + 1 == frames, false);
+    const StageTimes& t = filtered.last_times();
+    pt.push_back(t.path_tracing);
+    if (t.filter > 0) filter_app.push_back(t.filter + t.upload);
+    if (t.blend > 0) display.push_back(t.blend + t.tonemap);
+    row.range_ms += t.range;
+  }
+  row.filtered_ms = elapsed_ms(start);
+  Preview plain(b.scene, b.plain, b.width, b.height);
+  const auto plain_start = Clock::now();
+  for (int i = 0; i < frames; ++i) plain.add_frame(i + 1 == frames, false);
+  row.plain_ms = elapsed_ms(plain_start);
+  row.scene = scene_name;
+  row.width = b.width;
+  row.height = b.height;
+  row.filter_runs = filtered.filter_runs();
+  row.pt_ms = median_of(pt);
+  row.filter_ms = median_of(filter_app);
+  row.display_ms = median_of(display);
+  return row;
+}
+
+int run_stage_table(SceneOptions scene_options, PreviewOptions preview_options, const CommandLine& cli, int frames,
+                    const std::string& out) {
+  std::printf("per-stage ms over %d frames (scheduled filter runs), every built-in scene:\n", frames);
+  std::printf("   %-10s %9s %8s %9s %8s %8s %5s %9s\n", "scene", "size", "PT ms", "filter", "range", "display",
+              "runs", "overhead");
+  std::ostringstream csv;
+  csv << "scene,width,height,frames,path_tracing_ms,filter_ms,range_ms,blend_tonemap_ms,filter_runs,filtered_ms,"
+         "unfiltered_ms,overhead_percent\n";
+  PlotSeries overhead{"overhead over " + std::to_string(frames) + " frames", {}, {}, true};
+  for (const BuiltinScene& builtin : builtin_scenes()) {
+    SceneOptions so = scene_options;
+    so.scene = builtin.name;
+    if (!cli.given("--size")) so.width = so.height = 0;  // each scene's own default size
+    PreviewOptions po = preview_options;
+    BenchSetup b;
+    b.scene = load_scene_for(so, po, cli);
+    b.width = so.width;
+    b.height = so.height;
+    b.filtered = po.settings;
+    b.plain = b.filtered;
+    b.plain.filter_enabled = false;
+    const StageRow r = measure_stages(b, builtin.name, frames);
+    std::printf("   %-10s %4dx%-4d %8.1f %9.1f %8.1f %8.1f %5d %+8.1f %%\n", r.scene.c_str(), r.width, r.height,
+                r.pt_ms, r.filter_ms, r.range_ms, r.display_ms, r.filter_runs, 100.0 * r.overhead());
+    csv << r.scene << "," << r.width << "," << r.height << "," << frames << "," << r.pt_ms << "," << r.filter_ms << ","
+        << r.range_ms << "," << r.display_ms << "," << r.filter_runs << "," << r.filtered_ms << "," << r.plain_ms
+        << "," << 100.0 * r.overhead() << "\n";
+    overhead.x.push_back(static_cast<double>(overhead.x.size() + 1));
+    overhead.y.push_back(100.0 * r.overhead());
+  }
+  write_text(out + "/stage_table.csv", csv.str());
+  write_svg_plot(out + "/stage_overhead.svg",
+                 {"filtering overhead per built-in scene (x: scene number, order of --scene list)", "scene",
+                  "overhead (%)", false, false},
+                 {overhead});
+  std::printf("wrote %s/stage_table.csv, %s/stage_overhead.svg\n", out.c_str(), out.c_str());
+  return 0;
 }
 
 int run_pathtracer_bench(const BenchSetup& b, int timed) {
@@ -311,18 +409,19 @@ int run_variant_bench(const BenchSetup& b, const Image& reference_hv, int spp, i
 int run_bench(const Args& args) {
   SceneOptions scene_options;
   PreviewOptions preview_options;
-  bool pathtracer = false, variants = false;
+  bool pathtracer = false, variants = false, stage_table = false;
   int variant_spp = 4, variant_rounds = 5;
   std::string extra_taps_text;
-  std::string reference_path, out = "bench-out", budgets_text = "4,16,64";
-  int reference_spp = 4096, frames = 32, max_spp = 1024, timed = 20;
+  std::string reference_path, out = "bench-out", budgets_text = "8,32,128,256";
+  int reference_spp = 2048, frames = 32, max_spp = 1024, timed = 20;
   CommandLine cli("bench", "[options]",
                   "Run time against error on one scene (default cornell, 512x512, default settings):\n"
                   "  1. per-stage times of one scheduled filter application, in ms and in path-tracing frames;\n"
                   "  2. the relative overhead of filtering over --frames frames;\n"
-                  "  3. NRMSE to the reference of unfiltered vs filtered images at equal wall time, at budgets of\n"
-                  "     --budgets unfiltered frames, in HDR and on display values (both tone-mapped with the\n"
-                  "     reference's key and log-average), with the mean LDR-FLIP of the display images;\n"
+                  "  3. NRMSE to the reference of unfiltered vs filtered images at equal wall time of the whole job\n"
+                  "     (the --time machinery), at budgets of --budgets median path-tracing frames, in HDR and on\n"
+                  "     display values (both tone-mapped with the reference's key and log-average), with the mean\n"
+                  "     LDR-FLIP of the display images;\n"
                   "  4. the spp at which unfiltered path tracing reaches the NRMSE of the filtered image at --frames.\n"
                   "The reference (--reference-spp plain path tracing) is cached in --out. Writes CSV and SVG plots.\n"
                   "--pathtracer instead measures paths/s, rays/s and the raw Embree incoherent-ray rate.\n"
@@ -336,17 +435,26 @@ int run_bench(const Args& args) {
   cli.option("--variant-spp", &variant_spp, "spp of the --variants HV buffer (default 4)", 1, 1 << 16);
   cli.option("--variant-rounds", &variant_rounds, "timed rounds of --variants (default 5, after a warm-up)", 1, 1000);
   cli.option("--subsampled-taps", &extra_taps_text, "LIST", "--variants: also the subsampled variant with these tap counts");
+  cli.flag("--stage-table", &stage_table,
+           "per-stage ms and overhead over --frames frames for every built-in scene (no reference)");
   cli.option("--timed-frames", &timed, "timed frames of --pathtracer (after 3 warm-up frames)", 1, 100000);
   cli.option("--reference", &reference_path, "REF.exr", "reference image (default: render and cache one)");
-  cli.option("--reference-spp", &reference_spp, "samples of the rendered reference (default 4096)", 1, 1 << 20);
+  cli.option("--reference-spp", &reference_spp, "samples of the rendered reference (default 2048)", 1, 1 << 20);
   cli.option("--frames", &frames, "frames of the filtered run (default 32)", 1, 1 << 16);
-  cli.option("--budgets", &budgets_text, "LIST", "equal-time budgets in unfiltered frames (default 4,16,64)");
+  cli.option("--budgets", &budgets_text, "LIST", "equal-time budgets in median path-tracing frames (default 8,32,128,256)");
   cli.option("--max-spp", &max_spp, "most unfiltered spp tried to match the filtered NRMSE (default 1024)", 1, 1 << 20);
   cli.option("--out", &out, "DIR", "folder for CSV, plots and the cached reference (default bench-out)");
   if (!cli.parse(args)) return 0;
   if (print_scene_list_if_asked(scene_options)) return 0;
   const std::vector<int> budgets = parse_counts("--budgets", budgets_text);
   const std::vector<int> extra_taps = parse_counts("--subsampled-taps", extra_taps_text);
+  if (stage_table) {
+    std::filesystem::create_directories(out);
+    finish_preview_options(preview_options);
+    if (!preview_options.settings.filter_enabled) throw UsageError("--filter none: nothing to compare against");
+    auto context = create_gl_context(parse_gl_backend(scene_options.gl));
+    return run_stage_table(scene_options, preview_options, cli, frames, out);
+  }
 
   BenchSetup b;
   b.scene = load_scene_for(scene_options, preview_options, cli);
@@ -396,40 +504,34 @@ int run_bench(const Args& args) {
               (filter_ms + range_ms) / pt_ms);
 
   // 2 + 4. The unfiltered run: overhead and convergence.
-  const int max_budget = *std::max_element(budgets.begin(), budgets.end());
-  const PlainRun plain = run_plain(b, std::max({frames, max_budget, 64}), std::max({max_spp, max_budget, frames}),
+  const PlainRun plain = run_plain(b, std::max(frames, 64), std::max(max_spp, frames),
                                    filtered.nrmse, reference);
   const double plain_frames_ms = plain.wall_ms[frames - 1];
   std::printf("\n2. overhead of filtering over %d frames: %.0f ms filtered vs %.0f ms unfiltered = %+.1f %% (%d filter runs)\n",
               frames, filtered.wall_ms, plain_frames_ms, 100.0 * (filtered.wall_ms / plain_frames_ms - 1.0),
               filtered.filter_runs);
 
-  // 3. Equal time.
-  std::printf("\n3. NRMSE to the reference at equal wall time:\n");
-  std::printf("   budget  time ms  unfiltered NRMSE | filtered spp  time ms  NRMSE   ratio"
+  // 3. Equal time: both runs under the same --time budget of N median path-tracing frames.
+  std::printf("\n3. HDR NRMSE to the reference at equal wall time of the whole job (--time = N PT frames):\n");
+  std::printf("   budget  time ms | unfiltered spp  used ms  NRMSE   | filtered spp  used ms  NRMSE    ratio"
               " | display NRMSE unf / filt (ratio)  FLIP unf / filt\n");
   std::ostringstream eq_csv;
-  eq_csv << "budget_frames,budget_ms,unfiltered_nrmse_percent,filtered_spp,filtered_ms,filtered_nrmse_percent,"
-         << display_csv_header("unfiltered_") << "," << display_csv_header("filtered_") << "\n";
-  PlotSeries filtered_points{"filtered (equal time)", {}, {}, true};
+  eq_csv << kEqualTimeCsvHeader;
+  PlotSeries filtered_points{"filtered (--time)", {}, {}, true};
+  PlotSeries plain_points{"unfiltered (--time)", {}, {}, true};
   for (int budget : budgets) {
-    const double budget_ms = plain.wall_ms[budget - 1];
-    double plain_nrmse = 0;
-    RowError plain_error;
-    for (size_t i = 0; i < plain.spp.size(); ++i)
-      if (plain.spp[i] == budget) plain_nrmse = plain.nrmse[i], plain_error = plain.errors[i];
-    EqualTimeRow row = run_equal_time(b, budget, budget_ms, pt_ms, filter_ms, display_ms, reference);
-    row.plain_nrmse = plain_nrmse;
-    row.plain_error = plain_error;
-    std::printf("   %6d %8.0f  %14.3f %%  | %12d %8.0f  %6.3f %%  %5.2fx | %7.3f %% / %7.3f %% (%.2fx)  %.4f / %.4f\n",
-                budget, budget_ms, plain_nrmse, row.filtered_frames, row.filtered_ms, row.filtered_nrmse,
-                plain_nrmse / row.filtered_nrmse, plain_error.display_nrmse, row.filtered_error.display_nrmse,
-                row.filtered_error.display_nrmse / plain_error.display_nrmse, plain_error.flip, row.filtered_error.flip);
-    eq_csv << budget << "," << budget_ms << "," << plain_nrmse << "," << row.filtered_frames << ","
-           << row.filtered_ms << "," << row.filtered_nrmse << "," << display_csv(plain_error) << ","
-           << display_csv(row.filtered_error) << "\n";
-    filtered_points.x.push_back(row.filtered_ms / 1000);
-    filtered_points.y.push_back(row.filtered_nrmse);
+    const EqualTimeRow row = run_equal_time(b, budget, pt_ms, reference);
+    const RowError& u = row.plain.error;
+    const RowError& f = row.filtered.error;
+    std::printf("   %6d %8.0f | %14d %8.0f  %6.3f %% | %12d %8.0f  %6.3f %%  %5.2fx | %7.3f %% / %7.3f %% (%.2fx)  %.4f / %.4f\n",
+                budget, row.budget_ms, row.plain.spp, row.plain.used_ms, u.hdr_nrmse, row.filtered.spp,
+                row.filtered.used_ms, f.hdr_nrmse, f.hdr_nrmse / u.hdr_nrmse, u.display_nrmse, f.display_nrmse,
+                f.display_nrmse / u.display_nrmse, u.flip, f.flip);
+    eq_csv << equal_time_csv_row(row);
+    filtered_points.x.push_back(row.filtered.used_ms / 1000);
+    filtered_points.y.push_back(row.filtered.error.hdr_nrmse);
+    plain_points.x.push_back(row.plain.used_ms / 1000);
+    plain_points.y.push_back(row.plain.error.hdr_nrmse);
   }
   write_text(out + "/equal_time.csv", eq_csv.str());
 
@@ -453,7 +555,7 @@ int run_bench(const Args& args) {
   PlotSeries filtered_end{"filtered " + std::to_string(frames) + " spp", {filtered.wall_ms / 1000}, {filtered.nrmse}, true};
   write_svg_plot(out + "/nrmse_vs_time.svg",
                  {"NRMSE vs wall time: " + scene_options.scene, "wall time (s)", "NRMSE (%)", true, true},
-                 {plain_curve, filtered_points, filtered_end});
+                 {plain_curve, plain_points, filtered_points, filtered_end});
   std::printf("\nwrote %s/stages.csv, equal_time.csv, convergence.csv, nrmse_vs_time.svg\n", out.c_str());
   return 0;
 }

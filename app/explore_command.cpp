@@ -21,6 +21,9 @@ int run_explore(const Args& args) {
   cli.choice("--split", &o.split, buffer_view_names(), "split view: the --view buffer left, this one right");
   cli.option("--inspect", &inspect, "X,Y", "open the pixel inspector at pixel X,Y");
   cli.option("--spp", &o.spp, "stop path tracing at this many samples per pixel (default: never)", 0, 1 << 24);
+  cli.option("--time", &o.time_s,
+             "wall-clock budget in seconds of each accumulation (from its start or a camera change), finish included",
+             0.001, 1e7);
   cli.option("--zoom", &o.zoom, "display zoom of the image (default: fit the window)", 0, 16);
   cli.option("--out", &o.out, "DIR", "capture folder (default out)");
   cli.option("--frames", &o.frames, "quit after N displayed frames (testing)", 0, 1 << 30);

@@ -521,13 +521,19 @@ class Explorer {
     }
   }
 
-  bool spp_reached() const { return options_.spp > 0 && preview_->samples() >= options_.spp; }
+  bool spp_reached() const {
+    if (options_.spp > 0 && preview_->samples() >= options_.spp) return true;
+    if (options_.time_s <= 0 || preview_->samples() == 0) return false;
+    const double elapsed = ms_between(accumulation_start_, Clock::now());
+    return !next_frame_fits(preview_->predict_next_frame(options_.time_s * 1000.0, elapsed));
+  }
 
   // One path-traced frame per display frame, more while they fit in the time budget. At the
   // --spp limit the capture is finished exactly like `pxf render` (last-frame filter run).
   void trace() {
     const int before = preview_->samples();
     if (before < last_samples_) history_.clear();  // the accumulation was reset
+    if (before == 0) accumulation_start_ = Clock::now();  // --time counts from here
     if (paused_ || spp_reached()) {
       if (!finished_ && spp_reached()) preview_->finish(), finished_ = true;
       last_samples_ = preview_->samples();
@@ -539,6 +545,7 @@ class Explorer {
     if (options_.spp > 0) frames = std::min(frames, options_.spp - before);
     const auto start = Clock::now();
     for (int i = 0; i < frames; ++i) {
+      if (i > 0 && spp_reached()) break;  // --time
       const bool last = options_.spp > 0 && before + i + 1 == options_.spp;
       preview_->add_frame(/*last_frame=*/last, /*display=*/i + 1 == frames);
       finished_ = last;
@@ -636,6 +643,7 @@ class Explorer {
   int last_samples_ = 0, auto_scale_counter_ = 0;
   std::string out_dir_, scene_path_, scene_error_, status_message_;
   Clock::time_point started_;
+  Clock::time_point accumulation_start_ = Clock::now();
 };
 
 // The window fits the image at 1:1 (at least) beside the panel, within a usual screen.

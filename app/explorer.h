@@ -18,6 +18,7 @@ struct ExploreOptions {
   std::string screenshot;     // PNG of the whole window (UI included), saved before quitting
   int frames = 0;             // quit after this many displayed frames (0 = when the window closes)
   int spp = 0;                // stop path tracing at this many samples (0 = never)
+  double time_s = 0;          // stop each accumulation within this wall time, finish included (0 = never)
   int zoom = 0;               // display zoom of the image (0 = fit the window)
   bool capture_on_exit = false;
   std::string split;          // split view: the --view buffer left, this one right ("" = no split)

@@ -26,7 +26,9 @@ void add_preview_options(CommandLine& cli, PreviewOptions& o) {
   cli.option("--sigma-d", &s.filter.sigma_d, "range depth sigma, scene units (default 2)", 1e-6f, 1e6f);
   cli.choice("--filter", &o.filter, filter_option_names(), "filter variant (default bilateral-depth)");
   cli.choice("--schedule", &o.schedule, filter_schedule_names(),
-             "when the filter runs: pow2 = at power-of-two sample counts and the last frame (default)");
+             "when the filter runs: budget = at power-of-two sample counts while filter + range stay within\n"
+             "10 % of the tracing time (default); pow2 = at every power of two; every = each frame; all also\n"
+             "the last frame");
   cli.option("--seed", &o.seed, "random seed", 0, 2147483647);
   cli.option("--threads", &s.trace.threads, "path-tracing threads (0 = all cores)", 0, 1024);
   cli.option("--max-vertices", &s.trace.max_vertices, "maximum path length in vertices, camera and light included", 2, 1024);

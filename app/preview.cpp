@@ -1,5 +1,7 @@
 #include "app/preview.h"
 
+#include <algorithm>
+
 #include "pathtracer/bench.h"
 
 namespace pxf {
@@ -43,6 +45,14 @@ StageTimes& StageTimes::operator+=(const StageTimes& o) {
   return *this;
 }
 
+double share_outside_tracing(const StageTimes& t, double wall_ms) {
+  return wall_ms > 0 ? std::max(0.0, wall_ms - t.path_tracing) / wall_ms : 0.0;
+}
+
+double pass_share_of_tracing(const StageTimes& t) {
+  return t.path_tracing > 0 ? (t.filter + t.range) / t.path_tracing : 0.0;
+}
+
 Preview::Preview(const Scene& scene, const PreviewSettings& settings, int width, int height)
     : width_(width),
       height_(height),
@@ -64,7 +74,11 @@ Preview::~Preview() = default;
 
 void Preview::reset() {
   renderer_->reset();
+  // The newest run's cost stays a valid prediction (same size): the share bound then also holds
+  // right after a camera change.
+  const double last_run_ms = schedule_.last_run_ms;
   schedule_ = ScheduleState{};
+  schedule_.last_run_ms = last_run_ms;
   have_filtered_ = false;
   uploaded_ = false;
   filtered_samples_ = -1;
@@ -118,10 +132,13 @@ void Preview::converge_range_buffer() {
 }
 
 void Preview::run_filter() {
+  const double range_before = last_.range;
   converge_range_buffer();
   upload();
   filter_.run(inputs_, range_.guide(), settings_.filter);
   last_.filter += filter_.last_ms();
+  schedule_.last_run_ms = filter_.last_ms() + (last_.range - range_before);
+  schedule_.pass_ms += schedule_.last_run_ms;
   ++filter_runs_;
   filtered_samples_ = samples();
   have_filtered_ = true;
@@ -139,6 +156,7 @@ void Preview::update_hv_empty() {
 }
 
 void Preview::blend_and_tonemap() {
+  const double upload_before = last_.upload;
   upload();
   blend_.run(inputs_, have_filtered_ ? &filter_ : nullptr, range_.guide(),
              BlendParams{settings_.threshold, range_weights(settings_.filter)});
@@ -146,6 +164,7 @@ void Preview::blend_and_tonemap() {
   tonemap_.run(blend_.output(), settings_.tonemap);
   last_.tonemap += tonemap_.last_ms();
   case_counts_ = blend_.case_counts();
+  display_ms_ = last_.upload - upload_before + blend_.last_ms() + tonemap_.last_ms();
 }
 
 void Preview::redisplay() { blend_and_tonemap(); }
@@ -156,6 +175,10 @@ void Preview::add_frame(bool last_frame, bool display) {
   renderer_->add_frame();
   last_.path_tracing = elapsed_ms(start);
   uploaded_ = false;
+  schedule_.tracing_ms += last_.path_tracing;
+  constexpr size_t kRecentFrames = 8;
+  if (recent_frame_ms_.size() == kRecentFrames) recent_frame_ms_.erase(recent_frame_ms_.begin());
+  recent_frame_ms_.push_back(last_.path_tracing);
 
   update_hv_empty();
   schedule_.have_filtered = have_filtered_;
@@ -173,6 +196,17 @@ void Preview::finish_passes() {
       filter_due(settings_.schedule, samples(), true, schedule_))
     run_filter();
   blend_and_tonemap();
+}
+
+TimeBudget Preview::predict_next_frame(double budget_ms, double elapsed_ms) const {
+  MeasuredJob job;
+  job.schedule = settings_.schedule;
+  job.filtering = settings_.filter_enabled;
+  job.samples = samples();
+  job.state = schedule_;
+  job.recent_frame_ms = recent_frame_ms_;
+  job.display_ms = display_ms_;
+  return pxf::predict_next_frame(job, budget_ms, elapsed_ms);
 }
 
 void Preview::finish() {

@@ -28,7 +28,7 @@ struct PreviewSettings {
   float threshold = 0.001f;  // t: allowed perceived (relative) variance
   bool filter_enabled = true;  // false = plain path tracing (--filter none)
   FilterParams filter;         // kind and sigmas; filter.t is kept equal to threshold
-  FilterSchedule schedule = FilterSchedule::PowersOfTwo;
+  FilterSchedule schedule = FilterSchedule::Budget;
   TonemapParams tonemap;
   RangeSettings range;
 };
@@ -45,6 +45,11 @@ struct StageTimes {
   double total() const { return path_tracing + upload + range + filter + blend + tonemap; }
   StageTimes& operator+=(const StageTimes& o);
 };
+
+// Share of a job's wall time spent outside path tracing.
+double share_outside_tracing(const StageTimes& t, double wall_ms);
+// Filter + range time as a share of the path-tracing time (the budget schedule's bound).
+double pass_share_of_tracing(const StageTimes& t);
 
 class Preview {
  public:
@@ -74,6 +79,9 @@ class Preview {
   const StageTimes& last_times() const { return last_; }
   const StageTimes& total_times() const { return total_; }
   int filter_runs() const { return filter_runs_; }
+  // The `--time` prediction for one more frame: its tracing, the passes it makes due, and the
+  // finish after it (last filter run if due, upload, blend, tone map), from measured costs.
+  TimeBudget predict_next_frame(double budget_ms, double elapsed_ms) const;
   bool filter_stopped() const { return schedule_.all_pixels_case2; }
   // Pixels per BlendCase (gl/preview_params.h) of the last displayed frame.
   const std::array<uint32_t, kBlendCaseCount>& case_counts() const { return case_counts_; }
@@ -116,6 +124,8 @@ class Preview {
   int filtered_samples_ = -1;  // sample count of the newest L_f
   StageTimes last_, total_;
   std::array<uint32_t, kBlendCaseCount> case_counts_{};
+  std::vector<double> recent_frame_ms_;  // path tracing of the last frames, for predictions
+  double display_ms_ = 0;                // upload + blend + tone map of the newest display
 };
 
 }  // namespace pxf

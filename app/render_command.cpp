@@ -10,6 +10,7 @@
 #include "app/preview.h"
 #include "app/render_output.h"
 #include "gl/context.h"
+#include "pathtracer/bench.h"
 
 namespace pxf {
 
@@ -55,6 +56,7 @@ int run_render(const Args& args) {
   SceneOptions scene_options;
   PreviewOptions preview_options;
   int spp = 64;
+  double time_s = 0;
   std::string out = "out", reference;
   bool quiet = false;
   CommandLine cli("render", "[options]",
@@ -63,15 +65,24 @@ int run_render(const Args& args) {
                   "blend, case, range_color, depth, samples) and DIR/stats.json. Ctrl-C finishes the current\n"
                   "frame and writes everything. A reference: --filter none --spp 4096.");
   add_scene_options(cli, scene_options, /*headless=*/true);
-  cli.option("--spp", &spp, "samples (path-traced frames) per pixel (default 64)", 1, 1 << 24);
+  cli.option("--spp", &spp, "samples (path-traced frames) per pixel (default 64; unbounded with --time alone)", 1,
+             1 << 24);
+  cli.option("--time", &time_s,
+             "wall-clock budget in seconds of the whole job (load, trace, passes, finish); with --spp: first wins",
+             0.001, 1e7);
   add_preview_options(cli, preview_options);
   cli.option("--reference", &reference, "REF.exr", "report NRMSE of the final and the unfiltered image against it");
   cli.option("--out", &out, "DIR", "output folder (default out)");
   cli.flag("--quiet", &quiet, "no progress bar");
   if (!cli.parse(args)) return 0;
   if (print_scene_list_if_asked(scene_options)) return 0;
+  const double budget_ms = time_s * 1000.0;
+  if (budget_ms > 0 && !cli.given("--spp")) {
+    spp = 1 << 24;
+    quiet = true;  // no total to show progress against
+  }
 
-  const auto start = std::chrono::steady_clock::now();
+  const auto start = BenchClock::now();
   Scene scene = load_scene_for(scene_options, preview_options, cli);
   auto context = create_gl_context(parse_gl_backend(scene_options.gl));
   Preview preview(scene, preview_options.settings, scene_options.width, scene_options.height);
@@ -80,10 +91,14 @@ int run_render(const Args& args) {
   auto previous = std::signal(SIGINT, on_interrupt);
   ProgressBar progress(spp);
   for (int i = 0; i < spp && !g_interrupted; ++i) {
-    preview.add_frame(/*last_frame=*/false, /*display=*/false);
+    // The first frame always traces; the next ones only while they and the finish fit the budget.
+    if (i > 0 && !next_frame_fits(preview.predict_next_frame(budget_ms, elapsed_ms(start)))) break;
+    // With a budget the first frame is displayed: that measures the finish's blend and tone map.
+    preview.add_frame(/*last_frame=*/false, /*display=*/i == 0 && budget_ms > 0);
     if (!quiet) progress.update(i + 1, i + 1 == spp);
   }
   preview.finish();
+  const double used_ms = elapsed_ms(start);
   if (!quiet) progress.finish();
   std::signal(SIGINT, previous);
 
@@ -94,7 +109,9 @@ int run_render(const Args& args) {
   report.gl_backend = context->backend_name();
   report.gl_renderer = context->gl_renderer();
   report.reference_path = reference;
-  report.wall_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  report.budget_ms = budget_ms;
+  report.used_ms = used_ms;
+  report.wall_ms = elapsed_ms(start);
   write_render_outputs(out, preview, report);
 
   const StageTimes& t = preview.total_times();
@@ -103,6 +120,9 @@ int run_render(const Args& args) {
               scene_options.scene.c_str(), preview.width(), preview.height(), preview.samples(),
               report.interrupted ? " (interrupted)" : "", report.wall_ms / 1000.0, t.path_tracing, t.upload, t.range,
               t.filter, preview.filter_runs(), t.blend, t.tonemap);
+  std::printf("outside path tracing: %.1f %% of the job (filter + range %.1f %% of the tracing)\n",
+              100.0 * share_outside_tracing(t, used_ms), 100.0 * pass_share_of_tracing(t));
+  if (budget_ms > 0) std::printf("time budget %.2f s: used %.2f s until the finish\n", budget_ms / 1000.0, used_ms / 1000.0);
   if (report.final_vs_reference)
     std::printf("NRMSE vs reference: final %.3f %%, unfiltered %.3f %%\n", report.final_vs_reference->nrmse_percent,
                 report.unfiltered_vs_reference->nrmse_percent);

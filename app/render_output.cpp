@@ -60,6 +60,9 @@ nlohmann::json stats_json(Preview& preview, const RenderReport& r) {
   j["stage_ms_total"] = times_json(total);
   j["stage_ms_per_frame"] = {{"path_tracing", preview.samples() ? total.path_tracing / preview.samples() : 0.0}};
   j["wall_ms"] = r.wall_ms;
+  j["time_budget"] = {{"budget_ms", r.budget_ms}, {"used_ms", r.used_ms}, {"spp_reached", preview.samples()}};
+  j["share_outside_path_tracing"] = share_outside_tracing(total, r.used_ms > 0 ? r.used_ms : r.wall_ms);
+  j["filter_range_share_of_tracing"] = pass_share_of_tracing(total);
   j["paths_per_second"] = total.path_tracing > 0 ? trace.paths / (total.path_tracing / 1000.0) : 0.0;
   j["rays"] = trace.rays;
   j["filter_runs"] = preview.filter_runs();

@@ -14,6 +14,8 @@ struct RenderReport {
   const SceneOptions* scene = nullptr;
   const PreviewOptions* preview = nullptr;
   double wall_ms = 0;
+  double budget_ms = 0;  // --time (0 = none)
+  double used_ms = 0;    // from the start until the finish (files not included)
   bool interrupted = false;
   std::string gl_backend, gl_renderer;
   std::string reference_path;  // optional: NRMSE of the final and the unfiltered image against it

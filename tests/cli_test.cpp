@@ -65,7 +65,8 @@ TEST(Cli, UsageErrorsExitWithCode2AndOneLine) {
   for (const char* args : {"", "bogus", "render --nope", "render --spp 0", "render --spp", "render --size 3",
                            "render --threshold -1", "render --filter gauss", "render --gl window", "bench --budgets 4,x",
                            "bench --variants --subsampled-taps 0",
-                           "diff only-one.exr", "explore --sigma-s abc"}) {
+                           "diff only-one.exr", "explore --sigma-s abc", "render --time 0", "render --time -3",
+                           "render --time nan", "render --time 1e99", "render --time soon", "render --schedule x"}) {
     const Result r = run(args);
     EXPECT_EQ(r.code, 2) << args;
     if (std::string(args).find(' ') != std::string::npos) EXPECT_EQ(lines(r.err), 1u) << args << ": " << r.err;
@@ -104,7 +105,7 @@ TEST(Cli, BadSceneIsOneLineNamingTheFileAndWritesNothing) {
 
 TEST(Cli, RenderWritesEveryOutput) {
   const std::string out = temp_dir("render");
-  const Result r = run("render --size 32x24 --spp 4 --quiet --out " + out);
+  const Result r = run("render --size 32x24 --spp 4 --schedule pow2 --quiet --out " + out);
   ASSERT_EQ(r.code, 0) << r.err;
   for (const char* file : {"final.png", "final.exr", "buffers.exr", "stats.json"}) EXPECT_TRUE(fs::exists(out + "/" + file));
   std::vector<std::string> names;
@@ -144,6 +145,28 @@ TEST(Cli, BenchVariantsTabulatesEveryFilterVariant) {
   }
   EXPECT_EQ(lines(csv), rows.size() + 2);  // the header and the unfiltered row
   EXPECT_TRUE(fs::exists(out + "/variants.svg"));
+}
+
+TEST(Cli, RenderWithTimeStopsByItselfAndFinishes) {
+  // No --spp: only the budget stops it. The finish filters the last frame and writes everything.
+  const std::string out = temp_dir("render_time");
+  const Result r = run("render --size 32x24 --time 2 --out " + out);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto stats = nlohmann::json::parse(slurp(out + "/stats.json"));
+  EXPECT_EQ(stats["time_budget"]["budget_ms"].get<double>(), 2000.0);
+  const int spp = stats["time_budget"]["spp_reached"].get<int>();
+  EXPECT_GE(spp, 1);
+  EXPECT_LT(spp, 1 << 24);
+  EXPECT_EQ(stats["settings"]["spp"].get<int>(), spp);
+  EXPECT_GE(stats["filter_runs"].get<int>(), 1);  // the finish's run at least
+  EXPECT_GT(stats["time_budget"]["used_ms"].get<double>(), 0.0);
+  const double share = stats["share_outside_path_tracing"].get<double>();
+  EXPECT_TRUE(share >= 0.0 && share <= 1.0) << share;
+  EXPECT_NE(r.out.find("time budget 2.00 s"), std::string::npos) << r.out;
+  // With --spp too, whichever comes first: 3 spp arrive long before 60 s.
+  const Result r2 = run("render --size 32x24 --time 60 --spp 3 --quiet --out " + out);
+  ASSERT_EQ(r2.code, 0) << r2.err;
+  EXPECT_EQ(nlohmann::json::parse(slurp(out + "/stats.json"))["time_budget"]["spp_reached"].get<int>(), 3);
 }
 
 TEST(Cli, NoFilterAndNoRangePassWhenTheHvBufferIsEmpty) {
