@@ -156,8 +156,9 @@ class Explorer {
   // --- scene ---------------------------------------------------------------------------------
   void load(const std::string& path, bool first) {
     try {
-      auto scene = std::make_unique<Scene>(load_scene(path, first ? options_.scene.env : "", options_.scene.env_strength));
-      for (const std::string& w : scene->warnings) std::fprintf(stderr, "pxf: warning: %s\n", w.c_str());
+      auto scene = std::make_unique<Scene>(load_scene(path, first ? options_.scene.env : "", options_.scene.env_strength,
+                                                      parse_default_light(options_.scene.default_light)));
+      print_scene_messages(*scene);
       if (!options_.all_hv_given) settings_.trace.all_hv = scene->defaults.all_hv;
       if (first) size_image(*scene);
       auto preview = std::make_unique<Preview>(*scene, settings_, width_, height_);

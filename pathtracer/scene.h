@@ -119,6 +119,7 @@ struct Scene {
   Camera camera;
   SceneDefaults defaults;
   std::vector<std::string> warnings;  // what the loader skipped or substituted, one line each
+  std::vector<std::string> notes;     // what the loader added that a user should know (the default light)
 
   size_t triangle_count() const;
 };

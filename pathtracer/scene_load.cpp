@@ -18,6 +18,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "image/image.h"
+#include "pathtracer/default_light.h"
 #include "pathtracer/gltf_accessor.h"
 #include "pathtracer/gltf_geometry.h"
 #include "pathtracer/gltf_images.h"
@@ -690,14 +691,44 @@ class GltfLoader {
 // ---------------------------------------------------------------------------------------------
 // Environment
 
+enum class FileKind { Exr, RadianceHdr, Gltf, Glb, Other };
+
+// The format by its first bytes, not its name: a renamed or mislabelled file still gets the
+// right reader or a clear error.
+FileKind sniff_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path + ": cannot open file");
+  char head[10] = {};
+  in.read(head, sizeof head);
+  std::string bytes(head, static_cast<size_t>(in.gcount()));
+  if (bytes.compare(0, 4, "\x76\x2f\x31\x01") == 0) return FileKind::Exr;
+  if (bytes.compare(0, 2, "#?") == 0) return FileKind::RadianceHdr;
+  if (bytes.compare(0, 4, "glTF") == 0) return FileKind::Glb;
+  size_t first = bytes.find_first_not_of(" \t\r\n\xef\xbb\xbf");
+  if (first != std::string::npos && bytes[first] == '{') return FileKind::Gltf;
+  return FileKind::Other;
+}
+
+// The environment image as linear float RGB(A)/Y channels, by format.
+Image read_environment_image(const std::string& path) {
+  switch (sniff_file(path)) {
+    case FileKind::Exr: return read_exr(path);
+    case FileKind::RadianceHdr: return read_ldr_or_hdr(path);
+    default: throw Error(path + ": not a supported environment map (supported: OpenEXR .exr, Radiance .hdr)");
+  }
+}
+
 Environment load_environment(const std::string& path, float strength, std::vector<std::string>& warnings) {
   if (!std::isfinite(strength) || strength < 0.0f)
     throw Error(path + ": environment strength " + std::to_string(strength) + " must be finite and >= 0");
-  Image image = read_exr(path);
+  Image image = read_environment_image(path);
   int r = image.channel_index("R"), g = image.channel_index("G"), b = image.channel_index("B");
   int y = image.channel_index("Y");
   if ((r < 0 || g < 0 || b < 0) && y < 0) throw Error(path + ": environment map needs R, G, B (or Y) channels");
   if (image.empty()) throw Error(path + ": environment map is empty");
+  if (image.width != 2 * image.height)
+    warnings.push_back(path + ": environment map is " + std::to_string(image.width) + "x" + std::to_string(image.height) +
+                       ", not 2:1; read as equirectangular (latitude-longitude) anyway");
   Environment env;
   env.strength = strength;
   env.source = path;
@@ -721,9 +752,22 @@ Environment load_environment(const std::string& path, float strength, std::vecto
                         : glm::vec3(image.at(px, py, y));
       tex.texels[static_cast<size_t>(py) * image.width + px] = glm::vec4(clean(c.x), clean(c.y), clean(c.z), 1.0f);
     }
+  bool any_light = std::any_of(tex.texels.begin(), tex.texels.end(),
+                               [](const glm::vec4& t) { return t.x > 0.0f || t.y > 0.0f || t.z > 0.0f; });
+  if (!any_light) throw Error(path + ": environment map has no positive radiance (it would light nothing)");
   if (replaced)
     warnings.push_back(path + ": replaced " + std::to_string(replaced) + " NaN/Inf/negative environment values by 0");
   return env;
+}
+
+// An image passed as the scene gets told so, rather than reaching the JSON parser.
+void check_scene_file(const std::string& path) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) return;  // the glTF loader names the missing file
+  FileKind kind = sniff_file(path);
+  if (kind == FileKind::Exr || kind == FileKind::RadianceHdr)
+    throw Error(path + ": is an environment image, not a scene (--scene takes a .gltf/.glb file or a built-in name; "
+                "pass environment maps with --env)");
 }
 
 }  // namespace
@@ -738,7 +782,8 @@ std::vector<BuiltinScene> builtin_scenes() {
   return scenes;
 }
 
-Scene load_scene(const std::string& name_or_path, const std::string& env_path, float env_strength) {
+Scene load_scene(const std::string& name_or_path, const std::string& env_path, float env_strength,
+                 DefaultLight default_light) {
   std::string path = name_or_path;
   std::string builtin_env;
   for (const BuiltinScene& builtin : builtin_scenes())
@@ -748,10 +793,18 @@ Scene load_scene(const std::string& name_or_path, const std::string& env_path, f
       std::error_code ec;
       if (fs::is_regular_file(env, ec)) builtin_env = env;
     }
+  // Every input is checked before the (possibly long) scene load, so a bad --env fails at once.
+  std::vector<std::string> env_warnings;
+  std::string env = env_path.empty() ? builtin_env : env_path;
+  std::optional<Environment> environment;
+  if (!env.empty()) environment = load_environment(env, env_strength, env_warnings);
+  check_scene_file(path);
   Scene scene = GltfLoader(path).load();
   scene.source = name_or_path;
-  std::string env = env_path.empty() ? builtin_env : env_path;
-  if (!env.empty()) scene.environment = load_environment(env, env_strength, scene.warnings);
+  scene.warnings.insert(scene.warnings.end(), env_warnings.begin(), env_warnings.end());
+  if (environment) scene.environment = std::move(environment);
+  std::string note = apply_default_light(scene, default_light);
+  if (!note.empty()) (default_light == DefaultLight::None ? scene.warnings : scene.notes).push_back(note);
   return scene;
 }
 
