@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "gl/context.h"
+#include "pathtracer/auto_camera.h"
 #include "pathtracer/pathtracer.h"
 
 namespace pxf {
@@ -64,6 +65,7 @@ Scene load_scene_for(SceneOptions& options, PreviewOptions& preview, const Comma
     options.width = scene.defaults.width > 0 ? scene.defaults.width : 512;
     options.height = scene.defaults.height > 0 ? scene.defaults.height : 512;
   }
+  if (scene.automatic_camera) scene.camera = frame_scene(scene, static_cast<float>(options.width) / options.height);
   if (!cli.given("--all-hv") && scene.defaults.all_hv) preview.all_hv = true;
   finish_preview_options(preview);
   return scene;

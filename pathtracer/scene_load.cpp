@@ -18,6 +18,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "image/image.h"
+#include "pathtracer/auto_camera.h"
 #include "pathtracer/default_light.h"
 #include "pathtracer/gltf_accessor.h"
 #include "pathtracer/gltf_geometry.h"
@@ -174,8 +175,8 @@ class GltfLoader {
     images_.decode_buffer_view_images(model_, file_);
     load_materials();
     traverse_scene();
+    read_scene_defaults();  // before the camera: the default image aspect frames the model
     finish_camera();
-    read_scene_defaults();
     report_dropped_triangles();
     return std::move(scene_);
   }
@@ -452,8 +453,9 @@ class GltfLoader {
     if (index >= static_cast<int>(model_.cameras.size())) fail("camera " + std::to_string(index) + " out of range");
     if (have_camera_) return;  // the first camera in the hierarchy wins
     const tinygltf::Camera& camera = model_.cameras[index];
+    if (camera.type == "orthographic") return add_orthographic_camera(index, camera.orthographic, world);
     if (camera.type != "perspective") {
-      warn("camera " + std::to_string(index) + " is " + camera.type + ", only perspective cameras are supported; ignoring it");
+      warn("camera " + std::to_string(index) + " is of type '" + camera.type + "' (perspective or orthographic); ignoring it");
       return;
     }
     const auto& p = camera.perspective;
@@ -468,6 +470,28 @@ class GltfLoader {
     out.zfar = infinite_far_ ? Camera{}.zfar : zfar;
     float aspect = finite_or(p.aspectRatio, 0.0f);
     out.aspect = aspect > 0.0f ? aspect : 0.0f;
+    have_camera_ = true;
+  }
+
+  // glTF's xmag/ymag are half-extents; the image aspect wins over xmag as it does over aspectRatio.
+  void add_orthographic_camera(int index, const tinygltf::OrthographicCamera& o, const glm::mat4& world) {
+    float ymag = std::fabs(finite_or(o.ymag, 0.0f));
+    if (!(ymag > 0.0f)) {
+      warn("orthographic camera " + std::to_string(index) + " has ymag " + std::to_string(o.ymag) + "; ignoring it");
+      return;
+    }
+    Camera& out = scene_.camera;
+    out = Camera{};
+    out.camera_to_world = rigid_frame(world);
+    out.orthographic = true;
+    out.ymag = ymag;
+    float xmag = std::fabs(finite_or(o.xmag, 0.0f));
+    out.aspect = xmag > 0.0f ? xmag / ymag : 0.0f;
+    float znear = finite_or(o.znear, 0.0f);
+    out.znear = znear >= 0.0f ? znear : 0.0f;
+    float zfar = finite_or(o.zfar, 0.0f);
+    infinite_far_ = !(zfar > out.znear);  // zfar is required for orthographic; bad values are widened
+    out.zfar = infinite_far_ ? Camera{}.zfar : zfar;
     have_camera_ = true;
   }
 
@@ -641,13 +665,10 @@ class GltfLoader {
     glm::vec3 center = 0.5f * (lo + hi);
     float radius = std::max(0.5f * glm::length(hi - lo), 1e-3f);
     if (!have_camera_) {
-      // Frame the bounding sphere from +Z, looking down -Z (glTF's camera convention).
-      Camera camera;
-      float distance = radius / std::sin(0.5f * camera.yfov) * 1.05f;
-      camera.camera_to_world = glm::translate(glm::mat4(1.0f), center + glm::vec3(0.0f, 0.0f, distance));
-      camera.znear = std::max(distance * 1e-3f, 1e-4f);
-      camera.zfar = (distance + radius) * 2.0f;
-      scene_.camera = camera;
+      const SceneDefaults& d = scene_.defaults;
+      float aspect = d.width > 0 && d.height > 0 ? static_cast<float>(d.width) / d.height : 1.0f;
+      scene_.camera = frame_bounds(lo, hi, aspect);
+      scene_.automatic_camera = true;
       return;
     }
     if (infinite_far_) {

@@ -510,15 +510,35 @@ TEST(SceneLoadCamera, DefaultCameraFramesTheSceneBounds) {
   GltfBuilder b;
   b.scene({b.node({{"mesh", b.mesh(b.quad_primitive())}, {"translation", {10, 0, 0}}})});
   Scene scene = load_scene(b.write_gltf(dir + "/nocam.gltf"));
+  // The quad [10, 11] x [0, 1] at z = 0 is seen from its front, centered and inside the frame
+  // (auto_camera_test.cpp checks the framing itself).
   glm::vec3 eye(scene.camera.camera_to_world[3]);
-  EXPECT_NEAR(eye.x, 10.5f, 1e-5f);
-  EXPECT_NEAR(eye.y, 0.5f, 1e-5f);
+  glm::vec3 forward = -glm::vec3(scene.camera.camera_to_world[2]);
   EXPECT_GT(eye.z, 0.0f);
-  // The whole quad is inside the vertical field of view.
-  float half = std::atan(0.5f / eye.z);
-  EXPECT_LT(half, 0.5f * scene.camera.yfov);
-  EXPECT_LT(scene.camera.znear, eye.z);
-  EXPECT_GT(scene.camera.zfar, eye.z);
+  glm::vec3 to_center = glm::normalize(glm::vec3(10.5f, 0.5f, 0.0f) - eye);
+  EXPECT_GT(glm::dot(to_center, forward), 0.999f);
+  for (glm::vec3 corner : {glm::vec3(10, 0, 0), glm::vec3(11, 1, 0)}) {
+    glm::vec3 q = corner - eye;
+    float depth = glm::dot(q, forward);
+    EXPECT_LT(std::fabs(glm::dot(q, glm::vec3(scene.camera.camera_to_world[1]))) / depth, std::tan(0.5f * scene.camera.yfov));
+    EXPECT_GT(depth, scene.camera.znear);
+    EXPECT_LT(depth, scene.camera.zfar);
+  }
+}
+
+TEST(SceneLoadCamera, OrthographicCameraKeepsYmagAndItsFrame) {
+  std::string dir = temp_dir();
+  GltfBuilder b;
+  b.doc["cameras"] = {{{"type", "orthographic"}, {"orthographic", {{"xmag", 3.0}, {"ymag", 1.5}, {"znear", 0.0}, {"zfar", 50.0}}}}};
+  b.scene({b.node({{"camera", 0}, {"translation", {0, 0, 5}}}), b.node({{"mesh", b.mesh(b.quad_primitive())}})});
+  Scene scene = load_scene(b.write_gltf(dir + "/ortho.gltf"));
+  EXPECT_TRUE(scene.camera.orthographic);
+  EXPECT_FLOAT_EQ(scene.camera.ymag, 1.5f);
+  EXPECT_FLOAT_EQ(scene.camera.aspect, 2.0f);
+  EXPECT_FLOAT_EQ(scene.camera.znear, 0.0f);
+  EXPECT_FLOAT_EQ(scene.camera.zfar, 50.0f);
+  expect_vec3_near(glm::vec3(scene.camera.camera_to_world[3]), {0, 0, 5});
+  EXPECT_TRUE(scene.warnings.empty() || !any_warning_contains(scene, "camera")) << warnings_of(scene);
 }
 
 TEST(SceneLoadLights, PunctualLightsOfAllThreeTypes) {
