@@ -146,6 +146,8 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
   }
   SurfacePoint sp = geometry_.surface_point(hit, path.ray);
   const Material& material = *sp.material;
+  // Reaching a back face of an absorbing medium's boundary: the segment just traced ran inside it.
+  if (!sp.front_face && material.has_volume()) s.throughput *= volume_transmittance(material, hit.t);
   if (material.is_emissive() && (sp.front_face || material.double_sided)) {
     float w = 1.0f;
     if (!s.prev_delta)

@@ -51,11 +51,16 @@ struct Material {
   TextureRef specular_texture;          // A
   glm::vec3 specular_color{1.0f};
   TextureRef specular_color_texture;    // RGB
+  // KHR_materials_volume: absorption coefficient per scene unit, -ln(attenuationColor) /
+  // attenuationDistance; 0 = clear or thin-walled (thicknessFactor 0). The medium is the inside
+  // of the closed mesh, entered through its front faces.
+  glm::vec3 attenuation{0.0f};
   AlphaMode alpha_mode = AlphaMode::Opaque;
   float alpha_cutoff = 0.5f;
   bool double_sided = false;
 
   bool is_emissive() const { return emissive.x > 0 || emissive.y > 0 || emissive.z > 0; }
+  bool has_volume() const { return attenuation.x > 0 || attenuation.y > 0 || attenuation.z > 0; }
 };
 
 // One glTF primitive instance in world space. Optional attributes are empty when absent.

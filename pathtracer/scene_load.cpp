@@ -46,6 +46,7 @@ const std::set<std::string>& supported_extensions() {
   static const std::set<std::string> names = {
       "KHR_lights_punctual",      "KHR_texture_transform", "KHR_materials_emissive_strength",
       "KHR_materials_transmission", "KHR_materials_ior",   "KHR_materials_specular",
+      "KHR_materials_volume",
       "KHR_mesh_quantization"};
   return names;
 }
@@ -405,11 +406,26 @@ class GltfLoader {
       m.specular_color = glm::max(value_vec3_or(ext->Get("specularColorFactor"), glm::vec3(1.0f)), glm::vec3(0.0f));
       m.specular_color_texture = texture_ref(info_of(ext->Get("specularColorTexture")), true, m.name, "specular color");
     }
+    if (const tinygltf::Value* ext = find_extension(gm.extensions, "KHR_materials_volume")) read_volume(*ext, m);
     if (gm.alphaMode == "MASK") m.alpha_mode = AlphaMode::Mask;
     else if (gm.alphaMode == "BLEND") m.alpha_mode = AlphaMode::Blend;
     m.alpha_cutoff = std::max(finite_or(gm.alphaCutoff, 0.5f), 0.0f);
     m.double_sided = gm.doubleSided;
     return m;
+  }
+
+  // Beer-Lambert coefficient from attenuationColor (the color left after attenuationDistance).
+  // thicknessFactor 0 means thin-walled: no medium. A thickness texture only matters for
+  // rasterizers that do not trace the real path length, so it is not read.
+  void read_volume(const tinygltf::Value& ext, Material& m) {
+    double thickness = number_or(ext.Get("thicknessFactor"), 0.0);
+    const tinygltf::Value& distance_value = ext.Get("attenuationDistance");
+    double distance = distance_value.IsNumber() ? distance_value.GetNumberAsDouble() : 0.0;
+    if (!(thickness > 0.0) || !(distance > 0.0) || !std::isfinite(distance)) return;  // thin or clear
+    if (m.transmission <= 0.0f)
+      warn("material '" + m.name + "' has KHR_materials_volume without transmission; its volume is never entered");
+    glm::vec3 color = glm::clamp(value_vec3_or(ext.Get("attenuationColor"), glm::vec3(1.0f)), glm::vec3(1e-6f), glm::vec3(1.0f));
+    m.attenuation = -glm::log(color) / static_cast<float>(distance);
   }
 
   // -- node hierarchy ---------------------------------------------------------------------------

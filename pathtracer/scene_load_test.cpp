@@ -1069,6 +1069,26 @@ TEST(SceneLoadEnvironment, ImagePassedAsTheSceneIsNamedAsSuch) {
   EXPECT_NE(msg.find("environment image, not a scene"), std::string::npos) << msg;
 }
 
+TEST(SceneLoadMaterial, KhrMaterialsVolumeGivesTheBeerLambertCoefficient) {
+  std::string dir = temp_dir();
+  GltfBuilder b;
+  b.doc["extensionsUsed"] = {"KHR_materials_transmission", "KHR_materials_volume"};
+  auto volume = [&](json v) {
+    return b.material({{"extensions", {{"KHR_materials_transmission", {{"transmissionFactor", 1.0}}}, {"KHR_materials_volume", v}}}});
+  };
+  int absorbing = volume({{"thicknessFactor", 1.0}, {"attenuationDistance", 0.5}, {"attenuationColor", {0.5, 0.25, 1.0}}});
+  int thin = volume({{"thicknessFactor", 0.0}, {"attenuationDistance", 0.5}, {"attenuationColor", {0.5, 0.25, 1.0}}});
+  int clear = volume({{"thicknessFactor", 1.0}, {"attenuationColor", {0.5, 0.25, 1.0}}});  // distance: infinite
+  b.scene({b.node({{"mesh", b.mesh(b.quad_primitive(absorbing))}}), b.node({{"mesh", b.mesh(b.quad_primitive(thin))}}),
+           b.node({{"mesh", b.mesh(b.quad_primitive(clear))}})});
+  Scene scene = load_scene(b.write_gltf(dir + "/volume.gltf"));
+  // After attenuationDistance the light left is attenuationColor: exp(-sigma 0.5) = color.
+  expect_vec3_near(scene.materials[absorbing].attenuation, -glm::log(glm::vec3(0.5f, 0.25f, 1.0f)) / 0.5f);
+  EXPECT_FALSE(scene.materials[thin].has_volume());
+  EXPECT_FALSE(scene.materials[clear].has_volume());
+  EXPECT_FALSE(any_warning_contains(scene, "KHR_materials_volume")) << warnings_of(scene);
+}
+
 // ----------------------------------------------------------------------------------------------
 // Default light
 
