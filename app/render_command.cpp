@@ -9,6 +9,7 @@
 #include "app/options.h"
 #include "app/preview.h"
 #include "app/render_output.h"
+#include "pathtracer/bench.h"
 #include "gl/context.h"
 
 namespace pxf {
@@ -73,6 +74,7 @@ int run_render(const Args& args) {
 
   const auto start = std::chrono::steady_clock::now();
   Scene scene = load_scene_for(scene_options, preview_options, cli);
+  const double load_ms = elapsed_ms(start);
   auto context = create_gl_context(parse_gl_backend(scene_options.gl));
   Preview preview(scene, preview_options.settings, scene_options.width, scene_options.height);
 
@@ -94,6 +96,7 @@ int run_render(const Args& args) {
   report.gl_backend = context->backend_name();
   report.gl_renderer = context->gl_renderer();
   report.reference_path = reference;
+  report.load_ms = load_ms;
   report.wall_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   write_render_outputs(out, preview, report);
 

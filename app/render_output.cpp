@@ -1,4 +1,5 @@
 #include "app/render_output.h"
+#include "pathtracer/bench.h"
 
 #include <filesystem>
 #include <fstream>
@@ -60,6 +61,8 @@ nlohmann::json stats_json(Preview& preview, const RenderReport& r) {
   j["stage_ms_total"] = times_json(total);
   j["stage_ms_per_frame"] = {{"path_tracing", preview.samples() ? total.path_tracing / preview.samples() : 0.0}};
   j["wall_ms"] = r.wall_ms;
+  j["load_ms"] = r.load_ms;
+  j["peak_memory_mib"] = peak_memory_mib();
   j["paths_per_second"] = total.path_tracing > 0 ? trace.paths / (total.path_tracing / 1000.0) : 0.0;
   j["rays"] = trace.rays;
   j["filter_runs"] = preview.filter_runs();

@@ -14,6 +14,7 @@ struct RenderReport {
   const SceneOptions* scene = nullptr;
   const PreviewOptions* preview = nullptr;
   double wall_ms = 0;
+  double load_ms = 0;  // the scene and environment load (load_scene_for)
   bool interrupted = false;
   std::string gl_backend, gl_renderer;
   std::string reference_path;  // optional: NRMSE of the final and the unfiltered image against it
