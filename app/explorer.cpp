@@ -12,6 +12,7 @@
 #include "app/explorer_views.h"
 #include "app/preview.h"
 #include "app/render_output.h"
+#include "pathtracer/auto_camera.h"
 #include "gl/context.h"
 #include "gl/gl.h"
 #define GLFW_INCLUDE_NONE
@@ -156,10 +157,12 @@ class Explorer {
   // --- scene ---------------------------------------------------------------------------------
   void load(const std::string& path, bool first) {
     try {
-      auto scene = std::make_unique<Scene>(load_scene(path, first ? options_.scene.env : "", options_.scene.env_strength));
-      for (const std::string& w : scene->warnings) std::fprintf(stderr, "pxf: warning: %s\n", w.c_str());
+      auto scene = std::make_unique<Scene>(load_scene(path, first ? options_.scene.env : "", options_.scene.env_strength,
+                                                      parse_default_light(options_.scene.default_light)));
+      print_scene_messages(*scene);
       if (!options_.all_hv_given) settings_.trace.all_hv = scene->defaults.all_hv;
       if (first) size_image(*scene);
+      if (scene->automatic_camera) scene->camera = frame_scene(*scene, static_cast<float>(width_) / height_);
       auto preview = std::make_unique<Preview>(*scene, settings_, width_, height_);
       controller_ = std::make_unique<CameraController>(scene->camera, scene_bounds(*scene));
       preview_ = std::move(preview);  // the old preview goes before its scene

@@ -63,8 +63,10 @@ void CameraController::orbit(float dx, float dy) {
 }
 
 void CameraController::pan(float dx, float dy, float image_height) {
+  // The view height in scene units at the target: fixed for an orthographic camera.
   const float distance = glm::length(target_ - eye_);
-  const float units_per_pixel = 2.0f * distance * std::tan(0.5f * camera_.yfov) / std::max(image_height, 1.0f);
+  const float view_height = camera_.orthographic ? 2.0f * camera_.ymag : 2.0f * distance * std::tan(0.5f * camera_.yfov);
+  const float units_per_pixel = view_height / std::max(image_height, 1.0f);
   const glm::vec3 right(camera_.camera_to_world[0]), up(camera_.camera_to_world[1]);
   const glm::vec3 move = (-dx * glm::normalize(right) + dy * glm::normalize(up)) * units_per_pixel;
   eye_ += move;
@@ -73,6 +75,10 @@ void CameraController::pan(float dx, float dy, float image_height) {
 }
 
 void CameraController::zoom(float wheel_steps) {
+  if (camera_.orthographic) {  // moving an orthographic camera changes nothing on screen: narrow the view
+    camera_.ymag = std::max(camera_.ymag * std::pow(0.85f, wheel_steps), 1e-4f * bounds_.radius());
+    return;
+  }
   const glm::vec3 offset = eye_ - target_;
   const float distance = std::max(glm::length(offset) * std::pow(0.85f, wheel_steps), 1e-3f * bounds_.radius());
   eye_ = target_ + glm::normalize(offset) * distance;

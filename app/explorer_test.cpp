@@ -67,6 +67,24 @@ TEST(ExplorerCamera, PanMovesEyeAndTargetTogetherZoomAndFlyMoveAlongTheView) {
   EXPECT_NEAR(control.eye().x, before.x, 1e-4f);
 }
 
+// An orthographic camera: zoom narrows the view (moving would change nothing on screen), pan
+// moves by the view height (2 ymag) per image height, reset restores ymag.
+TEST(ExplorerCamera, OrthographicZoomNarrowsTheViewAndPanFollowsTheCursor) {
+  Camera home = test_camera();
+  home.orthographic = true;
+  home.ymag = 2.0f;
+  CameraController control(home, kUnitBox);
+  const glm::vec3 eye = control.eye();
+  control.zoom(1);
+  EXPECT_NEAR(control.camera().ymag, 2.0f * 0.85f, 1e-6f);
+  expect_near(control.eye(), eye);
+  control.pan(-50, 0, 100);  // half the image height to the left: the camera moves ymag to the right
+  EXPECT_NEAR(control.eye().x - eye.x, 0.5f * 2.0f * control.camera().ymag, 1e-4f);
+  EXPECT_TRUE(control.camera().orthographic);
+  control.reset();
+  EXPECT_FLOAT_EQ(control.camera().ymag, 2.0f);
+}
+
 TEST(ExplorerViews, NamesDigitsAndScalarViews) {
   EXPECT_EQ(buffer_view_names().size(), static_cast<size_t>(kBufferViewCount));
   for (const std::string& name : buffer_view_names())

@@ -3,13 +3,16 @@
 #include <cstdio>
 
 #include "gl/context.h"
+#include "pathtracer/auto_camera.h"
 #include "pathtracer/pathtracer.h"
 
 namespace pxf {
 
 void add_scene_options(CommandLine& cli, SceneOptions& o, bool headless) {
   cli.option("--scene", &o.scene, "NAME|FILE.gltf", "built-in scene name, a .gltf/.glb file, or 'list' (default cornell)");
-  cli.option("--env", &o.env, "FILE.exr", "equirectangular environment map replacing the scene's");
+  cli.option("--env", &o.env, "FILE.exr|FILE.hdr", "equirectangular environment map (OpenEXR or Radiance) replacing the scene's");
+  cli.choice("--default-light", &o.default_light, default_light_names(),
+             "environment for a scene without lights: sky (default), studio, none (black)");
   cli.option("--env-strength", &o.env_strength, "environment radiance scale", 0.0f, 1e6f);
   cli.size_option("--size", &o.width, &o.height, "image size (default: the scene's, else 512x512)");
   if (headless)
@@ -44,6 +47,11 @@ bool print_scene_list_if_asked(const SceneOptions& options) {
   return true;
 }
 
+void print_scene_messages(const Scene& scene) {
+  for (const std::string& n : scene.notes) std::fprintf(stderr, "pxf: %s\n", n.c_str());
+  for (const std::string& w : scene.warnings) std::fprintf(stderr, "pxf: warning: %s\n", w.c_str());
+}
+
 void finish_preview_options(PreviewOptions& o) {
   set_filter_option(o.settings, o.filter);
   o.settings.schedule = parse_filter_schedule(o.schedule);
@@ -53,12 +61,13 @@ void finish_preview_options(PreviewOptions& o) {
 }
 
 Scene load_scene_for(SceneOptions& options, PreviewOptions& preview, const CommandLine& cli) {
-  Scene scene = load_scene(options.scene, options.env, options.env_strength);
-  for (const std::string& w : scene.warnings) std::fprintf(stderr, "pxf: warning: %s\n", w.c_str());
+  Scene scene = load_scene(options.scene, options.env, options.env_strength, parse_default_light(options.default_light));
+  print_scene_messages(scene);
   if (options.width == 0) {
     options.width = scene.defaults.width > 0 ? scene.defaults.width : 512;
     options.height = scene.defaults.height > 0 ? scene.defaults.height : 512;
   }
+  if (scene.automatic_camera) scene.camera = frame_scene(scene, static_cast<float>(options.width) / options.height);
   if (!cli.given("--all-hv") && scene.defaults.all_hv) preview.all_hv = true;
   finish_preview_options(preview);
   return scene;

@@ -10,8 +10,9 @@ namespace pxf {
 
 struct SceneOptions {
   std::string scene = "cornell";  // built-in name or glTF path; "list" prints the built-ins
-  std::string env;                // equirect EXR replacing the scene's environment
+  std::string env;                // equirect EXR or .hdr replacing the scene's environment
   float env_strength = 1.0f;
+  std::string default_light = "sky";  // default_light_names(): lights a scene that has no light
   int width = 0, height = 0;      // 0 = the scene's default, else 512x512
   std::string gl = "auto";
 };
@@ -31,6 +32,8 @@ void add_preview_options(CommandLine& cli, PreviewOptions& options);
 bool print_scene_list_if_asked(const SceneOptions& options);
 // Loads the scene, applies its render defaults (size, all_hv unless given on the command line).
 Scene load_scene_for(SceneOptions& options, PreviewOptions& preview, const CommandLine& cli);
+// Prints the scene's notes and warnings to stderr, one "pxf: ..." line each.
+void print_scene_messages(const Scene& scene);
 // Resolves the names of PreviewOptions into its settings.
 void finish_preview_options(PreviewOptions& options);
 

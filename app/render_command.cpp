@@ -9,6 +9,7 @@
 #include "app/options.h"
 #include "app/preview.h"
 #include "app/render_output.h"
+#include "pathtracer/bench.h"
 #include "gl/context.h"
 #include "pathtracer/bench.h"
 
@@ -84,6 +85,7 @@ int run_render(const Args& args) {
 
   const auto start = BenchClock::now();
   Scene scene = load_scene_for(scene_options, preview_options, cli);
+  const double load_ms = elapsed_ms(start);
   auto context = create_gl_context(parse_gl_backend(scene_options.gl));
   Preview preview(scene, preview_options.settings, scene_options.width, scene_options.height);
 
@@ -112,6 +114,7 @@ int run_render(const Args& args) {
   report.budget_ms = budget_ms;
   report.used_ms = used_ms;
   report.wall_ms = elapsed_ms(start);
+  report.load_ms = load_ms;
   write_render_outputs(out, preview, report);
 
   const StageTimes& t = preview.total_times();

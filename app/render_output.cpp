@@ -1,4 +1,5 @@
 #include "app/render_output.h"
+#include "pathtracer/bench.h"
 
 #include <filesystem>
 #include <fstream>
@@ -63,6 +64,8 @@ nlohmann::json stats_json(Preview& preview, const RenderReport& r) {
   j["time_budget"] = {{"budget_ms", r.budget_ms}, {"used_ms", r.used_ms}, {"spp_reached", preview.samples()}};
   j["share_outside_path_tracing"] = share_outside_tracing(total, r.used_ms > 0 ? r.used_ms : r.wall_ms);
   j["filter_range_share_of_tracing"] = pass_share_of_tracing(total);
+  j["load_ms"] = r.load_ms;
+  j["peak_memory_mib"] = peak_memory_mib();
   j["paths_per_second"] = total.path_tracing > 0 ? trace.paths / (total.path_tracing / 1000.0) : 0.0;
   j["rays"] = trace.rays;
   j["filter_runs"] = preview.filter_runs();

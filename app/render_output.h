@@ -16,6 +16,7 @@ struct RenderReport {
   double wall_ms = 0;
   double budget_ms = 0;  // --time (0 = none)
   double used_ms = 0;    // from the start until the finish (files not included)
+  double load_ms = 0;  // the scene and environment load (load_scene_for)
   bool interrupted = false;
   std::string gl_backend, gl_renderer;
   std::string reference_path;  // optional: NRMSE of the final and the unfiltered image against it

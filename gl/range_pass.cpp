@@ -33,7 +33,8 @@ bool perfect_specular(const Material& m) {
 }
 
 bool same_camera(const Camera& a, const Camera& b) {
-  return a.camera_to_world == b.camera_to_world && a.yfov == b.yfov && a.znear == b.znear && a.zfar == b.zfar;
+  return a.camera_to_world == b.camera_to_world && a.orthographic == b.orthographic && a.yfov == b.yfov &&
+         a.ymag == b.ymag && a.znear == b.znear && a.zfar == b.zfar;
 }
 
 }  // namespace
@@ -158,6 +159,8 @@ void RangePass::draw_scene(glm::vec2 jitter) {
       camera_projection_matrix(camera_, width_, height_, jitter) * camera_view_matrix(camera_);
   raster_.set("view_projection", view_projection);
   raster_.set("camera_position", glm::vec3(camera_.camera_to_world[3]));
+  raster_.set("camera_forward", -glm::normalize(glm::vec3(camera_.camera_to_world[2])));
+  raster_.set("orthographic", camera_.orthographic ? 1 : 0);
   const float clear_color[4] = {0, 0, 0, 0};
   const float clear_distance[4] = {kBackgroundDepth, 0, 0, 0};
   const float clear_depth = 1.0f;

@@ -72,6 +72,39 @@ TEST(RangePass, FullScreenQuadGivesAlbedoShadingAndDistance) {
     }
 }
 
+// An orthographic camera: parallel rays from the camera's plane. A quad tilted about Y (z = -2 -
+// 0.3 x) makes the distance vary across the image; the raster pass must give each pixel the
+// traced ray's length to the plane and its shading, as for a perspective camera.
+TEST(RangePass, OrthographicCameraGivesTheTracedRaysDistanceAndShading) {
+  test::osmesa_context();
+  Scene scene = quad_scene(-10, 10, -10, 10);
+  for (glm::vec3& p : scene.meshes[0].positions) p.z = -2.0f - 0.3f * p.x;
+  const glm::vec3 normal = glm::normalize(glm::vec3(0.3f, 0.0f, 1.0f));
+  scene.meshes[0].normals.assign(4, normal);
+  scene.camera.orthographic = true;
+  scene.camera.ymag = 1.5f;
+  scene.camera.znear = 0.0f;
+  RangePass range(W, H);
+  range.set_scene(scene);
+  run_to_convergence(range);
+  Image color = range.range_color_image(), depth = range.depth_image();
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      glm::vec3 c(0.0f);
+      float d = 0.0f;
+      for (int k = 0; k < range.frames(); ++k) {
+        glm::vec2 j = raster_jitter(k);
+        Ray ray = camera_ray(scene.camera, W, H, x + j.x, y + j.y);
+        d += 2.0f + 0.3f * ray.origin.x;  // the ray (o.x, o.y, -t) meets z = -2 - 0.3 x at this t
+        c += range_shading(kAlbedo, normal, -ray.direction);
+      }
+      c /= float(range.frames());
+      d /= float(range.frames());
+      for (int i = 0; i < 3; ++i) ASSERT_NEAR(color.at(x, y, i), c[i], 1e-4f * c[i]) << x << "," << y;
+      ASSERT_NEAR(depth.at(x, y, 0), d, 1e-4f * d) << x << "," << y;
+    }
+}
+
 TEST(RangePass, TopHalfQuadIsInTopRowsWithAntialiasedEdge) {
   test::osmesa_context();
   RangePass range(W, H);

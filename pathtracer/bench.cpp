@@ -1,5 +1,7 @@
 #include "pathtracer/bench.h"
 
+#include <sys/resource.h>
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -16,6 +18,12 @@
 #include "pathtracer/sampling.h"
 
 namespace pxf {
+
+double peak_memory_mib() {
+  struct rusage usage {};
+  getrusage(RUSAGE_SELF, &usage);
+  return static_cast<double>(usage.ru_maxrss) / 1024.0;  // Linux reports KiB
+}
 
 double median_of(std::vector<double> v) {
   std::sort(v.begin(), v.end());

@@ -14,6 +14,8 @@ using BenchClock = std::chrono::steady_clock;
 inline double elapsed_ms(BenchClock::time_point start) {
   return std::chrono::duration<double, std::milli>(BenchClock::now() - start).count();
 }
+// Peak resident memory of this process so far (getrusage ru_maxrss), MiB.
+double peak_memory_mib();
 double median_of(std::vector<double> values);  // the upper median; 0 for none
 
 struct BenchResult {

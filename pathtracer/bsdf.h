@@ -39,6 +39,11 @@ float eval_opacity(const Scene& scene, const Material& material, glm::vec2 uv0, 
 bool material_is_perfect_specular(const Material& material);
 bool material_is_perfect_mirror(const Material& material);
 
+// Beer-Lambert transmittance of `distance` scene units inside the material's volume.
+inline glm::vec3 volume_transmittance(const Material& material, float distance) {
+  return glm::exp(-material.attenuation * distance);
+}
+
 struct BsdfSample {
   glm::vec3 wi{0.0f};      // world space, unit
   glm::vec3 weight{0.0f};  // f |cos| / pdf (for a delta branch: its throughput factor)

@@ -11,7 +11,8 @@ struct Ray {
   glm::vec3 direction;  // unit length
 };
 
-// The ray through image position (px, py) in pixels, (0,0) = top-left corner of the image,
+// The ray through image position (px, py) in pixels (an orthographic camera's rays are parallel
+// and start on the camera's plane), (0,0) = top-left corner of the image,
 // (width, height) = bottom-right. A pixel (x, y) with jitter j in [0,1)^2 uses (x + j.x, y + j.y).
 Ray camera_ray(const Camera& camera, int width, int height, float px, float py);
 
@@ -25,7 +26,9 @@ class CameraRays {
  private:
   glm::mat3 basis_;
   glm::vec3 origin_;
-  float tan_half_, aspect_, width_, height_;
+  bool orthographic_;
+  float half_height_;  // tan(yfov / 2), or ymag for an orthographic camera
+  float aspect_, width_, height_;
 };
 
 // View and projection matrices for OpenGL that rasterize exactly what camera_ray traces, with the

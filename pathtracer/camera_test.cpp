@@ -14,10 +14,7 @@ glm::vec3 window_of(const glm::mat4& view_projection, glm::vec3 p, int width, in
   return glm::vec3((ndc.x + 1.0f) * 0.5f * width, (ndc.y + 1.0f) * 0.5f * height, ndc.z);
 }
 
-TEST(Camera, ProjectionMatchesCameraRayForAnyJitter) {
-  Camera camera = look_at_camera(glm::vec3(1.0f, 2.0f, 5.0f), glm::vec3(0.2f, 0.5f, 0.0f), glm::vec3(0, 1, 0), 0.8f);
-  camera.znear = 0.05f;
-  camera.zfar = 100.0f;
+void expect_projection_matches_camera_rays(const Camera& camera) {
   const int width = 64, height = 40;
   for (glm::vec2 jitter : {glm::vec2(0.5f), glm::vec2(0.0f), glm::vec2(0.9f, 0.1f), raster_jitter(7)}) {
     glm::mat4 vp = camera_projection_matrix(camera, width, height, jitter) * camera_view_matrix(camera);
@@ -35,6 +32,37 @@ TEST(Camera, ProjectionMatchesCameraRayForAnyJitter) {
       }
     }
   }
+}
+
+TEST(Camera, ProjectionMatchesCameraRayForAnyJitter) {
+  Camera camera = look_at_camera(glm::vec3(1.0f, 2.0f, 5.0f), glm::vec3(0.2f, 0.5f, 0.0f), glm::vec3(0, 1, 0), 0.8f);
+  camera.znear = 0.05f;
+  camera.zfar = 100.0f;
+  expect_projection_matches_camera_rays(camera);
+}
+
+TEST(Camera, OrthographicProjectionMatchesCameraRayForAnyJitter) {
+  Camera camera = look_at_camera(glm::vec3(1.0f, 2.0f, 5.0f), glm::vec3(0.2f, 0.5f, 0.0f), glm::vec3(0, 1, 0), 0.8f);
+  camera.orthographic = true;
+  camera.ymag = 1.7f;
+  camera.znear = 0.0f;
+  camera.zfar = 100.0f;
+  expect_projection_matches_camera_rays(camera);
+}
+
+TEST(Camera, OrthographicRaysAreParallelAndSpanTwiceYmag) {
+  Camera camera;  // identity: looks down -z, +y up
+  camera.orthographic = true;
+  camera.ymag = 2.0f;
+  Ray top = camera_ray(camera, 100, 50, 50.0f, 0.0f);
+  Ray corner = camera_ray(camera, 100, 50, 100.0f, 50.0f);
+  EXPECT_EQ(top.direction, glm::vec3(0, 0, -1));
+  EXPECT_EQ(corner.direction, glm::vec3(0, 0, -1));
+  EXPECT_NEAR(top.origin.y, 2.0f, 1e-6f);
+  EXPECT_NEAR(top.origin.x, 0.0f, 1e-6f);
+  // The image aspect (2:1) sets the width: xmag = 2 ymag.
+  EXPECT_NEAR(corner.origin.x, 4.0f, 1e-6f);
+  EXPECT_NEAR(corner.origin.y, -2.0f, 1e-6f);
 }
 
 TEST(Camera, TopRowLooksUpAndRaysAreUnit) {

@@ -152,6 +152,8 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
   }
   SurfacePoint sp = geometry_.surface_point(hit, path.ray);
   const Material& material = *sp.material;
+  // Reaching a back face of an absorbing medium's boundary: the segment just traced ran inside it.
+  if (!sp.front_face && material.has_volume()) s.throughput *= volume_transmittance(material, hit.t);
   if (emission_visible(material, sp)) {
     float w = 1.0f;
     if (!s.prev_delta)

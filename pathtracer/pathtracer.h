@@ -8,6 +8,7 @@
 #include <vector>
 #include <glm/glm.hpp>
 #include "image/image.h"
+#include "pathtracer/default_light.h"
 #include "pathtracer/scene.h"
 
 namespace pxf {
@@ -21,8 +22,11 @@ struct TraceParams {
 };
 
 // Loads a glTF/GLB file or a built-in scene name ("cornell", ...); throws pxf::Error naming the
-// file and the problem. `env_path` (optional) replaces the environment with an equirect EXR.
-Scene load_scene(const std::string& name_or_path, const std::string& env_path = "", float env_strength = 1.0f);
+// file and the problem. `env_path` (optional) replaces the environment with an equirectangular
+// EXR or Radiance .hdr (checked before the scene loads). A scene without any light gets the
+// built-in `default_light` environment (Scene::notes says so); with None a warning says it is black.
+Scene load_scene(const std::string& name_or_path, const std::string& env_path = "", float env_strength = 1.0f,
+                 DefaultLight default_light = DefaultLight::None);
 // The built-in scenes: name and one-line description.
 struct BuiltinScene { std::string name, description, path; };
 std::vector<BuiltinScene> builtin_scenes();

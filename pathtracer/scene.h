@@ -51,11 +51,16 @@ struct Material {
   TextureRef specular_texture;          // A
   glm::vec3 specular_color{1.0f};
   TextureRef specular_color_texture;    // RGB
+  // KHR_materials_volume: absorption coefficient per scene unit, -ln(attenuationColor) /
+  // attenuationDistance; 0 = clear or thin-walled (thicknessFactor 0). The medium is the inside
+  // of the closed mesh, entered through its front faces.
+  glm::vec3 attenuation{0.0f};
   AlphaMode alpha_mode = AlphaMode::Opaque;
   float alpha_cutoff = 0.5f;
   bool double_sided = false;
 
   bool is_emissive() const { return emissive.x > 0 || emissive.y > 0 || emissive.z > 0; }
+  bool has_volume() const { return attenuation.x > 0 || attenuation.y > 0 || attenuation.z > 0; }
 };
 
 // One glTF primitive instance in world space. Optional attributes are empty when absent.
@@ -72,9 +77,13 @@ struct Mesh {
 };
 
 // glTF camera convention: looks down -Z of its frame, +Y up. Image rows go top to bottom.
+// Perspective (yfov) or orthographic (ymag: half the image height in scene units; the image
+// aspect sets the width, as it does for perspective).
 struct Camera {
   glm::mat4 camera_to_world{1.0f};  // rigid transform (no scale)
-  float yfov = 0.6911f;             // vertical field of view, radians
+  bool orthographic = false;
+  float yfov = 0.6911f;             // vertical field of view, radians (perspective)
+  float ymag = 1.0f;                // half the view height, scene units (orthographic)
   float znear = 0.01f;
   float zfar = 1000.0f;
   float aspect = 0.0f;              // glTF aspectRatio (0 = unspecified); the image size wins
@@ -117,8 +126,10 @@ struct Scene {
   std::vector<PunctualLight> lights;
   std::optional<Environment> environment;
   Camera camera;
+  bool automatic_camera = false;  // the file has no camera: frame_scene made it (reframe at the final aspect)
   SceneDefaults defaults;
   std::vector<std::string> warnings;  // what the loader skipped or substituted, one line each
+  std::vector<std::string> notes;     // what the loader added that a user should know (the default light)
 
   size_t triangle_count() const;
 };

@@ -18,6 +18,8 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "image/image.h"
+#include "pathtracer/auto_camera.h"
+#include "pathtracer/default_light.h"
 #include "pathtracer/gltf_accessor.h"
 #include "pathtracer/gltf_geometry.h"
 #include "pathtracer/gltf_images.h"
@@ -44,6 +46,7 @@ const std::set<std::string>& supported_extensions() {
   static const std::set<std::string> names = {
       "KHR_lights_punctual",      "KHR_texture_transform", "KHR_materials_emissive_strength",
       "KHR_materials_transmission", "KHR_materials_ior",   "KHR_materials_specular",
+      "KHR_materials_volume",
       "KHR_mesh_quantization"};
   return names;
 }
@@ -173,8 +176,8 @@ class GltfLoader {
     images_.decode_buffer_view_images(model_, file_);
     load_materials();
     traverse_scene();
+    read_scene_defaults();  // before the camera: the default image aspect frames the model
     finish_camera();
-    read_scene_defaults();
     report_dropped_triangles();
     return std::move(scene_);
   }
@@ -403,11 +406,26 @@ class GltfLoader {
       m.specular_color = glm::max(value_vec3_or(ext->Get("specularColorFactor"), glm::vec3(1.0f)), glm::vec3(0.0f));
       m.specular_color_texture = texture_ref(info_of(ext->Get("specularColorTexture")), true, m.name, "specular color");
     }
+    if (const tinygltf::Value* ext = find_extension(gm.extensions, "KHR_materials_volume")) read_volume(*ext, m);
     if (gm.alphaMode == "MASK") m.alpha_mode = AlphaMode::Mask;
     else if (gm.alphaMode == "BLEND") m.alpha_mode = AlphaMode::Blend;
     m.alpha_cutoff = std::max(finite_or(gm.alphaCutoff, 0.5f), 0.0f);
     m.double_sided = gm.doubleSided;
     return m;
+  }
+
+  // Beer-Lambert coefficient from attenuationColor (the color left after attenuationDistance).
+  // thicknessFactor 0 means thin-walled: no medium. A thickness texture only matters for
+  // rasterizers that do not trace the real path length, so it is not read.
+  void read_volume(const tinygltf::Value& ext, Material& m) {
+    double thickness = number_or(ext.Get("thicknessFactor"), 0.0);
+    const tinygltf::Value& distance_value = ext.Get("attenuationDistance");
+    double distance = distance_value.IsNumber() ? distance_value.GetNumberAsDouble() : 0.0;
+    if (!(thickness > 0.0) || !(distance > 0.0) || !std::isfinite(distance)) return;  // thin or clear
+    if (m.transmission <= 0.0f)
+      warn("material '" + m.name + "' has KHR_materials_volume without transmission; its volume is never entered");
+    glm::vec3 color = glm::clamp(value_vec3_or(ext.Get("attenuationColor"), glm::vec3(1.0f)), glm::vec3(1e-6f), glm::vec3(1.0f));
+    m.attenuation = -glm::log(color) / static_cast<float>(distance);
   }
 
   // -- node hierarchy ---------------------------------------------------------------------------
@@ -451,8 +469,9 @@ class GltfLoader {
     if (index >= static_cast<int>(model_.cameras.size())) fail("camera " + std::to_string(index) + " out of range");
     if (have_camera_) return;  // the first camera in the hierarchy wins
     const tinygltf::Camera& camera = model_.cameras[index];
+    if (camera.type == "orthographic") return add_orthographic_camera(index, camera.orthographic, world);
     if (camera.type != "perspective") {
-      warn("camera " + std::to_string(index) + " is " + camera.type + ", only perspective cameras are supported; ignoring it");
+      warn("camera " + std::to_string(index) + " is of type '" + camera.type + "' (perspective or orthographic); ignoring it");
       return;
     }
     const auto& p = camera.perspective;
@@ -467,6 +486,28 @@ class GltfLoader {
     out.zfar = infinite_far_ ? Camera{}.zfar : zfar;
     float aspect = finite_or(p.aspectRatio, 0.0f);
     out.aspect = aspect > 0.0f ? aspect : 0.0f;
+    have_camera_ = true;
+  }
+
+  // glTF's xmag/ymag are half-extents; the image aspect wins over xmag as it does over aspectRatio.
+  void add_orthographic_camera(int index, const tinygltf::OrthographicCamera& o, const glm::mat4& world) {
+    float ymag = std::fabs(finite_or(o.ymag, 0.0f));
+    if (!(ymag > 0.0f)) {
+      warn("orthographic camera " + std::to_string(index) + " has ymag " + std::to_string(o.ymag) + "; ignoring it");
+      return;
+    }
+    Camera& out = scene_.camera;
+    out = Camera{};
+    out.camera_to_world = rigid_frame(world);
+    out.orthographic = true;
+    out.ymag = ymag;
+    float xmag = std::fabs(finite_or(o.xmag, 0.0f));
+    out.aspect = xmag > 0.0f ? xmag / ymag : 0.0f;
+    float znear = finite_or(o.znear, 0.0f);
+    out.znear = znear >= 0.0f ? znear : 0.0f;
+    float zfar = finite_or(o.zfar, 0.0f);
+    infinite_far_ = !(zfar > out.znear);  // zfar is required for orthographic; bad values are widened
+    out.zfar = infinite_far_ ? Camera{}.zfar : zfar;
     have_camera_ = true;
   }
 
@@ -640,13 +681,10 @@ class GltfLoader {
     glm::vec3 center = 0.5f * (lo + hi);
     float radius = std::max(0.5f * glm::length(hi - lo), 1e-3f);
     if (!have_camera_) {
-      // Frame the bounding sphere from +Z, looking down -Z (glTF's camera convention).
-      Camera camera;
-      float distance = radius / std::sin(0.5f * camera.yfov) * 1.05f;
-      camera.camera_to_world = glm::translate(glm::mat4(1.0f), center + glm::vec3(0.0f, 0.0f, distance));
-      camera.znear = std::max(distance * 1e-3f, 1e-4f);
-      camera.zfar = (distance + radius) * 2.0f;
-      scene_.camera = camera;
+      const SceneDefaults& d = scene_.defaults;
+      float aspect = d.width > 0 && d.height > 0 ? static_cast<float>(d.width) / d.height : 1.0f;
+      scene_.camera = frame_bounds(lo, hi, aspect);
+      scene_.automatic_camera = true;
       return;
     }
     if (infinite_far_) {
@@ -690,14 +728,44 @@ class GltfLoader {
 // ---------------------------------------------------------------------------------------------
 // Environment
 
+enum class FileKind { Exr, RadianceHdr, Gltf, Glb, Other };
+
+// The format by its first bytes, not its name: a renamed or mislabelled file still gets the
+// right reader or a clear error.
+FileKind sniff_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path + ": cannot open file");
+  char head[10] = {};
+  in.read(head, sizeof head);
+  std::string bytes(head, static_cast<size_t>(in.gcount()));
+  if (bytes.compare(0, 4, "\x76\x2f\x31\x01") == 0) return FileKind::Exr;
+  if (bytes.compare(0, 2, "#?") == 0) return FileKind::RadianceHdr;
+  if (bytes.compare(0, 4, "glTF") == 0) return FileKind::Glb;
+  size_t first = bytes.find_first_not_of(" \t\r\n\xef\xbb\xbf");
+  if (first != std::string::npos && bytes[first] == '{') return FileKind::Gltf;
+  return FileKind::Other;
+}
+
+// The environment image as linear float RGB(A)/Y channels, by format.
+Image read_environment_image(const std::string& path) {
+  switch (sniff_file(path)) {
+    case FileKind::Exr: return read_exr(path);
+    case FileKind::RadianceHdr: return read_ldr_or_hdr(path);
+    default: throw Error(path + ": not a supported environment map (supported: OpenEXR .exr, Radiance .hdr)");
+  }
+}
+
 Environment load_environment(const std::string& path, float strength, std::vector<std::string>& warnings) {
   if (!std::isfinite(strength) || strength < 0.0f)
     throw Error(path + ": environment strength " + std::to_string(strength) + " must be finite and >= 0");
-  Image image = read_exr(path);
+  Image image = read_environment_image(path);
   int r = image.channel_index("R"), g = image.channel_index("G"), b = image.channel_index("B");
   int y = image.channel_index("Y");
   if ((r < 0 || g < 0 || b < 0) && y < 0) throw Error(path + ": environment map needs R, G, B (or Y) channels");
   if (image.empty()) throw Error(path + ": environment map is empty");
+  if (image.width != 2 * image.height)
+    warnings.push_back(path + ": environment map is " + std::to_string(image.width) + "x" + std::to_string(image.height) +
+                       ", not 2:1; read as equirectangular (latitude-longitude) anyway");
   Environment env;
   env.strength = strength;
   env.source = path;
@@ -721,9 +789,22 @@ Environment load_environment(const std::string& path, float strength, std::vecto
                         : glm::vec3(image.at(px, py, y));
       tex.texels[static_cast<size_t>(py) * image.width + px] = glm::vec4(clean(c.x), clean(c.y), clean(c.z), 1.0f);
     }
+  bool any_light = std::any_of(tex.texels.begin(), tex.texels.end(),
+                               [](const glm::vec4& t) { return t.x > 0.0f || t.y > 0.0f || t.z > 0.0f; });
+  if (!any_light) throw Error(path + ": environment map has no positive radiance (it would light nothing)");
   if (replaced)
     warnings.push_back(path + ": replaced " + std::to_string(replaced) + " NaN/Inf/negative environment values by 0");
   return env;
+}
+
+// An image passed as the scene gets told so, rather than reaching the JSON parser.
+void check_scene_file(const std::string& path) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) return;  // the glTF loader names the missing file
+  FileKind kind = sniff_file(path);
+  if (kind == FileKind::Exr || kind == FileKind::RadianceHdr)
+    throw Error(path + ": is an environment image, not a scene (--scene takes a .gltf/.glb file or a built-in name; "
+                "pass environment maps with --env)");
 }
 
 }  // namespace
@@ -738,7 +819,8 @@ std::vector<BuiltinScene> builtin_scenes() {
   return scenes;
 }
 
-Scene load_scene(const std::string& name_or_path, const std::string& env_path, float env_strength) {
+Scene load_scene(const std::string& name_or_path, const std::string& env_path, float env_strength,
+                 DefaultLight default_light) {
   std::string path = name_or_path;
   std::string builtin_env;
   for (const BuiltinScene& builtin : builtin_scenes())
@@ -748,10 +830,18 @@ Scene load_scene(const std::string& name_or_path, const std::string& env_path, f
       std::error_code ec;
       if (fs::is_regular_file(env, ec)) builtin_env = env;
     }
+  // Every input is checked before the (possibly long) scene load, so a bad --env fails at once.
+  std::vector<std::string> env_warnings;
+  std::string env = env_path.empty() ? builtin_env : env_path;
+  std::optional<Environment> environment;
+  if (!env.empty()) environment = load_environment(env, env_strength, env_warnings);
+  check_scene_file(path);
   Scene scene = GltfLoader(path).load();
   scene.source = name_or_path;
-  std::string env = env_path.empty() ? builtin_env : env_path;
-  if (!env.empty()) scene.environment = load_environment(env, env_strength, scene.warnings);
+  scene.warnings.insert(scene.warnings.end(), env_warnings.begin(), env_warnings.end());
+  if (environment) scene.environment = std::move(environment);
+  std::string note = apply_default_light(scene, default_light);
+  if (!note.empty()) (default_light == DefaultLight::None ? scene.warnings : scene.notes).push_back(note);
   return scene;
 }
 

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -509,15 +510,35 @@ TEST(SceneLoadCamera, DefaultCameraFramesTheSceneBounds) {
   GltfBuilder b;
   b.scene({b.node({{"mesh", b.mesh(b.quad_primitive())}, {"translation", {10, 0, 0}}})});
   Scene scene = load_scene(b.write_gltf(dir + "/nocam.gltf"));
+  // The quad [10, 11] x [0, 1] at z = 0 is seen from its front, centered and inside the frame
+  // (auto_camera_test.cpp checks the framing itself).
   glm::vec3 eye(scene.camera.camera_to_world[3]);
-  EXPECT_NEAR(eye.x, 10.5f, 1e-5f);
-  EXPECT_NEAR(eye.y, 0.5f, 1e-5f);
+  glm::vec3 forward = -glm::vec3(scene.camera.camera_to_world[2]);
   EXPECT_GT(eye.z, 0.0f);
-  // The whole quad is inside the vertical field of view.
-  float half = std::atan(0.5f / eye.z);
-  EXPECT_LT(half, 0.5f * scene.camera.yfov);
-  EXPECT_LT(scene.camera.znear, eye.z);
-  EXPECT_GT(scene.camera.zfar, eye.z);
+  glm::vec3 to_center = glm::normalize(glm::vec3(10.5f, 0.5f, 0.0f) - eye);
+  EXPECT_GT(glm::dot(to_center, forward), 0.999f);
+  for (glm::vec3 corner : {glm::vec3(10, 0, 0), glm::vec3(11, 1, 0)}) {
+    glm::vec3 q = corner - eye;
+    float depth = glm::dot(q, forward);
+    EXPECT_LT(std::fabs(glm::dot(q, glm::vec3(scene.camera.camera_to_world[1]))) / depth, std::tan(0.5f * scene.camera.yfov));
+    EXPECT_GT(depth, scene.camera.znear);
+    EXPECT_LT(depth, scene.camera.zfar);
+  }
+}
+
+TEST(SceneLoadCamera, OrthographicCameraKeepsYmagAndItsFrame) {
+  std::string dir = temp_dir();
+  GltfBuilder b;
+  b.doc["cameras"] = {{{"type", "orthographic"}, {"orthographic", {{"xmag", 3.0}, {"ymag", 1.5}, {"znear", 0.0}, {"zfar", 50.0}}}}};
+  b.scene({b.node({{"camera", 0}, {"translation", {0, 0, 5}}}), b.node({{"mesh", b.mesh(b.quad_primitive())}})});
+  Scene scene = load_scene(b.write_gltf(dir + "/ortho.gltf"));
+  EXPECT_TRUE(scene.camera.orthographic);
+  EXPECT_FLOAT_EQ(scene.camera.ymag, 1.5f);
+  EXPECT_FLOAT_EQ(scene.camera.aspect, 2.0f);
+  EXPECT_FLOAT_EQ(scene.camera.znear, 0.0f);
+  EXPECT_FLOAT_EQ(scene.camera.zfar, 50.0f);
+  expect_vec3_near(glm::vec3(scene.camera.camera_to_world[3]), {0, 0, 5});
+  EXPECT_TRUE(scene.warnings.empty() || !any_warning_contains(scene, "camera")) << warnings_of(scene);
 }
 
 TEST(SceneLoadLights, PunctualLightsOfAllThreeTypes) {
@@ -742,7 +763,8 @@ TEST(SceneLoadTexture, KhrTextureTransformAndTexcoordOverride) {
   json prim = b.quad_primitive(mat);
   prim["attributes"]["TEXCOORD_1"] = b.floats({0, 0, 1, 0, 1, 1, 0, 1}, "VEC2");
   b.scene({b.node({{"mesh", b.mesh(prim)}})});
-  Scene scene = load_scene(b.write_gltf(dir + "/tt.gltf"));
+  // (Lit by the default sky: its only emission is textured, so --default-light none would warn.)
+  Scene scene = load_scene(b.write_gltf(dir + "/tt.gltf"), "", 1.0f, DefaultLight::Sky);
   const TextureRef& ref = scene.materials[0].base_color_texture;
   ASSERT_TRUE(ref.valid());
   EXPECT_EQ(ref.texcoord, 1);
@@ -968,6 +990,187 @@ TEST(SceneLoadEnvironment, ExrIsSanitizedAndWrapsHorizontally) {
   EXPECT_FALSE(load_scene(scene_path).environment.has_value());
   std::string msg = error_of([&] { load_scene(scene_path, dir + "/no_sky.exr"); });
   EXPECT_NE(msg.find("no_sky.exr"), std::string::npos) << msg;
+}
+
+// A tiny uncompressed Radiance .hdr (RGBE pixels; flat scanlines, as width < 8 is never RLE).
+void write_radiance_hdr(const std::string& path, int w, int h, const std::vector<std::array<uint8_t, 4>>& rgbe) {
+  std::string header = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y " + std::to_string(h) + " +X " + std::to_string(w) + "\n";
+  std::vector<uint8_t> bytes(header.begin(), header.end());
+  for (const auto& p : rgbe) bytes.insert(bytes.end(), p.begin(), p.end());
+  write_bytes(path, bytes);
+}
+
+TEST(SceneLoadEnvironment, RadianceHdrIsReadByItsMagicBytes) {
+  std::string dir = temp_dir();
+  GltfBuilder b;
+  b.add_quad_scene();
+  std::string scene_path = b.write_gltf(dir + "/scene.gltf");
+  // RGBE (128, 64, 192, 129): mantissa / 256 * 2^(129 - 128) = (1, 0.5, 1.5).
+  std::vector<std::array<uint8_t, 4>> pixels(8, {128, 64, 192, 129});
+  pixels[5] = {0, 0, 0, 0};
+  std::string path = dir + "/sky.pic";  // the extension does not matter, the bytes do
+  write_radiance_hdr(path, 4, 2, pixels);
+  Scene scene = load_scene(scene_path, path, 1.0f);
+  ASSERT_TRUE(scene.environment.has_value()) << warnings_of(scene);
+  const Texture& t = scene.environment->image;
+  ASSERT_EQ(t.width, 4);
+  ASSERT_EQ(t.height, 2);
+  expect_vec3_near(glm::vec3(t.texels[0]), {1.0f, 0.5f, 1.5f});
+  expect_vec3_near(glm::vec3(t.texels[5]), {0.0f, 0.0f, 0.0f});
+  EXPECT_TRUE(scene.warnings.empty()) << warnings_of(scene);
+}
+
+TEST(SceneLoadEnvironment, BadMapsFailBeforeTheSceneLoadsWithOneLine) {
+  std::string dir = temp_dir();
+  GltfBuilder b;
+  b.add_quad_scene();
+  std::string scene_path = b.write_gltf(dir + "/scene.gltf");
+  // Not an environment format: the error lists the supported ones.
+  std::string png_path = dir + "/sky.png";
+  write_bytes(png_path, encode_png(2, 1, 3, 8, {255, 255, 255, 0, 0, 0}));
+  std::string msg = error_of([&] { load_scene(scene_path, png_path); });
+  EXPECT_NE(msg.find("OpenEXR"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("Radiance"), std::string::npos) << msg;
+  // The environment is checked first: with a bad scene too, the message names the environment.
+  msg = error_of([&] { load_scene(dir + "/missing.gltf", png_path); });
+  EXPECT_NE(msg.find("sky.png"), std::string::npos) << msg;
+  // No positive radiance anywhere is an error, not a black render.
+  Image negative = Image::rgb(4, 2, -1.0f);
+  write_exr(dir + "/negative.exr", negative);
+  msg = error_of([&] { load_scene(scene_path, dir + "/negative.exr"); });
+  EXPECT_NE(msg.find("no positive radiance"), std::string::npos) << msg;
+  write_radiance_hdr(dir + "/black.hdr", 4, 2, std::vector<std::array<uint8_t, 4>>(8, {0, 0, 0, 0}));
+  msg = error_of([&] { load_scene(scene_path, dir + "/black.hdr"); });
+  EXPECT_NE(msg.find("no positive radiance"), std::string::npos) << msg;
+}
+
+TEST(SceneLoadEnvironment, NonTwoToOneMapWarnsAboutTheLatLongAssumption) {
+  std::string dir = temp_dir();
+  GltfBuilder b;
+  b.add_quad_scene();
+  std::string scene_path = b.write_gltf(dir + "/scene.gltf");
+  write_exr(dir + "/square.exr", Image::rgb(4, 4, 1.0f));
+  Scene scene = load_scene(scene_path, dir + "/square.exr");
+  EXPECT_TRUE(scene.environment.has_value());
+  EXPECT_TRUE(any_warning_contains(scene, "not 2:1")) << warnings_of(scene);
+  EXPECT_TRUE(any_warning_contains(scene, "latitude-longitude")) << warnings_of(scene);
+  write_exr(dir + "/wide.exr", Image::rgb(4, 2, 1.0f));
+  EXPECT_FALSE(any_warning_contains(load_scene(scene_path, dir + "/wide.exr"), "not 2:1"));
+}
+
+TEST(SceneLoadEnvironment, ImagePassedAsTheSceneIsNamedAsSuch) {
+  std::string dir = temp_dir();
+  write_exr(dir + "/sky.exr", Image::rgb(4, 2, 1.0f));
+  std::string msg = error_of([&] { load_scene(dir + "/sky.exr"); });
+  EXPECT_NE(msg.find("environment image, not a scene"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("--env"), std::string::npos) << msg;
+  write_radiance_hdr(dir + "/sky.hdr", 2, 1, std::vector<std::array<uint8_t, 4>>(2, {128, 128, 128, 129}));
+  msg = error_of([&] { load_scene(dir + "/sky.hdr"); });
+  EXPECT_NE(msg.find("environment image, not a scene"), std::string::npos) << msg;
+}
+
+TEST(SceneLoadMaterial, KhrMaterialsVolumeGivesTheBeerLambertCoefficient) {
+  std::string dir = temp_dir();
+  GltfBuilder b;
+  b.doc["extensionsUsed"] = {"KHR_materials_transmission", "KHR_materials_volume"};
+  auto volume = [&](json v) {
+    return b.material({{"extensions", {{"KHR_materials_transmission", {{"transmissionFactor", 1.0}}}, {"KHR_materials_volume", v}}}});
+  };
+  int absorbing = volume({{"thicknessFactor", 1.0}, {"attenuationDistance", 0.5}, {"attenuationColor", {0.5, 0.25, 1.0}}});
+  int thin = volume({{"thicknessFactor", 0.0}, {"attenuationDistance", 0.5}, {"attenuationColor", {0.5, 0.25, 1.0}}});
+  int clear = volume({{"thicknessFactor", 1.0}, {"attenuationColor", {0.5, 0.25, 1.0}}});  // distance: infinite
+  b.scene({b.node({{"mesh", b.mesh(b.quad_primitive(absorbing))}}), b.node({{"mesh", b.mesh(b.quad_primitive(thin))}}),
+           b.node({{"mesh", b.mesh(b.quad_primitive(clear))}})});
+  Scene scene = load_scene(b.write_gltf(dir + "/volume.gltf"));
+  // After attenuationDistance the light left is attenuationColor: exp(-sigma 0.5) = color.
+  expect_vec3_near(scene.materials[absorbing].attenuation, -glm::log(glm::vec3(0.5f, 0.25f, 1.0f)) / 0.5f);
+  EXPECT_FALSE(scene.materials[thin].has_volume());
+  EXPECT_FALSE(scene.materials[clear].has_volume());
+  EXPECT_FALSE(any_warning_contains(scene, "KHR_materials_volume")) << warnings_of(scene);
+}
+
+// ----------------------------------------------------------------------------------------------
+// Default light
+
+TEST(SceneLoadDefaultLight, SceneWithoutLightsGetsTheBuiltInEnvironmentAndRendersLit) {
+  std::string dir = temp_dir();
+  GltfBuilder b;
+  b.add_quad_scene(b.material({{"pbrMetallicRoughness", {{"metallicFactor", 0.0}}}}));
+  std::string path = b.write_gltf(dir + "/bare.gltf");
+  for (DefaultLight light : {DefaultLight::Sky, DefaultLight::Studio}) {
+    Scene scene = load_scene(path, "", 1.0f, light);
+    ASSERT_TRUE(scene.environment.has_value()) << default_light_name(light);
+    ASSERT_EQ(scene.notes.size(), 1u);
+    EXPECT_NE(scene.notes[0].find("built-in " + default_light_name(light)), std::string::npos) << scene.notes[0];
+    TraceParams params;
+    params.threads = 1;
+    ProgressiveRenderer renderer(scene, params, 8, 8);
+    EXPECT_FALSE(renderer.scene_is_dark());
+    for (int i = 0; i < 4; ++i) renderer.add_frame();
+    const Accumulation& acc = renderer.accumulation();
+    // The quad faces the default camera and fills the middle of the image: lit, not black.
+    size_t center = 4 * 8 + 4;
+    glm::vec3 c = acc.lv_mean[center] + acc.hv_mean[center];
+    EXPECT_GT(luminance(c.x, c.y, c.z), 0.05f) << default_light_name(light);
+  }
+}
+
+TEST(SceneLoadDefaultLight, NoneKeepsTheSceneDarkAndWarns) {
+  std::string dir = temp_dir();
+  GltfBuilder b;
+  b.add_quad_scene();
+  std::string path = b.write_gltf(dir + "/bare.gltf");
+  Scene scene = load_scene(path, "", 1.0f, DefaultLight::None);
+  EXPECT_FALSE(scene.environment.has_value());
+  EXPECT_TRUE(scene.notes.empty());
+  EXPECT_TRUE(any_warning_contains(scene, "will be black")) << warnings_of(scene);
+}
+
+TEST(SceneLoadDefaultLight, OnlyScenesWithoutAnyLightGetIt) {
+  std::string dir = temp_dir();
+  // A uniform emitter is a light: no default environment.
+  GltfBuilder lamp;
+  lamp.add_quad_scene(lamp.material({{"emissiveFactor", {1.0, 1.0, 1.0}}}));
+  Scene lit = load_scene(lamp.write_gltf(dir + "/lamp.gltf"), "", 1.0f, DefaultLight::Sky);
+  EXPECT_FALSE(lit.environment.has_value());
+  EXPECT_TRUE(lit.notes.empty());
+  // Texture-modulated emission (a helmet's LEDs) lights nothing around it: the default applies.
+  GltfBuilder leds;
+  int texture = leds.texture(leds.image(encode_png(1, 1, 3, 8, {255, 0, 0})));
+  leds.add_quad_scene(leds.material({{"emissiveFactor", {1.0, 1.0, 1.0}}, {"emissiveTexture", {{"index", texture}}}}));
+  Scene decorated = load_scene(leds.write_gltf(dir + "/leds.gltf"), "", 1.0f, DefaultLight::Sky);
+  EXPECT_TRUE(decorated.environment.has_value());
+  // An --env wins over the default.
+  write_exr(dir + "/env.exr", Image::rgb(4, 2, 0.25f));
+  GltfBuilder bare;
+  bare.add_quad_scene();
+  Scene with_env = load_scene(bare.write_gltf(dir + "/bare.gltf"), dir + "/env.exr", 1.0f, DefaultLight::Studio);
+  ASSERT_TRUE(with_env.environment.has_value());
+  EXPECT_EQ(with_env.environment->source, dir + "/env.exr");
+}
+
+// The built-in environments are neutral light of a sensible scale: an upward white Lambert
+// surface sees an irradiance of order pi, and neither is a coloured cast.
+TEST(SceneLoadDefaultLight, BuiltInEnvironmentsGiveAboutPiIrradianceFromAbove) {
+  for (DefaultLight light : {DefaultLight::Sky, DefaultLight::Studio}) {
+    Environment env = make_default_environment(light);
+    const Texture& t = env.image;
+    ASSERT_EQ(t.width, 2 * t.height);
+    glm::dvec3 irradiance(0.0);
+    const double pi = 3.14159265358979;
+    for (int y = 0; y < t.height; ++y) {
+      double theta = (y + 0.5) / t.height * pi;
+      double solid_angle = (2 * pi / t.width) * (pi / t.height) * std::sin(theta);
+      double cos_up = std::cos(theta);
+      if (cos_up <= 0) continue;
+      for (int x = 0; x < t.width; ++x) irradiance += glm::dvec3(glm::vec3(t.texels[static_cast<size_t>(y) * t.width + x])) * cos_up * solid_angle;
+    }
+    double e = (irradiance.x + irradiance.y + irradiance.z) / 3.0;
+    EXPECT_GT(e, 0.5 * pi) << default_light_name(light);
+    EXPECT_LT(e, 2.0 * pi) << default_light_name(light);
+    EXPECT_LT(std::max({irradiance.x, irradiance.y, irradiance.z}) / std::min({irradiance.x, irradiance.y, irradiance.z}), 1.25)
+        << default_light_name(light);
+  }
 }
 
 TEST(SceneLoadBuiltin, ListsOnlyExistingScenesAndLoadsThemByName) {

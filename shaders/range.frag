@@ -1,6 +1,6 @@
 #version 450 core
 // Range color = range_shading(albedo, interpolated normal, to_viewer) (pathtracer.h), albedo =
-// base color factor x base color texture x vertex color (linear); distance to the camera; the
+// base color factor x base color texture x vertex color (linear); the camera ray's length; the
 // perfectly-specular flag. Alpha-mask cutouts are discarded; nothing is culled.
 in vec3 world_position;
 in vec3 world_normal;
@@ -17,6 +17,8 @@ uniform float alpha_cutoff;
 uniform int double_sided;
 uniform float specular;    // 1: perfectly specular material
 uniform vec3 camera_position;
+uniform vec3 camera_forward;  // unit view direction
+uniform int orthographic;     // 1: parallel rays along camera_forward from the camera's plane
 
 layout(location = 0) out vec4 out_color;  // rgb range color, a specular flag
 layout(location = 1) out float out_distance;
@@ -25,9 +27,10 @@ void main() {
   vec2 uv = (uv_transform * vec3(texcoord == 1 ? uv1 : uv0, 1.0)).xy;
   vec4 albedo = base_color * texture(base_color_tex, uv) * vertex_color;
   if (alpha_mask != 0 && !(albedo.a >= alpha_cutoff)) discard;
+  // The distance the path tracer's camera ray travels: to the eye, or to the orthographic plane.
   vec3 to_camera = camera_position - world_position;
-  float distance = length(to_camera);
-  vec3 v = to_camera / max(distance, 1e-30);
+  float distance = orthographic != 0 ? dot(-to_camera, camera_forward) : length(to_camera);
+  vec3 v = orthographic != 0 ? -camera_forward : to_camera / max(distance, 1e-30);
   vec3 n = normalize(world_normal);
   // As the path tracer: only double-sided materials flip the normal toward the viewer.
   if (double_sided != 0 && dot(n, v) < 0.0) n = -n;

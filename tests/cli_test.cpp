@@ -103,6 +103,40 @@ TEST(Cli, BadSceneIsOneLineNamingTheFileAndWritesNothing) {
   EXPECT_NE(missing.err.find("/nonexistent/scene.gltf"), std::string::npos) << missing.err;
 }
 
+// One triangle facing +Z (a data-URI buffer), no lights, no camera.
+std::string write_bare_triangle(const std::string& dir) {
+  fs::create_directories(dir);
+  const std::string path = dir + "/bare.gltf";
+  std::ofstream(path) << R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],)"
+                         R"("meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],)"
+                         R"("accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}],)"
+                         R"("bufferViews":[{"buffer":0,"byteLength":36}],)"
+                         R"("buffers":[{"byteLength":36,"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA"}]})";
+  return path;
+}
+
+TEST(Cli, SceneWithoutLightsIsLitByDefaultAndNoneWarnsOfBlack) {
+  const std::string dir = temp_dir("bare");
+  const std::string scene = write_bare_triangle(dir);
+  const Result lit = run("render --scene " + scene + " --size 16x16 --spp 2 --filter none --quiet --out " + dir + "/lit");
+  ASSERT_EQ(lit.code, 0) << lit.err;
+  EXPECT_NE(lit.err.find("lit by the built-in sky"), std::string::npos) << lit.err;
+  const Image image = read_exr(dir + "/lit/final.exr");
+  float peak = 0.0f;
+  for (float v : image.pixels) peak = std::max(peak, v);
+  EXPECT_GT(peak, 0.05f);
+  const Result dark = run("render --scene " + scene + " --default-light none --size 16x16 --spp 2 --quiet --out " + dir + "/dark");
+  ASSERT_EQ(dark.code, 0) << dark.err;
+  EXPECT_NE(dark.err.find("warning"), std::string::npos) << dark.err;
+  EXPECT_NE(dark.err.find("will be black"), std::string::npos) << dark.err;
+  // An environment image given as the scene: one line naming it, exit code 1.
+  write_exr(dir + "/sky.exr", Image::rgb(4, 2, 1.0f));
+  const Result wrong = run("render --scene " + dir + "/sky.exr --quiet --out " + dir + "/wrong");
+  EXPECT_EQ(wrong.code, 1);
+  EXPECT_EQ(lines(wrong.err), 1u) << wrong.err;
+  EXPECT_NE(wrong.err.find("not a scene"), std::string::npos) << wrong.err;
+}
+
 TEST(Cli, RenderWritesEveryOutput) {
   const std::string out = temp_dir("render");
   const Result r = run("render --size 32x24 --spp 4 --schedule pow2 --quiet --out " + out);
@@ -119,6 +153,8 @@ TEST(Cli, RenderWritesEveryOutput) {
   for (const char* stage : {"path_tracing", "upload", "range", "filter", "blend", "tonemap"})
     EXPECT_TRUE(stats["stage_ms_total"].contains(stage)) << stage;
   EXPECT_GT(stats["paths_per_second"].get<double>(), 0.0);
+  EXPECT_GT(stats["load_ms"].get<double>(), 0.0);
+  EXPECT_GT(stats["peak_memory_mib"].get<double>(), 1.0);  // at least the program itself
   // A reference render, then NRMSE against it.
   const std::string ref = temp_dir("reference");
   ASSERT_EQ(run("render --size 32x24 --spp 64 --filter none --seed 9 --quiet --out " + ref).code, 0);
