@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <unistd.h>
 
+#include "app/checkpoint.h"
 #include "app/commands.h"
 #include "app/options.h"
 #include "app/preview.h"
@@ -68,6 +69,8 @@ int run_render(const Args& args) {
   cli.option("--reference", &reference, "REF.exr", "report NRMSE of the final and the unfiltered image against it");
   cli.option("--out", &out, "DIR", "output folder (default out)");
   cli.flag("--quiet", &quiet, "no progress bar");
+  CheckpointOptions checkpoint_options;
+  add_checkpoint_options(cli, checkpoint_options);
   if (!cli.parse(args)) return 0;
   if (print_scene_list_if_asked(scene_options)) return 0;
 
@@ -75,15 +78,22 @@ int run_render(const Args& args) {
   Scene scene = load_scene_for(scene_options, preview_options, cli);
   auto context = create_gl_context(parse_gl_backend(scene_options.gl));
   Preview preview(scene, preview_options.settings, scene_options.width, scene_options.height);
+  const FrameRange frames = render_frame_range(checkpoint_options, spp);
+  Checkpointer checkpointer(checkpoint_options, out, render_sample_settings(scene_options, preview_options.settings),
+                            frames);
+  checkpointer.start(preview);
 
   g_interrupted = false;
   auto previous = std::signal(SIGINT, on_interrupt);
-  ProgressBar progress(spp);
-  for (int i = 0; i < spp && !g_interrupted; ++i) {
+  const int total = static_cast<int>(frames.count());
+  ProgressBar progress(total);
+  for (int i = preview.samples(); i < total && !g_interrupted; ++i) {
     preview.add_frame(/*last_frame=*/false, /*display=*/false);
-    if (!quiet) progress.update(i + 1, i + 1 == spp);
+    checkpointer.maybe_write(preview);
+    if (!quiet) progress.update(i + 1, i + 1 == total);
   }
   preview.finish();
+  checkpointer.write(preview);
   if (!quiet) progress.finish();
   std::signal(SIGINT, previous);
 
@@ -108,6 +118,8 @@ int run_render(const Args& args) {
                 report.unfiltered_vs_reference->nrmse_percent);
   std::printf("wrote %s/final.png, %s/final.exr, %s/buffers.exr, %s/stats.json\n", out.c_str(), out.c_str(),
               out.c_str(), out.c_str());
+  if (checkpointer.enabled())
+    std::printf("wrote %s (state writes %.0f ms in all)\n", state_path(out).c_str(), checkpointer.write_ms());
   return report.interrupted ? 130 : 0;
 }
 
