@@ -94,6 +94,11 @@ void CommandLine::positional(const std::string& name, std::string* target, const
   positionals_.push_back({name, help, target});
 }
 
+void CommandLine::positional_list(const std::string& name, std::vector<std::string>* target, const std::string& help) {
+  rest_ = {name, help, nullptr};
+  rest_target_ = target;
+}
+
 bool CommandLine::given(const std::string& name) const {
   for (const auto& g : given_)
     if (g == name) return true;
@@ -127,11 +132,17 @@ bool CommandLine::parse(const std::vector<std::string>& args) {
       given_.push_back(name);
       continue;
     }
+    if (next_positional >= positionals_.size() && rest_target_) {
+      rest_target_->push_back(arg);
+      continue;
+    }
     if (next_positional >= positionals_.size()) throw UsageError("unexpected argument '" + arg + "'");
     *positionals_[next_positional++].target = arg;
   }
   if (next_positional < positionals_.size())
     throw UsageError("missing argument " + positionals_[next_positional].name + " (see pxf " + command_ + " --help)");
+  if (rest_target_ && rest_target_->empty())
+    throw UsageError("missing argument " + rest_.name + " (see pxf " + command_ + " --help)");
   return true;
 }
 
@@ -141,6 +152,10 @@ std::string CommandLine::help() const {
   if (!positionals_.empty()) {
     out << "\narguments:\n";
     for (const auto& p : positionals_) out << "  " << p.name << "\n      " << p.help << "\n";
+  }
+  if (rest_target_) {
+    if (positionals_.empty()) out << "\narguments:\n";
+    out << "  " << rest_.name << "\n      " << rest_.help << "\n";
   }
   out << "\noptions:\n";
   for (const auto& o : options_)

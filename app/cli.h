@@ -28,6 +28,8 @@ class CommandLine {
   // "WxH" sizes.
   void size_option(const std::string& name, int* width, int* height, const std::string& help);
   void positional(const std::string& name, std::string* target, const std::string& help);
+  // One or more arguments after the single positionals ("STATE...").
+  void positional_list(const std::string& name, std::vector<std::string>* target, const std::string& help);
 
   // Returns false when --help was given (help is printed to stdout); throws UsageError.
   bool parse(const std::vector<std::string>& args);
@@ -49,6 +51,8 @@ class CommandLine {
   std::string command_, usage_, summary_;
   std::vector<Option> options_;
   std::vector<Positional> positionals_;
+  Positional rest_{"", "", nullptr};
+  std::vector<std::string>* rest_target_ = nullptr;
   std::vector<std::string> given_;
 };
 

@@ -78,3 +78,18 @@ TEST(CommandLine, RequiresPositionals) {
   EXPECT_EQ(a, "x.exr");
   EXPECT_EQ(b, "y.exr");
 }
+
+TEST(CommandLine, PositionalListTakesEveryRemainingArgument) {
+  std::vector<std::string> states;
+  std::string out;
+  CommandLine cli{"merge", "STATE...", "test"};
+  cli.positional_list("STATE...", &states, "states");
+  cli.option("--out", &out, "DIR", "output");
+  ASSERT_TRUE(cli.parse({"a.pxfs", "--out", "d", "b.pxfs", "c.pxfs"}));
+  EXPECT_EQ(states, (std::vector<std::string>{"a.pxfs", "b.pxfs", "c.pxfs"}));
+  EXPECT_EQ(out, "d");
+  std::vector<std::string> none;
+  CommandLine empty{"merge", "STATE...", "test"};
+  empty.positional_list("STATE...", &none, "states");
+  EXPECT_THROW(empty.parse({}), UsageError);
+}

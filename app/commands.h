@@ -12,5 +12,6 @@ int run_render(const Args& args);
 int run_explore(const Args& args);
 int run_bench(const Args& args);
 int run_diff(const Args& args);
+int run_merge(const Args& args);
 
 }  // namespace pxf

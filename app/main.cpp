@@ -19,6 +19,8 @@ const Command kCommands[] = {
     {"render", "headless progressive render with pixel filtering: images, all buffers, stats", pxf::run_render},
     {"explore", "interactive explorer (Dear ImGui): live view of every buffer, live parameters", pxf::run_explore},
     {"bench", "run time against error: per-stage timings, NRMSE at equal time, CSV and plots", pxf::run_bench},
+    {"merge", "combine the saved states of render shards (--frames, --shard) and write the usual outputs",
+     pxf::run_merge},
     {"diff", "image metrics (NRMSE, RMSE, relMSE, NaN/Inf) between two EXR images", pxf::run_diff},
 };
 

@@ -85,6 +85,17 @@ void Preview::reset() {
   case_counts_ = {};
 }
 
+void Preview::set_first_frame(uint32_t first) {
+  renderer_->set_first_frame(first);
+  reset();
+}
+
+void Preview::load_accumulation(const Accumulation& acc, uint32_t first, int frames) {
+  reset();
+  renderer_->restore(acc, first, frames);
+  update_hv_empty();
+}
+
 void Preview::set_camera(const Camera& camera) {
   renderer_->set_camera(camera);
   range_.set_camera(camera);

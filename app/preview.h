@@ -66,6 +66,11 @@ class Preview {
   void set_settings(const PreviewSettings& settings);
   void set_camera(const Camera& camera);  // resets
   void reset();
+  // Starts the frame sequence at `first` (a shard of frames first:B); resets.
+  void set_first_frame(uint32_t first);
+  // Replaces the samples by a saved accumulation of the frames [first, first + frames) (resume,
+  // merge); the passes then run on it as on traced frames.
+  void load_accumulation(const Accumulation& acc, uint32_t first, int frames);
   // Blend and tone map the current state (e.g. after a display-only change).
   void redisplay();
   // Runs the range pass until it has converged (the explorer's range views need it unfiltered too).

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <unistd.h>
 
+#include "app/checkpoint.h"
 #include "app/commands.h"
 #include "app/options.h"
 #include "app/preview.h"
@@ -75,6 +76,8 @@ int run_render(const Args& args) {
   cli.option("--reference", &reference, "REF.exr", "report NRMSE of the final and the unfiltered image against it");
   cli.option("--out", &out, "DIR", "output folder (default out)");
   cli.flag("--quiet", &quiet, "no progress bar");
+  CheckpointOptions checkpoint_options;
+  add_checkpoint_options(cli, checkpoint_options);
   if (!cli.parse(args)) return 0;
   if (print_scene_list_if_asked(scene_options)) return 0;
   const double budget_ms = time_s * 1000.0;
@@ -88,19 +91,27 @@ int run_render(const Args& args) {
   const double load_ms = elapsed_ms(start);
   auto context = create_gl_context(parse_gl_backend(scene_options.gl));
   Preview preview(scene, preview_options.settings, scene_options.width, scene_options.height);
+  const FrameRange frames = render_frame_range(checkpoint_options, spp);
+  Checkpointer checkpointer(checkpoint_options, out, render_sample_settings(scene_options, preview_options.settings),
+                            frames);
+  checkpointer.start(preview);
 
   g_interrupted = false;
   auto previous = std::signal(SIGINT, on_interrupt);
-  ProgressBar progress(spp);
-  for (int i = 0; i < spp && !g_interrupted; ++i) {
+  const int total = static_cast<int>(frames.count());
+  ProgressBar progress(total);
+  const int first = preview.samples();  // > 0 after --resume
+  for (int i = first; i < total && !g_interrupted; ++i) {
     // The first frame always traces; the next ones only while they and the finish fit the budget.
-    if (i > 0 && !next_frame_fits(preview.predict_next_frame(budget_ms, elapsed_ms(start)))) break;
+    if (i > first && !next_frame_fits(preview.predict_next_frame(budget_ms, elapsed_ms(start)))) break;
     // With a budget the first frame is displayed: that measures the finish's blend and tone map.
-    preview.add_frame(/*last_frame=*/false, /*display=*/i == 0 && budget_ms > 0);
-    if (!quiet) progress.update(i + 1, i + 1 == spp);
+    preview.add_frame(/*last_frame=*/false, /*display=*/i == first && budget_ms > 0);
+    checkpointer.maybe_write(preview);
+    if (!quiet) progress.update(i + 1, i + 1 == total);
   }
   preview.finish();
   const double used_ms = elapsed_ms(start);
+  checkpointer.write(preview);
   if (!quiet) progress.finish();
   std::signal(SIGINT, previous);
 
@@ -131,6 +142,8 @@ int run_render(const Args& args) {
                 report.unfiltered_vs_reference->nrmse_percent);
   std::printf("wrote %s/final.png, %s/final.exr, %s/buffers.exr, %s/stats.json\n", out.c_str(), out.c_str(),
               out.c_str(), out.c_str());
+  if (checkpointer.enabled())
+    std::printf("wrote %s (state writes %.0f ms in all)\n", state_path(out).c_str(), checkpointer.write_ms());
   return report.interrupted ? 130 : 0;
 }
 

@@ -89,8 +89,14 @@ class ProgressiveRenderer {
   void reset();                          // clears accumulation (camera, scene or params changed)
   void set_camera(const Camera& camera); // resets
   void set_params(const TraceParams& params);  // resets
-  void add_frame();                      // traces one path per pixel, frame index = frames()
-  int frames() const;
+  void add_frame();                      // traces one path per pixel, frame index = first_frame() + frames()
+  int frames() const;                    // frames traced (or restored) since the last reset
+  // Where the frame sequence starts (a shard of frames A:B starts at A); resets.
+  void set_first_frame(uint32_t first);
+  uint32_t first_frame() const;
+  // Continues from a saved accumulation holding the frames [first, first + frames) (checkpoint
+  // resume, merged shards). Throws pxf::Error when its size differs from the renderer's.
+  void restore(const Accumulation& acc, uint32_t first, int frames);
 
   const Accumulation& accumulation() const;
   const TraceStats& stats() const;

@@ -27,6 +27,7 @@ struct ProgressiveRenderer::Impl {
   Accumulation acc;
   TraceStats stats;
   int frames = 0;
+  uint32_t first_frame = 0;
 
   Impl(const Scene& s, const TraceParams& p, int w, int h) : scene(s), camera(s.camera), params(p), width(w), height(h) {
     if (w <= 0 || h <= 0) throw Error("path tracer: image size must be positive");
@@ -43,7 +44,7 @@ struct ProgressiveRenderer::Impl {
   void render_frame() {
     const int tiles_x = (width + kTileSize - 1) / kTileSize;
     const int tiles_y = (height + kTileSize - 1) / kTileSize;
-    const uint32_t frame = static_cast<uint32_t>(frames);
+    const uint32_t frame = first_frame + static_cast<uint32_t>(frames);
     std::atomic<uint64_t> rays{0}, paths{0}, dropped{0};
     auto render_tiles = [&](const tbb::blocked_range<int>& range) {
       uint64_t tile_rays = 0, tile_paths = 0, tile_dropped = 0;
@@ -112,6 +113,22 @@ void ProgressiveRenderer::add_frame() {
 }
 
 int ProgressiveRenderer::frames() const { return impl_->frames; }
+uint32_t ProgressiveRenderer::first_frame() const { return impl_->first_frame; }
+
+void ProgressiveRenderer::set_first_frame(uint32_t first) {
+  impl_->first_frame = first;
+  reset();
+}
+
+void ProgressiveRenderer::restore(const Accumulation& acc, uint32_t first, int frames) {
+  if (acc.width != impl_->width || acc.height != impl_->height || acc.samples.size() != impl_->acc.samples.size())
+    throw Error("saved accumulation is " + std::to_string(acc.width) + "x" + std::to_string(acc.height) +
+                ", the render " + std::to_string(impl_->width) + "x" + std::to_string(impl_->height));
+  impl_->acc = acc;
+  impl_->first_frame = first;
+  impl_->frames = frames;
+  impl_->stats = TraceStats{};
+}
 const Accumulation& ProgressiveRenderer::accumulation() const { return impl_->acc; }
 const TraceStats& ProgressiveRenderer::stats() const { return impl_->stats; }
 const Scene& ProgressiveRenderer::scene() const { return impl_->scene; }

@@ -1,0 +1,349 @@
+#include "pathtracer/accumulation_state.h"
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <fcntl.h>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+#include <unistd.h>
+
+namespace pxf {
+
+static_assert(sizeof(glm::vec3) == 3 * sizeof(float), "glm::vec3 must be three packed floats");
+
+namespace {
+
+constexpr char kMagic[8] = {'P', 'X', 'F', 'S', 'T', 'A', 'T', 'E'};
+constexpr uint32_t kMaxSide = 1u << 15;     // a bound that keeps a corrupt header from allocating
+constexpr uint32_t kMaxFrameRanges = 1u << 20;
+
+bool little_endian() {
+  const uint16_t one = 1;
+  uint8_t first;
+  std::memcpy(&first, &one, 1);
+  return first == 1;
+}
+
+// The per-pixel arrays of an Accumulation, in file order. A new field of Accumulation is one line
+// here: the writer, the reader and the size check all go through this list.
+template <class Acc, class Visit>
+void visit_arrays(Acc& acc, Visit&& visit) {
+  visit(acc.lv_mean);
+  visit(acc.hv_mean);
+  visit(acc.hv_lum_mean);
+  visit(acc.hv_lum_m2);
+  visit(acc.samples);
+}
+
+class Writer {
+ public:
+  template <class T>
+  void put(const T& v) { put_bytes(&v, sizeof(T)); }
+  template <class T>
+  void put_array(const std::vector<T>& v) { put_bytes(v.data(), v.size() * sizeof(T)); }
+  void put_bytes(const void* p, size_t n) {
+    const uint8_t* b = static_cast<const uint8_t*>(p);
+    bytes.insert(bytes.end(), b, b + n);
+  }
+  std::vector<uint8_t> bytes;
+};
+
+// Every read is bounds-checked against the buffer: a truncated or fuzzed file ends in pxf::Error.
+class Reader {
+ public:
+  Reader(const uint8_t* data, size_t size) : data_(data), size_(size) {}
+  template <class T>
+  T get(const char* what) {
+    T v;
+    get_bytes(&v, sizeof(T), what);
+    return v;
+  }
+  template <class T>
+  void get_array(std::vector<T>& v, size_t count, const char* what) {
+    if (count > remaining() / sizeof(T)) throw Error(std::string("state file truncated in ") + what);
+    v.resize(count);
+    get_bytes(v.data(), count * sizeof(T), what);
+  }
+  void get_bytes(void* out, size_t n, const char* what) {
+    if (n > remaining()) throw Error(std::string("state file truncated in ") + what);
+    std::memcpy(out, data_ + pos_, n);
+    pos_ += n;
+  }
+  size_t remaining() const { return size_ - pos_; }
+  size_t pos() const { return pos_; }
+
+ private:
+  const uint8_t* data_;
+  size_t size_, pos_ = 0;
+};
+
+void put_settings(Writer& w, const SampleSettings& s) {
+  w.put(s.scene_hash);
+  w.put(s.width);
+  w.put(s.height);
+  w.put(s.seed);
+  w.put(s.max_vertices);
+  w.put(s.rr_start_vertex);
+  w.put(s.all_hv);
+}
+
+SampleSettings get_settings(Reader& r) {
+  SampleSettings s;
+  s.scene_hash = r.get<uint64_t>("header");
+  s.width = r.get<uint32_t>("header");
+  s.height = r.get<uint32_t>("header");
+  s.seed = r.get<uint64_t>("header");
+  s.max_vertices = r.get<int32_t>("header");
+  s.rr_start_vertex = r.get<int32_t>("header");
+  s.all_hv = r.get<uint32_t>("header");
+  if (s.width == 0 || s.height == 0 || s.width > kMaxSide || s.height > kMaxSide)
+    throw Error("state file has an invalid image size " + std::to_string(s.width) + "x" + std::to_string(s.height));
+  return s;
+}
+
+void check_frame_ranges(const std::vector<FrameRange>& ranges) {
+  for (size_t i = 0; i < ranges.size(); ++i) {
+    if (ranges[i].begin >= ranges[i].end) throw Error("state file has an empty or reversed frame range");
+    if (i > 0 && ranges[i].begin < ranges[i - 1].end) throw Error("state file has unsorted or overlapping frame ranges");
+  }
+}
+
+void check_pixels(const AccumulationState& state) {
+  const Accumulation& acc = state.acc;
+  const uint32_t frames = state.frame_count();
+  for (size_t i = 0; i < acc.samples.size(); ++i) {
+    // Samples are per frame at most one per pixel (non-finite ones are dropped).
+    if (acc.samples[i] > frames) throw Error("state file has more samples in a pixel than frames");
+    const glm::vec3 lv = acc.lv_mean[i], hv = acc.hv_mean[i];
+    const bool finite = std::isfinite(lv.x) && std::isfinite(lv.y) && std::isfinite(lv.z) && std::isfinite(hv.x) &&
+                        std::isfinite(hv.y) && std::isfinite(hv.z) && std::isfinite(acc.hv_lum_mean[i]) &&
+                        std::isfinite(acc.hv_lum_m2[i]) && acc.hv_lum_m2[i] >= 0.0;
+    if (!finite) throw Error("state file has a non-finite or negative value at pixel " + std::to_string(i));
+  }
+}
+
+// Sample-count weighted mean of two means, in double, rounded once.
+float combine_mean(float a, uint32_t na, float b, uint32_t nb, double n) {
+  return static_cast<float>((static_cast<double>(a) * na + static_cast<double>(b) * nb) / n);
+}
+
+void merge_into(Accumulation& into, const Accumulation& from) {
+  for (size_t i = 0; i < into.samples.size(); ++i) {
+    const uint32_t na = into.samples[i], nb = from.samples[i];
+    if (nb == 0) continue;
+    if (na == 0) {
+      into.lv_mean[i] = from.lv_mean[i];
+      into.hv_mean[i] = from.hv_mean[i];
+      into.hv_lum_mean[i] = from.hv_lum_mean[i];
+      into.hv_lum_m2[i] = from.hv_lum_m2[i];
+      into.samples[i] = nb;
+      continue;
+    }
+    const double n = static_cast<double>(na) + nb;
+    for (int c = 0; c < 3; ++c) {
+      into.lv_mean[i][c] = combine_mean(into.lv_mean[i][c], na, from.lv_mean[i][c], nb, n);
+      into.hv_mean[i][c] = combine_mean(into.hv_mean[i][c], na, from.hv_mean[i][c], nb, n);
+    }
+    // Chan, Golub and LeVeque's pairwise update of the Welford state.
+    const double delta = from.hv_lum_mean[i] - into.hv_lum_mean[i];
+    into.hv_lum_mean[i] += delta * nb / n;
+    into.hv_lum_m2[i] += from.hv_lum_m2[i] + delta * delta * (static_cast<double>(na) * nb / n);
+    into.samples[i] = na + nb;
+  }
+}
+
+}  // namespace
+
+bool SampleSettings::operator==(const SampleSettings& o) const { return difference(o).empty(); }
+
+std::string SampleSettings::difference(const SampleSettings& o) const {
+  auto diff = [](const char* name, auto a, auto b) {
+    std::ostringstream s;
+    s << name << " " << a << " vs " << b;
+    return s.str();
+  };
+  if (scene_hash != o.scene_hash) return "scene content (hash) differs";
+  if (width != o.width || height != o.height)
+    return "image size " + std::to_string(width) + "x" + std::to_string(height) + " vs " + std::to_string(o.width) +
+           "x" + std::to_string(o.height);
+  if (seed != o.seed) return diff("seed", seed, o.seed);
+  if (max_vertices != o.max_vertices) return diff("max vertices", max_vertices, o.max_vertices);
+  if (rr_start_vertex != o.rr_start_vertex) return diff("Russian roulette start", rr_start_vertex, o.rr_start_vertex);
+  if (all_hv != o.all_hv) return diff("all-hv", all_hv, o.all_hv);
+  return "";
+}
+
+uint32_t AccumulationState::frame_count() const {
+  uint64_t n = 0;
+  for (const FrameRange& r : frames) n += r.count();
+  return static_cast<uint32_t>(std::min<uint64_t>(n, UINT32_MAX));
+}
+
+SampleSettings sample_settings(uint64_t scene_hash, int width, int height, const TraceParams& params) {
+  SampleSettings s;
+  s.scene_hash = scene_hash;
+  s.width = static_cast<uint32_t>(width);
+  s.height = static_cast<uint32_t>(height);
+  s.seed = params.seed;
+  s.max_vertices = params.max_vertices;
+  s.rr_start_vertex = params.rr_start_vertex;
+  s.all_hv = params.all_hv ? 1u : 0u;
+  return s;
+}
+
+uint64_t fnv1a64(const void* data, size_t size, uint64_t hash) {
+  const uint8_t* b = static_cast<const uint8_t*>(data);
+  for (size_t i = 0; i < size; ++i) {
+    hash ^= b[i];
+    hash *= 0x100000001b3ull;
+  }
+  return hash;
+}
+
+namespace {
+uint64_t hash_file(const std::string& path, uint64_t hash) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path + ": cannot read file to hash the scene");
+  std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  return fnv1a64(bytes.data(), bytes.size(), hash);
+}
+}  // namespace
+
+uint64_t scene_content_hash(const std::string& scene, const std::string& env_path, float env_strength) {
+  std::string path = scene;
+  for (const BuiltinScene& b : builtin_scenes())
+    if (b.name == scene) path = b.path;
+  uint64_t hash = hash_file(path, fnv1a64(nullptr, 0));
+  if (!env_path.empty()) hash = hash_file(env_path, hash);
+  return fnv1a64(&env_strength, sizeof(env_strength), hash);
+}
+
+std::vector<uint8_t> encode_state(const AccumulationState& state) {
+  if (!little_endian()) throw Error("state files are little-endian; this machine is not");
+  Writer w;
+  w.put_bytes(kMagic, sizeof(kMagic));
+  w.put(kStateFormatVersion);
+  put_settings(w, state.settings);
+  w.put(static_cast<uint32_t>(state.frames.size()));
+  for (const FrameRange& r : state.frames) {
+    w.put(r.begin);
+    w.put(r.end);
+  }
+  visit_arrays(state.acc, [&](const auto& array) { w.put_array(array); });
+  w.put(fnv1a64(w.bytes.data(), w.bytes.size()));
+  return std::move(w.bytes);
+}
+
+AccumulationState decode_state(const uint8_t* data, size_t size) {
+  if (!little_endian()) throw Error("state files are little-endian; this machine is not");
+  Reader r(data, size);
+  char magic[sizeof(kMagic)];
+  r.get_bytes(magic, sizeof(magic), "the magic number");
+  if (std::memcmp(magic, kMagic, sizeof(kMagic)) != 0) throw Error("not a pxf state file (bad magic number)");
+  const uint32_t version = r.get<uint32_t>("header");
+  if (version != kStateFormatVersion)
+    throw Error("state file format version " + std::to_string(version) + " is not supported (this pxf reads version " +
+                std::to_string(kStateFormatVersion) + ")");
+  // The checksum covers everything before it: check it before trusting any count.
+  if (size < sizeof(uint64_t) + r.pos()) throw Error("state file truncated");
+  uint64_t stored;
+  std::memcpy(&stored, data + size - sizeof(uint64_t), sizeof(uint64_t));
+  if (stored != fnv1a64(data, size - sizeof(uint64_t))) throw Error("state file is corrupt or truncated (checksum mismatch)");
+
+  AccumulationState state;
+  state.settings = get_settings(r);
+  const uint32_t range_count = r.get<uint32_t>("header");
+  if (range_count == 0 || range_count > kMaxFrameRanges) throw Error("state file has an invalid frame range count");
+  if (range_count > r.remaining() / (2 * sizeof(uint32_t))) throw Error("state file truncated in the frame ranges");
+  state.frames.resize(range_count);
+  for (FrameRange& range : state.frames) {
+    range.begin = r.get<uint32_t>("the frame ranges");
+    range.end = r.get<uint32_t>("the frame ranges");
+  }
+  check_frame_ranges(state.frames);
+  const size_t pixels = static_cast<size_t>(state.settings.width) * state.settings.height;
+  state.acc.width = static_cast<int>(state.settings.width);
+  state.acc.height = static_cast<int>(state.settings.height);
+  visit_arrays(state.acc, [&](auto& array) { r.get_array(array, pixels, "the pixel arrays"); });
+  if (r.remaining() != sizeof(uint64_t)) throw Error("state file has trailing bytes");
+  check_pixels(state);
+  return state;
+}
+
+void write_state_file(const std::string& path, const AccumulationState& state) {
+  const std::vector<uint8_t> bytes = encode_state(state);
+  write_file_atomically(path, [&](const std::string& tmp) {
+    const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd < 0) throw Error(path + ": cannot write state: " + std::strerror(errno));
+    size_t done = 0;
+    while (done < bytes.size()) {
+      const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) {
+        const int err = errno;
+        ::close(fd);
+        throw Error(path + ": cannot write state: " + std::strerror(err));
+      }
+      done += static_cast<size_t>(n);
+    }
+    // The data must be on disk before the rename makes it the state: a crash then leaves the old
+    // state or the new one, never a torn one.
+    const bool synced = ::fsync(fd) == 0;
+    ::close(fd);
+    if (!synced) throw Error(path + ": cannot write state: fsync failed");
+  });
+}
+
+AccumulationState read_state_file(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) throw Error(path + ": not a state file (no such regular file)");
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  if (!in) throw Error(path + ": cannot open state file");
+  std::vector<uint8_t> bytes(static_cast<size_t>(std::max<std::streamoff>(0, in.tellg())));
+  in.seekg(0);
+  if (!in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(bytes.size())))
+    throw Error(path + ": cannot read state file");
+  try {
+    return decode_state(bytes.data(), bytes.size());
+  } catch (const Error& e) {
+    throw Error(path + ": " + e.what());
+  }
+}
+
+AccumulationState merge_states(const std::vector<AccumulationState>& states) {
+  if (states.empty()) throw Error("no state to merge");
+  AccumulationState merged = states.front();
+  for (size_t i = 1; i < states.size(); ++i) {
+    const std::string diff = states[i].settings.difference(merged.settings);
+    if (!diff.empty()) throw Error("state " + std::to_string(i + 1) + " was rendered with other settings: " + diff);
+    merged.frames.insert(merged.frames.end(), states[i].frames.begin(), states[i].frames.end());
+    merge_into(merged.acc, states[i].acc);
+  }
+  std::sort(merged.frames.begin(), merged.frames.end(),
+            [](const FrameRange& a, const FrameRange& b) { return a.begin < b.begin; });
+  for (size_t i = 1; i < merged.frames.size(); ++i)
+    if (merged.frames[i].begin < merged.frames[i - 1].end)
+      throw Error("frame ranges overlap (" + frame_ranges_text(merged.frames) + "): a frame would count twice");
+  // Adjacent ranges become one, so the shards of 0:N merge into the state of a plain 0:N render.
+  std::vector<FrameRange> joined;
+  for (const FrameRange& r : merged.frames) {
+    if (!joined.empty() && joined.back().end == r.begin)
+      joined.back().end = r.end;
+    else
+      joined.push_back(r);
+  }
+  merged.frames = joined;
+  return merged;
+}
+
+std::string frame_ranges_text(const std::vector<FrameRange>& ranges) {
+  std::string text;
+  for (const FrameRange& r : ranges)
+    text += (text.empty() ? "" : ",") + std::to_string(r.begin) + ":" + std::to_string(r.end);
+  return text;
+}
+
+}  // namespace pxf

@@ -1,0 +1,69 @@
+// The accumulation of a render as a file (docs/state-format.md): what `pxf render --checkpoint`
+// writes, `--resume` continues and `pxf merge` combines. Frame k of pixel p is the same sample
+// wherever it is traced (counter-based random numbers), so states of disjoint frame ranges combine
+// exactly into the state of their union.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "pathtracer/pathtracer.h"
+
+namespace pxf {
+
+constexpr uint32_t kStateFormatVersion = 1;
+
+// The frames [begin, end) of the counter-based sample sequence.
+struct FrameRange {
+  uint32_t begin = 0, end = 0;
+  uint32_t count() const { return end - begin; }
+  bool operator==(const FrameRange& o) const { return begin == o.begin && end == o.end; }
+};
+
+// Everything that decides which sample frame k of pixel p is: two states may be continued or
+// combined only when these are equal. Filter, blend and tone-map settings are not here: they act
+// on the accumulation afterwards and may differ between a render and a merge.
+struct SampleSettings {
+  uint64_t scene_hash = 0;  // scene_content_hash() of the scene file(s) and environment
+  uint32_t width = 0, height = 0;
+  uint64_t seed = 0;
+  int32_t max_vertices = 0, rr_start_vertex = 0;
+  uint32_t all_hv = 0;
+  bool operator==(const SampleSettings& o) const;
+  // "" when equal, else one phrase naming the first difference ("seed 1 vs 2").
+  std::string difference(const SampleSettings& o) const;
+};
+
+struct AccumulationState {
+  SampleSettings settings;
+  std::vector<FrameRange> frames;  // sorted, disjoint, non-empty ranges
+  Accumulation acc;
+  uint32_t frame_count() const;
+};
+
+SampleSettings sample_settings(uint64_t scene_hash, int width, int height, const TraceParams& params);
+
+// 64-bit FNV-1a of the scene file's bytes (a built-in's file for a built-in name; for a .gltf also
+// every buffer and image file beside it is NOT included: see docs/state-format.md), the
+// environment file's bytes and the environment strength.
+uint64_t scene_content_hash(const std::string& scene_name_or_path, const std::string& env_path, float env_strength);
+uint64_t fnv1a64(const void* data, size_t size, uint64_t hash = 0xcbf29ce484222325ull);
+
+// The file image of a state, and back. decode_state throws pxf::Error with a one-line message for
+// any buffer that is not a complete, uncorrupted state of this format version.
+std::vector<uint8_t> encode_state(const AccumulationState& state);
+AccumulationState decode_state(const uint8_t* data, size_t size);
+
+// Atomic write (temporary name, fsync, rename) and read; errors name the file.
+void write_state_file(const std::string& path, const AccumulationState& state);
+AccumulationState read_state_file(const std::string& path);
+
+// Combines states of disjoint frame ranges with equal sample settings: sample-count weighted means
+// and Chan's parallel combination of the Welford M2. Throws pxf::Error when settings differ or the
+// frame ranges overlap.
+AccumulationState merge_states(const std::vector<AccumulationState>& states);
+
+// "0:16,32:48"
+std::string frame_ranges_text(const std::vector<FrameRange>& ranges);
+
+}  // namespace pxf

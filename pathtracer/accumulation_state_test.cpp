@@ -1,0 +1,149 @@
+// The state file (docs/state-format.md): exact round trip, every truncation and every corrupted
+// byte refused with a one-line error, and merging of disjoint frame ranges equal to one sequential
+// accumulation (Chan's combination of the Welford state).
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "pathtracer/accumulation_state.h"
+#include "pathtracer/integrator.h"
+
+using namespace pxf;
+
+namespace {
+
+constexpr int kW = 5, kH = 3;
+
+// A deterministic stand-in for frame `frame` of pixel `p`: what the path tracer guarantees too.
+void sample_of(size_t p, uint32_t frame, glm::vec3& lv, glm::vec3& hv) {
+  std::mt19937 rng(static_cast<uint32_t>(p * 7919u + frame * 104729u + 17u));
+  std::exponential_distribution<float> radiance(2.0f);
+  lv = glm::vec3(radiance(rng), radiance(rng), radiance(rng));
+  hv = glm::vec3(radiance(rng), radiance(rng), radiance(rng)) * (frame % 5 == 0 ? 20.0f : 1.0f);
+}
+
+AccumulationState render_frames(FrameRange range) {
+  AccumulationState state;
+  state.settings = sample_settings(0x1234, kW, kH, TraceParams{});
+  state.frames = {range};
+  resize_accumulation(state.acc, kW, kH);
+  for (uint32_t f = range.begin; f < range.end; ++f)
+    for (size_t p = 0; p < state.acc.samples.size(); ++p) {
+      if ((p + f) % 11 == 3) continue;  // a dropped (non-finite) sample: counts differ per pixel
+      glm::vec3 lv, hv;
+      sample_of(p, f, lv, hv);
+      accumulate_sample(state.acc, p, lv, hv);
+    }
+  return state;
+}
+
+std::string decode_error(const std::vector<uint8_t>& bytes) {
+  try {
+    decode_state(bytes.data(), bytes.size());
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// Relative tolerance of a merged float mean against the sequential running mean: both round at
+// each step, the running mean n times in float; 64 frames stay well inside 1e-5.
+constexpr float kMeanTolerance = 1e-5f;
+
+void expect_same_accumulation(const Accumulation& a, const Accumulation& b) {
+  ASSERT_EQ(a.samples, b.samples);
+  for (size_t i = 0; i < a.samples.size(); ++i) {
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NEAR(a.lv_mean[i][c], b.lv_mean[i][c], kMeanTolerance * std::abs(b.lv_mean[i][c])) << i;
+      EXPECT_NEAR(a.hv_mean[i][c], b.hv_mean[i][c], kMeanTolerance * std::abs(b.hv_mean[i][c])) << i;
+    }
+    EXPECT_NEAR(a.hv_lum_mean[i], b.hv_lum_mean[i], 1e-12 * std::abs(b.hv_lum_mean[i])) << i;
+    EXPECT_NEAR(a.hv_lum_m2[i], b.hv_lum_m2[i], 1e-12 * std::abs(b.hv_lum_m2[i])) << i;
+  }
+}
+
+}  // namespace
+
+TEST(AccumulationState, RoundTripIsExact) {
+  const AccumulationState state = render_frames({4, 20});
+  const std::vector<uint8_t> bytes = encode_state(state);
+  const AccumulationState back = decode_state(bytes.data(), bytes.size());
+  EXPECT_EQ(back.settings.difference(state.settings), "");
+  ASSERT_EQ(back.frames.size(), 1u);
+  EXPECT_EQ(back.frames[0], (FrameRange{4, 20}));
+  EXPECT_EQ(encode_state(back), bytes);  // every array bit for bit
+}
+
+TEST(AccumulationState, EveryTruncationIsRefused) {
+  const std::vector<uint8_t> bytes = encode_state(render_frames({0, 3}));
+  for (size_t size = 0; size < bytes.size(); ++size) {
+    const std::vector<uint8_t> cut(bytes.begin(), bytes.begin() + size);
+    const std::string error = decode_error(cut);
+    EXPECT_FALSE(error.empty()) << "a state cut to " << size << " bytes was accepted";
+    EXPECT_EQ(error.find('\n'), std::string::npos);
+  }
+  std::vector<uint8_t> longer = bytes;
+  longer.push_back(0);
+  EXPECT_FALSE(decode_error(longer).empty());
+}
+
+TEST(AccumulationState, EveryCorruptedByteIsRefused) {
+  const std::vector<uint8_t> bytes = encode_state(render_frames({0, 3}));
+  for (size_t i = 0; i < bytes.size(); ++i) {
+    std::vector<uint8_t> bad = bytes;
+    bad[i] ^= 0x5a;
+    EXPECT_FALSE(decode_error(bad).empty()) << "byte " << i;
+  }
+}
+
+TEST(AccumulationState, OtherVersionIsRefusedByName) {
+  std::vector<uint8_t> bytes = encode_state(render_frames({0, 2}));
+  bytes[8] = 2;  // the version follows the 8-byte magic
+  EXPECT_NE(decode_error(bytes).find("version 2 is not supported"), std::string::npos) << decode_error(bytes);
+  bytes[0] = 'Q';
+  EXPECT_NE(decode_error(bytes).find("not a pxf state file"), std::string::npos);
+}
+
+TEST(AccumulationState, HeaderWithHugeCountsIsRefusedWithoutAllocating) {
+  // A valid checksum over a header claiming 2^15 x 2^15 pixels and no arrays.
+  AccumulationState state = render_frames({0, 1});
+  state.settings.width = state.settings.height = 1u << 15;
+  std::vector<uint8_t> bytes = encode_state(state);
+  EXPECT_NE(decode_error(bytes).find("truncated"), std::string::npos) << decode_error(bytes);
+}
+
+TEST(AccumulationState, MergedUnevenShardsEqualOneAccumulation) {
+  const AccumulationState whole = render_frames({0, 64});
+  for (const std::vector<uint32_t>& cuts :
+       {std::vector<uint32_t>{0, 41, 64}, {0, 1, 30, 64}, {0, 3, 4, 20, 21, 50, 63, 64}}) {
+    std::vector<AccumulationState> shards;
+    for (size_t i = 0; i + 1 < cuts.size(); ++i) shards.push_back(render_frames({cuts[i], cuts[i + 1]}));
+    std::reverse(shards.begin(), shards.end());  // the order of the states does not matter
+    const AccumulationState merged = merge_states(shards);
+    SCOPED_TRACE(cuts.size() - 1);
+    ASSERT_EQ(merged.frames.size(), 1u);
+    EXPECT_EQ(merged.frames[0], (FrameRange{0, 64}));
+    expect_same_accumulation(merged.acc, whole.acc);
+  }
+}
+
+TEST(AccumulationState, OverlapAndMismatchAreRefused) {
+  EXPECT_THROW(merge_states({render_frames({0, 10}), render_frames({9, 12})}), Error);
+  AccumulationState other_seed = render_frames({10, 12});
+  other_seed.settings.seed = 7;
+  try {
+    merge_states({render_frames({0, 10}), other_seed});
+    FAIL() << "states of another seed were merged";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("seed"), std::string::npos) << e.what();
+  }
+  AccumulationState other_scene = render_frames({10, 12});
+  other_scene.settings.scene_hash ^= 1;
+  EXPECT_THROW(merge_states({render_frames({0, 10}), other_scene}), Error);
+}
+
+TEST(AccumulationState, NonContiguousRangesStaySeparate) {
+  const AccumulationState merged = merge_states({render_frames({8, 10}), render_frames({0, 4})});
+  EXPECT_EQ(frame_ranges_text(merged.frames), "0:4,8:10");
+  EXPECT_EQ(merged.frame_count(), 6u);
+}

@@ -1,0 +1,202 @@
+// Checkpoint, resume and shard merging end to end through the pxf executable (issue 13): a render
+// killed with SIGKILL at random moments and resumed gives the uninterrupted render's images bit for
+// bit; merges of uneven shards equal one render within the stated tolerance; states of another
+// render, overlapping shards and corrupt files are refused with one line and overwrite nothing.
+#include <gtest/gtest.h>
+
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <thread>
+
+#include "image/image.h"
+
+namespace fs = std::filesystem;
+using namespace pxf;
+
+namespace {
+
+const std::string kScene = "--scene cornell --size 40x32 --quiet";
+constexpr int kSpp = 24;
+
+std::string temp_dir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("pxf_checkpoint_test_" + std::to_string(::getpid())) / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir.parent_path());
+  return dir.string();
+}
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+struct Result {
+  int code = -1;
+  std::string err;
+};
+
+Result pxf_run(const std::string& args) {
+  const std::string err = temp_dir("stderr");
+  const std::string cmd = std::string(PXF_EXECUTABLE) + " " + args + " >/dev/null 2>" + err;
+  const int status = std::system(cmd.c_str());
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(err)};
+}
+
+// Starts pxf without a shell so that the pid is pxf's own.
+pid_t pxf_spawn(const std::vector<std::string>& args) {
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    std::vector<char*> argv{const_cast<char*>(PXF_EXECUTABLE)};
+    for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    ::freopen("/dev/null", "w", stdout);
+    ::freopen("/dev/null", "w", stderr);
+    ::execv(PXF_EXECUTABLE, argv.data());
+    ::_exit(127);
+  }
+  return pid;
+}
+
+std::vector<std::string> split(const std::string& text) {
+  std::vector<std::string> words;
+  std::istringstream in(text);
+  for (std::string w; in >> w;) words.push_back(w);
+  return words;
+}
+
+bool same_pixels(const std::vector<Layer>& a, const std::vector<Layer>& b) {
+  if (a.size() != b.size()) return false;
+  for (size_t i = 0; i < a.size(); ++i)
+    if (a[i].name != b[i].name || a[i].image.pixels != b[i].image.pixels) return false;
+  return true;
+}
+
+// Every file under an output name is complete: it reads back whole.
+void expect_outputs_complete(const std::string& dir) {
+  if (fs::exists(dir + "/final.exr")) EXPECT_NO_THROW(read_exr(dir + "/final.exr")) << dir;
+  if (fs::exists(dir + "/buffers.exr")) EXPECT_NO_THROW(read_exr_layers(dir + "/buffers.exr")) << dir;
+  if (fs::exists(dir + "/final.png")) EXPECT_NO_THROW(read_ldr_or_hdr(dir + "/final.png")) << dir;
+  if (fs::exists(dir + "/stats.json")) EXPECT_NO_THROW((void)nlohmann::json::parse(slurp(dir + "/stats.json"))) << dir;
+}
+
+// The tolerance of a merge against one render: shard means are combined as n-weighted means in
+// double and rounded to float once, where the single render rounds its running float mean at every
+// sample, so values differ by a few float ulps of the radiance.
+void expect_close(const Image& merged, const Image& single, const std::string& what) {
+  ASSERT_EQ(merged.pixels.size(), single.pixels.size()) << what;
+  size_t bad = 0;
+  for (size_t i = 0; i < merged.pixels.size(); ++i)
+    if (!(std::abs(merged.pixels[i] - single.pixels[i]) <= 2e-5f * std::abs(single.pixels[i]) + 1e-6f)) ++bad;
+  EXPECT_EQ(bad, 0u) << what << ": " << bad << " values outside 2e-5 relative + 1e-6";
+}
+
+}  // namespace
+
+TEST(Checkpoint, ResumeAfterSigkillAtRandomMomentsIsBitIdentical) {
+  const std::string ref = temp_dir("uninterrupted");
+  ASSERT_EQ(pxf_run("render " + kScene + " --spp " + std::to_string(kSpp) + " --out " + ref).code, 0);
+  const std::vector<Layer> ref_buffers = read_exr_layers(ref + "/buffers.exr");
+  const Image ref_final = read_exr(ref + "/final.exr");
+
+  std::mt19937 rng(13);
+  std::uniform_int_distribution<int> kill_after_ms(20, 1500);
+  int resumed = 0;
+  for (int trial = 0; trial < 20; ++trial) {
+    SCOPED_TRACE("trial " + std::to_string(trial));
+    const std::string out = temp_dir("killed_" + std::to_string(trial));
+    const pid_t pid = pxf_spawn(split("render " + kScene + " --spp " + std::to_string(kSpp) +
+                                      " --checkpoint 0.05 --out " + out));
+    ASSERT_GT(pid, 0);
+    std::this_thread::sleep_for(std::chrono::milliseconds(kill_after_ms(rng)));
+    ::kill(pid, SIGKILL);
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    expect_outputs_complete(out);
+    const std::string state = out + "/state.pxfs";
+    const std::string resume = fs::exists(state) ? " --resume " + state : "";
+    resumed += !resume.empty();
+    const Result r = pxf_run("render " + kScene + " --spp " + std::to_string(kSpp) + resume + " --out " + out);
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(same_pixels(read_exr_layers(out + "/buffers.exr"), ref_buffers));
+    EXPECT_EQ(read_exr(out + "/final.exr").pixels, ref_final.pixels);
+  }
+  EXPECT_GE(resumed, 5) << "too few kills landed after the first checkpoint to test resuming";
+}
+
+TEST(Checkpoint, MergeOfUnevenShardsEqualsOneRender) {
+  const std::string ref = temp_dir("single");
+  ASSERT_EQ(pxf_run("render " + kScene + " --spp " + std::to_string(kSpp) + " --out " + ref).code, 0);
+  const std::vector<Layer> single = read_exr_layers(ref + "/buffers.exr");
+  for (const std::vector<int>& cuts : {std::vector<int>{0, 17, 24}, {0, 2, 11, 24}, {0, 1, 2, 7, 8, 15, 23, 24}}) {
+    const int n = static_cast<int>(cuts.size()) - 1;
+    SCOPED_TRACE(std::to_string(n) + " shards");
+    std::string states;
+    for (int i = 0; i < n; ++i) {
+      const std::string dir = temp_dir("shard_" + std::to_string(n) + "_" + std::to_string(i));
+      const std::string frames = std::to_string(cuts[i]) + ":" + std::to_string(cuts[i + 1]);
+      const Result r = pxf_run("render " + kScene + " --frames " + frames + " --out " + dir);
+      ASSERT_EQ(r.code, 0) << r.err;
+      states += " " + dir + "/state.pxfs";
+    }
+    const std::string merged_dir = temp_dir("merged_" + std::to_string(n));
+    const Result r = pxf_run("merge" + states + " --scene cornell --out " + merged_dir);
+    ASSERT_EQ(r.code, 0) << r.err;
+    const std::vector<Layer> merged = read_exr_layers(merged_dir + "/buffers.exr");
+    for (const char* layer : {"lv", "hv", "var_u", "samples", "final"}) {
+      const auto find = [&](const std::vector<Layer>& layers) -> const Image& {
+        for (const Layer& l : layers)
+          if (l.name == layer) return l.image;
+        throw Error(std::string("no layer ") + layer);
+      };
+      expect_close(find(merged), find(single), layer);
+    }
+  }
+}
+
+TEST(Checkpoint, ForeignOverlappingAndCorruptStatesAreRefused) {
+  const std::string a = temp_dir("a"), b = temp_dir("b");
+  ASSERT_EQ(pxf_run("render " + kScene + " --frames 0:4 --out " + a).code, 0);
+  ASSERT_EQ(pxf_run("render " + kScene + " --frames 2:6 --out " + b).code, 0);
+  const std::string out = temp_dir("refused");
+
+  const Result overlap = pxf_run("merge " + a + "/state.pxfs " + b + "/state.pxfs --scene cornell --out " + out);
+  EXPECT_EQ(overlap.code, 1);
+  EXPECT_NE(overlap.err.find("overlap"), std::string::npos) << overlap.err;
+
+  const std::string seed2 = temp_dir("seed2");
+  ASSERT_EQ(pxf_run("render " + kScene + " --frames 4:6 --seed 2 --out " + seed2).code, 0);
+  const Result mismatch = pxf_run("merge " + a + "/state.pxfs " + seed2 + "/state.pxfs --scene cornell --out " + out);
+  EXPECT_EQ(mismatch.code, 1);
+  EXPECT_NE(mismatch.err.find("seed"), std::string::npos) << mismatch.err;
+
+  const Result other_scene = pxf_run("merge " + a + "/state.pxfs --scene atrium --out " + out);
+  EXPECT_EQ(other_scene.code, 1);
+  EXPECT_NE(other_scene.err.find("scene"), std::string::npos) << other_scene.err;
+
+  const std::string bytes = slurp(a + "/state.pxfs");
+  const std::string cut = temp_dir("cut.pxfs");
+  std::ofstream(cut, std::ios::binary) << bytes.substr(0, bytes.size() / 2);
+  const Result corrupt = pxf_run("merge " + cut + " --scene cornell --out " + out);
+  EXPECT_EQ(corrupt.code, 1);
+  EXPECT_NE(corrupt.err.find("truncated"), std::string::npos) << corrupt.err;
+
+  for (const Result* r : {&overlap, &mismatch, &other_scene, &corrupt})
+    EXPECT_EQ(std::count(r->err.begin(), r->err.end(), '\n'), 1) << r->err;
+  EXPECT_FALSE(fs::exists(out));
+
+  // Resuming with other settings: refused before anything in the output folder changes.
+  const std::string before = slurp(a + "/final.exr");
+  const Result resume = pxf_run("render " + kScene + " --spp 8 --max-vertices 4 --resume " + a +
+                                "/state.pxfs --out " + a);
+  EXPECT_EQ(resume.code, 1);
+  EXPECT_NE(resume.err.find("max vertices"), std::string::npos) << resume.err;
+  EXPECT_EQ(slurp(a + "/final.exr"), before);
+}
