@@ -22,6 +22,7 @@ struct PreviewOptions {
   std::string schedule = "pow2";
   int seed = 1;
   bool all_hv = false;
+  std::string sampler = "sobol";
 };
 
 void add_scene_options(CommandLine& cli, SceneOptions& options, bool headless);

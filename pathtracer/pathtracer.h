@@ -8,6 +8,7 @@
 #include <vector>
 #include <glm/glm.hpp>
 #include "image/image.h"
+#include "pathtracer/sampler.h"
 #include "pathtracer/scene.h"
 
 namespace pxf {
@@ -18,6 +19,10 @@ struct TraceParams {
   bool all_hv = false;      // every contribution goes to HV (environment-lit scenes)
   uint64_t seed = 1;
   int threads = 0;          // 0 = all cores
+  SamplerType sampler = SamplerType::Sobol;  // see pathtracer/sampler.h for the dimension table
+  // Independently scrambled interleaved Sobol replicates (frame k is in replicate k mod K): their
+  // means give Var[L_u] of the pixel mean under QMC. 1 = one sequence, no replicate estimate.
+  int replicates = 4;
 };
 
 // Loads a glTF/GLB file or a built-in scene name ("cornell", ...); throws pxf::Error naming the
@@ -61,8 +66,21 @@ struct Accumulation {
   std::vector<double> hv_lum_mean;     // Welford state of HV luminance
   std::vector<double> hv_lum_m2;
   std::vector<uint32_t> samples;       // accepted samples per pixel (NaN/Inf samples dropped)
-  // Var[L_u] = s^2 / n of the HV luminance mean; negative (-1) when n < 2 (unknown).
+  // Interleaved replicates (TraceParams::replicates, 1 = none): HV luminance sum and sample count
+  // of replicate r of pixel p at [p * replicates + r].
+  int replicates = 1;
+  std::vector<double> replicate_lum_sum;
+  std::vector<uint32_t> replicate_samples;
+
+  // Var[L_u] of the HV luminance mean; negative (-1) when n < 2 (unknown). Without replicates it is
+  // s^2 / n. With replicates (randomized QMC, where s^2 / n overestimates), it is s^2 / n times the
+  // QMC gain: the sum over the 3x3 neighbourhood of the replicate estimates divided by the sum of
+  // the s^2 / n estimates. Each replicate estimate alone has only K - 1 degrees of freedom; pooling
+  // the gain, which varies slowly across the image, keeps the n - 1 of s^2 / n.
   float variance_of_mean(size_t pixel) const;
+  float per_sample_variance_of_mean(size_t pixel) const;  // s^2 / n, -1 when n < 2
+  // K'/(K'-1) sum_r (n_r / n)^2 (m_r - m)^2 over the K' replicates with samples; -1 when K' < 2.
+  float replicate_variance_of_mean(size_t pixel) const;
 };
 
 struct TraceStats {

@@ -31,9 +31,12 @@ struct ProgressiveRenderer::Impl {
   Impl(const Scene& s, const TraceParams& p, int w, int h) : scene(s), camera(s.camera), params(p), width(w), height(h) {
     if (w <= 0 || h <= 0) throw Error("path tracer: image size must be positive");
     tracer = std::make_unique<PathTracer>(scene);
-    resize_accumulation(acc, w, h);
+    resize_accumulation(acc, w, h, accumulation_replicates());
     make_arena();
   }
+
+  // The replicates only mean something for the Sobol sampler; independent samples are their own.
+  int accumulation_replicates() const { return params.sampler == SamplerType::Sobol ? params.replicates : 1; }
 
   void make_arena() {
     int threads = params.threads > 0 ? params.threads : static_cast<int>(tbb::task_arena::automatic);
@@ -44,6 +47,7 @@ struct ProgressiveRenderer::Impl {
     const int tiles_x = (width + kTileSize - 1) / kTileSize;
     const int tiles_y = (height + kTileSize - 1) / kTileSize;
     const uint32_t frame = static_cast<uint32_t>(frames);
+    const int replicate = static_cast<int>(frame % static_cast<uint32_t>(acc.replicates));
     std::atomic<uint64_t> rays{0}, paths{0}, dropped{0};
     auto render_tiles = [&](const tbb::blocked_range<int>& range) {
       uint64_t tile_rays = 0, tile_paths = 0, tile_dropped = 0;
@@ -61,7 +65,7 @@ struct ProgressiveRenderer::Impl {
             continue;
           }
           const int x = rect.x0 + i % rect.width(), y = rect.y0 + i / rect.width();
-          accumulate_sample(acc, static_cast<size_t>(y) * width + x, sample.lv, sample.hv);
+          accumulate_sample(acc, static_cast<size_t>(y) * width + x, sample.lv, sample.hv, replicate);
         }
       }
       rays += tile_rays;
@@ -76,7 +80,8 @@ struct ProgressiveRenderer::Impl {
 
   // A dark scene is black: every pixel gets an exact zero sample without tracing.
   void add_dark_frame() {
-    for (size_t i = 0; i < acc.samples.size(); ++i) accumulate_sample(acc, i, glm::vec3(0.0f), glm::vec3(0.0f));
+    const int replicate = frames % acc.replicates;
+    for (size_t i = 0; i < acc.samples.size(); ++i) accumulate_sample(acc, i, glm::vec3(0.0f), glm::vec3(0.0f), replicate);
   }
 };
 
@@ -85,7 +90,7 @@ ProgressiveRenderer::ProgressiveRenderer(const Scene& scene, const TraceParams& 
 ProgressiveRenderer::~ProgressiveRenderer() = default;
 
 void ProgressiveRenderer::reset() {
-  resize_accumulation(impl_->acc, impl_->width, impl_->height);
+  resize_accumulation(impl_->acc, impl_->width, impl_->height, impl_->accumulation_replicates());
   impl_->stats = TraceStats{};
   impl_->frames = 0;
 }
