@@ -74,7 +74,14 @@ constexpr Matrices make_matrices() {
 }
 inline constexpr Matrices kMatrices = make_matrices();
 
-// Coordinate `dim` of Sobol point `index` as a 32-bit fixed-point fraction.
+inline uint32_t reverse_bits(uint32_t x) {
+  x = __builtin_bswap32(x);
+  x = ((x >> 4) & 0x0f0f0f0fu) | ((x & 0x0f0f0f0fu) << 4);
+  x = ((x >> 2) & 0x33333333u) | ((x & 0x33333333u) << 2);
+  return ((x >> 1) & 0x55555555u) | ((x & 0x55555555u) << 1);
+}
+
+// Coordinate `dim` of Sobol point `index` as a 32-bit fixed-point fraction (bit 31 = 1/2).
 inline uint32_t sample_bits(uint32_t index, int dim) {
   uint32_t x = 0;
   for (int k = 0; index != 0; index >>= 1, ++k)
@@ -82,12 +89,36 @@ inline uint32_t sample_bits(uint32_t index, int dim) {
   return x;
 }
 
-inline uint32_t reverse_bits(uint32_t x) {
-  x = ((x >> 1) & 0x55555555u) | ((x & 0x55555555u) << 1);
-  x = ((x >> 2) & 0x33333333u) | ((x & 0x33333333u) << 2);
-  x = ((x >> 4) & 0x0f0f0f0fu) | ((x & 0x0f0f0f0fu) << 4);
-  x = ((x >> 8) & 0x00ff00ffu) | ((x & 0x00ff00ffu) << 8);
-  return (x >> 16) | (x << 16);
+// The same products in the bit-reversed domain where the Owen scrambles work, one table per byte:
+// kReversedProducts[dim][b][v] = reverse(C_dim x reverse(v << 8b)). A shuffled index has all 32
+// bits set at random, so four lookups beat a loop over its bits, and no reversal is needed
+// between the index shuffle and the coordinate scramble.
+using ByteProducts = std::array<std::array<std::array<uint32_t, 256>, 4>, kDimensions>;
+constexpr uint32_t constexpr_reverse(uint32_t x) {
+  uint32_t r = 0;
+  for (int i = 0; i < 32; ++i) r |= ((x >> i) & 1u) << (31 - i);
+  return r;
+}
+constexpr ByteProducts make_reversed_products() {
+  ByteProducts t{};
+  for (int d = 0; d < kDimensions; ++d)
+    for (int b = 0; b < 4; ++b)
+      for (uint32_t v = 0; v < 256; ++v) {
+        const uint32_t index = constexpr_reverse(v << (8 * b));
+        uint32_t x = 0;
+        for (int k = 0; k < 32; ++k)
+          if ((index >> k) & 1u) x ^= kMatrices[d][k];
+        t[d][b][v] = constexpr_reverse(x);
+      }
+  return t;
+}
+inline constexpr ByteProducts kReversedProducts = make_reversed_products();
+
+inline uint32_t reversed_sample_bits(uint32_t reversed_index, int dim) {
+  if (dim == 0) return reversed_index;  // van der Corput: the identity in the reversed domain
+  const auto& t = kReversedProducts[dim];
+  const uint32_t r = reversed_index;
+  return t[0][r & 0xffu] ^ t[1][(r >> 8) & 0xffu] ^ t[2][(r >> 16) & 0xffu] ^ t[3][r >> 24];
 }
 
 // Laine-Karras style hash on bit-reversed values (Burley 2020, with Vegdahl's constants): each bit
@@ -108,11 +139,34 @@ inline uint32_t nested_uniform_scramble(uint32_t x, uint32_t seed) {
 
 inline float to_unit_float(uint32_t x) { return static_cast<float>(x >> 8) * 0x1p-24f; }
 
-// Point `index` of the shuffled, Owen-scrambled sequence with scramble key `key`, dimension `dim`.
+// A 32-bit integer hash (Wellons' lowbias32): decorrelates the per-dimension scramble seeds.
+inline uint32_t hash32(uint32_t x) {
+  x ^= x >> 16;
+  x *= 0x7feb352du;
+  x ^= x >> 15;
+  x *= 0x846ca68bu;
+  x ^= x >> 16;
+  return x;
+}
+
+// One group of dimensions of one path: its shuffled index and its scramble seeds, derived from
+// a 64-bit key once. Everything stays bit-reversed until the coordinate leaves bits().
+struct ScrambledGroup {
+  uint32_t reversed_shuffled_index;
+  uint32_t seed;
+  ScrambledGroup(uint32_t reversed_index, uint64_t key)
+      : reversed_shuffled_index(laine_karras_permutation(reversed_index, static_cast<uint32_t>(key))),
+        seed(static_cast<uint32_t>(key >> 32)) {}
+  uint32_t bits(int dim) const {
+    const uint32_t dim_seed = hash32(seed + 0x9e3779b9u * static_cast<uint32_t>(dim));
+    return reverse_bits(laine_karras_permutation(reversed_sample_bits(reversed_shuffled_index, dim), dim_seed));
+  }
+};
+
+// Point `index` of the shuffled, Owen-scrambled sequence with scramble key `key`, dimension `dim`:
+// nested_uniform_scramble(sample_bits(nested_uniform_scramble(index, s0), dim), s_dim).
 inline uint32_t scrambled_bits(uint32_t index, int dim, uint64_t key) {
-  const uint32_t shuffled = nested_uniform_scramble(index, static_cast<uint32_t>(mix64(key)));
-  const uint32_t dim_seed = static_cast<uint32_t>(mix64(key + 0x9e3779b97f4a7c15ULL * (dim + 1)));
-  return nested_uniform_scramble(sample_bits(shuffled, dim), dim_seed);
+  return ScrambledGroup(reverse_bits(index), key).bits(dim);
 }
 
 }  // namespace sobol
@@ -131,7 +185,7 @@ class PathSampler {
       return;
     }
     const uint32_t k = replicates > 1 ? static_cast<uint32_t>(replicates) : 1u;
-    index_ = frame / k;
+    reversed_index_ = sobol::reverse_bits(frame / k);
     key_ = mix64(seed * 0x9e3779b97f4a7c15ULL + mix64(pixel + 0x632be59bd9b4e019ULL));
     key_ = mix64(key_ ^ mix64((frame % k) + 0xd6e8feb86659fd93ULL));
   }
@@ -157,19 +211,18 @@ class PathSampler {
   }
 
  private:
-  uint64_t group_key(int group) const { return mix64(key_ + 0xbf58476d1ce4e5b9ULL * static_cast<uint64_t>(group + 1)); }
-  float sobol_1d(int group, int dim) const {
-    return sobol::to_unit_float(sobol::scrambled_bits(index_, dim, group_key(group)));
+  sobol::ScrambledGroup group(int id) const {
+    return sobol::ScrambledGroup(reversed_index_, mix64(key_ + 0xbf58476d1ce4e5b9ULL * static_cast<uint64_t>(id + 1)));
   }
-  glm::vec2 sobol_2d(int group) const {
-    const uint64_t key = group_key(group);
-    return glm::vec2(sobol::to_unit_float(sobol::scrambled_bits(index_, 0, key)),
-                     sobol::to_unit_float(sobol::scrambled_bits(index_, 1, key)));
+  float sobol_1d(int group_id, int dim) const { return sobol::to_unit_float(group(group_id).bits(dim)); }
+  glm::vec2 sobol_2d(int group_id) const {
+    const sobol::ScrambledGroup g = group(group_id);
+    return glm::vec2(sobol::to_unit_float(g.bits(0)), sobol::to_unit_float(g.bits(1)));
   }
 
   SamplerType type_ = SamplerType::Independent;
   Rng camera_rng_, rng_;
-  uint32_t index_ = 0;
+  uint32_t reversed_index_ = 0;  // the frame's index in its replicate, bit-reversed
   uint64_t key_ = 0;
 };
 

@@ -52,6 +52,23 @@ TEST(Sobol, MatricesGiveTheKnownFirstPoints) {
   }
 }
 
+TEST(Sobol, FastPathEqualsTheNestedScrambleDefinition) {
+  // The byte tables in the bit-reversed domain against the plain loop over index bits, and the
+  // sampler's scrambled coordinate against Burley's definition written out.
+  Rng rng(5, 0, 0);
+  for (int i = 0; i < 2000; ++i) {
+    const uint32_t index = rng.next_u32(), seed = rng.next_u32();
+    const uint64_t key = (static_cast<uint64_t>(rng.next_u32()) << 32) | seed;
+    for (int d = 0; d < sobol::kDimensions; ++d) {
+      ASSERT_EQ(sobol::reversed_sample_bits(sobol::reverse_bits(index), d), sobol::reverse_bits(sobol::sample_bits(index, d)));
+      const uint32_t shuffled = sobol::nested_uniform_scramble(index, seed);
+      const uint32_t dim_seed = sobol::hash32(static_cast<uint32_t>(key >> 32) + 0x9e3779b9u * static_cast<uint32_t>(d));
+      ASSERT_EQ(sobol::scrambled_bits(index, d, key),
+                sobol::nested_uniform_scramble(sobol::sample_bits(shuffled, d), dim_seed));
+    }
+  }
+}
+
 TEST(Sobol, PairsAreZeroTwoNetsBeforeAndAfterScrambling) {
   for (int m = 1; m <= 10; ++m) {
     const uint32_t n = 1u << m;
