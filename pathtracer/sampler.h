@@ -115,7 +115,6 @@ constexpr ByteProducts make_reversed_products() {
 inline constexpr ByteProducts kReversedProducts = make_reversed_products();
 
 inline uint32_t reversed_sample_bits(uint32_t reversed_index, int dim) {
-  if (dim == 0) return reversed_index;  // van der Corput: the identity in the reversed domain
   const auto& t = kReversedProducts[dim];
   const uint32_t r = reversed_index;
   return t[0][r & 0xffu] ^ t[1][(r >> 8) & 0xffu] ^ t[2][(r >> 16) & 0xffu] ^ t[3][r >> 24];
