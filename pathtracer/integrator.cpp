@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "pathtracer/bsdf.h"
 #include "pathtracer/sampler.h"
@@ -302,21 +303,45 @@ float Accumulation::replicate_variance_of_mean(size_t pixel) const {
   return static_cast<float>(sum * used / (used - 1));
 }
 
-float Accumulation::variance_of_mean(size_t pixel) const {
-  const float own = per_sample_variance_of_mean(pixel);
-  if (replicates < 2 || own <= 0.0f) return own;
-  const int x = static_cast<int>(pixel % static_cast<size_t>(width)), y = static_cast<int>(pixel / static_cast<size_t>(width));
+namespace {
+
+// s^2 / n of `pixel` times the QMC gain pooled over its 3x3 neighbourhood; estimates(q) gives the
+// replicate and the per-sample estimate of pixel q (-1: unknown). One formula for the per-pixel
+// query and the whole image, so both give the same bits.
+template <class Estimates>
+float pooled_gain_variance_of_mean(const Accumulation& acc, size_t pixel, const Estimates& estimates) {
+  const float own = estimates(pixel).second;
+  if (acc.replicates < 2 || own <= 0.0f) return own;
+  const int x = static_cast<int>(pixel % static_cast<size_t>(acc.width));
+  const int y = static_cast<int>(pixel / static_cast<size_t>(acc.width));
   double replicate_sum = 0, per_sample_sum = 0;
-  for (int ny = std::max(0, y - 1); ny <= std::min(height - 1, y + 1); ++ny)
-    for (int nx = std::max(0, x - 1); nx <= std::min(width - 1, x + 1); ++nx) {
-      const size_t q = static_cast<size_t>(ny) * static_cast<size_t>(width) + static_cast<size_t>(nx);
-      const float r = replicate_variance_of_mean(q), v = per_sample_variance_of_mean(q);
+  for (int ny = std::max(0, y - 1); ny <= std::min(acc.height - 1, y + 1); ++ny)
+    for (int nx = std::max(0, x - 1); nx <= std::min(acc.width - 1, x + 1); ++nx) {
+      const auto [r, v] = estimates(static_cast<size_t>(ny) * static_cast<size_t>(acc.width) + static_cast<size_t>(nx));
       if (r < 0.0f || v < 0.0f) continue;
       replicate_sum += r;
       per_sample_sum += v;
     }
   if (!(per_sample_sum > 0.0)) return own;
   return static_cast<float>(own * (replicate_sum / per_sample_sum));
+}
+
+}  // namespace
+
+float Accumulation::variance_of_mean(size_t pixel) const {
+  return pooled_gain_variance_of_mean(*this, pixel, [this](size_t q) {
+    return std::make_pair(replicate_variance_of_mean(q), per_sample_variance_of_mean(q));
+  });
+}
+
+std::vector<float> Accumulation::variance_of_mean_image() const {
+  const size_t n = samples.size();
+  std::vector<std::pair<float, float>> estimates(n);
+  for (size_t q = 0; q < n; ++q) estimates[q] = {replicate_variance_of_mean(q), per_sample_variance_of_mean(q)};
+  std::vector<float> out(n);
+  for (size_t p = 0; p < n; ++p)
+    out[p] = pooled_gain_variance_of_mean(*this, p, [&estimates](size_t q) { return estimates[q]; });
+  return out;
 }
 
 }  // namespace pxf

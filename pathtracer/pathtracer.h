@@ -78,6 +78,7 @@ struct Accumulation {
   // the s^2 / n estimates. Each replicate estimate alone has only K - 1 degrees of freedom; pooling
   // the gain, which varies slowly across the image, keeps the n - 1 of s^2 / n.
   float variance_of_mean(size_t pixel) const;
+  std::vector<float> variance_of_mean_image() const;  // variance_of_mean of every pixel, in O(pixels)
   float per_sample_variance_of_mean(size_t pixel) const;  // s^2 / n, -1 when n < 2
   // K'/(K'-1) sum_r (n_r / n)^2 (m_r - m)^2 over the K' replicates with samples; -1 when K' < 2.
   float replicate_variance_of_mean(size_t pixel) const;

@@ -142,7 +142,8 @@ Image ProgressiveRenderer::hv_image() const { return rgb_image(impl_->acc.hv_mea
 
 Image ProgressiveRenderer::variance_image() const {
   Image image = Image::gray(impl_->width, impl_->height);
-  for (size_t i = 0; i < impl_->acc.samples.size(); ++i) image.pixels[i] = std::max(0.0f, impl_->acc.variance_of_mean(i));
+  const std::vector<float> variance = impl_->acc.variance_of_mean_image();
+  for (size_t i = 0; i < variance.size(); ++i) image.pixels[i] = std::max(0.0f, variance[i]);
   return image;
 }
 
@@ -160,9 +161,7 @@ Image ProgressiveRenderer::samples_image() const {
 }
 
 std::vector<float> ProgressiveRenderer::variance_of_mean() const {
-  std::vector<float> v(impl_->acc.samples.size());
-  for (size_t i = 0; i < v.size(); ++i) v[i] = impl_->acc.variance_of_mean(i);
-  return v;
+  return impl_->acc.variance_of_mean_image();
 }
 
 bool ProgressiveRenderer::scene_has_perfect_specular() const { return impl_->tracer->has_perfect_specular(); }

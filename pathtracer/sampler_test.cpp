@@ -184,5 +184,25 @@ TEST(Accumulation, ReplicateVarianceFromReplicateMeans) {
   EXPECT_NEAR(acc.per_sample_variance_of_mean(0), 20.0f / 12.0f, 1e-5f);
 }
 
+TEST(Accumulation, VarianceImageEqualsPerPixelQueries) {
+  // 5 x 4 pixels, 4 replicates, per-pixel noise of different scales: the whole-image estimate is
+  // bit-identical to the per-pixel one, and differs from s^2 / n where the replicates disagree.
+  Accumulation acc;
+  resize_accumulation(acc, 5, 4, 4);
+  Rng rng(12, 0, 0);
+  for (int frame = 0; frame < 11; ++frame)
+    for (size_t p = 0; p < 20; ++p)
+      accumulate_sample(acc, p, glm::vec3(0), glm::vec3(rng.next_float() * (1.0f + p) + (frame % 4 == 1 ? 0.5f : 0.0f)),
+                        frame % 4);
+  const std::vector<float> image = acc.variance_of_mean_image();
+  int differs = 0;
+  for (size_t p = 0; p < 20; ++p) {
+    EXPECT_EQ(image[p], acc.variance_of_mean(p)) << p;
+    EXPECT_GT(image[p], 0.0f);
+    differs += std::abs(image[p] - acc.per_sample_variance_of_mean(p)) > 1e-3f * image[p];
+  }
+  EXPECT_GT(differs, 10);
+}
+
 }  // namespace
 }  // namespace pxf
