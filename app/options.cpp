@@ -31,7 +31,7 @@ void add_preview_options(CommandLine& cli, PreviewOptions& o) {
   cli.choice("--sampler", &o.sampler, {"sobol", "independent"},
              "random numbers of the path tracer: Owen-scrambled Sobol (default) or independent PCG32");
   cli.option("--replicates", &s.trace.replicates,
-             "independently scrambled Sobol replicates for the variance estimate (default 4, 1 = none)", 1, 64);
+             "independently scrambled Sobol replicates for the variance estimate (default 1 = none)", 1, 64);
   cli.option("--threads", &s.trace.threads, "path-tracing threads (0 = all cores)", 0, 1024);
   cli.option("--max-vertices", &s.trace.max_vertices, "maximum path length in vertices, camera and light included", 2, 1024);
   cli.option("--rr-start", &s.trace.rr_start_vertex, "Russian roulette from this vertex on", 2, 1024);

@@ -21,8 +21,10 @@ struct TraceParams {
   int threads = 0;          // 0 = all cores
   SamplerType sampler = SamplerType::Sobol;  // see pathtracer/sampler.h for the dimension table
   // Independently scrambled interleaved Sobol replicates (frame k is in replicate k mod K): their
-  // means give Var[L_u] of the pixel mean under QMC. 1 = one sequence, no replicate estimate.
-  int replicates = 4;
+  // means give Var[L_u] of the pixel mean under QMC. 1 = one sequence and the estimate s^2 / n.
+  // Default 1: K > 1 makes the estimate exact on average but costs unfiltered error (each
+  // replicate is a shorter sequence), and s^2 / n overestimates by 1.1-1.4x only (docs/sampling.md).
+  int replicates = 1;
 };
 
 // Loads a glTF/GLB file or a built-in scene name ("cornell", ...); throws pxf::Error naming the
