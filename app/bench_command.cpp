@@ -2,6 +2,7 @@
 // prints figures and writes CSV and SVG plots into --out.
 //   pxf bench                 per-stage times, filtering overhead, equal-time NRMSE, spp to match
 //   pxf bench --pathtracer    paths/s, rays/s, ms/frame and the raw Embree ray rate
+//   pxf bench --pathtracer --sampler-error | --variance-ratio   the samplers (app/sampler_bench.h)
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -13,6 +14,7 @@
 #include "app/commands.h"
 #include "app/options.h"
 #include "app/plot.h"
+#include "app/sampler_bench.h"
 #include "app/preview.h"
 #include "gl/context.h"
 #include "image/metrics.h"
@@ -409,11 +411,13 @@ int run_variant_bench(const BenchSetup& b, const Image& reference_hv, int spp, i
 int run_bench(const Args& args) {
   SceneOptions scene_options;
   PreviewOptions preview_options;
-  bool pathtracer = false, variants = false, stage_table = false;
+  bool pathtracer = false, variants = false, stage_table = false, sampler_error = false, variance_ratio = false;
   int variant_spp = 4, variant_rounds = 5;
   std::string extra_taps_text;
   std::string reference_path, out = "bench-out", budgets_text = "8,32,128,256";
   int reference_spp = 2048, frames = 32, max_spp = 1024, timed = 20;
+  int seeds = 32, rounds = 7;
+  std::string spp_text;
   CommandLine cli("bench", "[options]",
                   "Run time against error on one scene (default cornell, 512x512, default settings):\n"
                   "  1. per-stage times of one scheduled filter application, in ms and in path-tracing frames;\n"
@@ -437,6 +441,14 @@ int run_bench(const Args& args) {
   cli.option("--subsampled-taps", &extra_taps_text, "LIST", "--variants: also the subsampled variant with these tap counts");
   cli.flag("--stage-table", &stage_table,
            "per-stage ms and overhead over --frames frames for every built-in scene (no reference)");
+  cli.flag("--sampler-error", &sampler_error,
+           "with --pathtracer: unfiltered NRMSE (and LV alone) of sobol vs independent at --spp against a "
+           "--reference-spp Sobol reference of another seed, and paths/s of both back to back");
+  cli.flag("--variance-ratio", &variance_ratio,
+           "with --pathtracer: estimated / empirical Var[L_u] of the pixel mean over --seeds seeds at --spp");
+  cli.option("--spp", &spp_text, "LIST", "spp of --sampler-error (default 8,32,128) or --variance-ratio (4,16,64,256)");
+  cli.option("--seeds", &seeds, "seeds of --variance-ratio (default 32)", 2, 4096);
+  cli.option("--rounds", &rounds, "timing rounds of --sampler-error (default 7)", 1, 1000);
   cli.option("--timed-frames", &timed, "timed frames of --pathtracer (after 3 warm-up frames)", 1, 100000);
   cli.option("--reference", &reference_path, "REF.exr", "reference image (default: render and cache one)");
   cli.option("--reference-spp", &reference_spp, "samples of the rendered reference (default 2048)", 1, 1 << 20);
@@ -466,6 +478,15 @@ int run_bench(const Args& args) {
   b.plain = b.filtered;
   b.plain.filter_enabled = false;
   std::filesystem::create_directories(out);
+  if (pathtracer && (sampler_error || variance_ratio)) {
+    SamplerBenchSetup sb{b.scene, std::filesystem::path(scene_options.scene).stem().string(), b.plain.trace, b.width,
+                         b.height, out};
+    if (sampler_error)
+      run_sampler_error_bench(sb, cli.given("--reference-spp") ? reference_spp : 2048,
+                              parse_counts("--spp", spp_text.empty() ? "8,32,128" : spp_text), rounds);
+    if (variance_ratio) run_variance_ratio_bench(sb, parse_counts("--spp", spp_text.empty() ? "4,16,64,256" : spp_text), seeds);
+    return 0;
+  }
   if (pathtracer) return run_pathtracer_bench(b, timed);
 
   auto context = create_gl_context(parse_gl_backend(scene_options.gl));

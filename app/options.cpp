@@ -33,6 +33,10 @@ void add_preview_options(CommandLine& cli, PreviewOptions& o) {
              "10 % of the tracing time (default); pow2 = at every power of two; every = each frame; all also\n"
              "the last frame");
   cli.option("--seed", &o.seed, "random seed", 0, 2147483647);
+  cli.choice("--sampler", &o.sampler, {"sobol", "independent"},
+             "random numbers of the path tracer: Owen-scrambled Sobol or independent PCG32 (default)");
+  cli.option("--replicates", &s.trace.replicates,
+             "independently scrambled Sobol replicates for the variance estimate (default 1 = none)", 1, 64);
   cli.option("--threads", &s.trace.threads, "path-tracing threads (0 = all cores)", 0, 1024);
   cli.option("--max-vertices", &s.trace.max_vertices, "maximum path length in vertices, camera and light included", 2, 1024);
   cli.option("--rr-start", &s.trace.rr_start_vertex, "Russian roulette from this vertex on", 2, 1024);
@@ -57,6 +61,7 @@ void finish_preview_options(PreviewOptions& o) {
   o.settings.schedule = parse_filter_schedule(o.schedule);
   o.settings.trace.seed = static_cast<uint64_t>(o.seed);
   o.settings.trace.all_hv = o.all_hv;
+  o.settings.trace.sampler = o.sampler == "independent" ? SamplerType::Independent : SamplerType::Sobol;
   o.settings.filter.t = o.settings.threshold;
 }
 

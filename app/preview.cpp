@@ -126,7 +126,7 @@ void Preview::upload() {
   if (uploaded_) return;
   const auto start = BenchClock::now();
   const Accumulation& acc = renderer_->accumulation();
-  for (size_t i = 0; i < variance_.size(); ++i) variance_[i] = acc.variance_of_mean(i);
+  variance_ = acc.variance_of_mean_image();
   inputs_.upload(&acc.lv_mean[0].x, &acc.hv_mean[0].x, variance_.data(), acc.samples.data());
   last_.upload += elapsed_ms(start);
   uploaded_ = true;

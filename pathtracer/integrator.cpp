@@ -2,9 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "pathtracer/bsdf.h"
-#include "pathtracer/rng.h"
+#include "pathtracer/sampler.h"
 
 namespace pxf {
 namespace {
@@ -41,7 +42,7 @@ void add_contribution(PathSample& out, glm::vec3 value, bool lv, bool all_hv) {
 
 // One path of a batch: its random stream, the ray it traces next, and what it has gathered.
 struct PathTracer::Path {
-  Rng rng;
+  PathSampler sampler;
   Ray ray;
   PathState state;
   PathSample* out = nullptr;
@@ -104,13 +105,11 @@ void PathTracer::trace_batch(const Camera& camera, int width, int height, const 
   for (int i = 0; i < count; ++i) {
     const int x = rect.x0 + (first + i) % rect.width(), y = rect.y0 + (first + i) / rect.width();
     const uint64_t pixel = static_cast<uint64_t>(y) * static_cast<uint64_t>(width) + static_cast<uint64_t>(x);
-    Rng pixel_rng(params.seed, pixel, frame);
-    const glm::vec2 jitter = pixel_rng.next_2d();  // box filter: uniform in the pixel
     out[i] = PathSample{};
     Path& path = paths[i];
+    path.sampler = PathSampler(params.sampler, params.seed, pixel, frame, params.replicates);
+    const glm::vec2 jitter = path.sampler.camera_jitter();  // box filter: uniform in the pixel
     path.ray = camera_rays(static_cast<float>(x) + jitter.x, static_cast<float>(y) + jitter.y);
-    // A second stream for the path itself (the pixel stream's first draws went to the jitter).
-    path.rng = Rng(params.seed ^ 0x5bd1e9955bd1e995ULL, pixel, frame);
     path.state = PathState{};
     path.out = &out[i];
   }
@@ -140,7 +139,7 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
   const Scene& scene = geometry_.scene();
   PathState& s = path.state;
   PathSample& out = *path.out;
-  Rng& rng = path.rng;
+  PathSampler& sampler = path.sampler;
   ++out.rays;
   if (!hit.valid()) {  // the environment is the light vertex
     if (lights_.has_environment()) {
@@ -170,8 +169,8 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
   if (bsdf.is_black()) return false;
 
   // Next event estimation (the light vertex is vertex + 1 <= max_vertices).
-  float u_light = rng.next_float();
-  glm::vec2 u_light2 = rng.next_2d();
+  float u_light = sampler.get_1d(vertex, VertexDim::LightSelect);
+  glm::vec2 u_light2 = sampler.get_2d(vertex, VertexDim::LightPoint);
   if (bsdf.has_nondelta()) {
     LightSample ls;
     if (lights_.sample(sp.position, u_light, u_light2, &ls)) {
@@ -190,9 +189,9 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
   }
 
   // Continue the path by sampling the BSDF.
-  float u_lobe = rng.next_float();
-  glm::vec2 u_dir = rng.next_2d();
-  float u_rr = rng.next_float();
+  float u_lobe = sampler.get_1d(vertex, VertexDim::BsdfLobe);
+  glm::vec2 u_dir = sampler.get_2d(vertex, VertexDim::BsdfDirection);
+  float u_rr = sampler.get_1d(vertex, VertexDim::Roulette);
   BsdfSample bs;
   if (!bsdf.sample(u_lobe, u_dir, &bs)) return false;
   s.throughput *= bs.weight;
@@ -260,7 +259,7 @@ SpecularChainHit PathTracer::trace_specular_chain(const Ray& camera_ray) const {
   return result;
 }
 
-void resize_accumulation(Accumulation& acc, int width, int height) {
+void resize_accumulation(Accumulation& acc, int width, int height, int replicates) {
   size_t n = static_cast<size_t>(width) * static_cast<size_t>(height);
   acc.width = width;
   acc.height = height;
@@ -269,9 +268,13 @@ void resize_accumulation(Accumulation& acc, int width, int height) {
   acc.hv_lum_mean.assign(n, 0.0);
   acc.hv_lum_m2.assign(n, 0.0);
   acc.samples.assign(n, 0u);
+  acc.replicates = std::max(1, replicates);
+  const size_t replicate_slots = acc.replicates > 1 ? n * static_cast<size_t>(acc.replicates) : 0;
+  acc.replicate_lum_sum.assign(replicate_slots, 0.0);
+  acc.replicate_samples.assign(replicate_slots, 0u);
 }
 
-void accumulate_sample(Accumulation& acc, size_t pixel, glm::vec3 lv, glm::vec3 hv) {
+void accumulate_sample(Accumulation& acc, size_t pixel, glm::vec3 lv, glm::vec3 hv, int replicate) {
   uint32_t n = ++acc.samples[pixel];
   float inv_n = 1.0f / static_cast<float>(n);
   acc.lv_mean[pixel] += (lv - acc.lv_mean[pixel]) * inv_n;
@@ -280,13 +283,82 @@ void accumulate_sample(Accumulation& acc, size_t pixel, glm::vec3 lv, glm::vec3 
   double delta = y - acc.hv_lum_mean[pixel];
   acc.hv_lum_mean[pixel] += delta / static_cast<double>(n);
   acc.hv_lum_m2[pixel] += delta * (y - acc.hv_lum_mean[pixel]);
+  if (acc.replicates > 1) {
+    const size_t slot = pixel * static_cast<size_t>(acc.replicates) + static_cast<size_t>(replicate % acc.replicates);
+    acc.replicate_lum_sum[slot] += y;
+    ++acc.replicate_samples[slot];
+  }
 }
 
-float Accumulation::variance_of_mean(size_t pixel) const {
+float Accumulation::per_sample_variance_of_mean(size_t pixel) const {
   uint32_t n = samples[pixel];
   if (n < 2) return -1.0f;
   double var = hv_lum_m2[pixel] / static_cast<double>(n - 1) / static_cast<double>(n);
   return static_cast<float>(std::max(0.0, var));
+}
+
+float Accumulation::replicate_variance_of_mean(size_t pixel) const {
+  if (replicates < 2) return -1.0f;
+  const double* sums = &replicate_lum_sum[pixel * static_cast<size_t>(replicates)];
+  const uint32_t* counts = &replicate_samples[pixel * static_cast<size_t>(replicates)];
+  int used = 0;
+  double total = 0, n = 0;
+  for (int r = 0; r < replicates; ++r) {
+    if (counts[r] == 0) continue;
+    ++used;
+    total += sums[r];
+    n += counts[r];
+  }
+  if (used < 2) return -1.0f;
+  const double mean = total / n;
+  double sum = 0;
+  for (int r = 0; r < replicates; ++r) {
+    if (counts[r] == 0) continue;
+    const double weight = counts[r] / n, d = sums[r] / counts[r] - mean;
+    sum += weight * weight * d * d;
+  }
+  return static_cast<float>(sum * used / (used - 1));
+}
+
+namespace {
+
+// s^2 / n of `pixel` times the QMC gain pooled over its 3x3 neighbourhood; estimates(q) gives the
+// replicate and the per-sample estimate of pixel q (-1: unknown). One formula for the per-pixel
+// query and the whole image, so both give the same bits.
+template <class Estimates>
+float pooled_gain_variance_of_mean(const Accumulation& acc, size_t pixel, const Estimates& estimates) {
+  const float own = estimates(pixel).second;
+  if (acc.replicates < 2 || own <= 0.0f) return own;
+  const int x = static_cast<int>(pixel % static_cast<size_t>(acc.width));
+  const int y = static_cast<int>(pixel / static_cast<size_t>(acc.width));
+  double replicate_sum = 0, per_sample_sum = 0;
+  for (int ny = std::max(0, y - 1); ny <= std::min(acc.height - 1, y + 1); ++ny)
+    for (int nx = std::max(0, x - 1); nx <= std::min(acc.width - 1, x + 1); ++nx) {
+      const auto [r, v] = estimates(static_cast<size_t>(ny) * static_cast<size_t>(acc.width) + static_cast<size_t>(nx));
+      if (r < 0.0f || v < 0.0f) continue;
+      replicate_sum += r;
+      per_sample_sum += v;
+    }
+  if (!(per_sample_sum > 0.0)) return own;
+  return static_cast<float>(own * (replicate_sum / per_sample_sum));
+}
+
+}  // namespace
+
+float Accumulation::variance_of_mean(size_t pixel) const {
+  return pooled_gain_variance_of_mean(*this, pixel, [this](size_t q) {
+    return std::make_pair(replicate_variance_of_mean(q), per_sample_variance_of_mean(q));
+  });
+}
+
+std::vector<float> Accumulation::variance_of_mean_image() const {
+  const size_t n = samples.size();
+  std::vector<std::pair<float, float>> estimates(n);
+  for (size_t q = 0; q < n; ++q) estimates[q] = {replicate_variance_of_mean(q), per_sample_variance_of_mean(q)};
+  std::vector<float> out(n);
+  for (size_t p = 0; p < n; ++p)
+    out[p] = pooled_gain_variance_of_mean(*this, p, [&estimates](size_t q) { return estimates[q]; });
+  return out;
 }
 
 }  // namespace pxf

@@ -64,7 +64,8 @@ class PathTracer {
 
 // Adds one accepted sample to pixel `pixel`: running means of LV/HV RGB and Welford (double) of
 // the HV luminance. The caller has already rejected non-finite samples.
-void accumulate_sample(Accumulation& acc, size_t pixel, glm::vec3 lv, glm::vec3 hv);
-void resize_accumulation(Accumulation& acc, int width, int height);  // and clear
+// `replicate` is the sample's replicate (frame mod acc.replicates).
+void accumulate_sample(Accumulation& acc, size_t pixel, glm::vec3 lv, glm::vec3 hv, int replicate = 0);
+void resize_accumulation(Accumulation& acc, int width, int height, int replicates = 1);  // and clear
 
 }  // namespace pxf

@@ -31,7 +31,53 @@ float spot_attenuation(const PunctualLight& light, glm::vec3 to_point) {
   return a * a;
 }
 
+// The radius of a sphere around the scene's geometry (1 without geometry): environment and
+// directional lights deliver their power through its cross-section.
+float scene_bounding_radius(const Scene& scene) {
+  glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+  for (const Mesh& mesh : scene.meshes)
+    for (const glm::vec3& p : mesh.positions)
+      if (is_finite(p)) lo = glm::min(lo, p), hi = glm::max(hi, p);
+  if (!(hi.x >= lo.x)) return 1.0f;
+  const float r = 0.5f * glm::length(hi - lo);
+  return r > 0.0f ? r : 1.0f;
+}
+
 }  // namespace
+
+// Luminous powers, in the units of radiance x area x solid angle, used to share light samples
+// between the light types. Lambertian emitters: pi x L x area per emitting side (the triangle
+// weights already hold L x area x sides).
+double LightSampler::triangle_power(double weighted_area_sum) { return kPi * weighted_area_sum; }
+
+// An environment sends pi r^2 x integral of L over the sphere through a scene of radius r (the
+// irradiance from each direction times the scene's cross-section).
+double LightSampler::environment_power(const Environment& env, float scene_radius) {
+  const Texture& image = env.image;
+  double integral = 0;
+  for (int y = 0; y < image.height; ++y) {
+    const double sin_theta = std::sin(kPi * (y + 0.5) / image.height);
+    for (int x = 0; x < image.width; ++x) {
+      const glm::vec4& t = image.texels[static_cast<size_t>(y) * image.width + x];
+      const double l = luminance(glm::vec3(t));
+      if (std::isfinite(l) && l > 0.0) integral += l * sin_theta;
+    }
+  }
+  integral *= (2.0 * kPi / image.width) * (kPi / image.height) * env.strength;
+  return kPi * scene_radius * scene_radius * integral;
+}
+
+// Point: 4 pi I; spot: 2 pi (1 - cos of the mean cone angle) I; directional: E x pi r^2.
+double LightSampler::punctual_power(const PunctualLight& light, float scene_radius) {
+  const double intensity = luminance(light.color) * light.intensity;
+  switch (light.type) {
+    case PunctualLight::Type::Point: return 4.0 * kPi * intensity;
+    case PunctualLight::Type::Spot:
+      return 2.0 * kPi * (1.0 - std::cos(0.5 * (light.inner_cone + light.outer_cone))) * intensity;
+    case PunctualLight::Type::Directional: return kPi * scene_radius * scene_radius * intensity;
+  }
+  return 0.0;
+}
 
 glm::vec2 equirect_uv(glm::vec3 d) {
   float u = 0.5f + std::atan2(d.x, -d.z) * (0.5f * kInvPi);
@@ -93,10 +139,21 @@ LightSampler::LightSampler(const Scene& scene) : scene_(scene) {
   bool has_tri = triangle_dist_.valid(), has_env = env_ != nullptr, has_punctual = !punctual_.empty();
   category_count_ = int(has_tri) + int(has_env) + int(has_punctual);
   if (category_count_ == 0) return;
-  float share = 1.0f / category_count_;
-  p_triangles_ = has_tri ? share : 0.0f;
-  p_environment_ = has_env ? share : 0.0f;
-  p_punctual_ = has_punctual ? 1.0f - p_triangles_ - p_environment_ : 0.0f;
+  const float scene_radius = scene_bounding_radius(scene);
+  power_triangles_ = has_tri ? triangle_power(triangle_dist_.total()) : 0.0;
+  power_environment_ = has_env ? environment_power(*env_, scene_radius) : 0.0;
+  power_punctual_ = 0.0;
+  for (const PunctualLight* light : punctual_) power_punctual_ += punctual_power(*light, scene_radius);
+  const double total = power_triangles_ + power_environment_ + power_punctual_;
+  if (!(total > 0.0) || !std::isfinite(total)) {  // no usable estimate: equal shares
+    float share = 1.0f / category_count_;
+    p_triangles_ = has_tri ? share : 0.0f;
+    p_environment_ = has_env ? share : 0.0f;
+  } else {
+    p_triangles_ = static_cast<float>(power_triangles_ / total);
+    p_environment_ = static_cast<float>(power_environment_ / total);
+  }
+  p_punctual_ = has_punctual ? std::max(0.0f, 1.0f - p_triangles_ - p_environment_) : 0.0f;
 }
 
 bool LightSampler::sample(glm::vec3 position, float u_select, glm::vec2 u, LightSample* out) const {

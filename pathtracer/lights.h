@@ -1,7 +1,7 @@
 // Light sampling for next event estimation: emissive triangles (area sampling, power-weighted
 // triangle choice), the environment (luminance x sin(theta) importance sampling on the equirect
 // image) and KHR punctual lights (delta lights, NEE only). One light sample per call: a category
-// (triangles / environment / punctual) is picked first, with fixed equal shares of those present.
+// (triangles / environment / punctual) is picked first, in proportion to its estimated power.
 #pragma once
 #include <limits>
 #include <vector>
@@ -55,6 +55,14 @@ class LightSampler {
   };
   const EmissiveTriangle& triangle(size_t light) const { return triangles_[light]; }
 
+  // Category selection probabilities and the power estimates they come from.
+  float triangles_probability() const { return p_triangles_; }
+  float environment_probability() const { return p_environment_; }
+  float punctual_probability() const { return p_punctual_; }
+  static double triangle_power(double weighted_area_sum);  // sum of L x area x sides
+  static double environment_power(const Environment& env, float scene_radius);
+  static double punctual_power(const PunctualLight& light, float scene_radius);
+
  private:
   bool sample_triangles(glm::vec3 position, float u_select, glm::vec2 u, LightSample* out) const;
   bool sample_environment(glm::vec3 position, glm::vec2 u, LightSample* out) const;
@@ -69,6 +77,7 @@ class LightSampler {
   std::vector<const PunctualLight*> punctual_;
   // Category selection: [0, p_tri) triangles, [p_tri, p_tri + p_env) environment, rest punctual.
   float p_triangles_ = 0.0f, p_environment_ = 0.0f, p_punctual_ = 0.0f;
+  double power_triangles_ = 0.0, power_environment_ = 0.0, power_punctual_ = 0.0;
   int category_count_ = 0;
 };
 

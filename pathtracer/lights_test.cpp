@@ -126,6 +126,60 @@ TEST(Lights, EnvironmentSamplingMatchesItsPdf) {
   EXPECT_GT(r.p_value, kAlpha) << "chi2 " << r.statistic << " dof " << r.dof;
 }
 
+TEST(Lights, LightTypesAreSelectedByPower) {
+  // A one-sided emitter quad (L = 2, area 0.5), a uniform sky (L = 0.25), a point light (I = 3), a
+  // spot (I = 5, mean cone angle 0.3) and a sun (E = 1.5), white. The geometry spans a 4 x 2 x 4
+  // box: r = sqrt(36) / 2 = 3. Expected powers: quad pi x 2 x 0.5; sky pi r^2 x 4 pi x 0.25;
+  // punctual 4 pi x 3 + 2 pi (1 - cos 0.3) x 5 + pi r^2 x 1.5.
+  Scene scene;
+  scene.materials = {make_diffuse(glm::vec3(0.5f)), make_emitter(glm::vec3(2.0f))};
+  scene.meshes.push_back(make_quad(glm::vec3(-2, 0, -2), glm::vec3(4, 0, 0), glm::vec3(0, 0, 4), 0));
+  scene.meshes.push_back(make_quad(glm::vec3(0, 2, 0), glm::vec3(1, 0, 0), glm::vec3(0, 0, 0.5f), 1));
+  Environment env;
+  env.image.width = 64;
+  env.image.height = 32;
+  env.image.texels.assign(64 * 32, glm::vec4(0.25f, 0.25f, 0.25f, 1.0f));
+  scene.environment = env;
+  PunctualLight point, spot, sun;
+  point.intensity = 3.0f;
+  point.position = spot.position = glm::vec3(0, 3, 0);
+  spot.direction = glm::vec3(0, -1, 0);
+  spot.type = PunctualLight::Type::Spot;
+  spot.intensity = 5.0f;
+  spot.inner_cone = 0.2f;
+  spot.outer_cone = 0.4f;
+  sun.type = PunctualLight::Type::Directional;
+  sun.intensity = 1.5f;
+  scene.lights = {point, spot, sun};
+  LightSampler lights(scene);
+  const double r2 = 9.0;
+  const double tri = kPi * 2.0 * 0.5, sky = kPi * r2 * 4 * kPi * 0.25;
+  const double punctual = 4 * kPi * 3.0 + 2 * kPi * (1 - std::cos(0.3)) * 5.0 + kPi * r2 * 1.5;
+  const double total = tri + sky + punctual;
+  EXPECT_NEAR(lights.triangles_probability(), tri / total, 1e-3 * tri / total);
+  EXPECT_NEAR(lights.environment_probability(), sky / total, 1e-3 * sky / total);
+  EXPECT_NEAR(lights.punctual_probability(), punctual / total, 1e-3 * punctual / total);
+  // The pdfs of the samples carry the selection: the punctual lights share their category evenly.
+  LightSample ls;
+  ASSERT_TRUE(lights.sample(glm::vec3(0.5f, 1.0f, 0.25f), 0.9999f, glm::vec2(0.5f), &ls));
+  EXPECT_TRUE(ls.delta);
+  EXPECT_NEAR(ls.pdf, lights.punctual_probability() / 3.0f, 1e-6f);
+  float env_pdf;
+  lights.sample_environment_direction(glm::vec2(0.3f, 0.6f), &env_pdf);
+  EXPECT_NEAR(lights.pdf_environment(glm::vec3(0, 0, -1)), lights.environment_probability() / (4 * kPi), 1e-3f);
+  // Frequencies of the selected category over many draws, from a point every light reaches: chi-square against the probabilities.
+  const int n = 100000;
+  std::vector<double> observed(3, 0.0);
+  Rng rng(17, 0, 0);
+  for (int k = 0; k < n; ++k) {
+    if (!lights.sample(glm::vec3(0.5f, 1.0f, 0.25f), rng.next_float(), rng.next_2d(), &ls)) continue;
+    observed[ls.delta ? 2 : std::isinf(ls.distance) ? 1 : 0] += 1.0;
+  }
+  const std::vector<double> expected = {n * tri / total, n * sky / total, n * punctual / total};
+  stat::ChiSquareResult r = stat::chi_square(observed, expected);
+  EXPECT_GT(r.p_value, kAlpha) << "chi2 " << r.statistic << " dof " << r.dof;
+}
+
 TEST(Lights, EquirectRoundTrip) {
   for (glm::vec3 d : {glm::vec3(0, 0, -1), glm::vec3(1, 0, 0), glm::normalize(glm::vec3(0.3f, 0.8f, 0.5f))}) {
     glm::vec3 back = equirect_direction(equirect_uv(d));

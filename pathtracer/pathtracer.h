@@ -9,6 +9,7 @@
 #include <glm/glm.hpp>
 #include "image/image.h"
 #include "pathtracer/default_light.h"
+#include "pathtracer/sampler.h"
 #include "pathtracer/scene.h"
 
 namespace pxf {
@@ -19,6 +20,12 @@ struct TraceParams {
   bool all_hv = false;      // every contribution goes to HV (environment-lit scenes)
   uint64_t seed = 1;
   int threads = 0;          // 0 = all cores
+  SamplerType sampler = SamplerType::Independent;  // see pathtracer/sampler.h for the dimension table
+  // Independently scrambled interleaved Sobol replicates (frame k is in replicate k mod K): their
+  // means give Var[L_u] of the pixel mean under QMC. 1 = one sequence and the estimate s^2 / n.
+  // Default 1: K > 1 makes the estimate exact on average but costs unfiltered error (each
+  // replicate is a shorter sequence), and s^2 / n overestimates by 1.1-1.4x only (docs/sampling.md).
+  int replicates = 1;
 };
 
 // Loads a glTF/GLB file or a built-in scene name ("cornell", ...); throws pxf::Error naming the
@@ -65,8 +72,22 @@ struct Accumulation {
   std::vector<double> hv_lum_mean;     // Welford state of HV luminance
   std::vector<double> hv_lum_m2;
   std::vector<uint32_t> samples;       // accepted samples per pixel (NaN/Inf samples dropped)
-  // Var[L_u] = s^2 / n of the HV luminance mean; negative (-1) when n < 2 (unknown).
+  // Interleaved replicates (TraceParams::replicates, 1 = none): HV luminance sum and sample count
+  // of replicate r of pixel p at [p * replicates + r].
+  int replicates = 1;
+  std::vector<double> replicate_lum_sum;
+  std::vector<uint32_t> replicate_samples;
+
+  // Var[L_u] of the HV luminance mean; negative (-1) when n < 2 (unknown). Without replicates it is
+  // s^2 / n. With replicates (randomized QMC, where s^2 / n overestimates), it is s^2 / n times the
+  // QMC gain: the sum over the 3x3 neighbourhood of the replicate estimates divided by the sum of
+  // the s^2 / n estimates. Each replicate estimate alone has only K - 1 degrees of freedom; pooling
+  // the gain, which varies slowly across the image, keeps the n - 1 of s^2 / n.
   float variance_of_mean(size_t pixel) const;
+  std::vector<float> variance_of_mean_image() const;  // variance_of_mean of every pixel, in O(pixels)
+  float per_sample_variance_of_mean(size_t pixel) const;  // s^2 / n, -1 when n < 2
+  // K'/(K'-1) sum_r (n_r / n)^2 (m_r - m)^2 over the K' replicates with samples; -1 when K' < 2.
+  float replicate_variance_of_mean(size_t pixel) const;
 };
 
 struct TraceStats {

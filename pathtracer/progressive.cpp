@@ -32,9 +32,12 @@ struct ProgressiveRenderer::Impl {
   Impl(const Scene& s, const TraceParams& p, int w, int h) : scene(s), camera(s.camera), params(p), width(w), height(h) {
     if (w <= 0 || h <= 0) throw Error("path tracer: image size must be positive");
     tracer = std::make_unique<PathTracer>(scene);
-    resize_accumulation(acc, w, h);
+    resize_accumulation(acc, w, h, accumulation_replicates());
     make_arena();
   }
+
+  // The replicates only mean something for the Sobol sampler; independent samples are their own.
+  int accumulation_replicates() const { return params.sampler == SamplerType::Sobol ? params.replicates : 1; }
 
   void make_arena() {
     int threads = params.threads > 0 ? params.threads : static_cast<int>(tbb::task_arena::automatic);
@@ -45,6 +48,7 @@ struct ProgressiveRenderer::Impl {
     const int tiles_x = (width + kTileSize - 1) / kTileSize;
     const int tiles_y = (height + kTileSize - 1) / kTileSize;
     const uint32_t frame = first_frame + static_cast<uint32_t>(frames);
+    const int replicate = static_cast<int>(frame % static_cast<uint32_t>(acc.replicates));
     std::atomic<uint64_t> rays{0}, paths{0}, dropped{0};
     auto render_tiles = [&](const tbb::blocked_range<int>& range) {
       uint64_t tile_rays = 0, tile_paths = 0, tile_dropped = 0;
@@ -62,7 +66,7 @@ struct ProgressiveRenderer::Impl {
             continue;
           }
           const int x = rect.x0 + i % rect.width(), y = rect.y0 + i / rect.width();
-          accumulate_sample(acc, static_cast<size_t>(y) * width + x, sample.lv, sample.hv);
+          accumulate_sample(acc, static_cast<size_t>(y) * width + x, sample.lv, sample.hv, replicate);
         }
       }
       rays += tile_rays;
@@ -77,7 +81,8 @@ struct ProgressiveRenderer::Impl {
 
   // A dark scene is black: every pixel gets an exact zero sample without tracing.
   void add_dark_frame() {
-    for (size_t i = 0; i < acc.samples.size(); ++i) accumulate_sample(acc, i, glm::vec3(0.0f), glm::vec3(0.0f));
+    const int replicate = frames % acc.replicates;
+    for (size_t i = 0; i < acc.samples.size(); ++i) accumulate_sample(acc, i, glm::vec3(0.0f), glm::vec3(0.0f), replicate);
   }
 };
 
@@ -86,7 +91,7 @@ ProgressiveRenderer::ProgressiveRenderer(const Scene& scene, const TraceParams& 
 ProgressiveRenderer::~ProgressiveRenderer() = default;
 
 void ProgressiveRenderer::reset() {
-  resize_accumulation(impl_->acc, impl_->width, impl_->height);
+  resize_accumulation(impl_->acc, impl_->width, impl_->height, impl_->accumulation_replicates());
   impl_->stats = TraceStats{};
   impl_->frames = 0;
 }
@@ -154,7 +159,8 @@ Image ProgressiveRenderer::hv_image() const { return rgb_image(impl_->acc.hv_mea
 
 Image ProgressiveRenderer::variance_image() const {
   Image image = Image::gray(impl_->width, impl_->height);
-  for (size_t i = 0; i < impl_->acc.samples.size(); ++i) image.pixels[i] = std::max(0.0f, impl_->acc.variance_of_mean(i));
+  const std::vector<float> variance = impl_->acc.variance_of_mean_image();
+  for (size_t i = 0; i < variance.size(); ++i) image.pixels[i] = std::max(0.0f, variance[i]);
   return image;
 }
 
@@ -190,9 +196,7 @@ Image ProgressiveRenderer::emitter_coverage_image() const {
 }
 
 std::vector<float> ProgressiveRenderer::variance_of_mean() const {
-  std::vector<float> v(impl_->acc.samples.size());
-  for (size_t i = 0; i < v.size(); ++i) v[i] = impl_->acc.variance_of_mean(i);
-  return v;
+  return impl_->acc.variance_of_mean_image();
 }
 
 bool ProgressiveRenderer::scene_has_perfect_specular() const { return impl_->tracer->has_perfect_specular(); }

@@ -1,0 +1,145 @@
+#include "app/sampler_bench.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include "pathtracer/bench.h"
+
+namespace pxf {
+namespace {
+
+const char* sampler_name(SamplerType type) { return type == SamplerType::Sobol ? "sobol" : "independent"; }
+constexpr SamplerType kSamplers[2] = {SamplerType::Independent, SamplerType::Sobol};
+
+void write_csv(const std::string& path, const std::string& text) {
+  std::ofstream out(path);
+  out << text;
+  if (!out) throw Error(path + ": cannot write");
+  std::printf("wrote %s\n", path.c_str());
+}
+
+TraceParams with_sampler(TraceParams params, SamplerType type, uint64_t seed) {
+  params.sampler = type;
+  params.seed = seed;
+  return params;
+}
+
+// paths/s of a renderer over `frames` frames (after the caller's warm-up).
+double paths_per_second(ProgressiveRenderer& renderer, int frames) {
+  const uint64_t before = renderer.stats().paths;
+  const auto start = BenchClock::now();
+  for (int i = 0; i < frames; ++i) renderer.add_frame();
+  return static_cast<double>(renderer.stats().paths - before) / (elapsed_ms(start) / 1000.0);
+}
+
+}  // namespace
+
+void run_sampler_error_bench(const SamplerBenchSetup& b, int reference_spp, const std::vector<int>& spps, int rounds) {
+  // The reference: Sobol from a seed no run below uses.
+  ProgressiveRenderer reference(b.scene, with_sampler(b.trace, SamplerType::Sobol, b.trace.seed + 7919), b.width, b.height);
+  const auto start = BenchClock::now();
+  for (int i = 0; i < reference_spp; ++i) reference.add_frame();
+  std::printf("%s %dx%d: reference %d spp in %.1f s\n", b.scene_name.c_str(), b.width, b.height, reference_spp,
+              elapsed_ms(start) / 1000);
+  const Image reference_all = reference.unfiltered_image(), reference_lv = reference.lv_image();
+  const int max_spp = *std::max_element(spps.begin(), spps.end());
+
+  std::ostringstream csv;
+  csv << "scene,sampler,spp,nrmse_percent,lv_nrmse_percent\n";
+  std::printf("%-12s %6s %14s %14s\n", "sampler", "spp", "NRMSE %", "LV NRMSE %");
+  double nrmse[2][16] = {}, lv_nrmse[2][16] = {};
+  for (int s = 0; s < 2; ++s) {
+    ProgressiveRenderer renderer(b.scene, with_sampler(b.trace, kSamplers[s], b.trace.seed), b.width, b.height);
+    for (int frame = 1; frame <= max_spp; ++frame) {
+      renderer.add_frame();
+      const auto it = std::find(spps.begin(), spps.end(), frame);
+      if (it == spps.end()) continue;
+      const size_t k = static_cast<size_t>(it - spps.begin());
+      nrmse[s][k] = compare_images(renderer.unfiltered_image(), reference_all).nrmse_percent;
+      lv_nrmse[s][k] = compare_images(renderer.lv_image(), reference_lv).nrmse_percent;
+      std::printf("%-12s %6d %14.2f %14.2f\n", sampler_name(kSamplers[s]), frame, nrmse[s][k], lv_nrmse[s][k]);
+      csv << b.scene_name << "," << sampler_name(kSamplers[s]) << "," << frame << "," << nrmse[s][k] << ","
+          << lv_nrmse[s][k] << "\n";
+    }
+  }
+  for (size_t k = 0; k < spps.size() && k < 16; ++k)
+    std::printf("%d spp: sobol / independent NRMSE %.3f, LV %.3f\n", spps[k], nrmse[1][k] / nrmse[0][k],
+                lv_nrmse[1][k] / lv_nrmse[0][k]);
+  write_csv(b.out + "/sampler_error_" + b.scene_name + ".csv", csv.str());
+
+  // Throughput: both samplers in one process, alternating rounds; the median of each.
+  std::vector<double> rate[2];
+  ProgressiveRenderer independent(b.scene, with_sampler(b.trace, SamplerType::Independent, b.trace.seed), b.width, b.height);
+  ProgressiveRenderer sobol(b.scene, with_sampler(b.trace, SamplerType::Sobol, b.trace.seed), b.width, b.height);
+  paths_per_second(independent, 3);
+  paths_per_second(sobol, 3);
+  const int frames_per_round = 8;
+  for (int r = 0; r < rounds; ++r) {
+    rate[0].push_back(paths_per_second(independent, frames_per_round));
+    rate[1].push_back(paths_per_second(sobol, frames_per_round));
+  }
+  const double independent_rate = median_of(rate[0]), sobol_rate = median_of(rate[1]);
+  std::printf("paths/s (median of %d rounds of %d frames): independent %.0f, sobol %.0f, sobol / independent %.3f\n",
+              rounds, frames_per_round, independent_rate, sobol_rate, sobol_rate / independent_rate);
+}
+
+void run_variance_ratio_bench(const SamplerBenchSetup& b, const std::vector<int>& spps, int seeds) {
+  const size_t pixels = static_cast<size_t>(b.width) * static_cast<size_t>(b.height);
+  const int max_spp = *std::max_element(spps.begin(), spps.end());
+  std::ostringstream csv;
+  csv << "scene,sampler,spp,median_ratio,fraction_of_mean_below_0.25,fraction_of_estimates_below_0.25,pixels\n";
+  std::printf("%s %dx%d, %d seeds: ratio of estimated to empirical Var[L_u] of the pixel mean (HV luminance)\n",
+              b.scene_name.c_str(), b.width, b.height, seeds);
+  std::printf("%-12s %6s %14s %22s %22s %8s\n", "sampler", "spp", "median ratio", "mean est. < 0.25 emp.",
+              "single est. < 0.25 emp.", "pixels");
+  for (SamplerType type : kSamplers) {
+    // [spp][seed][pixel]: the pixel mean and the estimated variance of the mean.
+    std::vector<std::vector<std::vector<float>>> mean(spps.size()), estimate(spps.size());
+    for (int seed = 0; seed < seeds; ++seed) {
+      ProgressiveRenderer renderer(b.scene, with_sampler(b.trace, type, b.trace.seed + 1000 + seed), b.width, b.height);
+      for (int frame = 1; frame <= max_spp; ++frame) {
+        renderer.add_frame();
+        const auto it = std::find(spps.begin(), spps.end(), frame);
+        if (it == spps.end()) continue;
+        const size_t k = static_cast<size_t>(it - spps.begin());
+        const Accumulation& acc = renderer.accumulation();
+        mean[k].emplace_back(acc.hv_lum_mean.begin(), acc.hv_lum_mean.end());
+        estimate[k].push_back(renderer.variance_of_mean());
+      }
+    }
+    for (size_t k = 0; k < spps.size(); ++k) {
+      std::vector<double> ratios;
+      size_t single_below = 0, singles = 0, mean_below = 0;
+      for (size_t p = 0; p < pixels; ++p) {
+        double sum = 0, sum2 = 0, est = 0;
+        bool known = true;
+        for (int s = 0; s < seeds; ++s) {
+          sum += mean[k][s][p];
+          est += estimate[k][s][p];
+          known = known && estimate[k][s][p] >= 0.0f;
+        }
+        const double m = sum / seeds;
+        for (int s = 0; s < seeds; ++s) sum2 += (mean[k][s][p] - m) * (mean[k][s][p] - m);
+        const double empirical = sum2 / (seeds - 1);
+        if (!known || !(empirical > 1e-12 * (m * m + 1e-12))) continue;  // a noiseless pixel: no ratio
+        const double ratio = est / seeds / empirical;
+        ratios.push_back(ratio);
+        mean_below += ratio < 0.25;
+        for (int s = 0; s < seeds; ++s, ++singles) single_below += estimate[k][s][p] < 0.25 * empirical;
+      }
+      const double median = median_of(ratios);
+      const double mean_fraction = ratios.empty() ? 0 : static_cast<double>(mean_below) / ratios.size();
+      const double single_fraction = singles ? static_cast<double>(single_below) / singles : 0;
+      std::printf("%-12s %6d %14.3f %21.1f%% %21.1f%% %8zu\n", sampler_name(type), spps[k], median, 100 * mean_fraction,
+                  100 * single_fraction, ratios.size());
+      csv << b.scene_name << "," << sampler_name(type) << "," << spps[k] << "," << median << "," << mean_fraction << ","
+          << single_fraction << "," << ratios.size() << "\n";
+    }
+  }
+  write_csv(b.out + "/variance_ratio_" + b.scene_name + ".csv", csv.str());
+}
+
+}  // namespace pxf

@@ -1,0 +1,228 @@
+// The random numbers of a path: an Owen-scrambled Sobol sampler (the default) or independent PCG32
+// draws (the old path, kept for comparison). Either way a path's numbers depend only on
+// (seed, pixel, frame) and the dimension asked for, never on threads or tiles, so frame k of pixel
+// p can be recomputed anywhere (progressive accumulation, checkpoints, shards).
+//
+// Sobol: shuffled, Owen-scrambled 4D Sobol padded per group of dimensions (Burley 2020, "Practical
+// Hash-based Owen Scrambling", JCGT 9(4)). Each group below is its own 4D Sobol sequence whose
+// index is shuffled by a nested uniform scramble (a permutation of every prefix of 2^m indices, so
+// every power-of-two prefix keeps its stratification) and whose coordinates are Owen scrambled
+// with hashes seeded by (seed, pixel, replicate, group). Per-pixel seeds decorrelate pixels; the
+// per-group shuffles decorrelate groups (padding). The 2D sample pairs always take Sobol
+// dimensions 0 and 1, which form a (0,2)-sequence: every 2^m-prefix is a (0,m,2)-net.
+//
+// Dimension table (group: Sobol dimension -> use):
+//   camera            : 0,1 pixel jitter (box filter; the pinhole camera has no lens)
+//   vertex v, light   : 0,1 point on the light (2D) | 2 light selection
+//   vertex v, bsdf    : 0,1 BSDF direction (2D) | 2 BSDF lobe | 3 Russian roulette
+// Group ids: camera = 0, light of vertex v = 2v, bsdf of vertex v = 2v + 1 (v >= 2).
+//
+// Replicates (for honest variance estimates under QMC): frame k belongs to replicate k mod K and is
+// point k div K of that replicate's independently scrambled sequence. The K replicate means are
+// i.i.d., so their spread estimates the variance of the pixel mean (see Accumulation).
+#pragma once
+#include <array>
+#include <cstdint>
+#include <glm/glm.hpp>
+#include "pathtracer/rng.h"
+
+namespace pxf {
+
+enum class SamplerType { Sobol, Independent };
+
+// The dimensions a path vertex uses, in the order the integrator asks for them.
+enum class VertexDim { LightSelect, LightPoint, BsdfLobe, BsdfDirection, Roulette };
+
+namespace sobol {
+
+constexpr int kDimensions = 4;
+
+// Sobol generator matrices, one 32-bit column per index bit, most significant output bit first.
+// Dimension 0 is the van der Corput sequence; dimensions 1..3 come from the primitive polynomials
+// and initial direction numbers of Joe and Kuo's table new-joe-kuo-6.21201 (its dimensions 2..4):
+//   d  s  a  m_1..m_s
+//   2  1  0  1
+//   3  2  1  1 3
+//   4  3  1  1 3 1
+struct JoeKuoEntry {
+  int s;
+  uint32_t a;
+  uint32_t m[3];
+};
+constexpr JoeKuoEntry kJoeKuo[kDimensions - 1] = {{1, 0, {1, 0, 0}}, {2, 1, {1, 3, 0}}, {3, 1, {1, 3, 1}}};
+
+using Matrices = std::array<std::array<uint32_t, 32>, kDimensions>;
+
+// Bratley and Fox's recurrence: v_k = a_1 v_{k-1} ^ ... ^ a_{s-1} v_{k-s+1} ^ v_{k-s} ^ (v_{k-s} >> s).
+constexpr Matrices make_matrices() {
+  Matrices c{};
+  for (int k = 0; k < 32; ++k) c[0][k] = 1u << (31 - k);
+  for (int d = 1; d < kDimensions; ++d) {
+    const JoeKuoEntry& e = kJoeKuo[d - 1];
+    for (int k = 0; k < 32; ++k) {
+      if (k < e.s) {
+        c[d][k] = e.m[k] << (31 - k);
+        continue;
+      }
+      uint32_t v = c[d][k - e.s] ^ (c[d][k - e.s] >> e.s);
+      for (int j = 1; j < e.s; ++j)
+        if ((e.a >> (e.s - 1 - j)) & 1u) v ^= c[d][k - j];
+      c[d][k] = v;
+    }
+  }
+  return c;
+}
+inline constexpr Matrices kMatrices = make_matrices();
+
+inline uint32_t reverse_bits(uint32_t x) {
+  x = __builtin_bswap32(x);
+  x = ((x >> 4) & 0x0f0f0f0fu) | ((x & 0x0f0f0f0fu) << 4);
+  x = ((x >> 2) & 0x33333333u) | ((x & 0x33333333u) << 2);
+  return ((x >> 1) & 0x55555555u) | ((x & 0x55555555u) << 1);
+}
+
+// Coordinate `dim` of Sobol point `index` as a 32-bit fixed-point fraction (bit 31 = 1/2).
+inline uint32_t sample_bits(uint32_t index, int dim) {
+  uint32_t x = 0;
+  for (int k = 0; index != 0; index >>= 1, ++k)
+    if (index & 1u) x ^= kMatrices[dim][k];
+  return x;
+}
+
+// The same products in the bit-reversed domain where the Owen scrambles work, one table per byte:
+// kReversedProducts[dim][b][v] = reverse(C_dim x reverse(v << 8b)). A shuffled index has all 32
+// bits set at random, so four lookups beat a loop over its bits, and no reversal is needed
+// between the index shuffle and the coordinate scramble.
+using ByteProducts = std::array<std::array<std::array<uint32_t, 256>, 4>, kDimensions>;
+constexpr uint32_t constexpr_reverse(uint32_t x) {
+  uint32_t r = 0;
+  for (int i = 0; i < 32; ++i) r |= ((x >> i) & 1u) << (31 - i);
+  return r;
+}
+constexpr ByteProducts make_reversed_products() {
+  ByteProducts t{};
+  for (int d = 0; d < kDimensions; ++d)
+    for (int b = 0; b < 4; ++b)
+      for (uint32_t v = 0; v < 256; ++v) {
+        const uint32_t index = constexpr_reverse(v << (8 * b));
+        uint32_t x = 0;
+        for (int k = 0; k < 32; ++k)
+          if ((index >> k) & 1u) x ^= kMatrices[d][k];
+        t[d][b][v] = constexpr_reverse(x);
+      }
+  return t;
+}
+inline constexpr ByteProducts kReversedProducts = make_reversed_products();
+
+inline uint32_t reversed_sample_bits(uint32_t reversed_index, int dim) {
+  const auto& t = kReversedProducts[dim];
+  const uint32_t r = reversed_index;
+  return t[0][r & 0xffu] ^ t[1][(r >> 8) & 0xffu] ^ t[2][(r >> 16) & 0xffu] ^ t[3][r >> 24];
+}
+
+// Laine-Karras style hash on bit-reversed values (Burley 2020, with Vegdahl's constants): each bit
+// is flipped by a function of the bits below it only, i.e. of the more significant bits of the
+// unreversed value, which is an Owen scramble: a bijection on every level of the binary tree.
+inline uint32_t laine_karras_permutation(uint32_t x, uint32_t seed) {
+  x += seed;
+  x ^= x * 0x6c50b47cu;
+  x ^= x * 0xb82f1e52u;
+  x ^= x * 0xc7afe638u;
+  x ^= x * 0x8d22f6e6u;
+  return x;
+}
+
+inline uint32_t nested_uniform_scramble(uint32_t x, uint32_t seed) {
+  return reverse_bits(laine_karras_permutation(reverse_bits(x), seed));
+}
+
+inline float to_unit_float(uint32_t x) { return static_cast<float>(x >> 8) * 0x1p-24f; }
+
+// A 32-bit integer hash (Wellons' lowbias32): decorrelates the per-dimension scramble seeds.
+inline uint32_t hash32(uint32_t x) {
+  x ^= x >> 16;
+  x *= 0x7feb352du;
+  x ^= x >> 15;
+  x *= 0x846ca68bu;
+  x ^= x >> 16;
+  return x;
+}
+
+// One group of dimensions of one path: its shuffled index and its scramble seeds, derived from
+// a 64-bit key once. Everything stays bit-reversed until the coordinate leaves bits().
+struct ScrambledGroup {
+  uint32_t reversed_shuffled_index;
+  uint32_t seed;
+  ScrambledGroup(uint32_t reversed_index, uint64_t key)
+      : reversed_shuffled_index(laine_karras_permutation(reversed_index, static_cast<uint32_t>(key))),
+        seed(static_cast<uint32_t>(key >> 32)) {}
+  uint32_t bits(int dim) const {
+    const uint32_t dim_seed = hash32(seed + 0x9e3779b9u * static_cast<uint32_t>(dim));
+    return reverse_bits(laine_karras_permutation(reversed_sample_bits(reversed_shuffled_index, dim), dim_seed));
+  }
+};
+
+// Point `index` of the shuffled, Owen-scrambled sequence with scramble key `key`, dimension `dim`:
+// nested_uniform_scramble(sample_bits(nested_uniform_scramble(index, s0), dim), s_dim).
+inline uint32_t scrambled_bits(uint32_t index, int dim, uint64_t key) {
+  return ScrambledGroup(reverse_bits(index), key).bits(dim);
+}
+
+}  // namespace sobol
+
+// The sampler of one path (one pixel, one frame). Calls follow the dimension table above; the
+// independent sampler ignores the dimension and draws in call order, as the integrator always did.
+class PathSampler {
+ public:
+  PathSampler() = default;  // a placeholder: assign a seeded sampler before drawing
+  PathSampler(SamplerType type, uint64_t seed, uint64_t pixel, uint32_t frame, int replicates)
+      : type_(type) {
+    if (type == SamplerType::Independent) {
+      // The pixel stream's first two draws are the jitter; the path has a second stream.
+      camera_rng_ = Rng(seed, pixel, frame);
+      rng_ = Rng(seed ^ 0x5bd1e9955bd1e995ULL, pixel, frame);
+      return;
+    }
+    const uint32_t k = replicates > 1 ? static_cast<uint32_t>(replicates) : 1u;
+    reversed_index_ = sobol::reverse_bits(frame / k);
+    key_ = mix64(seed * 0x9e3779b97f4a7c15ULL + mix64(pixel + 0x632be59bd9b4e019ULL));
+    key_ = mix64(key_ ^ mix64((frame % k) + 0xd6e8feb86659fd93ULL));
+  }
+
+  glm::vec2 camera_jitter() {
+    if (type_ == SamplerType::Independent) return camera_rng_.next_2d();
+    return sobol_2d(0);
+  }
+
+  float get_1d(int vertex, VertexDim dim) {
+    if (type_ == SamplerType::Independent) return rng_.next_float();
+    switch (dim) {
+      case VertexDim::LightSelect: return sobol_1d(2 * vertex, 2);
+      case VertexDim::BsdfLobe: return sobol_1d(2 * vertex + 1, 2);
+      case VertexDim::Roulette: return sobol_1d(2 * vertex + 1, 3);
+      default: return sobol_1d(2 * vertex + 1, 0);  // a 2D dimension asked for as 1D: its first half
+    }
+  }
+
+  glm::vec2 get_2d(int vertex, VertexDim dim) {
+    if (type_ == SamplerType::Independent) return rng_.next_2d();
+    return sobol_2d(dim == VertexDim::LightPoint ? 2 * vertex : 2 * vertex + 1);
+  }
+
+ private:
+  sobol::ScrambledGroup group(int id) const {
+    return sobol::ScrambledGroup(reversed_index_, mix64(key_ + 0xbf58476d1ce4e5b9ULL * static_cast<uint64_t>(id + 1)));
+  }
+  float sobol_1d(int group_id, int dim) const { return sobol::to_unit_float(group(group_id).bits(dim)); }
+  glm::vec2 sobol_2d(int group_id) const {
+    const sobol::ScrambledGroup g = group(group_id);
+    return glm::vec2(sobol::to_unit_float(g.bits(0)), sobol::to_unit_float(g.bits(1)));
+  }
+
+  SamplerType type_ = SamplerType::Independent;
+  Rng camera_rng_, rng_;
+  uint32_t reversed_index_ = 0;  // the frame's index in its replicate, bit-reversed
+  uint64_t key_ = 0;
+};
+
+}  // namespace pxf
