@@ -23,6 +23,10 @@ struct TraceParams {
 // Loads a glTF/GLB file or a built-in scene name ("cornell", ...); throws pxf::Error naming the
 // file and the problem. `env_path` (optional) replaces the environment with an equirect EXR.
 Scene load_scene(const std::string& name_or_path, const std::string& env_path = "", float env_strength = 1.0f);
+// The same from a glTF/GLB already in memory (the fuzzer's entry point); `name` prefixes errors and
+// relative uris resolve against `base_dir`.
+Scene load_scene_from_memory(const std::vector<unsigned char>& bytes, const std::string& name,
+                             const std::string& base_dir);
 // The built-in scenes: name and one-line description.
 struct BuiltinScene { std::string name, description, path; };
 std::vector<BuiltinScene> builtin_scenes();
