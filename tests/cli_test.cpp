@@ -12,10 +12,12 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <thread>
 
 #include "image/image.h"
+#include "pathtracer/pathtracer.h"
 
 namespace fs = std::filesystem;
 using namespace pxf;
@@ -175,4 +177,64 @@ TEST(Cli, DiffReadsForeignHalfFloatExrsAndGetsTheNumbersRight) {
   const Result missing = run("diff " + dir + "/nope.exr " + dir + "/ref.exr");
   EXPECT_EQ(missing.code, 1);
   EXPECT_NE(missing.err.find("nope.exr"), std::string::npos);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Issue 12: very bright but finite input still gives a finished render with finite layers.
+
+namespace {
+
+// Every channel of every layer of DIR's buffers.exr and final.exr is finite.
+void expect_outputs_finite(const std::string& dir, const std::string& what) {
+  for (const char* file : {"buffers.exr", "final.exr"})
+    for (const Layer& layer : read_exr_layers(dir + "/" + file))
+      EXPECT_EQ(count_nonfinite(layer.image), 0u) << what << ": " << file << " layer '" << layer.name << "'";
+}
+
+// The Cornell box with its buffer uri made absolute, `edit` applied, written to DIR/scene.gltf.
+std::string edited_cornell(const std::string& dir, const std::function<void(nlohmann::json&)>& edit) {
+  std::string cornell;
+  for (const BuiltinScene& s : builtin_scenes())
+    if (s.name == "cornell") cornell = s.path;
+  if (cornell.empty()) return "";
+  auto doc = nlohmann::json::parse(slurp(cornell));
+  for (auto& buffer : doc["buffers"])
+    buffer["uri"] = (fs::path(cornell).parent_path() / buffer["uri"].get<std::string>()).string();
+  edit(doc);
+  fs::create_directories(dir);
+  std::ofstream(dir + "/scene.gltf") << doc.dump();
+  return dir + "/scene.gltf";
+}
+
+}  // namespace
+
+TEST(Cli, VeryBrightFiniteInputGivesFiniteOutputs) {
+  const std::string dir = temp_dir("bright");
+  const std::string emissive = edited_cornell(dir + "/emissive", [](nlohmann::json& doc) {
+    for (auto& m : doc["materials"])
+      if (m.contains("emissiveFactor")) m["extensions"]["KHR_materials_emissive_strength"] = {{"emissiveStrength", 1e20}};
+  });
+  if (emissive.empty()) GTEST_SKIP() << "assets/cornell not generated";
+  const std::string point = edited_cornell(dir + "/point", [](nlohmann::json& doc) {
+    doc["extensionsUsed"].push_back("KHR_lights_punctual");
+    doc["extensions"]["KHR_lights_punctual"]["lights"] = {{{"type", "point"}, {"intensity", 1e20}}};
+    doc["nodes"].push_back({{"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}, {"translation", {0, 1, 0}}});
+    doc["scenes"][0]["nodes"].push_back(doc["nodes"].size() - 1);
+  });
+  for (const std::string& scene : {emissive, point}) {
+    const std::string out = dir + "/out";
+    const Result r = run("render --scene " + scene + " --size 16x16 --spp 4 --quiet --out " + out);
+    ASSERT_EQ(r.code, 0) << scene << ": " << r.err;
+    expect_outputs_finite(out, scene);
+  }
+  for (float pixel : {1e38f, 3e38f}) {
+    Image env(8, 4, {"R", "G", "B"});
+    std::fill(env.pixels.begin(), env.pixels.end(), 1.0f);
+    env.pixels[0] = env.pixels[1] = env.pixels[2] = pixel;
+    write_exr(dir + "/env.exr", env);
+    const std::string out = dir + "/env_out";
+    const Result r = run("render --scene envmap --env " + dir + "/env.exr --size 16x16 --spp 4 --quiet --out " + out);
+    ASSERT_EQ(r.code, 0) << pixel << ": " << r.err;
+    expect_outputs_finite(out, "environment pixel " + std::to_string(pixel));
+  }
 }
