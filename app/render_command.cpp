@@ -19,8 +19,27 @@ std::atomic<bool> g_interrupted{false};
 
 extern "C" void on_interrupt(int) {
   g_interrupted = true;
-  std::signal(SIGINT, SIG_DFL);  // a second Ctrl-C stops at once
+  std::signal(SIGINT, SIG_DFL);  // a second Ctrl-C stops at once (after the writes: they block it)
 }
+
+// Installs on_interrupt unless SIGINT is ignored (a background job of a shell script must stay
+// immune to the terminal's Ctrl-C); the previous disposition comes back at scope exit.
+class InterruptHandler {
+ public:
+  InterruptHandler() {
+    struct sigaction current {};
+    sigaction(SIGINT, nullptr, &current);
+    ignored_ = current.sa_handler == SIG_IGN;
+    if (!ignored_) previous_ = std::signal(SIGINT, on_interrupt);
+  }
+  ~InterruptHandler() {
+    if (!ignored_) std::signal(SIGINT, previous_);
+  }
+
+ private:
+  bool ignored_ = false;
+  void (*previous_)(int) = SIG_DFL;
+};
 
 // "[#######.....]  12/64 spp  1.2 s elapsed  ETA 5.1 s" on stderr, at most ~10 times a second.
 class ProgressBar {
@@ -73,11 +92,12 @@ int run_render(const Args& args) {
 
   const auto start = std::chrono::steady_clock::now();
   Scene scene = load_scene_for(scene_options, preview_options, cli);
+  if (!reference.empty()) check_reference(reference, scene_options.width, scene_options.height);  // before tracing
   auto context = create_gl_context(parse_gl_backend(scene_options.gl));
   Preview preview(scene, preview_options.settings, scene_options.width, scene_options.height);
 
   g_interrupted = false;
-  auto previous = std::signal(SIGINT, on_interrupt);
+  const InterruptHandler interrupt_handler;  // kept through the writes: Ctrl-C then still gives 130
   ProgressBar progress(spp);
   for (int i = 0; i < spp && !g_interrupted; ++i) {
     preview.add_frame(/*last_frame=*/false, /*display=*/false);
@@ -85,7 +105,6 @@ int run_render(const Args& args) {
   }
   preview.finish();
   if (!quiet) progress.finish();
-  std::signal(SIGINT, previous);
 
   RenderReport report;
   report.scene = &scene_options;
@@ -108,7 +127,7 @@ int run_render(const Args& args) {
                 report.unfiltered_vs_reference->nrmse_percent);
   std::printf("wrote %s/final.png, %s/final.exr, %s/buffers.exr, %s/stats.json\n", out.c_str(), out.c_str(),
               out.c_str(), out.c_str());
-  return report.interrupted ? 130 : 0;
+  return report.interrupted || g_interrupted ? 130 : 0;
 }
 
 }  // namespace pxf
