@@ -317,19 +317,19 @@ TEST(Cli, IgnoredSigintStaysIgnored) {
     signal(SIGINT, SIG_IGN);  // as for a background job of a shell script
     std::freopen("/dev/null", "w", stderr);
     std::freopen("/dev/null", "w", stdout);
-    execl(PXF_EXECUTABLE, "pxf", "render", "--size", "16x16", "--spp", "40", "--quiet", "--out", out.c_str(),
+    execl(PXF_EXECUTABLE, "pxf", "render", "--size", "16x16", "--spp", "400", "--quiet", "--out", out.c_str(),
           static_cast<char*>(nullptr));
     _exit(127);
   }
-  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  std::this_thread::sleep_for(std::chrono::milliseconds(800));
   kill(pid, SIGINT);
   int status = 0;
   waitpid(pid, &status, 0);
   ASSERT_TRUE(WIFEXITED(status));
-  EXPECT_EQ(WEXITSTATUS(status), 0);  // ran all 40 samples, not interrupted
+  EXPECT_EQ(WEXITSTATUS(status), 0);  // ran all 400 samples, not interrupted
   const auto stats = nlohmann::json::parse(slurp(out + "/stats.json"));
   EXPECT_FALSE(stats["interrupted"].get<bool>());
-  EXPECT_EQ(stats["settings"]["spp"].get<int>(), 40);
+  EXPECT_EQ(stats["settings"]["spp"].get<int>(), 400);
 }
 
 // SIGKILL or SIGINT at 50 random moments of renders of alternating sizes into one folder: every
