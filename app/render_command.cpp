@@ -22,8 +22,27 @@ std::atomic<bool> g_interrupted{false};
 
 extern "C" void on_interrupt(int) {
   g_interrupted = true;
-  std::signal(SIGINT, SIG_DFL);  // a second Ctrl-C stops at once
+  std::signal(SIGINT, SIG_DFL);  // a second Ctrl-C stops at once (after the writes: they block it)
 }
+
+// Installs on_interrupt unless SIGINT is ignored (a background job of a shell script must stay
+// immune to the terminal's Ctrl-C); the previous disposition comes back at scope exit.
+class InterruptHandler {
+ public:
+  InterruptHandler() {
+    struct sigaction current {};
+    sigaction(SIGINT, nullptr, &current);
+    ignored_ = current.sa_handler == SIG_IGN;
+    if (!ignored_) previous_ = std::signal(SIGINT, on_interrupt);
+  }
+  ~InterruptHandler() {
+    if (!ignored_) std::signal(SIGINT, previous_);
+  }
+
+ private:
+  bool ignored_ = false;
+  void (*previous_)(int) = SIG_DFL;
+};
 
 // "[#######.....]  12/64 spp  1.2 s elapsed  ETA 5.1 s" on stderr, at most ~10 times a second.
 class ProgressBar {
@@ -89,6 +108,7 @@ int run_render(const Args& args) {
   const auto start = BenchClock::now();
   Scene scene = load_scene_for(scene_options, preview_options, cli);
   const double load_ms = elapsed_ms(start);
+  if (!reference.empty()) check_reference(reference, scene_options.width, scene_options.height);  // before tracing
   auto context = create_gl_context(parse_gl_backend(scene_options.gl));
   Preview preview(scene, preview_options.settings, scene_options.width, scene_options.height);
   const FrameRange frames = render_frame_range(checkpoint_options, spp);
@@ -97,7 +117,7 @@ int run_render(const Args& args) {
   checkpointer.start(preview);
 
   g_interrupted = false;
-  auto previous = std::signal(SIGINT, on_interrupt);
+  const InterruptHandler interrupt_handler;  // kept through the writes: Ctrl-C then still gives 130
   const int total = static_cast<int>(frames.count());
   ProgressBar progress(total);
   const int first = preview.samples();  // > 0 after --resume
@@ -113,7 +133,6 @@ int run_render(const Args& args) {
   const double used_ms = elapsed_ms(start);
   checkpointer.write(preview);
   if (!quiet) progress.finish();
-  std::signal(SIGINT, previous);
 
   RenderReport report;
   report.scene = &scene_options;
@@ -144,7 +163,7 @@ int run_render(const Args& args) {
               out.c_str(), out.c_str());
   if (checkpointer.enabled())
     std::printf("wrote %s (state writes %.0f ms in all)\n", state_path(out).c_str(), checkpointer.write_ms());
-  return report.interrupted ? 130 : 0;
+  return report.interrupted || g_interrupted ? 130 : 0;
 }
 
 }  // namespace pxf

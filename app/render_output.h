@@ -1,5 +1,6 @@
 // What `pxf render` (and the explorer's capture) writes: final.png, final.exr, buffers.exr and
-// stats.json in an output folder. Every file is written atomically.
+// stats.json in an output folder. The set is written into a staging folder inside the output
+// folder and moved into place only once every file is complete (see write_render_outputs).
 #pragma once
 #include <optional>
 #include <string>
@@ -26,6 +27,10 @@ struct RenderReport {
 // The unfiltered image L_lv + L_u (what plain path tracing shows), from the preview's buffers.
 Image unfiltered_image(const std::vector<Layer>& buffers);
 const Image& layer_image(const std::vector<Layer>& buffers, const std::string& name);
+
+// Reads the --reference EXR and checks that it matches the render size, so that a bad reference is
+// reported before the render rather than after it; throws pxf::Error naming the file.
+void check_reference(const std::string& path, int width, int height);
 
 // Writes DIR/final.png, DIR/final.exr, DIR/buffers.exr, DIR/stats.json; creates DIR.
 void write_render_outputs(const std::string& dir, Preview& preview, RenderReport& report);

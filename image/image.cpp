@@ -2,7 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
+#include <fcntl.h>
 #include <unistd.h>
 
 namespace pxf {
@@ -36,6 +39,35 @@ Image Image::select(const std::vector<std::string>& names) const {
   return out;
 }
 
+void write_file_completely(const std::string& path, const void* data, size_t size) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) throw Error(path + ": cannot create: " + std::strerror(errno));
+  const char* p = static_cast<const char*>(data);
+  size_t left = size;
+  while (left > 0) {
+    const ssize_t n = ::write(fd, p, left);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      const int error = n < 0 ? errno : ENOSPC;
+      ::close(fd);
+      throw Error(path + ": cannot write: " + std::strerror(error));
+    }
+    p += n;
+    left -= static_cast<size_t>(n);
+  }
+  // fsync: a full disk or an I/O error may only show when the data reaches the device.
+  const bool synced = ::fsync(fd) == 0;
+  const int sync_error = errno;
+  if (::close(fd) != 0 || !synced) throw Error(path + ": cannot write: " + std::strerror(synced ? errno : sync_error));
+}
+
+void sync_folder(const std::string& folder) {
+  const int fd = ::open(folder.empty() ? "." : folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) return;  // best effort: the renames themselves already happened
+  ::fsync(fd);
+  ::close(fd);
+}
+
 void write_file_atomically(const std::string& path, const std::function<void(const std::string&)>& write) {
   const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
   try {
@@ -45,9 +77,12 @@ void write_file_atomically(const std::string& path, const std::function<void(con
     throw;
   }
   if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    const int error = errno;
     std::remove(tmp.c_str());
-    throw Error(path + ": cannot rename temporary file into place");
+    throw Error(path + ": cannot rename temporary file into place: " + std::strerror(error));
   }
+  const size_t slash = path.rfind('/');
+  sync_folder(slash == std::string::npos ? "" : path.substr(0, slash));
 }
 
 float srgb_from_linear(float v) {

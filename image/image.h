@@ -44,6 +44,11 @@ struct Layer {
 
 // Writes go to "<path>.tmp-<pid>" and are renamed, so an interrupted run never leaves a truncated file.
 void write_file_atomically(const std::string& path, const std::function<void(const std::string& tmp_path)>& write);
+// Writes `size` bytes to `path`, checking every write, the fsync and the close; throws pxf::Error
+// naming the file (a full disk included).
+void write_file_completely(const std::string& path, const void* data, size_t size);
+// fsync of a folder, so that renames into it survive a crash (best effort).
+void sync_folder(const std::string& folder);
 
 void write_exr(const std::string& path, const Image& image);  // half=false: full 32-bit float
 void write_exr(const std::string& path, const std::vector<Layer>& layers);

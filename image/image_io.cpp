@@ -3,6 +3,7 @@
 #include <OpenEXR/ImfFrameBuffer.h>
 #include <OpenEXR/ImfHeader.h>
 #include <OpenEXR/ImfInputFile.h>
+#include <OpenEXR/ImfIO.h>
 #include <OpenEXR/ImfOutputFile.h>
 #include <stb_image.h>
 #include <stb_image_write.h>
@@ -27,6 +28,25 @@ int channel_rank(const std::string& name) {
   auto it = std::find(order.begin(), order.end(), name);
   return it == order.end() ? static_cast<int>(order.size()) : static_cast<int>(it - order.begin());
 }
+
+// OpenEXR's own file stream flushes in a destructor that ignores errors (a full disk): encode into
+// memory instead and write the bytes with every write checked.
+class MemoryOStream : public Imf::OStream {
+ public:
+  MemoryOStream() : Imf::OStream("memory") {}
+  void write(const char c[], int n) override {
+    const size_t end = position_ + static_cast<size_t>(n);
+    if (end > bytes.size()) bytes.resize(end);
+    std::copy(c, c + n, bytes.begin() + static_cast<ptrdiff_t>(position_));
+    position_ = end;
+  }
+  uint64_t tellp() override { return position_; }
+  void seekp(uint64_t pos) override { position_ = static_cast<size_t>(pos); }
+  std::vector<char> bytes;
+
+ private:
+  size_t position_ = 0;
+};
 
 void check_layers(const std::string& path, const std::vector<Layer>& layers) {
   if (layers.empty()) throw Error(path + ": no layer to write");
@@ -59,9 +79,13 @@ void write_exr(const std::string& path, const std::vector<Layer>& layers) {
           frame.insert(name, Imf::Slice(Imf::FLOAT, base, x_stride, x_stride * width));
         }
       }
-      Imf::OutputFile file(tmp.c_str(), header);
-      file.setFrameBuffer(frame);
-      file.writePixels(height);
+      MemoryOStream stream;
+      {
+        Imf::OutputFile file(stream, header);
+        file.setFrameBuffer(frame);
+        file.writePixels(height);
+      }  // the destructor writes the line offset table
+      write_file_completely(tmp, stream.bytes.data(), stream.bytes.size());
     } catch (const Error&) {
       throw;
     } catch (const std::exception& e) {
@@ -141,10 +165,14 @@ void write_png(const std::string& path, const Image& display) {
       const float clamped = std::isfinite(v) ? std::clamp(v, 0.0f, 1.0f) : 0.0f;
       bytes[p * n + c] = static_cast<unsigned char>(std::lround(clamped * 255.0f));
     }
-  write_file_atomically(path, [&](const std::string& tmp) {
-    if (!stbi_write_png(tmp.c_str(), display.width, display.height, n, bytes.data(), display.width * n))
-      throw Error(path + ": cannot write PNG");
-  });
+  std::vector<unsigned char> encoded;
+  auto append = [](void* context, void* data, int size) {
+    auto* out = static_cast<std::vector<unsigned char>*>(context);
+    out->insert(out->end(), static_cast<unsigned char*>(data), static_cast<unsigned char*>(data) + size);
+  };
+  if (!stbi_write_png_to_func(append, &encoded, display.width, display.height, n, bytes.data(), display.width * n))
+    throw Error(path + ": cannot encode PNG");
+  write_file_atomically(path, [&](const std::string& tmp) { write_file_completely(tmp, encoded.data(), encoded.size()); });
 }
 
 Image read_ldr_or_hdr(const std::string& path) {

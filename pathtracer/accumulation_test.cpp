@@ -2,6 +2,8 @@
 // renderer's buffers, reset and image getters.
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include <cmath>
 
 #include "pathtracer/integrator.h"
@@ -123,4 +125,14 @@ TEST(Accumulation, EmitterCoverageIsTheFractionOfCameraRaysSeeingAnEmitter) {
 }
 
 }  // namespace
+
+// Issue 12: luminance near the float limit has a variance beyond float range; it saturates.
+TEST(Accumulation, VarianceOfMeanSaturatesInsteadOfOverflowing) {
+  Accumulation acc;
+  resize_accumulation(acc, 1, 1);
+  for (int i = 0; i < 8; ++i) accumulate_sample(acc, 0, glm::vec3(0.0f), glm::vec3(i % 2 ? 3e38f : 0.0f));
+  EXPECT_TRUE(std::isfinite(acc.variance_of_mean(0)));
+  EXPECT_EQ(acc.variance_of_mean(0), std::numeric_limits<float>::max());
+}
+
 }  // namespace pxf

@@ -21,10 +21,12 @@ namespace {
 // A triangle is degenerate when its area is zero relative to its size: this catches repeated and
 // collinear vertices without rejecting small but well-shaped triangles at any scene scale.
 bool is_degenerate(glm::vec3 a, glm::vec3 b, glm::vec3 c) {
-  glm::vec3 e1 = b - a, e2 = c - a;
-  float twice_area = glm::length(glm::cross(e1, e2));
-  float scale = std::max(glm::dot(e1, e1), glm::dot(e2, e2));
-  return !(twice_area > 1e-7f * scale) || !std::isfinite(twice_area);
+  // In double: in float the cross product overflows for edges above ~1e9 units and underflows
+  // below ~1e-10, which dropped whole scenes at those scales.
+  const glm::dvec3 e1 = glm::dvec3(b) - glm::dvec3(a), e2 = glm::dvec3(c) - glm::dvec3(a);
+  const double twice_area = glm::length(glm::cross(e1, e2));
+  const double scale = std::max(glm::dot(e1, e1), glm::dot(e2, e2));
+  return !(twice_area > 1e-7 * scale) || !std::isfinite(twice_area);
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 #include "pathtracer/integrator.h"
 
 #include <algorithm>
+#include <limits>
 #include <cmath>
 #include <utility>
 
@@ -294,7 +295,9 @@ float Accumulation::per_sample_variance_of_mean(size_t pixel) const {
   uint32_t n = samples[pixel];
   if (n < 2) return -1.0f;
   double var = hv_lum_m2[pixel] / static_cast<double>(n - 1) / static_cast<double>(n);
-  return static_cast<float>(std::max(0.0, var));
+  // Saturate rather than overflow: a very bright but finite input (luminance near the float limit)
+  // has a variance beyond float range, and an infinite variance would poison every later pass.
+  return static_cast<float>(std::clamp(var, 0.0, static_cast<double>(std::numeric_limits<float>::max())));
 }
 
 float Accumulation::replicate_variance_of_mean(size_t pixel) const {

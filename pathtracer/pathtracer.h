@@ -34,6 +34,10 @@ struct TraceParams {
 // built-in `default_light` environment (Scene::notes says so); with None a warning says it is black.
 Scene load_scene(const std::string& name_or_path, const std::string& env_path = "", float env_strength = 1.0f,
                  DefaultLight default_light = DefaultLight::None);
+// The same from a glTF/GLB already in memory (the fuzzer's entry point); `name` prefixes errors and
+// relative uris resolve against `base_dir`.
+Scene load_scene_from_memory(const std::vector<unsigned char>& bytes, const std::string& name,
+                             const std::string& base_dir);
 // The built-in scenes: name and one-line description.
 struct BuiltinScene { std::string name, description, path; };
 std::vector<BuiltinScene> builtin_scenes();

@@ -8,6 +8,8 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <cstdio>
+#include <cstring>
 #include <functional>
 #include <map>
 #include <set>
@@ -68,6 +70,15 @@ std::string builtin_path(const std::string& name) {
 
 // ---------------------------------------------------------------------------------------------
 // Small conversions
+
+constexpr float kMaxCoordinate = 1e12f;
+
+// "1e+12", "3.4e+38", "0.5": short and exact enough for an error message.
+std::string format_number(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g", v);
+  return text;
+}
 
 float finite_or(double value, float fallback) {
   return std::isfinite(value) ? static_cast<float>(value) : fallback;
@@ -172,6 +183,16 @@ class GltfLoader {
 
   Scene load() {
     read_model();
+    return build();
+  }
+
+  Scene load_from_memory(const unsigned char* data, size_t size, const std::string& base_dir) {
+    parse_model(data, size, base_dir);
+    return build();
+  }
+
+ private:
+  Scene build() {
     check_extensions();
     images_.decode_buffer_view_images(model_, file_);
     load_materials();
@@ -182,27 +203,51 @@ class GltfLoader {
     return std::move(scene_);
   }
 
- private:
   [[noreturn]] void fail(const std::string& problem) const { throw Error(file_ + ": " + problem); }
+
+  // Ray origins come from the camera and from surface points; Embree asserts on origins beyond
+  // about 1.8e18, and float precision is long gone well before that.
+  void check_magnitude(glm::vec3 p, const std::string& what) const {
+    const float m = std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
+    if (m > kMaxCoordinate)
+      fail(what + " has a world-space coordinate of " + format_number(m) + ", beyond the supported " +
+           format_number(kMaxCoordinate) + " (check the node transforms and units)");
+  }
   void warn(const std::string& message) { scene_.warnings.push_back(file_ + ": " + message); }
 
   void read_model() {
     std::error_code ec;
     if (!fs::is_regular_file(file_, ec)) fail("no such file");
-    char magic[4] = {0, 0, 0, 0};
-    {
-      std::ifstream in(file_, std::ios::binary);
-      if (!in) fail("cannot open file");
-      in.read(magic, 4);
-    }
-    bool binary = std::string(magic, 4) == "glTF";
+    std::ifstream in(file_, std::ios::binary);
+    if (!in) fail("cannot open file");
+    std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (in.bad()) fail("cannot read file");
+    parse_model(bytes.data(), bytes.size(), fs::path(file_).parent_path().string());
+  }
+
+  // tinygltf joins its base folder with every uri, which breaks absolute uris ("dir//abs/x.bin").
+  // So it gets no base folder, and this callback resolves relative uris against the glTF's folder.
+  // It also replaces tinygltf's default, which runs wordexp() on uris from the file.
+  static std::string resolve_uri(const std::string& uri, void* base_dir) {
+    const fs::path path(uri);
+    if (path.is_absolute()) return uri;
+    return (fs::path(*static_cast<const std::string*>(base_dir)) / path).string();
+  }
+
+  void parse_model(const unsigned char* data, size_t size, const std::string& base_dir) {
+    base_dir_ = base_dir;
+    if (size > std::numeric_limits<unsigned int>::max()) fail("file larger than 4 GiB");
+    const bool binary = size >= 4 && std::memcmp(data, "glTF", 4) == 0;
     tinygltf::TinyGLTF loader;
+    loader.SetFsCallbacks({&tinygltf::FileExists, &GltfLoader::resolve_uri, &tinygltf::ReadWholeFile,
+                           &tinygltf::WriteWholeFile, &base_dir_});
     images_.install(loader);
     std::string err, warn_text;
     bool ok = false;
     try {
-      ok = binary ? loader.LoadBinaryFromFile(&model_, &err, &warn_text, file_)
-                  : loader.LoadASCIIFromFile(&model_, &err, &warn_text, file_);
+      ok = binary ? loader.LoadBinaryFromMemory(&model_, &err, &warn_text, data, static_cast<unsigned int>(size), "")
+                  : loader.LoadASCIIFromString(&model_, &err, &warn_text, reinterpret_cast<const char*>(data),
+                                               static_cast<unsigned int>(size), "");
     } catch (const std::exception& e) {
       fail(std::string("invalid glTF: ") + e.what());
     }
@@ -450,19 +495,41 @@ class GltfLoader {
     for (int root : roots) visit_node(root, glm::mat4(1.0f), on_path);
   }
 
-  void visit_node(int index, const glm::mat4& parent, std::vector<bool>& on_path) {
-    if (index < 0 || index >= static_cast<int>(model_.nodes.size())) fail("node " + std::to_string(index) + " out of range");
-    if (on_path[index]) fail("node " + std::to_string(index) + " is its own ancestor (cycle in the node hierarchy)");
-    on_path[index] = true;
-    const tinygltf::Node& node = model_.nodes[index];
-    glm::mat4 world = parent * node_local_transform(node);
-    if (node.mesh >= 0) add_mesh(node.mesh, world);
-    else if (node.mesh < -1) fail("node " + std::to_string(index) + " mesh index out of range");
-    if (node.camera >= 0) add_camera(node.camera, world);
-    if (const tinygltf::Value* ext = find_extension(node.extensions, "KHR_lights_punctual"))
-      add_light(int_or(ext->Get("light"), -1), world);
-    for (int child : node.children) visit_node(child, world, on_path);
-    on_path[index] = false;
+  // Depth-first with an explicit stack: a hierarchy thousands of levels deep must not overflow the
+  // call stack. A node reached again while still on the current path is a cycle.
+  void visit_node(int root, const glm::mat4& parent, std::vector<bool>& on_path) {
+    struct Frame {
+      int index;
+      glm::mat4 world;
+      size_t next_child = 0;
+    };
+    std::vector<Frame> stack;
+    auto enter = [&](int index, const glm::mat4& parent_world) {
+      if (index < 0 || index >= static_cast<int>(model_.nodes.size())) fail("node " + std::to_string(index) + " out of range");
+      if (on_path[index]) fail("node " + std::to_string(index) + " is its own ancestor (cycle in the node hierarchy)");
+      on_path[index] = true;
+      const tinygltf::Node& node = model_.nodes[index];
+      glm::mat4 world = parent_world * node_local_transform(node);
+      if (node.mesh >= 0) add_mesh(node.mesh, world);
+      else if (node.mesh < -1) fail("node " + std::to_string(index) + " mesh index out of range");
+      if (node.camera >= 0) add_camera(node.camera, world);
+      if (const tinygltf::Value* ext = find_extension(node.extensions, "KHR_lights_punctual"))
+        add_light(int_or(ext->Get("light"), -1), world);
+      stack.push_back({index, world});
+    };
+    enter(root, parent);
+    while (!stack.empty()) {
+      Frame& top = stack.back();
+      const std::vector<int>& children = model_.nodes[top.index].children;
+      if (top.next_child < children.size()) {
+        const int child = children[top.next_child++];
+        const glm::mat4 world = top.world;  // `top` may dangle once enter() grows the stack
+        enter(child, world);
+      } else {
+        on_path[top.index] = false;
+        stack.pop_back();
+      }
+    }
   }
 
   void add_camera(int index, const glm::mat4& world) {
@@ -477,6 +544,7 @@ class GltfLoader {
     const auto& p = camera.perspective;
     Camera& out = scene_.camera;
     out.camera_to_world = rigid_frame(world);
+    check_magnitude(glm::vec3(out.camera_to_world[3]), "camera " + std::to_string(index));
     float yfov = finite_or(p.yfov, 0.0f);
     out.yfov = (yfov > 1e-4f && yfov < 3.1f) ? yfov : Camera{}.yfov;
     float znear = finite_or(p.znear, 0.0f);
@@ -536,6 +604,7 @@ class GltfLoader {
       warn("light " + std::to_string(index) + " has a non-finite position; ignoring it");
       return;
     }
+    check_magnitude(out.position, "light " + std::to_string(index));
     scene_.lights.push_back(out);
   }
 
@@ -622,6 +691,8 @@ class GltfLoader {
     transform_to_world(mesh, world);
     gltf::drop_invalid_triangles(mesh, dropped_);
     if (mesh.triangles.empty()) return;
+    for (const glm::uvec3& t : mesh.triangles)
+      for (uint32_t v : {t.x, t.y, t.z}) check_magnitude(mesh.positions[v], what + " vertex");
     finish_attributes(mesh, what);
     scene_.meshes.push_back(std::move(mesh));
   }
@@ -715,6 +786,7 @@ class GltfLoader {
   }
 
   std::string file_;
+  std::string base_dir_;  // what relative uris are resolved against
   tinygltf::Model model_;
   gltf::ImageStore images_;
   Scene scene_;
@@ -817,6 +889,13 @@ std::vector<BuiltinScene> builtin_scenes() {
     if (fs::is_regular_file(path, ec)) scenes.push_back({info.name, info.description, path});
   }
   return scenes;
+}
+
+Scene load_scene_from_memory(const std::vector<unsigned char>& bytes, const std::string& name,
+                             const std::string& base_dir) {
+  Scene scene = GltfLoader(name).load_from_memory(bytes.data(), bytes.size(), base_dir);
+  scene.source = name;
+  return scene;
 }
 
 Scene load_scene(const std::string& name_or_path, const std::string& env_path, float env_strength,

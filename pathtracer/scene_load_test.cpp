@@ -958,6 +958,100 @@ TEST(SceneLoadBadInput, NodeCycleAndBadMaterialIndex) {
 }
 
 // ----------------------------------------------------------------------------------------------
+// Hostile input (issue 12)
+
+TEST(SceneLoadBadInput, DeepNodeHierarchyLoadsWithoutOverflowingTheStack) {
+  // Far deeper than the ~8,400 levels a recursive traversal survived in Release.
+  std::string dir = temp_dir();
+  GltfBuilder b;
+  const int depth = 30000;
+  b.doc["nodes"] = json::array();
+  for (int i = 0; i < depth; ++i) {
+    json n = {{"translation", {0.0, 0.0, 1e-6}}};
+    if (i + 1 < depth) n["children"] = {i + 1};
+    b.doc["nodes"].push_back(n);
+  }
+  b.doc["nodes"][depth - 1]["mesh"] = b.mesh(b.quad_primitive());
+  b.doc["scenes"] = {{{"nodes", {0}}}};
+  Scene scene = load_scene(b.write_gltf(dir + "/deep.gltf"));
+  ASSERT_EQ(scene.meshes.size(), 1u);
+  EXPECT_NEAR(scene.meshes[0].positions[0].z, depth * 1e-6f, 1e-3f);
+
+  // A cycle at the bottom of a deep chain is still found and named.
+  b.doc["nodes"][depth - 1]["children"] = {depth / 2};
+  std::string cyclic = b.write_gltf(dir + "/deep_cycle.gltf");
+  EXPECT_NE(error_of([&] { load_scene(cyclic); }).find("cycle"), std::string::npos);
+}
+
+TEST(SceneLoadBadInput, HugeWorldCoordinatesAreRefusedWithTheLimit) {
+  std::string dir = temp_dir();
+  auto load_with = [&](const json& node_extra, const std::string& name) {
+    GltfBuilder b;
+    json n = {{"mesh", b.mesh(b.quad_primitive())}};
+    n.update(node_extra);
+    b.scene({b.node(n)});
+    return b.write_gltf(dir + "/" + name);
+  };
+  std::string far_mesh = load_with({{"translation", {0, 0, 3.4e38}}}, "far_mesh.gltf");
+  std::string msg = error_of([&] { load_scene(far_mesh); });
+  EXPECT_EQ(msg.rfind(far_mesh, 0), 0u) << msg;
+  EXPECT_NE(msg.find("3.4e+38"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("1e+12"), std::string::npos) << msg;
+
+  GltfBuilder c;
+  c.doc["cameras"] = {{{"type", "perspective"}, {"perspective", {{"yfov", 0.8}, {"znear", 0.1}}}}};
+  c.scene({c.node({{"mesh", c.mesh(c.quad_primitive())}}), c.node({{"camera", 0}, {"translation", {0, 0, 1e20}}})});
+  std::string far_camera = c.write_gltf(dir + "/far_camera.gltf");
+  EXPECT_NE(error_of([&] { load_scene(far_camera); }).find("camera 0"), std::string::npos);
+
+  // Large but representable scenes still load.
+  EXPECT_EQ(load_scene(load_with({{"translation", {0, 0, 1e11}}}, "near.gltf")).meshes.size(), 1u);
+}
+
+TEST(SceneLoadGeometry, DegenerateTriangleTestIsScaleInvariant) {
+  // Well-shaped triangles at 1e-12 and 1e11 units: float cross products underflow or overflow there.
+  std::string dir = temp_dir();
+  for (double scale : {1e-12, 1e-10, 1.0, 1e9, 1e11}) {
+    GltfBuilder b;
+    b.scene({b.node({{"mesh", b.mesh(b.quad_primitive())}, {"scale", {scale, scale, scale}}})});
+    Scene scene = load_scene(b.write_gltf(dir + "/scaled.gltf"));
+    ASSERT_EQ(scene.meshes.size(), 1u) << scale << "\n" << warnings_of(scene);
+    EXPECT_EQ(scene.meshes[0].triangles.size(), 2u) << scale;
+    EXPECT_FALSE(any_warning_contains(scene, "degenerate")) << scale << "\n" << warnings_of(scene);
+  }
+}
+
+TEST(SceneLoadBadInput, AbsoluteUrisWorkWhateverTheScenePath) {
+  std::string dir = fs::absolute(temp_dir()).string();
+  GltfBuilder b;
+  b.add_quad_scene();
+  write_bytes(dir + "/data.bin", b.bin);
+  json d = b.doc;
+  d["buffers"] = json::array({{{"byteLength", b.bin.size()}, {"uri", dir + "/data.bin"}}});
+  fs::create_directories(dir + "/sub");
+  std::ofstream(dir + "/sub/abs.gltf") << d.dump();
+  EXPECT_EQ(load_scene(dir + "/sub/abs.gltf").meshes.size(), 1u);
+  // Relative uris still resolve against the glTF's folder, not the working directory.
+  d["buffers"][0]["uri"] = "../data.bin";
+  std::ofstream(dir + "/sub/rel.gltf") << d.dump();
+  EXPECT_EQ(load_scene(dir + "/sub/rel.gltf").meshes.size(), 1u);
+}
+
+TEST(SceneLoadBadInput, FromMemoryMatchesFromFile) {
+  std::string dir = temp_dir();
+  GltfBuilder b;
+  b.add_quad_scene();
+  std::string path = b.write_glb(dir + "/quad.glb");
+  std::ifstream in(path, std::ios::binary);
+  std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  Scene scene = load_scene_from_memory(bytes, "memory.glb", dir);
+  ASSERT_EQ(scene.meshes.size(), 1u);
+  EXPECT_EQ(scene.meshes[0].triangles.size(), 2u);
+  bytes.resize(bytes.size() / 2);
+  EXPECT_EQ(error_of([&] { load_scene_from_memory(bytes, "memory.glb", dir); }).rfind("memory.glb: ", 0), 0u);
+}
+
+// ----------------------------------------------------------------------------------------------
 // Environment and built-in scenes
 
 TEST(SceneLoadEnvironment, ExrIsSanitizedAndWrapsHorizontally) {

@@ -13,11 +13,16 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <map>
+#include <random>
+#include <set>
 #include <nlohmann/json.hpp>
 #include <thread>
 
 #include "gl/preview_params.h"
 #include "image/image.h"
+#include "pathtracer/pathtracer.h"
 
 namespace fs = std::filesystem;
 using namespace pxf;
@@ -314,4 +319,197 @@ TEST(Cli, DiffReportsDisplayMetricsWithAndWithoutEmitters) {
   EXPECT_EQ(run("diff " + test + "/final.exr " + ref + "/final.exr --max-flip " + std::to_string(flip * 0.5)).code, 1);
   EXPECT_EQ(run("diff " + test + "/final.exr " + ref + "/final.exr --max-flip " + std::to_string(flip * 2)).code, 0);
   EXPECT_EQ(run("diff " + ref + "/final.exr " + ref + "/final.exr --max-flip 0").code, 0);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Issue 12: very bright but finite input still gives a finished render with finite layers.
+
+namespace {
+
+// Every channel of every layer of DIR's buffers.exr and final.exr is finite.
+void expect_outputs_finite(const std::string& dir, const std::string& what) {
+  for (const char* file : {"buffers.exr", "final.exr"})
+    for (const Layer& layer : read_exr_layers(dir + "/" + file))
+      EXPECT_EQ(count_nonfinite(layer.image), 0u) << what << ": " << file << " layer '" << layer.name << "'";
+}
+
+// The Cornell box with its buffer uri made absolute, `edit` applied, written to DIR/scene.gltf.
+std::string edited_cornell(const std::string& dir, const std::function<void(nlohmann::json&)>& edit) {
+  std::string cornell;
+  for (const BuiltinScene& s : builtin_scenes())
+    if (s.name == "cornell") cornell = s.path;
+  if (cornell.empty()) return "";
+  auto doc = nlohmann::json::parse(slurp(cornell));
+  for (auto& buffer : doc["buffers"])
+    buffer["uri"] = (fs::path(cornell).parent_path() / buffer["uri"].get<std::string>()).string();
+  edit(doc);
+  fs::create_directories(dir);
+  std::ofstream(dir + "/scene.gltf") << doc.dump();
+  return dir + "/scene.gltf";
+}
+
+}  // namespace
+
+TEST(Cli, VeryBrightFiniteInputGivesFiniteOutputs) {
+  const std::string dir = temp_dir("bright");
+  const std::string emissive = edited_cornell(dir + "/emissive", [](nlohmann::json& doc) {
+    for (auto& m : doc["materials"])
+      if (m.contains("emissiveFactor")) m["extensions"]["KHR_materials_emissive_strength"] = {{"emissiveStrength", 1e20}};
+  });
+  if (emissive.empty()) GTEST_SKIP() << "assets/cornell not generated";
+  const std::string point = edited_cornell(dir + "/point", [](nlohmann::json& doc) {
+    doc["extensionsUsed"].push_back("KHR_lights_punctual");
+    doc["extensions"]["KHR_lights_punctual"]["lights"] = {{{"type", "point"}, {"intensity", 1e20}}};
+    doc["nodes"].push_back({{"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}, {"translation", {0, 1, 0}}});
+    doc["scenes"][0]["nodes"].push_back(doc["nodes"].size() - 1);
+  });
+  for (const std::string& scene : {emissive, point}) {
+    const std::string out = dir + "/out";
+    const Result r = run("render --scene " + scene + " --size 16x16 --spp 4 --quiet --out " + out);
+    ASSERT_EQ(r.code, 0) << scene << ": " << r.err;
+    expect_outputs_finite(out, scene);
+  }
+  for (float pixel : {1e38f, 3e38f}) {
+    Image env(8, 4, {"R", "G", "B"});
+    std::fill(env.pixels.begin(), env.pixels.end(), 1.0f);
+    env.pixels[0] = env.pixels[1] = env.pixels[2] = pixel;
+    write_exr(dir + "/env.exr", env);
+    const std::string out = dir + "/env_out";
+    const Result r = run("render --scene envmap --env " + dir + "/env.exr --size 16x16 --spp 4 --quiet --out " + out);
+    ASSERT_EQ(r.code, 0) << pixel << ": " << r.err;
+    expect_outputs_finite(out, "environment pixel " + std::to_string(pixel));
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Issue 12: the output set is replaced whole or not at all.
+
+namespace {
+
+std::string file_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+std::vector<std::string> leftovers(const std::string& dir) {
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    const std::string name = entry.path().filename().string();
+    if (name.find(".tmp-") != std::string::npos || name.rfind(".pxf-staging-", 0) == 0) names.push_back(name);
+  }
+  return names;
+}
+
+const char* const kOutputs[] = {"final.png", "final.exr", "buffers.exr", "stats.json"};
+
+}  // namespace
+
+TEST(Cli, FullDiskKeepsThePreviousOutputSetAndNamesTheFile) {
+  const std::string out = temp_dir("full_disk");
+  ASSERT_EQ(run("render --size 64x64 --spp 3 --quiet --out " + out).code, 0);
+  std::map<std::string, std::string> before;
+  // A file size limit of 4 KiB (8 blocks of 512 bytes) stands in for a nearly full disk: writes
+  // past it fail with EFBIG.
+  for (const char* name : kOutputs) before[name] = file_bytes(out + "/" + name);
+  const std::string limited = "sh -c \"ulimit -f 8; trap '' XFSZ; exec " + std::string(PXF_EXECUTABLE) +
+                              " render --size 64x64 --spp 3 --seed 7 --quiet --out " + out + "\"";
+  const std::string base = temp_dir("io_full");
+  fs::create_directories(base);
+  const int status = std::system((limited + " 2>" + base + "/err").c_str());
+  const std::string err = slurp(base + "/err");
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 1) << err;
+  EXPECT_EQ(lines(err), 1u) << err;
+  EXPECT_NE(err.find("cannot write"), std::string::npos) << err;
+  for (const char* name : kOutputs) EXPECT_EQ(file_bytes(out + "/" + name), before[name]) << name << " changed";
+  EXPECT_TRUE(leftovers(out).empty());
+}
+
+TEST(Cli, StaleTemporariesOfDeadProcessesAreRemoved) {
+  const std::string out = temp_dir("stale");
+  fs::create_directories(out + "/.pxf-staging-999999999");
+  std::ofstream(out + "/final.png.tmp-999999999") << "partial";
+  std::ofstream(out + "/notes.txt") << "kept";
+  ASSERT_EQ(run("render --size 16x16 --spp 2 --quiet --out " + out).code, 0);
+  EXPECT_TRUE(leftovers(out).empty());
+  EXPECT_TRUE(fs::exists(out + "/notes.txt"));
+}
+
+TEST(Cli, ReferenceIsCheckedBeforeTracing) {
+  const std::string out = temp_dir("bad_reference");
+  const Result missing = run("render --size 16x16 --spp 1000000 --quiet --reference /nonexistent/ref.exr --out " + out);
+  EXPECT_EQ(missing.code, 1);
+  EXPECT_NE(missing.err.find("/nonexistent/ref.exr"), std::string::npos) << missing.err;
+  ASSERT_EQ(run("render --size 16x16 --spp 1 --quiet --out " + out).code, 0);
+  const Result wrong_size =
+      run("render --size 24x16 --spp 1000000 --quiet --reference " + out + "/final.exr --out " + out + "/b");
+  EXPECT_EQ(wrong_size.code, 1);
+  EXPECT_NE(wrong_size.err.find(out + "/final.exr"), std::string::npos) << wrong_size.err;
+  EXPECT_NE(wrong_size.err.find("16x16"), std::string::npos) << wrong_size.err;
+  EXPECT_FALSE(fs::exists(out + "/b"));
+}
+
+TEST(Cli, IgnoredSigintStaysIgnored) {
+  const std::string out = temp_dir("ignored_sigint");
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    signal(SIGINT, SIG_IGN);  // as for a background job of a shell script
+    std::freopen("/dev/null", "w", stderr);
+    std::freopen("/dev/null", "w", stdout);
+    execl(PXF_EXECUTABLE, "pxf", "render", "--size", "16x16", "--spp", "400", "--quiet", "--out", out.c_str(),
+          static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(800));
+  kill(pid, SIGINT);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0);  // ran all 400 samples, not interrupted
+  const auto stats = nlohmann::json::parse(slurp(out + "/stats.json"));
+  EXPECT_FALSE(stats["interrupted"].get<bool>());
+  EXPECT_EQ(stats["settings"]["spp"].get<int>(), 400);
+}
+
+// SIGKILL or SIGINT at 50 random moments of renders of alternating sizes into one folder: every
+// file under a final name is complete, and all of them come from the same run (same size).
+TEST(Cli, KillsAtRandomMomentsNeverLeavePartialOrMixedOutputs) {
+  const std::string out = temp_dir("kills");
+  std::mt19937 rng(12);
+  const int sizes[] = {16, 20, 24};
+  for (int round = 0; round < 50; ++round) {
+    const std::string size = std::to_string(sizes[round % 3]) + "x16";
+    const pid_t pid = fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+      std::freopen("/dev/null", "w", stderr);
+      std::freopen("/dev/null", "w", stdout);
+      execl(PXF_EXECUTABLE, "pxf", "render", "--size", size.c_str(), "--spp", "8", "--quiet", "--out", out.c_str(),
+            static_cast<char*>(nullptr));
+      _exit(127);
+    }
+    std::this_thread::sleep_for(std::chrono::microseconds(std::uniform_int_distribution<int>(0, 900000)(rng)));
+    kill(pid, round % 2 ? SIGKILL : SIGINT);
+    int status = 0;
+    waitpid(pid, &status, 0);
+    std::set<int> widths;
+    for (const char* name : kOutputs) {
+      const std::string path = out + "/" + name;
+      if (!fs::exists(path)) continue;
+      const std::string where = std::string(name) + " after round " + std::to_string(round);
+      if (std::string(name) == "stats.json") {
+        const auto stats = nlohmann::json::parse(slurp(path), nullptr, false);
+        ASSERT_FALSE(stats.is_discarded()) << where;
+        widths.insert(stats["settings"]["width"].get<int>());
+      } else if (std::string(name) == "final.png") {
+        widths.insert(read_ldr_or_hdr(path).width);
+      } else {
+        widths.insert(read_exr_layers(path).front().image.width);  // throws on a truncated file
+      }
+    }
+    EXPECT_LE(widths.size(), 1u) << "a mix of two runs after round " << round;
+  }
+  // A later run cleans what the killed ones left.
+  ASSERT_EQ(run("render --size 16x16 --spp 1 --quiet --out " + out).code, 0);
+  EXPECT_TRUE(leftovers(out).empty());
 }
