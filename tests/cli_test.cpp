@@ -436,12 +436,13 @@ TEST(Cli, StaleTemporariesOfDeadProcessesAreRemoved) {
 
 TEST(Cli, ReferenceIsCheckedBeforeTracing) {
   const std::string out = temp_dir("bad_reference");
-  const Result missing = run("render --size 16x16 --spp 1000000 --quiet --reference /nonexistent/ref.exr --out " + out);
+  const Result missing = run("render --size 16x16 --spp 64 --quiet --reference /nonexistent/ref.exr --out " + out);
   EXPECT_EQ(missing.code, 1);
+  EXPECT_FALSE(fs::exists(out)) << "the render ran before the reference was checked";
   EXPECT_NE(missing.err.find("/nonexistent/ref.exr"), std::string::npos) << missing.err;
   ASSERT_EQ(run("render --size 16x16 --spp 1 --quiet --out " + out).code, 0);
   const Result wrong_size =
-      run("render --size 24x16 --spp 1000000 --quiet --reference " + out + "/final.exr --out " + out + "/b");
+      run("render --size 24x16 --spp 64 --quiet --reference " + out + "/final.exr --out " + out + "/b");
   EXPECT_EQ(wrong_size.code, 1);
   EXPECT_NE(wrong_size.err.find(out + "/final.exr"), std::string::npos) << wrong_size.err;
   EXPECT_NE(wrong_size.err.find("16x16"), std::string::npos) << wrong_size.err;
