@@ -16,7 +16,8 @@ bool same_trace_params(const TraceParams& a, const TraceParams& b) {
 bool same_filter_params(const PreviewSettings& a, const PreviewSettings& b) {
   return a.filter_enabled == b.filter_enabled && a.filter.kind == b.filter.kind && a.filter.sigma_s == b.filter.sigma_s &&
          a.filter.sigma_c == b.filter.sigma_c && a.filter.sigma_d == b.filter.sigma_d &&
-         a.filter.skip_case2 == b.filter.skip_case2 && a.threshold == b.threshold;
+         a.filter.skip_case2 == b.filter.skip_case2 && a.filter.subsampled_taps == b.filter.subsampled_taps &&
+         a.threshold == b.threshold;
 }
 }  // namespace
 
