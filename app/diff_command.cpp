@@ -38,6 +38,15 @@ size_t masked_pixels(const Image& mask) {
   return n;
 }
 
+// compare_images, its errors naming the reference file (the one a user has to fix).
+ImageMetrics compare_against(const Image& test, const Image& reference, const std::string& reference_path) {
+  try {
+    return compare_images(test, reference);
+  } catch (const Error& e) {
+    throw Error(reference_path + ": " + e.what());
+  }
+}
+
 void print_display(const char* label, const DisplayMetrics& m) {
   std::printf("%s: HDR NRMSE %.4f %%  display NRMSE %.4f %%  FLIP %.6f\n", label, m.hdr.nrmse_percent,
               m.display_nrmse_percent, m.flip_mean);
@@ -69,7 +78,7 @@ int run_diff(const Args& args) {
 
   const Image test = read_exr(test_path, layer);
   const Image reference = read_exr(reference_path, reference_layer);
-  const ImageMetrics m = compare_images(test, reference);
+  const ImageMetrics m = compare_against(test, reference, reference_path);
   std::printf("%s\n", format_metrics(m).c_str());
   if (m.reference_nonfinite > 0) {
     std::fprintf(stderr, "pxf diff: %s has %zu non-finite samples; it cannot serve as a reference\n",
