@@ -27,7 +27,7 @@ void add_preview_options(CommandLine& cli, PreviewOptions& o) {
   cli.option("--sigma-s", &s.filter.sigma_s, "spatial sigma in pixels (default 8)", 0.1f, kMaxFilterRadius / 3.0f);
   cli.option("--sigma-c", &s.filter.sigma_c, "range color sigma, linear RGB (default 0.02)", 1e-6f, 1e6f);
   cli.option("--sigma-d", &s.filter.sigma_d, "range depth sigma, scene units (default 2)", 1e-6f, 1e6f);
-  cli.choice("--filter", &o.filter, filter_option_names(), "filter variant (default bilateral-depth)");
+  cli.choice("--filter", &o.filter, filter_option_names(), "filter variant (default grid: the bilateral grid on the range luminance)");
   cli.choice("--schedule", &o.schedule, filter_schedule_names(),
              "when the filter runs: budget = at power-of-two sample counts while filter + range stay within\n"
              "10 % of the tracing time (default); pow2 = at every power of two; every = each frame; all also\n"

@@ -19,7 +19,7 @@ struct SceneOptions {
 
 struct PreviewOptions {
   PreviewSettings settings;
-  std::string filter = "bilateral-depth";
+  std::string filter = "grid";
   std::string schedule = "budget";
   int seed = 1;
   bool all_hv = false;

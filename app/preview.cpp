@@ -133,19 +133,35 @@ void Preview::upload() {
   uploaded_ = true;
 }
 
-void Preview::converge_range_buffer() {
+bool Preview::step_range_buffer() {
   const auto start = BenchClock::now();
-  const auto tracer = [this](const std::vector<uint32_t>& pixels, glm::vec2 jitter) {
+  const bool stepped = range_.step([this](const std::vector<uint32_t>& pixels, glm::vec2 jitter) {
     return renderer_->trace_specular_chains(pixels, jitter);
-  };
-  while (range_.step(tracer)) {
-  }
+  });
   last_.range += elapsed_ms(start);
+  return stepped;
+}
+
+void Preview::converge_range_buffer() {
+  while (step_range_buffer()) {
+  }
+}
+
+// The range buffer's antialiasing frames are spread over the path-tracing frames instead of all
+// run before the first filter: the first filter run takes one range frame, and each later frame
+// adds one more only while filter + range stay within kPassShare of the tracing time. A camera
+// change so costs one range frame up front, and the guide sharpens as the budget allows.
+void Preview::advance_range_buffer() {
+  if (!settings_.filter_enabled || schedule_.hv_empty || range_.frames() == 0 || range_.converged()) return;
+  if (schedule_.pass_ms + range_.last_ms() > kPassShare * schedule_.tracing_ms) return;
+  const double before = last_.range;
+  step_range_buffer();
+  schedule_.pass_ms += last_.range - before;
 }
 
 void Preview::run_filter() {
   const double range_before = last_.range;
-  converge_range_buffer();
+  if (range_.frames() == 0) step_range_buffer();
   upload();
   filter_.run(inputs_, range_.guide(), settings_.filter);
   last_.filter += filter_.last_ms();
@@ -193,6 +209,7 @@ void Preview::add_frame(bool last_frame, bool display) {
   recent_frame_ms_.push_back(last_.path_tracing);
 
   update_hv_empty();
+  advance_range_buffer();
   schedule_.have_filtered = have_filtered_;
   if (last_frame) {
     finish_passes();
@@ -231,7 +248,7 @@ Image Preview::display_image() const { return tonemap_.display_image(); }
 Image Preview::final_image() const { return blend_.final_image(); }
 
 std::vector<Layer> Preview::buffers() {
-  converge_range_buffer();
+  if (range_.frames() == 0) converge_range_buffer();  // else the guide the filter and blend used
   upload();
   std::vector<Layer> layers;
   layers.push_back({"final", blend_.final_image()});

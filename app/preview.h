@@ -98,17 +98,19 @@ class Preview {
   const BlendPass& blend() const { return blend_; }
   const TonemapPass& tonemap() const { return tonemap_; }
   bool has_filtered() const { return have_filtered_; }
-  // Runs the range pass until it has converged (the explorer's range views need it while no filter runs).
 
   Image display_image() const;        // tone-mapped sRGB "R,G,B" in [0,1]
   Image final_image() const;          // linear radiance after the blend
   // Every buffer as EXR layers: final, lv, hv, hv_filtered, var_u, var_f, blend, case,
-  // range_color, depth, samples. Runs the range pass first if it has not converged yet.
+  // range_color, depth, emitter, samples: the range layers are the guide the filter used (the range
+  // pass runs to convergence only if it never ran).
   std::vector<Layer> buffers();
 
  private:
   void upload();
   void run_filter();
+  bool step_range_buffer();     // one antialiasing frame of the range pass; false once converged
+  void advance_range_buffer();  // one more range frame if the pass budget allows
   void update_hv_empty();
   void blend_and_tonemap();
   void finish_passes();

@@ -28,7 +28,7 @@ const char* filter_kind_name(FilterKind kind);
 FilterKind parse_filter_kind(const std::string& name);  // throws pxf::Error listing the names
 
 struct FilterParams {
-  FilterKind kind = FilterKind::BilateralDepth;
+  FilterKind kind = FilterKind::Grid;  // cheapest and most accurate on llvmpipe: README "Filter variants"
   float sigma_s = 8.0f;   // pixels; kernel radius ceil(3 sigma_s), at most kMaxFilterRadius
   float sigma_c = 0.02f;  // range color, Euclidean distance in linear RGB
   float sigma_d = 2.0f;   // depth, scene units
