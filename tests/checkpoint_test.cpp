@@ -17,6 +17,7 @@
 #include <thread>
 
 #include "image/image.h"
+#include "tests/test_support.h"
 
 namespace fs = std::filesystem;
 using namespace pxf;
@@ -26,17 +27,8 @@ namespace {
 const std::string kScene = "--scene cornell --size 40x32 --quiet";
 constexpr int kSpp = 24;
 
-std::string temp_dir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("pxf_checkpoint_test_" + std::to_string(::getpid())) / name;
-  fs::remove_all(dir);
-  fs::create_directories(dir.parent_path());
-  return dir.string();
-}
-
-std::string slurp(const std::string& path) {
-  std::ifstream in(path);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
+std::string temp_dir(const std::string& name) { return test_support::temp_dir("checkpoint", name); }
+using test_support::slurp;
 
 struct Result {
   int code = -1;

@@ -22,6 +22,7 @@
 
 #include "gl/preview_params.h"
 #include "image/image.h"
+#include "tests/test_support.h"
 #include "pathtracer/pathtracer.h"
 
 namespace fs = std::filesystem;
@@ -34,17 +35,8 @@ struct Result {
   std::string out, err;
 };
 
-std::string temp_dir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("pxf_cli_test_" + std::to_string(::getpid())) / name;
-  fs::remove_all(dir);
-  fs::create_directories(dir.parent_path());
-  return dir.string();
-}
-
-std::string slurp(const std::string& path) {
-  std::ifstream in(path);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
+std::string temp_dir(const std::string& name) { return test_support::temp_dir("cli", name); }
+using test_support::slurp;
 
 Result run(const std::string& args) {
   const std::string base = temp_dir("io");

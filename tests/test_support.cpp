@@ -1,6 +1,10 @@
 #include "tests/test_support.h"
 
+#include <unistd.h>
+
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 
 #include "pathtracer/pathtracer.h"
 
@@ -27,6 +31,19 @@ std::string failure_dir(const std::string& test_name) {
   const std::string dir = std::string(PXF_BINARY_DIR) + "/test-failures/" + test_name;
   std::filesystem::create_directories(dir);
   return dir;
+}
+
+std::string temp_dir(const std::string& suite, const std::string& name) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() /
+                                    ("pxf_" + suite + "_test_" + std::to_string(::getpid())) / name;
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir.parent_path());
+  return dir.string();
+}
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path);
+  return std::string(std::istreambuf_iterator<char>(in), {});
 }
 
 }  // namespace pxf::test_support

@@ -16,6 +16,12 @@ GlContext& headless_context();
 std::unique_ptr<Preview> render_preview(const std::string& scene, int width, int height, int spp,
                                         const PreviewSettings& settings);
 
+// An empty-to-be folder path for one test, under a per-process folder named for the suite
+// (removed first if a previous run left it; its parent exists).
+std::string temp_dir(const std::string& suite, const std::string& name);
+// The whole file as text ("" if it cannot be read).
+std::string slurp(const std::string& path);
+
 // Folder for files a failing test leaves behind for a person to look at.
 std::string failure_dir(const std::string& test_name);
 
