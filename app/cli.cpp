@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <sstream>
 
 namespace pxf {
@@ -25,18 +26,32 @@ double parse_number(const std::string& option, const std::string& text) {
   return value;
 }
 
+// A limit as a person reads it: integers in full (16777216, not 1.67772e+07), others with the
+// digits of a float (21.33333).
+std::string readable_number(double v) {
+  char buffer[64];
+  if (v == std::floor(v) && std::abs(v) < 1e15)
+    std::snprintf(buffer, sizeof buffer, "%.0f", v);
+  else
+    std::snprintf(buffer, sizeof buffer, "%.7g", v);
+  return buffer;
+}
+
 template <typename T>
 std::function<void(const std::string&)> number_setter(const std::string& name, T* target, double min, double max,
                                                       bool integer) {
   return [=](const std::string& text) {
     const double value = parse_number(name, text);
     if (integer && value != std::floor(value)) throw UsageError(name + ": '" + text + "' is not an integer");
-    if (value < min || value > max) {
-      std::ostringstream msg;
-      msg << name << ": " << text << " is out of range [" << min << ", " << max << "]";
-      throw UsageError(msg.str());
-    }
-    *target = static_cast<T>(value);
+    // Compared in the target's type: a float limit such as 0.1f is not 0.1 in double, so "0.1"
+    // would be out of a range that prints as starting at 0.1.
+    const bool representable = value >= static_cast<double>(std::numeric_limits<T>::lowest()) &&
+                               value <= static_cast<double>(std::numeric_limits<T>::max());
+    const T typed = representable ? static_cast<T>(value) : T{};
+    if (!representable || typed < static_cast<T>(min) || typed > static_cast<T>(max))
+      throw UsageError(name + ": " + text + " is out of range [" + readable_number(static_cast<T>(min)) + ", " +
+                       readable_number(static_cast<T>(max)) + "]");
+    *target = typed;
   };
 }
 }  // namespace

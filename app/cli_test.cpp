@@ -93,3 +93,28 @@ TEST(CommandLine, PositionalListTakesEveryRemainingArgument) {
   empty.positional_list("STATE...", &none, "states");
   EXPECT_THROW(empty.parse({}), UsageError);
 }
+
+// Issue 12 item 10: a limit given as a float is compared as a float (0.1 is inside [0.1f, ...]), and
+// limits print as a person reads them.
+TEST(CommandLine, FloatLimitsCompareInTheirTypeAndPrintReadably) {
+  float sigma = 0;
+  int spp = 0;
+  CommandLine cli{"render", "[options]", "test"};
+  cli.option("--sigma-s", &sigma, "sigma", 0.1f, 64.0f / 3.0f);
+  cli.option("--spp", &spp, "samples", 1, 1 << 24);
+  ASSERT_TRUE(cli.parse({"--sigma-s", "0.1"}));
+  EXPECT_FLOAT_EQ(sigma, 0.1f);
+  try {
+    cli.parse({"--sigma-s", "22"});
+    FAIL() << "22 accepted";
+  } catch (const UsageError& e) {
+    EXPECT_NE(std::string(e.what()).find("[0.1, 21.33333]"), std::string::npos) << e.what();
+  }
+  try {
+    cli.parse({"--spp", "16777217"});
+    FAIL() << "16777217 accepted";
+  } catch (const UsageError& e) {
+    EXPECT_NE(std::string(e.what()).find("[1, 16777216]"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(cli.parse({"--sigma-s", "1e99"}), UsageError);  // beyond float: out of range, not inf
+}
