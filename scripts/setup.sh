@@ -14,6 +14,7 @@ PACKAGES=(
   libopenexr-dev libembree-dev libtbb-dev
   libgtest-dev
   xvfb xauth                           # explorer test under a virtual display
+  slurm-wlm munge                      # Slurm.* test: a single-node Slurm on localhost
 )
 
 missing=()
