@@ -163,8 +163,8 @@ TEST(Atrous, IterationsFollowSigmaS) {
   EXPECT_EQ(atrous_iterations(kNaN), 1);
 }
 
-TEST(Atrous, EdgesArePreserved) {
-  // A step in range color, and one in depth, with constant HV on each side: no mixing across.
+// A step in range color, and one in depth, with constant HV on each side: no mixing across.
+void expect_edges_preserved(FilterKind kind) {
   test::osmesa_context();
   Scenario s = make_scenario(3);
   for (int y = 0; y < H; ++y)
@@ -180,7 +180,7 @@ TEST(Atrous, EdgesArePreserved) {
   GpuFixture gpu(s);
   FilterPass filter(W, H);
   FilterParams p;
-  p.kind = FilterKind::Atrous;
+  p.kind = kind;
   p.skip_case2 = false;
   filter.run(gpu.inputs, gpu.guide, p);
   Image f = filter.filtered_image();
@@ -188,6 +188,8 @@ TEST(Atrous, EdgesArePreserved) {
     for (int x = 0; x < W; ++x)
       EXPECT_NEAR(f.at(x, y, 0), (x < W / 2 ? 1.0f : 3.0f) * (y < H / 2 ? 1.0f : 2.0f), 1e-5f);
 }
+
+TEST(Atrous, EdgesArePreserved) { expect_edges_preserved(FilterKind::Atrous); }
 
 TEST(Atrous, ZeroVarianceIsNoEvidence) {
   // Var[L_u] = 0 with n >= 2 (identical samples) is no evidence of low variance: as a neighbour it
@@ -383,31 +385,7 @@ TEST(Subsampled, WhiteNoiseVarianceIsExactForTheWeightsUsed) {
   }
 }
 
-TEST(Subsampled, EdgesArePreserved) {
-  // A step in range color, and one in depth, with constant HV on each side: no mixing across.
-  test::osmesa_context();
-  Scenario s = make_scenario(3);
-  for (int y = 0; y < H; ++y)
-    for (int x = 0; x < W; ++x) {
-      bool left = x < W / 2, top = y < H / 2;
-      for (int c = 0; c < 3; ++c) {
-        s.range.at(x, y, c) = left ? 0.8f : 0.1f;
-        s.hv.at(x, y, c) = (left ? 1.0f : 3.0f) * (top ? 1.0f : 2.0f);
-      }
-      s.depth.at(x, y, 0) = top ? 3.0f : 30.0f;
-      s.var.at(x, y, 0) = 0.5f;
-    }
-  GpuFixture gpu(s);
-  FilterPass filter(W, H);
-  FilterParams p;
-  p.kind = FilterKind::Subsampled;
-  p.skip_case2 = false;
-  filter.run(gpu.inputs, gpu.guide, p);
-  Image f = filter.filtered_image();
-  for (int y = 0; y < H; ++y)
-    for (int x = 0; x < W; ++x)
-      EXPECT_NEAR(f.at(x, y, 0), (x < W / 2 ? 1.0f : 3.0f) * (y < H / 2 ? 1.0f : 2.0f), 1e-5f);
-}
+TEST(Subsampled, EdgesArePreserved) { expect_edges_preserved(FilterKind::Subsampled); }
 
 TEST(FilterVsCpu, EdgesArePreserved) {
   // A step in range color with constant HV on each side: the filter must not mix the sides.

@@ -79,16 +79,7 @@ void expect_outputs_complete(const std::string& dir) {
   if (fs::exists(dir + "/stats.json")) EXPECT_NO_THROW((void)nlohmann::json::parse(slurp(dir + "/stats.json"))) << dir;
 }
 
-// The tolerance of a merge against one render: shard means are combined as n-weighted means in
-// double and rounded to float once, where the single render rounds its running float mean at every
-// sample, so values differ by a few float ulps of the radiance.
-void expect_close(const Image& merged, const Image& single, const std::string& what) {
-  ASSERT_EQ(merged.pixels.size(), single.pixels.size()) << what;
-  size_t bad = 0;
-  for (size_t i = 0; i < merged.pixels.size(); ++i)
-    if (!(std::abs(merged.pixels[i] - single.pixels[i]) <= 2e-5f * std::abs(single.pixels[i]) + 1e-6f)) ++bad;
-  EXPECT_EQ(bad, 0u) << what << ": " << bad << " values outside 2e-5 relative + 1e-6";
-}
+using test_support::expect_merge_close;
 
 }  // namespace
 
@@ -148,7 +139,7 @@ TEST(Checkpoint, MergeOfUnevenShardsEqualsOneRender) {
           if (l.name == layer) return l.image;
         throw Error(std::string("no layer ") + layer);
       };
-      expect_close(find(merged), find(single), layer);
+      expect_merge_close(find(merged), find(single), layer);
     }
   }
 }

@@ -27,6 +27,7 @@
 #include <thread>
 
 #include "image/image.h"
+#include "tests/test_support.h"
 
 namespace fs = std::filesystem;
 using namespace pxf;
@@ -280,14 +281,7 @@ class Cluster {
   pid_t munged_ = -1, ctld_ = -1, slurmd_ = -1;
 };
 
-// Same tolerance as Checkpoint.MergeOfUnevenShardsEqualsOneRender (docs/state-format.md).
-void expect_close(const Image& merged, const Image& single, const std::string& what) {
-  ASSERT_EQ(merged.pixels.size(), single.pixels.size()) << what;
-  size_t bad = 0;
-  for (size_t i = 0; i < merged.pixels.size(); ++i)
-    if (!(std::abs(merged.pixels[i] - single.pixels[i]) <= 2e-5f * std::abs(single.pixels[i]) + 1e-6f)) ++bad;
-  EXPECT_EQ(bad, 0u) << what << ": " << bad << " values outside 2e-5 relative + 1e-6";
-}
+using test_support::expect_merge_close;
 
 const Image& layer(const std::vector<Layer>& layers, const std::string& name) {
   for (const Layer& l : layers)
@@ -343,7 +337,7 @@ TEST(Slurm, ShardArrayAndDependentMergeEqualOneRender) {
   const std::vector<Layer> merged = read_exr_layers(out + "/merged/buffers.exr");
   const std::vector<Layer> reference = read_exr_layers(ref + "/buffers.exr");
   for (const char* name : {"lv", "hv", "var_u", "samples", "final"})
-    expect_close(layer(merged, name), layer(reference, name), std::string("buffers.exr ") + name);
-  expect_close(read_exr(out + "/merged/final.exr"), read_exr(ref + "/final.exr"), "final.exr");
+    expect_merge_close(layer(merged, name), layer(reference, name), std::string("buffers.exr ") + name);
+  expect_merge_close(read_exr(out + "/merged/final.exr"), read_exr(ref + "/final.exr"), "final.exr");
   std::printf("[ slurm    ] jobs done in %.1f s\n", std::chrono::duration<double>(Clock::now() - started).count());
 }

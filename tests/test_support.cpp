@@ -1,7 +1,9 @@
 #include "tests/test_support.h"
 
+#include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -44,6 +46,14 @@ std::string temp_dir(const std::string& suite, const std::string& name) {
 std::string slurp(const std::string& path) {
   std::ifstream in(path);
   return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+void expect_merge_close(const Image& merged, const Image& single, const std::string& what) {
+  ASSERT_EQ(merged.pixels.size(), single.pixels.size()) << what;
+  size_t bad = 0;
+  for (size_t i = 0; i < merged.pixels.size(); ++i)
+    if (!(std::abs(merged.pixels[i] - single.pixels[i]) <= 2e-5f * std::abs(single.pixels[i]) + 1e-6f)) ++bad;
+  EXPECT_EQ(bad, 0u) << what << ": " << bad << " values outside 2e-5 relative + 1e-6";
 }
 
 }  // namespace pxf::test_support

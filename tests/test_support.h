@@ -22,6 +22,12 @@ std::string temp_dir(const std::string& suite, const std::string& name);
 // The whole file as text ("" if it cannot be read).
 std::string slurp(const std::string& path);
 
+// A merge of accumulation states against one render of the same samples: shard means are combined
+// as n-weighted means in double and rounded to float once, where the single render rounds its
+// running float mean at every sample, so values may differ by a few float ulps of the radiance
+// (2e-5 relative + 1e-6; docs/state-format.md).
+void expect_merge_close(const Image& merged, const Image& single, const std::string& what);
+
 // Folder for files a failing test leaves behind for a person to look at.
 std::string failure_dir(const std::string& test_name);
 
