@@ -4,6 +4,7 @@
 //   pxf bench --pathtracer    paths/s, rays/s, ms/frame and the raw Embree ray rate
 //   pxf bench --pathtracer --sampler-error | --variance-ratio   the samplers (app/sampler_bench.h)
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -362,6 +363,7 @@ int run_variant_bench(const BenchSetup& b, const Image& reference_hv, int spp, i
   std::vector<double> pt_ms;
   std::vector<Image> filtered(names.size());
   std::vector<uint32_t> filtered_pixels(names.size());
+  std::array<std::vector<double>, 4> grid_step_ms;  // what the default variant's steps cost
   for (int round = -1; round < rounds; ++round) {
     const auto start = Clock::now();
     timing_tracer.add_frame();
@@ -369,6 +371,8 @@ int run_variant_bench(const BenchSetup& b, const Image& reference_hv, int spp, i
     for (size_t k = 0; k < names.size(); ++k) {
       filter.run(preview.inputs(), preview.range().guide(), params[k]);
       if (round >= 0) ms[k].push_back(filter.last_ms());
+      if (round >= 0 && params[k].kind == FilterKind::Grid)
+        for (size_t i = 0; i < grid_step_ms.size(); ++i) grid_step_ms[i].push_back(filter.grid()->last_step_ms()[i]);
       if (round == 0) filtered[k] = filter.filtered_image(), filtered_pixels[k] = filter.filtered_pixels();
     }
   }
@@ -396,6 +400,12 @@ int run_variant_bench(const BenchSetup& b, const Image& reference_hv, int spp, i
         << application_ms / frame_ms << "," << nrmse << "," << filtered_pixels[k] << "\n";
     points.push_back({names[k], {application_ms / frame_ms}, {nrmse}, true});
     write_png(b.out + "/variant_" + names[k] + ".png", cpu_tonemap(filtered[k], tonemap));
+  }
+  if (!grid_step_ms[0].empty()) {
+    std::printf("   grid steps, median ms:");
+    for (size_t i = 0; i < grid_step_ms.size(); ++i)
+      std::printf(" %s %.1f", GridFilter::kStepNames[i], median_of(grid_step_ms[i]));
+    std::printf("\n");
   }
   write_text(b.out + "/variants.csv", csv.str());
   write_svg_plot(b.out + "/variants.svg",

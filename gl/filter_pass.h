@@ -30,6 +30,8 @@ class FilterPass {
   // Pixels actually filtered (not skipped) by the last run; 0 = every pixel was in case 2.
   uint32_t filtered_pixels() const;
   double last_ms() const { return timer_.last_ms(); }
+  // The grid variant's step times of its last run (GridFilter::last_step_ms); nullptr before one.
+  const GridFilter* grid() const { return grid_.get(); }
 
   Image filtered_image() const;  // "R,G,B" L_f
   Image variance_image() const;  // "Y" Var[L_f], 0 where unknown or skipped

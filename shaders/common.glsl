@@ -88,8 +88,14 @@ float blend_factor(float u, float f, float t, out int blend_case) {
 // The filter's case-2 skip (FilterParams::skip_case2, final pass only): the blend's u (pooled
 // variance) with the unfiltered background; a zero variance (all samples equal, no neighbour known)
 // is not trusted. Mirrors skip_as_case2() in gl/cpu_reference.cpp.
+// The pooled variance is at least the pixel's own, so a pixel whose own variance already exceeds
+// t is not skipped without looking at its neighbours: the same answer for a fraction of the cost
+// (at low spp nearly every pixel leaves here, and the 3x3 pooling cost more than a grid slice).
 bool skip_as_case2(sampler2D hv, sampler2D lv, sampler2D guide, ivec2 p, float k_c, float k_d, float t) {
+  vec4 hv_p = texelFetch(hv, p, 0);
+  float lb = max(luminance(clean(hv_p.rgb)) + luminance(clean(texelFetch(lv, p, 0).rgb)), 0.0);
+  float own = clean_var(hv_p.a);
+  if (own > 0.0 && relative_variance(own, lb) > max(t, 0.0)) return false;
   float v = pooled_var_u(hv, guide, p, k_c, k_d);
-  float lb = max(luminance(clean(texelFetch(hv, p, 0).rgb)) + luminance(clean(texelFetch(lv, p, 0).rgb)), 0.0);
   return v > 0.0 && relative_variance(v, lb) <= max(t, 0.0);
 }
