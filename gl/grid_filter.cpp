@@ -36,7 +36,7 @@ void GridFilter::run(const FilterParams& p, const Framebuffer& target) {
   splat_.set("grid_xy", grid_xy);
   splat_.set("cell_s", layout_.cell_s);
   splat_.set("inv_cell_s", inv_cell_s);
-  splat_.set("sigma_c", p.sigma_c);
+  splat_.set("min_cell_z", grid_min_cell_z(p.sigma_c));
   splat_.use();
   grid_[0].bind_storage(1);
   glDispatchCompute((layout_.nx + 7) / 8, (layout_.ny + 7) / 8, 1);
@@ -61,7 +61,7 @@ void GridFilter::run(const FilterParams& p, const Framebuffer& target) {
   const RangeWeights range = range_weights(p);
   slice_.set("grid_xy", grid_xy);
   slice_.set("inv_cell_s", inv_cell_s);
-  slice_.set("sigma_c", p.sigma_c);
+  slice_.set("min_cell_z", grid_min_cell_z(p.sigma_c));
   slice_.set("k_c", range.k_c);
   slice_.set("k_d", range.k_d);
   slice_.set("skip_case2", p.skip_case2 ? 1 : 0);
