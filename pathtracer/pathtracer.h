@@ -114,7 +114,12 @@ class ProgressiveRenderer {
   void reset();                          // clears accumulation (camera, scene or params changed)
   void set_camera(const Camera& camera); // resets
   void set_params(const TraceParams& params);  // resets
-  void add_frame();                      // traces one path per pixel, frame index = first_frame() + frames()
+  // Traces one path per pixel, frame index = first_frame() + frames(). Returns false when
+  // cancel_frame() stopped it: the frame is then incomplete and the accumulation is reset.
+  bool add_frame();
+  // Thread-safe: a running add_frame() (on another thread) stops after the tiles in flight. For a
+  // caller about to reset anyway (the explorer's camera moves), so that it need not wait a frame.
+  void cancel_frame();
   int frames() const;                    // frames traced (or restored) since the last reset
   // Where the frame sequence starts (a shard of frames A:B starts at A); resets.
   void set_first_frame(uint32_t first);
