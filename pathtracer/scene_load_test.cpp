@@ -644,9 +644,9 @@ TEST(SceneLoadMaterial, KhrExtensionsEmissiveStrengthTransmissionIorSpecular) {
   EXPECT_FLOAT_EQ(m.metallic, 0.0f);
   ASSERT_TRUE(m.transmission_texture.valid() && m.specular_texture.valid() && m.specular_color_texture.valid());
   // The specular/transmission textures are linear; the specular color texture is sRGB-decoded.
-  EXPECT_NEAR(scene.textures[m.specular_texture.texture].texels[0].x, 128 / 255.0f, 1e-6f);
-  EXPECT_NEAR(scene.textures[m.specular_texture.texture].texels[0].w, 64 / 255.0f, 1e-6f);
-  EXPECT_NEAR(scene.textures[m.specular_color_texture.texture].texels[0].x, linear_from_srgb(128 / 255.0f), 1e-6f);
+  EXPECT_NEAR(scene.textures[m.specular_texture.texture].texel(0).x, 128 / 255.0f, 1e-6f);
+  EXPECT_NEAR(scene.textures[m.specular_texture.texture].texel(0).w, 64 / 255.0f, 1e-6f);
+  EXPECT_NEAR(scene.textures[m.specular_color_texture.texture].texel(0).x, linear_from_srgb(128 / 255.0f), 1e-6f);
   EXPECT_EQ(m.specular_texture.texture, m.transmission_texture.texture);  // one linear copy shared
   EXPECT_NE(m.specular_texture.texture, m.specular_color_texture.texture);
   EXPECT_TRUE(scene.warnings.empty()) << warnings_of(scene);
@@ -690,10 +690,10 @@ TEST(SceneLoadTexture, BaseColorIsSrgbDecodedAndMetallicRoughnessIsLinear) {
   const Texture& linear = scene.textures[m.metallic_roughness_texture.texture];
   ASSERT_EQ(color.width, 2);
   ASSERT_EQ(color.height, 1);
-  EXPECT_NEAR(color.texels[0].x, linear_from_srgb(128 / 255.0f), 1e-6f);
-  EXPECT_NEAR(color.texels[0].y, 1.0f, 1e-6f);
-  EXPECT_EQ(color.texels[0].w, 1.0f);
-  EXPECT_NEAR(linear.texels[1].y, 64 / 255.0f, 1e-6f);  // roughness channel as stored
+  EXPECT_NEAR(color.texel(0).x, linear_from_srgb(128 / 255.0f), 1e-6f);
+  EXPECT_NEAR(color.texel(0).y, 1.0f, 1e-6f);
+  EXPECT_EQ(color.texel(0).w, 1.0f);
+  EXPECT_NEAR(linear.texel(1).y, 64 / 255.0f, 1e-6f);  // roughness channel as stored
   EXPECT_NEAR(eval_texture(scene, m.base_color_texture, {0.75f, 0.5f}, {}).z, 1.0f, 1e-6f);
   EXPECT_EQ(color.name, "color.png");
 }
@@ -713,9 +713,60 @@ TEST(SceneLoadTexture, SixteenBitNonPowerOfTwoGrayTexture) {
   ASSERT_EQ(t.width, 3);
   ASSERT_EQ(t.height, 5);
   for (int i = 0; i < 15; ++i) {
-    EXPECT_NEAR(t.texels[i].x, samples[i] / 65535.0f, 1e-7f) << i;
-    EXPECT_EQ(t.texels[i].x, t.texels[i].z);
-    EXPECT_EQ(t.texels[i].w, 1.0f);
+    EXPECT_NEAR(t.texel(i).x, samples[i] / 65535.0f, 1e-7f) << i;
+    EXPECT_EQ(t.texel(i).x, t.texel(i).z);
+    EXPECT_EQ(t.texel(i).w, 1.0f);
+  }
+}
+
+// 8-bit textures keep their codes; every lookup (nearest and bilinear, any wrap) returns exactly
+// what a float texture holding the loader's former per-texel decoding returns: sRGB channels
+// linear_from_srgb(k / 255), linear channels and alpha k / 255, gray expanded, missing alpha 1.
+TEST(SceneLoadTexture, EightBitStorageLooksUpBitExactly) {
+  std::string dir = temp_dir();
+  uint32_t state = 12345;
+  auto next = [&] {
+    state = state * 1664525u + 1013904223u;
+    return (state >> 24) & 255u;
+  };
+  for (int channels = 1; channels <= 4; ++channels) {
+    const int w = 7, h = 5;
+    std::vector<uint32_t> codes(static_cast<size_t>(w) * h * channels);
+    for (uint32_t& c : codes) c = next();
+    codes[0] = 0;
+    codes[1 % codes.size()] = 255;
+    GltfBuilder b;
+    b.doc["samplers"] = {{{"wrapS", 33648}, {"wrapT", 10497}}};
+    int tex = b.texture(b.image(encode_png(w, h, channels, 8, codes)), {{"sampler", 0}});
+    int mat = b.material({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", tex}}}, {"metallicRoughnessTexture", {{"index", tex}}}}}});
+    b.add_quad_scene(mat);
+    Scene scene = load_scene(b.write_gltf(dir + "/t8_" + std::to_string(channels) + ".gltf"));
+    for (bool srgb : {true, false}) {
+      const Material& m = scene.materials[0];
+      const TextureRef& ref = srgb ? m.base_color_texture : m.metallic_roughness_texture;
+      ASSERT_TRUE(ref.valid()) << warnings_of(scene);
+      const Texture& t = scene.textures[ref.texture];
+      EXPECT_TRUE(t.is_8bit());
+      EXPECT_EQ(t.memory_bytes(), static_cast<size_t>(w) * h * 4);
+      Texture reference = t;
+      reference.texels8.clear();
+      for (int i = 0; i < w * h; ++i) {
+        const uint32_t* p = &codes[static_cast<size_t>(i) * channels];
+        auto color = [&](uint32_t k) { return srgb ? linear_from_srgb(k / 255.0f) : k / 255.0f; };
+        glm::vec4 v = channels <= 2 ? glm::vec4(color(p[0]), color(p[0]), color(p[0]), channels == 2 ? p[1] / 255.0f : 1.0f)
+                                    : glm::vec4(color(p[0]), color(p[1]), color(p[2]), channels == 4 ? p[3] / 255.0f : 1.0f);
+        reference.texels.push_back(v);
+      }
+      for (bool nearest : {false, true}) {
+        Texture a = t, r = reference;
+        a.nearest = r.nearest = nearest;
+        for (int k = 0; k < 500; ++k) {
+          glm::vec2 uv(next() / 64.0f - 1.5f + next() / 16384.0f, next() / 64.0f - 1.5f + next() / 16384.0f);
+          glm::vec4 got = sample_texture(a, uv), want = sample_texture(r, uv);
+          ASSERT_EQ(got, want) << channels << " channels, srgb " << srgb << ", uv " << uv.x << " " << uv.y;
+        }
+      }
+    }
   }
 }
 
@@ -730,8 +781,8 @@ TEST(SceneLoadTexture, GlbEmbeddedImageInBufferView) {
   Scene scene = load_scene(b.write_glb(dir + "/img.glb"));
   ASSERT_TRUE(scene.materials[0].base_color_texture.valid()) << warnings_of(scene);
   const Texture& t = scene.textures[scene.materials[0].base_color_texture.texture];
-  EXPECT_EQ(t.texels[0], glm::vec4(1, 0, 0, 1));
-  EXPECT_NEAR(t.texels[1].w, 128 / 255.0f, 1e-6f);  // alpha stays linear
+  EXPECT_EQ(t.texel(0), glm::vec4(1, 0, 0, 1));
+  EXPECT_NEAR(t.texel(1).w, 128 / 255.0f, 1e-6f);  // alpha stays linear
 }
 
 TEST(SceneLoadTexture, SamplerWrapModesAndMagFilter) {
