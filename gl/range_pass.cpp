@@ -91,7 +91,7 @@ void RangePass::set_scene(const Scene& scene) {
     }
     Texture2D tex(t.width, t.height,
                   t.is_8bit() ? (t.srgb ? TextureFormat::SRGB8_ALPHA8 : TextureFormat::RGBA8) : TextureFormat::RGBA32F);
-    if (t.is_8bit()) tex.upload_rgba8(t.texels8.data());
+    if (t.is_8bit()) tex.upload_rgba8(t.texels8->data());
     else tex.upload(&t.texels[0].x, 4);
     tex.set_filter(!t.nearest);  // bilinear without mipmaps, as the path tracer samples
     tex.set_wrap(gl_wrap(t.wrap_s), gl_wrap(t.wrap_t));

@@ -371,16 +371,17 @@ class GltfLoader {
     return out;
   }
 
-  // 8-bit images keep their codes (RGBA8, sRGB decoded at lookup); 16-bit and HDR images become
-  // linear floats. `decoded.bytes` is moved from when `last_use`.
-  static void fill_texels(Texture& out, gltf::DecodedImage& decoded, bool srgb, bool last_use) {
+  // 8-bit images keep their codes (RGBA8, sRGB decoded at lookup), shared by the textures that use
+  // the image (`codes`, made on first use); 16-bit and HDR images become linear floats.
+  static void fill_texels(Texture& out, gltf::DecodedImage& decoded, bool srgb,
+                          std::shared_ptr<const std::vector<unsigned char>>& codes) {
     out.width = decoded.width;
     out.height = decoded.height;
     size_t texel_count = static_cast<size_t>(decoded.width) * decoded.height;
     if (decoded.bits == 8) {
       out.srgb = srgb;
-      if (last_use) out.texels8 = std::move(decoded.bytes);
-      else out.texels8 = decoded.bytes;
+      if (!codes) codes = std::make_shared<const std::vector<unsigned char>>(std::move(decoded.bytes));
+      out.texels8 = codes;
       return;
     }
     out.texels.resize(texel_count);
@@ -451,16 +452,15 @@ class GltfLoader {
     auto slot_of = [&](int image) {
       return static_cast<size_t>(std::lower_bound(images.begin(), images.end(), image) - images.begin());
     };
-    std::vector<size_t> last_use(images.size(), 0);
-    for (size_t t = 0; t < pending_.size(); ++t) last_use[slot_of(pending_[t].image)] = t;
-    // Textures sharing an image copy it before the last one moves it.
-    for (size_t t = 0; t < pending_.size(); ++t) {
-      const size_t k = slot_of(pending_[t].image);
-      if (decoded[k].decoded && last_use[k] != t) fill_texels(scene_.textures[t], decoded[k], pending_[t].srgb, false);
-    }
-    tbb::parallel_for(size_t(0), pending_.size(), [&](size_t t) {
-      const size_t k = slot_of(pending_[t].image);
-      if (decoded[k].decoded && last_use[k] == t) fill_texels(scene_.textures[t], decoded[k], pending_[t].srgb, true);
+    // Per image: its textures in order (one image's textures share its storage).
+    std::vector<std::vector<size_t>> users(images.size());
+    for (size_t t = 0; t < pending_.size(); ++t) users[slot_of(pending_[t].image)].push_back(t);
+    tbb::parallel_for(size_t(0), images.size(), [&](size_t k) {
+      if (!decoded[k].decoded) return;
+      std::shared_ptr<const std::vector<unsigned char>> codes;
+      for (size_t t : users[k]) fill_texels(scene_.textures[t], decoded[k], pending_[t].srgb, codes);
+      std::vector<unsigned char>().swap(decoded[k].bytes);  // moved from, or no longer needed
+      std::vector<float>().swap(decoded[k].values);
     });
     std::vector<int> renumber(pending_.size(), -1);
     std::vector<Texture> kept;

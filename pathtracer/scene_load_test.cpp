@@ -749,7 +749,7 @@ TEST(SceneLoadTexture, EightBitStorageLooksUpBitExactly) {
       EXPECT_TRUE(t.is_8bit());
       EXPECT_EQ(t.memory_bytes(), static_cast<size_t>(w) * h * 4);
       Texture reference = t;
-      reference.texels8.clear();
+      reference.texels8.reset();
       for (int i = 0; i < w * h; ++i) {
         const uint32_t* p = &codes[static_cast<size_t>(i) * channels];
         auto color = [&](uint32_t k) { return srgb ? linear_from_srgb(k / 255.0f) : k / 255.0f; };

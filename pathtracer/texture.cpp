@@ -49,10 +49,10 @@ float texel8_to_linear(unsigned char k, bool srgb) {
 }
 
 glm::vec4 Texture::texel(size_t i) const {
-  if (texels8.empty()) return texels[i];
+  if (!is_8bit()) return texels[i];
   const Texel8Tables& tables = texel8_tables();
   const float* rgb = srgb ? tables.srgb.data() : tables.linear.data();
-  const unsigned char* p = &texels8[4 * i];
+  const unsigned char* p = texels8->data() + 4 * i;
   return glm::vec4(rgb[p[0]], rgb[p[1]], rgb[p[2]], tables.linear[p[3]]);
 }
 
