@@ -4,6 +4,8 @@
 #include <tiny_gltf.h>
 
 #include <climits>
+#include <cstdint>
+#include <cstring>
 
 namespace pxf::gltf {
 
@@ -11,7 +13,22 @@ ImageHeader probe_image(const unsigned char* bytes, size_t size) {
   ImageHeader header;
   if (size == 0 || size > static_cast<size_t>(INT_MAX)) return header;
   int len = static_cast<int>(size);
-  if (!stbi_info_from_memory(bytes, len, &header.width, &header.height, &header.channels)) return ImageHeader{};
+  if (!stbi_info_from_memory(bytes, len, &header.width, &header.height, &header.channels)) {
+    // stb refuses PNG headers whose image would exceed 1 GiB; the size is still worth reporting.
+    static const unsigned char kPng[] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n', 0, 0, 0, 13, 'I', 'H', 'D', 'R'};
+    if (size < 26 || std::memcmp(bytes, kPng, sizeof kPng) != 0) return ImageHeader{};
+    auto u32 = [&](size_t at) {
+      return (uint32_t(bytes[at]) << 24) | (uint32_t(bytes[at + 1]) << 16) | (uint32_t(bytes[at + 2]) << 8) | bytes[at + 3];
+    };
+    const uint32_t w = u32(16), h = u32(20);
+    if (w == 0 || h == 0 || w > INT_MAX || h > INT_MAX) return ImageHeader{};
+    header.width = static_cast<int>(w);
+    header.height = static_cast<int>(h);
+    header.channels = 4;
+    header.bits = bytes[24] == 16 ? 16 : 8;
+    header.ok = true;
+    return header;
+  }
   header.bits = stbi_is_hdr_from_memory(bytes, len) ? 32 : stbi_is_16_bit_from_memory(bytes, len) ? 16 : 8;
   header.ok = header.width > 0 && header.height > 0;
   return header;
