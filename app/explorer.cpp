@@ -169,7 +169,8 @@ class Explorer {
     stop_tracing(/*cancel=*/true);
     try {
       auto scene = std::make_unique<Scene>(load_scene(path, first ? options_.scene.env : "", options_.scene.env_strength,
-                                                      parse_default_light(options_.scene.default_light)));
+                                                      parse_default_light(options_.scene.default_light),
+                                                      load_limits(options_.scene)));
       print_scene_messages(*scene);
       if (!options_.all_hv_given) settings_.trace.all_hv = scene->defaults.all_hv;
       if (first) size_image(*scene);
