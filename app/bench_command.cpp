@@ -235,7 +235,8 @@ std::vector<int> parse_counts(const std::string& option, const std::string& text
 }
 
 // One scene's row of the per-stage table (thesis Table 3.2): medians over `frames` frames of the
-// scheduled run, and the overhead of the filtered run over the unfiltered one.
+// scheduled run, and the overhead of the filtered run over the unfiltered one. The two runs advance
+// frame by frame in turn, so that background load on a shared machine hits both alike.
 struct StageRow {
   std::string scene;
   int width = 0, height = 0, filter_runs = 0;
@@ -245,22 +246,22 @@ struct StageRow {
 
 StageRow measure_stages(const BenchSetup& b, const std::string& scene_name, int frames) {
   Preview filtered(b.scene, b.filtered, b.width, b.height);
+  Preview plain(b.scene, b.plain, b.width, b.height);
   std::vector<double> pt, filter_app, display;
   StageRow row;
-  const auto start = Clock::now();
   for (int i = 0; i < frames; ++i) {
+    const auto start = Clock::now();
     filtered.add_frame(i + 1 == frames, false);
+    row.filtered_ms += elapsed_ms(start);
+    const auto plain_start = Clock::now();
+    plain.add_frame(i + 1 == frames, false);
+    row.plain_ms += elapsed_ms(plain_start);
     const StageTimes& t = filtered.last_times();
     pt.push_back(t.path_tracing);
     if (t.filter > 0) filter_app.push_back(t.filter + t.upload);
     if (t.blend > 0) display.push_back(t.blend + t.tonemap);
     row.range_ms += t.range;
   }
-  row.filtered_ms = elapsed_ms(start);
-  Preview plain(b.scene, b.plain, b.width, b.height);
-  const auto plain_start = Clock::now();
-  for (int i = 0; i < frames; ++i) plain.add_frame(i + 1 == frames, false);
-  row.plain_ms = elapsed_ms(plain_start);
   row.scene = scene_name;
   row.width = b.width;
   row.height = b.height;
