@@ -309,6 +309,24 @@ BlendDecision blend_decision(float u, float f, float t) {
   return {std::clamp(s, 0.0f, 1.0f), kCaseMixed};
 }
 
+BlendDecision blend_decision(float u, float f, float t, float w) {
+  const BlendDecision plain = blend_decision(u, f, t);
+  if (!(w > 0.0f) || plain.blend_case == kCaseUnfiltered || !std::isfinite(u) || !std::isfinite(f)) return plain;
+  if (!(t >= 0.0f)) t = 0.0f;
+  u = std::max(u, 0.0f);
+  f = std::max(f, 0.0f);
+  // Scaled by hi = max(u, f) > t as above; double keeps the products of the scaled values.
+  const double hi = std::max(u, f), uh = u / hi, fh = f / hi, th = t / hi;
+  const double c = std::min(static_cast<double>(std::min(w, 1.0f)) * uh, std::sqrt(uh * fh));
+  const double a = uh + fh - 2.0 * c;  // >= (sqrt(uh) - sqrt(fh))^2 >= 0
+  if (!(a > 1e-12)) return {0.0f, kCaseFilteredOnly};  // g(s) = f = u > t for every s
+  // g's minimum lies at s* = (f - c) / a, below 0 where c > f: then the lowest g on [0, 1] is g(0) = f.
+  const double s_min = (fh - c) / a, g_min = std::max(0.0, (uh * fh - c * c) / a);
+  if (th < (s_min >= 0.0 ? g_min : fh)) return {0.0f, kCaseFilteredOnly};
+  const double s = s_min + std::sqrt((th - g_min) / a);
+  return {static_cast<float>(std::clamp(s, 0.0, 1.0)), kCaseMixed};
+}
+
 namespace {
 
 // One bilateral pass over `signal` (rgb) with variance `signal_var`, kernel extent (ex, ey) times
