@@ -242,6 +242,7 @@ struct KernelSums {
     out.variance.at(x, y, 0) =
         w_known > 0 ? static_cast<float>(variance_factor * (w2_var_known + w2_unknown * (w_var_known / w_known)) / (w * w))
                     : kVarUnknown;
+    if (!out.centre_weight.pixels.empty()) out.centre_weight.at(x, y, 0) = static_cast<float>(1.0 / w);
   }
 };
 
@@ -335,7 +336,7 @@ FilterOutput filter_once(const Image& signal, const Image& signal_var, const Ima
                          const Image& lv, const Image& range_color, const Image& depth, const FilterParams& p,
                          int ex, int ey, bool final_pass) {
   const int w = hv.width, h = hv.height;
-  FilterOutput out{Image::rgb(w, h), Image::gray(w, h)};
+  FilterOutput out{Image::rgb(w, h), Image::gray(w, h), Image::gray(w, h, "Y", 1.0f)};
   const int radius = std::min(kMaxFilterRadius, static_cast<int>(std::ceil(3.0f * std::max(p.sigma_s, 0.0f))));
   const float ks = inv_two_sigma2(p.sigma_s);
   const RangeWeights range = range_weights(p);
@@ -431,7 +432,9 @@ FilterOutput cpu_filter(const Image& hv, const Image& var_u, const Image& lv, co
   if (p.kind == FilterKind::Grid) return cpu_grid_filter(hv, var_u, lv, range_color, depth, p);
   if (p.kind != FilterKind::Separable) return filter_once(hv, var_u, hv, var_u, lv, range_color, depth, p, 1, 1, true);
   FilterOutput rows = filter_once(hv, var_u, hv, var_u, lv, range_color, depth, p, 1, 0, false);
-  return filter_once(rows.filtered, rows.variance, hv, var_u, lv, range_color, depth, p, 0, 1, true);
+  FilterOutput out = filter_once(rows.filtered, rows.variance, hv, var_u, lv, range_color, depth, p, 0, 1, true);
+  out.centre_weight = Image();  // the second pass's centre weight alone would understate it: none
+  return out;
 }
 
 BlendOutput cpu_blend(const Image& lv, const Image& hv, const Image& var_u, const FilterOutput* filtered,
@@ -457,7 +460,8 @@ BlendOutput cpu_blend(const Image& lv, const Image& hv, const Image& var_u, cons
           float lb = std::max(lum(lf.c) + lum(l.c), 0.0f);
           if (pool) vu = pooled_var_u(var_u, *range_color, *depth, x, y, params.range);
           float u = vu > 0.0f ? relative_variance(vu, lb) : zero_variance_u(lum(lf.c), lb);
-          d = blend_decision(u, relative_variance(vf, lb), params.t);
+          const float w_centre = filtered->centre_weight.pixels.empty() ? 0.0f : filtered->centre_weight.at(x, y, 0);
+          d = blend_decision(u, relative_variance(vf, lb), params.t, w_centre);
         }
       }
       for (int c = 0; c < 3; ++c)

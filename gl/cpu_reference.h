@@ -40,6 +40,9 @@ float pooled_var_u(const Image& var_u, const Image& range_color, const Image& de
 struct FilterOutput {
   Image filtered;  // "R,G,B": L_f (L_u where skipped)
   Image variance;  // "Y": Var[L_f]; kVarUnknown, or kVarSkipped where skipped
+  // "Y": the normalized weight of the pixel's own L_u in its L_f (1 / sum w for the full bilateral
+  // kernel, 1 where skipped), for the blend's covariance term; empty for the other variants.
+  Image centre_weight;
 };
 FilterOutput cpu_filter(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
                         const Image& depth, const FilterParams& params);
