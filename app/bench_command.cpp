@@ -3,6 +3,7 @@
 //   pxf bench                 per-stage times, filtering overhead, equal-time NRMSE, spp to match
 //   pxf bench --pathtracer    paths/s, rays/s, ms/frame and the raw Embree ray rate
 //   pxf bench --pathtracer --sampler-error | --variance-ratio   the samplers (app/sampler_bench.h)
+//   pxf bench --threshold-fidelity   the blend's threshold against the empirical variance (app/fidelity_bench.h)
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -15,6 +16,7 @@
 #include "app/commands.h"
 #include "app/options.h"
 #include "app/plot.h"
+#include "app/fidelity_bench.h"
 #include "app/sampler_bench.h"
 #include "app/preview.h"
 #include "gl/context.h"
@@ -423,6 +425,7 @@ int run_bench(const Args& args) {
   SceneOptions scene_options;
   PreviewOptions preview_options;
   bool pathtracer = false, variants = false, stage_table = false, sampler_error = false, variance_ratio = false;
+  bool threshold_fidelity = false;
   int variant_spp = 4, variant_rounds = 5;
   std::string extra_taps_text;
   std::string reference_path, out = "bench-out", budgets_text = "8,32,128,256";
@@ -457,8 +460,13 @@ int run_bench(const Args& args) {
            "--reference-spp Sobol reference of another seed, and paths/s of both back to back");
   cli.flag("--variance-ratio", &variance_ratio,
            "with --pathtracer: estimated / empirical Var[L_u] of the pixel mean over --seeds seeds at --spp");
-  cli.option("--spp", &spp_text, "LIST", "spp of --sampler-error (default 8,32,128) or --variance-ratio (4,16,64,256)");
-  cli.option("--seeds", &seeds, "seeds of --variance-ratio (default 32)", 2, 4096);
+  cli.flag("--threshold-fidelity", &threshold_fidelity,
+           "empirical perceived variance of the final image over --seeds seeds at --spp (default 16,64,256) "
+           "against t = 0.001 and 0.01, by blend case (the --filter's; bilateral and bilateral-depth give the "
+           "blend the covariance of L_u and L_f)");
+  cli.option("--spp", &spp_text, "LIST",
+             "spp of --sampler-error (default 8,32,128), --variance-ratio (4,16,64,256) or --threshold-fidelity (16,64,256)");
+  cli.option("--seeds", &seeds, "seeds of --variance-ratio and --threshold-fidelity (default 32)", 2, 4096);
   cli.option("--rounds", &rounds, "timing rounds of --sampler-error (default 7)", 1, 1000);
   cli.option("--timed-frames", &timed, "timed frames of --pathtracer (after 3 warm-up frames)", 1, 100000);
   cli.option("--reference", &reference_path, "REF.exr", "reference image (default: render and cache one)");
@@ -499,6 +507,14 @@ int run_bench(const Args& args) {
     return 0;
   }
   if (pathtracer) return run_pathtracer_bench(b, timed);
+  if (threshold_fidelity) {
+    auto context = create_gl_context(parse_gl_backend(scene_options.gl));
+    const FidelityBenchSetup fb{b.scene, std::filesystem::path(scene_options.scene).stem().string(), b.filtered,
+                                b.width, b.height, out};
+    run_threshold_fidelity_bench(fb, parse_counts("--spp", spp_text.empty() ? "16,64,256" : spp_text), {0.001f, 0.01f},
+                                 seeds);
+    return 0;
+  }
 
   auto context = create_gl_context(parse_gl_backend(scene_options.gl));
   std::printf("bench: %s %dx%d, t=%g, filter %s, sigma_s=%g sigma_c=%g sigma_d=%g, GL %s (%s)\n",

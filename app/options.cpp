@@ -39,7 +39,7 @@ void add_preview_options(CommandLine& cli, PreviewOptions& o) {
              "the last frame");
   cli.option("--seed", &o.seed, "random seed", 0, 2147483647);
   cli.choice("--sampler", &o.sampler, {"sobol", "independent"},
-             "random numbers of the path tracer: Owen-scrambled Sobol or independent PCG32 (default)");
+             "random numbers of the path tracer: Owen-scrambled Sobol (default) or independent PCG32");
   cli.option("--replicates", &s.trace.replicates,
              "independently scrambled Sobol replicates for the variance estimate (default 1 = none)", 1, 64);
   cli.option("--threads", &s.trace.threads, "path-tracing threads (0 = all cores)", 0, 1024);

@@ -29,7 +29,7 @@ struct PreviewOptions {
   std::string schedule = "budget";
   int seed = 1;
   bool all_hv = false;
-  std::string sampler = "independent";
+  std::string sampler = "sobol";
 };
 
 void add_scene_options(CommandLine& cli, SceneOptions& options, bool headless);

@@ -20,7 +20,7 @@ struct TraceParams {
   bool all_hv = false;      // every contribution goes to HV (environment-lit scenes)
   uint64_t seed = 1;
   int threads = 0;          // 0 = all cores
-  SamplerType sampler = SamplerType::Independent;  // see pathtracer/sampler.h for the dimension table
+  SamplerType sampler = SamplerType::Sobol;  // see pathtracer/sampler.h for the dimension table
   // Independently scrambled interleaved Sobol replicates (frame k is in replicate k mod K): their
   // means give Var[L_u] of the pixel mean under QMC. 1 = one sequence and the estimate s^2 / n.
   // Default 1: K > 1 makes the estimate exact on average but costs unfiltered error (each
