@@ -1,4 +1,4 @@
-// pxf bench: run time against error (SPEC 4, issue 4 "Measured and reported"). Not a test: it
+// pxf bench: run time against error (README "Measured", docs/timebudget.md). Not a test: it
 // prints figures and writes CSV and SVG plots into --out.
 //   pxf bench                 per-stage times, filtering overhead, equal-time NRMSE, spp to match
 //   pxf bench --pathtracer    paths/s, rays/s, ms/frame and the raw Embree ray rate
@@ -236,7 +236,7 @@ std::vector<int> parse_counts(const std::string& option, const std::string& text
   return counts;
 }
 
-// One scene's row of the per-stage table (thesis Table 3.2): medians over `frames` frames of the
+// One scene's row of the per-stage table: medians over `frames` frames of the
 // scheduled run, and the overhead of the filtered run over the unfiltered one. The two runs advance
 // frame by frame in turn, so that background load on a shared machine hits both alike.
 struct StageRow {
@@ -330,7 +330,7 @@ int run_pathtracer_bench(const BenchSetup& b, int timed) {
   return 0;
 }
 
-// The variant table (the thesis' Fig. 3.8): every filter variant applied to the same 4-spp HV
+// The variant table: every filter variant applied to the same 4-spp HV
 // buffer with the same converged range buffer: ms per application (median of `rounds` after one
 // warm-up, the variants alternating so background load hits them alike), that in path-tracing
 // frames (median of one frame per round, traced in the same run), and HV-only NRMSE against the

@@ -1,4 +1,4 @@
-// pxf diff: image metrics between two images (SPEC section 4), the same code the tests use:
+// pxf diff: image metrics between two images (docs/metrics.md), the same code the tests use:
 // HDR metrics, then display-space NRMSE and LDR-FLIP, each also with the emitters masked out.
 #include <cstdio>
 #include <optional>

@@ -92,7 +92,7 @@ PixelProbe probe_pixel(const Preview& preview, const std::vector<uint32_t>& samp
   p.case_code = read_texel(preview.blend().case_texture(), x, y).r;
   const size_t i = static_cast<size_t>(y) * preview.width() + x;
   p.n = i < samples.size() ? samples[i] : 0;
-  // SPEC 3.4: L_b = Y(L_f) + Y(L_lv); u and f relative to it (0 where the variance is unknown).
+  // docs/method.md section 3.1: L_b = Y(L_f) + Y(L_lv); u and f relative to it (0 where the variance is unknown).
   p.background = luminance(p.filtered_var) + luminance(p.lv);
   const float b2 = p.background * p.background;
   p.u = p.hv_var.a > 0 && b2 > 0 ? p.hv_var.a / b2 : 0.0f;

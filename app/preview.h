@@ -1,5 +1,5 @@
 // The preview core shared by `pxf render`, `pxf explore` and `pxf bench`: the progressive path
-// tracer plus the GL passes (range, filter, blend, tone map) on the schedule of SPEC 3.5.
+// tracer plus the GL passes (range, filter, blend, tone map) on the schedule of docs/method.md section 4.
 // Requires a current GL context (gl/context.h) for its whole life.
 // Usage:
 //   Preview preview(scene, settings, w, h);
@@ -41,7 +41,7 @@ std::vector<std::string> filter_option_names();
 void set_filter_option(PreviewSettings& settings, const std::string& name);
 std::string filter_option_name(const PreviewSettings& settings);
 
-// Milliseconds per stage (SPEC 4).
+// Milliseconds per stage (reported in stats.json and by pxf bench).
 struct StageTimes {
   double path_tracing = 0, upload = 0, range = 0, filter = 0, blend = 0, tonemap = 0;
   double total() const { return path_tracing + upload + range + filter + blend + tonemap; }

@@ -1,4 +1,4 @@
-// The blend factor s (SPEC 3.4) at every case boundary and at extreme magnitudes, for the CPU
+// The blend factor s (docs/method.md section 3.2) at every case boundary and at extreme magnitudes, for the CPU
 // definition (blend_decision) and for the shader (blend.frag through BlendPass).
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-// Blend pass (SPEC 3.4): per pixel s from u = Var[L_u]/L_b^2 and f = Var[L_f]/L_b^2 and threshold t,
+// Blend pass (docs/method.md section 3): per pixel s from u = Var[L_u]/L_b^2 and f = Var[L_f]/L_b^2 and threshold t,
 // composite L = L_lv + s L_u + (1 - s) L_f. Runs every displayed frame with the newest L_f.
 // Usage:
 //   BlendPass blend(w, h);

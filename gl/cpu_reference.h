@@ -1,4 +1,4 @@
-// Plain C++ implementation of the preview formulas (SPEC 3.3–3.5) on pxf::Image: the reference the
+// Plain C++ implementation of the preview formulas (docs/method.md sections 2, 3, 5) on pxf::Image: the reference the
 // GL shaders are tested against, and the single CPU definition of the blend case logic.
 // Images: L_u/L_lv "R,G,B"; Var[L_u] one channel (kVarUnknown where n < 2; exactly 0 where all
 // n >= 2 samples were equal, which the filter and blend do not trust as low variance); the range guide
@@ -14,7 +14,7 @@ struct BlendDecision {
   float s = 1.0f;
   int blend_case = kCaseUnfiltered;
 };
-// SPEC 3.4's case logic on relative variances u, f (>= 0, may be +inf) and threshold t, computed
+// The blend case logic (docs/method.md section 3.2) on relative variances u, f (>= 0, may be +inf) and threshold t, computed
 // after scaling by max(u, f) so that no intermediate overflows: case 2 (u <= t) first, then
 // case 1 (D < 0), else case 3. NaN u or f count as +inf, NaN or negative t as 0.
 BlendDecision blend_decision(float u, float f, float t);

@@ -1,4 +1,4 @@
-// Cross bilateral filter pass (SPEC 3.3; FilterKind picks the variant: shaders/bilateral.frag,
+// Cross bilateral filter pass (docs/method.md section 2; FilterKind picks the variant: shaders/bilateral.frag,
 // shaders/atrous.frag for the à-trous one, shaders/subsampled.frag for the subsampled one): L_f and Var[L_f] from the HV buffer, guided by the
 // range buffer (color + distance). Runs on a schedule; the output texture persists between runs.
 // Usage:

@@ -1,4 +1,4 @@
-// Parameters and codes of the preview passes (SPEC 3.3–3.5), shared by the GL passes, the CPU
+// Parameters and codes of the preview passes (docs/method.md sections 2-4), shared by the GL passes, the CPU
 // reference and the app. No GL here.
 #pragma once
 #include <algorithm>
@@ -9,7 +9,7 @@
 
 namespace pxf {
 
-// Cross bilateral filter variants: "bilateral-depth" (SPEC default: spatial x color x depth) and
+// Cross bilateral filter variants: "bilateral-depth" (the full weight: spatial x color x depth) and
 // "bilateral" (spatial x color, no depth term) are the exact square kernel; "separable" is the
 // bilateral-depth weight applied as a horizontal then a vertical 1D pass (an approximation of
 // the 2D kernel, about 2r+1 times cheaper; its Var[L_f] is exact for what it computes); "atrous"
@@ -98,7 +98,7 @@ struct BlendParams {
   RangeWeights range = range_weights(FilterParams{});
 };
 
-// Blend case per pixel (the "case" buffer). 1, 2, 3 are SPEC 3.4's cases.
+// Blend case per pixel (the "case" buffer), tested in the order of docs/method.md section 3.2.
 enum BlendCase : int {
   kCaseNoFiltered = 0,   // no L_f exists yet (the filter never ran): s = 1
   kCaseFilteredOnly = 1, // D < 0: s = 0

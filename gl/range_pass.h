@@ -1,4 +1,4 @@
-// G-buffer/range pass (SPEC 3.2): rasterizes the scene with the path tracer's exact camera into a
+// G-buffer/range pass (docs/method.md section 1.2): rasterizes the scene with the path tracer's exact camera into a
 // noise-free guide (range color + distance), antialiased by accumulating jittered frames
 // (raster_jitter(k)) until the mean per-pixel change drops below a tolerance or a frame cap.
 // Re-rendered only when the camera or the scene changes.

@@ -1,4 +1,4 @@
-// Tone map pass (SPEC 3.5): Reinhard's global photographic operator with the log-average
+// Tone map pass (docs/method.md section 5): Reinhard's global photographic operator with the log-average
 // luminance reduced on the GPU (reduce.comp, no CPU round trip), then the sRGB curve.
 // Usage:
 //   TonemapPass tonemap(w, h);

@@ -67,7 +67,7 @@ inline float luminance(float r, float g, float b) { return 0.2126f * r + 0.7152f
 float srgb_from_linear(float linear);
 float linear_from_srgb(float encoded);
 
-// Error metrics of SPEC section 4, one implementation for tests, bench and `pxf diff`.
+// Error metrics (docs/metrics.md), one implementation for tests, bench and `pxf diff`.
 struct ImageMetrics {
   double rmse = 0;           // over finite pixels of the compared channels
   double nrmse_percent = 0;  // 100 * rmse / mean(reference)

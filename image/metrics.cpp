@@ -1,4 +1,4 @@
-// SPEC section 4: one implementation of the error metrics for tests, `pxf bench` and `pxf diff`.
+// docs/metrics.md: one implementation of the error metrics for tests, `pxf bench` and `pxf diff`.
 #include <cmath>
 #include <cstdio>
 

@@ -1,4 +1,4 @@
-// The unidirectional path tracer of SPEC 3.1: NEE at every non-specular vertex combined with BSDF
+// The unidirectional path tracer (docs/method.md section 1.1): NEE at every non-specular vertex combined with BSDF
 // sampling by the power heuristic, Russian roulette, and the LV/HV split of every contribution.
 #pragma once
 #include <cstdint>

@@ -1,4 +1,4 @@
-// Public API of the path tracer (SPEC 3.1): a progressive state with make/step/get functions in the
+// Public API of the path tracer (docs/method.md section 1.1): a progressive state with make/step/get functions in the
 // style of yocto_trace. No GL here; the GL passes read these buffers and upload them.
 #pragma once
 #include <cmath>
@@ -69,7 +69,7 @@ struct BuiltinScene { std::string name, description, path; };
 std::vector<BuiltinScene> builtin_scenes();
 
 // The range-buffer color of a surface: albedo times a noise-free shading term that separates
-// differently oriented surfaces (SPEC 3.2). The raster shader implements the same formula.
+// differently oriented surfaces (docs/method.md section 1.2). The raster shader implements the same formula.
 inline glm::vec3 range_shading(glm::vec3 albedo, glm::vec3 normal, glm::vec3 to_viewer) {
   float c = glm::dot(normal, to_viewer);
   return albedo * (0.2f + 0.8f * (c > 0.0f ? c : 0.0f));
@@ -85,7 +85,7 @@ inline glm::vec3 range_environment_color(glm::vec3 radiance) {
   return l / (1.0f + l);
 }
 
-// Result of following a perfectly specular chain from the camera (SPEC 3.2).
+// Result of following a perfectly specular chain from the camera (docs/method.md section 1.2).
 struct SpecularChainHit {
   // hit: albedo x chain tint x range_shading at the first non-specular hit; escaped:
   // range_environment_color(chain tint x environment radiance), black without an environment.

@@ -1,5 +1,5 @@
 #version 450 core
-// Cross bilateral filter (SPEC 3.3) of the HV buffer guided by the range buffer, with the variance
+// Cross bilateral filter (docs/method.md section 2) of the HV buffer guided by the range buffer, with the variance
 // of the result: L_f = sum w L_u / sum w, Var[L_f] = sum w^2 Var[L_u] / (sum w)^2.
 // extent (1,1): the full square kernel; (1,0) then (0,1): the separable variant's two 1D passes
 // (the second filters the first's output, whose rows are independent, so its variance is exact).

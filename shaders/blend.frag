@@ -1,5 +1,5 @@
 #version 450 core
-// Blend of filtered and unfiltered HV light (SPEC 3.4): s per pixel, L = L_lv + s L_u + (1-s) L_f.
+// Blend of filtered and unfiltered HV light (docs/method.md section 3): s per pixel, L = L_lv + s L_u + (1-s) L_f.
 #include "common.glsl"
 
 layout(binding = 0) uniform sampler2D hv_tex;        // rgb L_u, a Var[L_u]

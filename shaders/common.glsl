@@ -27,7 +27,7 @@ float range_weight(vec4 g_p, vec4 g_q, float k_c, float k_d) {
   return exp(-(dot(dr, dr) * k_c + dd * dd * k_d));
 }
 
-// Var[L_u] for the decisions of the blend and the filter's skipping (u of SPEC 3.4). A variance
+// Var[L_u] for the decisions of the blend and the filter's skipping (docs/method.md section 3.3). A variance
 // estimated from few samples is itself noisy, and far more often too low than too high: path
 // contributions are heavy-tailed, and a pixel that missed the rare bright paths looks quiet (dark
 // speckles kept by case 2). So the decision uses the larger of the pixel's own variance and the
@@ -64,7 +64,7 @@ float zero_variance_u(float y_f, float lb) {
   return r * r;
 }
 
-// SPEC 3.4: case 2 (u <= t) first, case 1 (D < 0), else case 3. Same algorithm as
+// docs/method.md section 3.2: case 2 (u <= t) first, case 1 (D < 0), else case 3. Same algorithm as
 // blend_decision() in gl/cpu_reference.cpp: D < 0 <=> t < H = u f / (u + f) = lo / (1 + lo / hi),
 // s = f / (u + f) + sqrt((t - H) / (u + f)), all without overflow or harmful underflow.
 float blend_factor(float u, float f, float t, out int blend_case) {
