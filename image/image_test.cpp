@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 
 #include "image/image.h"
 
@@ -89,6 +90,70 @@ TEST(ImageExr, MissingAndCorruptFilesGiveOneLineErrorsNamingTheFile) {
   const std::string corrupt = temp_path("corrupt.exr");
   std::ofstream(corrupt) << "not an exr";
   EXPECT_THROW(read_exr(corrupt), Error);
+}
+
+namespace {
+std::vector<unsigned char> file_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::vector<unsigned char>((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+}  // namespace
+
+// The file readers read the bytes and decode them from memory: both entry points agree, and every
+// truncation of a valid file is a pxf::Error naming the input, never a crash or a partial image.
+TEST(ImageExr, FromMemoryMatchesTheFileAndRefusesEveryTruncation) {
+  const std::string path = temp_path("memory.exr");
+  const Image img = ramp(5, 3, {"R", "G", "B"});
+  write_exr(path, std::vector<Layer>{{"", img}, {"var", ramp(5, 3, {"Y"})}});
+  const std::vector<unsigned char> bytes = file_bytes(path);
+  const std::vector<Layer> from_memory = read_exr_layers_from_memory(bytes.data(), bytes.size(), "memory.exr");
+  const std::vector<Layer> from_file = read_exr_layers(path);
+  ASSERT_EQ(from_memory.size(), from_file.size());
+  for (size_t i = 0; i < from_file.size(); ++i) {
+    EXPECT_EQ(from_memory[i].name, from_file[i].name);
+    EXPECT_EQ(from_memory[i].image.channels, from_file[i].image.channels);
+    EXPECT_EQ(from_memory[i].image.pixels, from_file[i].image.pixels);
+  }
+  EXPECT_EQ(from_file[0].image.pixels, img.pixels);
+  for (size_t size = 0; size < bytes.size(); size += 7) {
+    try {
+      read_exr_layers_from_memory(bytes.data(), size, "cut.exr");
+      ADD_FAILURE() << "a file cut to " << size << " of " << bytes.size() << " bytes was read";
+    } catch (const Error& e) {
+      const std::string msg = e.what();
+      EXPECT_EQ(msg.rfind("cut.exr: ", 0), 0u) << msg;
+      EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+    }
+  }
+}
+
+// A header that asks for more samples than the reader allows is refused before anything is
+// allocated, with the size in the message.
+TEST(ImageIo, ImagesLargerThanTheSampleLimitAreRefused) {
+  const std::string exr_path = temp_path("limit.exr");
+  write_exr(exr_path, Image::rgb(8, 4, 0.5f));
+  const std::vector<unsigned char> exr = file_bytes(exr_path);
+  EXPECT_EQ(read_exr_layers_from_memory(exr.data(), exr.size(), "limit.exr", 8 * 4 * 3).size(), 1u);
+  try {
+    read_exr_layers_from_memory(exr.data(), exr.size(), "limit.exr", 8 * 4 * 3 - 1);
+    ADD_FAILURE() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("8x4 pixels with 3 channels"), std::string::npos) << e.what();
+  }
+  const std::string png_path = temp_path("limit.png");
+  write_png(png_path, Image::rgb(8, 4, 0.5f));
+  const std::vector<unsigned char> png = file_bytes(png_path);
+  EXPECT_EQ(read_ldr_or_hdr_from_memory(png.data(), png.size(), "limit.png", 8 * 4 * 3).width, 8);
+  EXPECT_THROW(read_ldr_or_hdr_from_memory(png.data(), png.size(), "limit.png", 8 * 4 * 3 - 1), Error);
+  // A Radiance header declaring 2^20 x 2^20 pixels and no data (stb would allocate 12 TiB of floats).
+  const std::string hdr = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 1048576 +X 1048576\n";
+  try {
+    read_ldr_or_hdr_from_memory(hdr.data(), hdr.size(), "huge.hdr");
+    ADD_FAILURE() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("huge.hdr: ", 0), 0u) << e.what();
+  }
+  EXPECT_THROW(read_ldr_or_hdr_from_memory(hdr.data(), 0, "empty.hdr"), Error);
 }
 
 TEST(ImageIo, WritesAreAtomicAndLeaveNoTemporaryFile) {
