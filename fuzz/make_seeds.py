@@ -307,14 +307,50 @@ def gltf_seeds():
     put("gltf_scene", "external.gltf", json.dumps({"asset": {"version": "2.0"}, "buffers": [{"uri": "missing.bin", "byteLength": 8}],
                                                    "images": [{"uri": "missing.png"}]}))
 
-    # The built-in cornell scene as one GLB.
+    # The built-in cornell scene as one GLB, its two spheres (12k indices each) replaced by octahedra
+    # so that the seed stays small enough for fast mutation; materials, nodes and camera as built.
     src = os.path.join(ROOT, "..", "assets", "cornell", "cornell.gltf")
     with open(src) as f:
         doc = json.load(f)
     with open(os.path.join(os.path.dirname(src), doc["buffers"][0]["uri"]), "rb") as f:
-        bin_chunk = f.read()
+        old_bin = f.read()
+    octa_pos = [(1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 1), (0, 0, -1)]
+    octa_idx = [0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4, 2, 0, 5, 1, 2, 5, 3, 1, 5, 0, 3, 5]
+    sizes = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4}
+    comp = {5126: 4, 5125: 4, 5123: 2, 5121: 1}
+    replaced = {}
+    for mesh in doc["meshes"]:
+        for prim in mesh["primitives"]:
+            if doc["accessors"][prim["indices"]]["count"] <= 100:
+                continue
+            for sem, a in prim["attributes"].items():
+                acc = doc["accessors"][a]
+                n = sizes[acc["type"]]
+                verts = octa_pos if sem == "NORMAL" else [(0.5,) * n] * 6
+                if sem == "POSITION":  # the octahedron inscribed in the sphere's bounds
+                    lo, hi = acc["min"], acc["max"]
+                    verts = [tuple((lo[k] + hi[k]) / 2 + v[k] * (hi[k] - lo[k]) / 2 for k in range(3)) for v in octa_pos]
+                replaced[a] = b"".join(struct.pack("<%df" % n, *v[:n]) for v in verts)
+                acc["count"] = 6
+            acc = doc["accessors"][prim["indices"]]
+            acc["componentType"], acc["count"] = 5125, len(octa_idx)
+            replaced[prim["indices"]] = struct.pack("<%dI" % len(octa_idx), *octa_idx)
+    new_bin, views = b"", []
+    for i, acc in enumerate(doc["accessors"]):
+        if i in replaced:
+            data = replaced[i]
+        else:
+            view = doc["bufferViews"][acc["bufferView"]]
+            start = view.get("byteOffset", 0) + acc.get("byteOffset", 0)
+            data = old_bin[start:start + acc["count"] * sizes[acc["type"]] * comp[acc["componentType"]]]
+        new_bin += b"\0" * (-len(new_bin) % 4)
+        views.append({"buffer": 0, "byteOffset": len(new_bin), "byteLength": len(data)})
+        new_bin += data
+        acc["bufferView"] = i
+        acc.pop("byteOffset", None)
+    doc["bufferViews"] = views
     del doc["buffers"]
-    put("gltf_scene", "cornell.glb", glb(doc, bin_chunk))
+    put("gltf_scene", "cornell_lowpoly.glb", glb(doc, new_bin))
 
 
 png_seeds()

@@ -408,7 +408,7 @@ TEST(Integrator, RadianceFromTinyToHugeWithNonFiniteTexelsStaysFinite) {
   }
   EXPECT_GT(renderer.stats().nan_samples_dropped, 0u);
   EXPECT_EQ(accepted + renderer.stats().nan_samples_dropped, renderer.stats().paths);
-  EXPECT_GT(brightest, 1e29);  // pixels that see the bright emitter (luminance 1e30 there)
+  EXPECT_GT(brightest, 1e29) << "dimmest " << dimmest << " dropped " << renderer.stats().nan_samples_dropped << " of " << renderer.stats().paths;  // pixels that see the bright emitter (luminance 1e30 there)
   EXPECT_LT(dimmest, 1e-25);   // ... and the dim one (1e-30 and nothing else: black base color)
   for (const Image& image : {renderer.lv_image(), renderer.hv_image(), renderer.unfiltered_image(),
                              renderer.variance_image(), renderer.samples_image()})

@@ -404,16 +404,13 @@ TEST(Cli, VeryBrightFiniteInputGivesFiniteOutputs) {
 TEST(Cli, ExtremeRadianceGivesFiniteOutputsAndAnExactDroppedSampleCount) {
   const std::string dir = temp_dir("extreme_radiance");
   const std::string scene = edited_cornell(dir, [](nlohmann::json& doc) {
-    // The ceiling light at the float limit (its indirect light overflows to Inf in some samples),
-    // one wall emitting 1e-30 and another 1e30.
-    int emitters = 0;
-    for (auto& m : doc["materials"])
-      if (m.contains("emissiveFactor")) {
-        m["extensions"]["KHR_materials_emissive_strength"] = {{"emissiveStrength", 3.0e38}};
-        ++emitters;
-      }
-    ASSERT_GT(emitters, 0);
+    // A point light at the float limit just above the floor (its light overflows to Inf in many
+    // samples), one wall emitting 1e-30 and another 1e30, beside the ceiling light.
+    doc["extensionsUsed"].push_back("KHR_lights_punctual");
     doc["extensionsUsed"].push_back("KHR_materials_emissive_strength");
+    doc["extensions"]["KHR_lights_punctual"]["lights"] = {{{"type", "point"}, {"intensity", 3.4e38}}};
+    doc["nodes"].push_back({{"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}, {"translation", {0, 0.05, 0}}});
+    doc["scenes"][0]["nodes"].push_back(doc["nodes"].size() - 1);
     ASSERT_GE(doc["materials"].size(), 3u);
     doc["materials"][0]["emissiveFactor"] = {1, 1, 1};
     doc["materials"][0]["extensions"]["KHR_materials_emissive_strength"] = {{"emissiveStrength", 1e-30}};
