@@ -76,7 +76,7 @@ def hdr_seeds():
 
 
 # --------------------------------------------------------------------------------------------- EXR
-def exr(channels, width, height, compression, pixel_fn, window=None, line_order=0):
+def exr(channels, width, height, compression, pixel_fn, window=None, line_order=0, extra=b""):
     """Scanline EXR. channels: list of (name, type) with type 0 uint, 1 half, 2 float."""
     xmin, ymin = window or (0, 0)
     xmax, ymax = xmin + width - 1, ymin + height - 1
@@ -94,7 +94,7 @@ def exr(channels, width, height, compression, pixel_fn, window=None, line_order=
     head += attr("pixelAspectRatio", "float", struct.pack("<f", 1.0))
     head += attr("screenWindowCenter", "v2f", struct.pack("<ff", 0, 0))
     head += attr("screenWindowWidth", "float", struct.pack("<f", 1.0))
-    head += b"\0"
+    head += extra + b"\0"
     lines_per_block = {0: 1, 1: 1, 2: 1, 3: 16}[compression]
     sorted_channels = sorted(channels)
 
@@ -165,8 +165,17 @@ def exr_seeds():
     put("exr_reader", "nonfinite.exr", exr(rgb, 2, 1, 0, lambda x, y, c: special[(x * 3 + "RGB".index(c)) % 6]))
     put("exr_reader", "decreasing_y.exr", exr(rgb, 2, 2, 2, ramp, line_order=1))
     put("exr_reader", "truncated.exr", exr(rgb, 8, 8, 3, ramp)[:-20])
+    # Header attributes whose declared length OpenEXR would allocate or misread: an unknown type of
+    # 2 GiB, a box2i of 256 bytes, a preview of 65535^2 pixels.
+    put("exr_reader", "attribute_past_end.exr", exr(rgb, 2, 2, 0, ramp, extra=b"junk\0opaque_t\0" + struct.pack("<i", 2**31 - 1)))
+    put("exr_reader", "box2i_wrong_length.exr", exr(rgb, 2, 2, 0, ramp, extra=b"box\0box2i\0" + struct.pack("<i", 256) + bytes(256)))
+    put("exr_reader", "huge_preview.exr", exr(rgb, 2, 2, 0, ramp, extra=b"preview\0preview\0" + struct.pack("<iII", 8, 65535, 65535)))
+    put("exr_reader", "tiles_huge.exr", exr(rgb, 2, 2, 0, ramp, extra=b"tiles\0tiledesc\0" + struct.pack("<iIIB", 9, 1 << 20, 1 << 20, 0)))
     huge = exr([("Y", 2)], 1, 1, 0, ramp)
-    put("exr_reader", "huge_window.exr", huge.replace(struct.pack("<iiii", 0, 0, 0, 0), struct.pack("<iiii", -2**31, -2**31, 2**31 - 1, 2**31 - 1)))
+    key = b"dataWindow\0box2i\0" + struct.pack("<i", 16)
+    at = huge.index(key) + len(key)
+    huge = huge[:at] + struct.pack("<iiii", -2**31, -2**31, 2**31 - 1, 2**31 - 1) + huge[at + 16:]
+    put("exr_reader", "huge_window.exr", huge)
 
 
 # --------------------------------------------------------------------------------------------- glTF

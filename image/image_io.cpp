@@ -90,10 +90,12 @@ void check_sample_count(const std::string& path, int64_t width, int64_t height, 
 
 // stb's Radiance decoder (Debian's 2022 copy) loops forever on a run-length scanline that holds a
 // zero-length literal run, which is what a file cut inside its pixel data reads as (stb returns 0 past
-// the end). This walks the scanlines the same way first and refuses such a file.
+// the end), and fills other truncated scanlines with zeros. This walks the run-length scanlines the
+// same way first and refuses both.
 void check_radiance_runs(const unsigned char* data, size_t size, const std::string& path) {
   size_t pos = 0;
-  auto get = [&]() -> unsigned { return pos < size ? data[pos++] : 0; };
+  // Past the end stb reads zeros; `pos` counts on, so that a truncation shows as pos > size.
+  auto get = [&]() -> unsigned { return pos < size ? data[pos++] : (++pos, 0u); };
   // stb's header tokens: up to a newline or the end (the last byte of a file without a newline is
   // not part of the token), at most 1023 characters, a NUL ends the token as a string.
   auto token = [&]() {
@@ -120,11 +122,18 @@ void check_radiance_runs(const unsigned char* data, size_t size, const std::stri
   while (*rest == ' ') ++rest;
   if (std::strncmp(rest, "+X ", 3) != 0) return;
   const long width = std::strtol(rest + 3, nullptr, 10);
-  if (width < 8 || width >= 32768 || height <= 0 || height > (1 << 24))
-    return;  // no run-length scanlines: stb reads (or refuses) it without looping
+  if (width <= 0 || height <= 0 || width > (1 << 24) || height > (1 << 24)) return;  // stb refuses it
+  // Flat pixels: 4 bytes each. Where a scanline turns out not to be run-length encoded, stb reads
+  // the whole image flat from there (starting over at the first row), so all of it must be there.
+  auto check_flat_rest = [&](size_t start) {
+    if (static_cast<double>(size - std::min(start, size)) < 4.0 * static_cast<double>(width) * static_cast<double>(height))
+      throw Error(path + ": cannot read image: file is truncated in its flat pixel data");
+  };
+  if (width < 8 || width >= 32768) return check_flat_rest(pos);  // stb reads these flat
   for (long y = 0; y < height; ++y) {
+    const size_t start = pos;
     const unsigned c1 = get(), c2 = get(), hi = get();
-    if (c1 != 2 || c2 != 2 || (hi & 0x80)) return;  // a flat scanline: stb reads the rest flat
+    if (c1 != 2 || c2 != 2 || (hi & 0x80)) return check_flat_rest(start);
     if (((hi << 8) | get()) != static_cast<unsigned long>(width)) return;  // stb refuses it
     for (int k = 0; k < 4; ++k)
       for (long x = 0; x < width;) {
@@ -141,6 +150,8 @@ void check_radiance_runs(const unsigned char* data, size_t size, const std::stri
           pos += count;
         }
       }
+    if (pos > size)
+      throw Error(path + ": cannot read image: file is truncated in the run-length data of scanline " + std::to_string(y));
   }
 }
 
