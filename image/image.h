@@ -72,6 +72,10 @@ void write_png(const std::string& path, const Image& display);
 Image read_ldr_or_hdr(const std::string& path);
 Image read_ldr_or_hdr_from_memory(const void* data, size_t size, const std::string& name,
                                   size_t max_samples = kMaxImageSamples);
+// Throws pxf::Error when Radiance HDR data is truncated or holds a zero-length run: stb's decoder
+// loops forever on the latter and fills the former with zeros. Call it before any stbi_loadf* of
+// Radiance data (read_ldr_or_hdr_from_memory does).
+void check_radiance_data(const void* data, size_t size, const std::string& name);
 
 // Rec. 709 luminance of linear RGB.
 inline float luminance(float r, float g, float b) { return 0.2126f * r + 0.7152f * g + 0.0722f * b; }

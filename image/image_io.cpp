@@ -88,11 +88,31 @@ void check_sample_count(const std::string& path, int64_t width, int64_t height, 
                 " samples (a corrupt header, or an image too large to load)");
 }
 
+std::vector<unsigned char> read_file_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path + ": cannot open file");
+  std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) throw Error(path + ": cannot read file");
+  return bytes;
+}
+
+void check_layers(const std::string& path, const std::vector<Layer>& layers) {
+  if (layers.empty()) throw Error(path + ": no layer to write");
+  const Image& first = layers.front().image;
+  if (first.empty()) throw Error(path + ": empty image");
+  for (const Layer& layer : layers)
+    if (layer.image.width != first.width || layer.image.height != first.height)
+      throw Error(path + ": layer '" + layer.name + "' has a different size than the others");
+}
+
+}  // namespace
+
 // stb's Radiance decoder (Debian's 2022 copy) loops forever on a run-length scanline that holds a
 // zero-length literal run, which is what a file cut inside its pixel data reads as (stb returns 0 past
 // the end), and fills other truncated scanlines with zeros. This walks the run-length scanlines the
 // same way first and refuses both.
-void check_radiance_runs(const unsigned char* data, size_t size, const std::string& path) {
+void check_radiance_data(const void* bytes, size_t size, const std::string& path) {
+  const auto* data = static_cast<const unsigned char*>(bytes);
   size_t pos = 0;
   // Past the end stb reads zeros; `pos` counts on, so that a truncation shows as pos > size.
   auto get = [&]() -> unsigned { return pos < size ? data[pos++] : (++pos, 0u); };
@@ -232,25 +252,6 @@ void check_exr_header_sizes(const unsigned char* data, size_t size, const std::s
     pos += static_cast<size_t>(length);
   }
 }
-
-std::vector<unsigned char> read_file_bytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(path + ": cannot open file");
-  std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) throw Error(path + ": cannot read file");
-  return bytes;
-}
-
-void check_layers(const std::string& path, const std::vector<Layer>& layers) {
-  if (layers.empty()) throw Error(path + ": no layer to write");
-  const Image& first = layers.front().image;
-  if (first.empty()) throw Error(path + ": empty image");
-  for (const Layer& layer : layers)
-    if (layer.image.width != first.width || layer.image.height != first.height)
-      throw Error(path + ": layer '" + layer.name + "' has a different size than the others");
-}
-
-}  // namespace
 
 void write_exr(const std::string& path, const Image& image) { write_exr(path, std::vector<Layer>{{"", image}}); }
 
@@ -403,7 +404,7 @@ Image read_ldr_or_hdr_from_memory(const void* data, size_t size, const std::stri
     return img;
   };
   if (stbi_is_hdr_from_memory(bytes, len)) {
-    check_radiance_runs(bytes, size, path);
+    check_radiance_data(bytes, size, path);
     return make(stbi_loadf_from_memory(bytes, len, &w, &h, &n, 0), 1.0f);
   }
   if (stbi_is_16_bit_from_memory(bytes, len))

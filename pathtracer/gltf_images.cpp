@@ -7,6 +7,9 @@
 #include <cstdint>
 #include <cstring>
 
+#include "image/image.h"
+#include "pathtracer/gltf_accessor.h"
+
 namespace pxf::gltf {
 
 ImageHeader probe_image(const unsigned char* bytes, size_t size) {
@@ -44,6 +47,12 @@ bool decode_image(const unsigned char* bytes, size_t size, DecodedImage& out) {
   int w = 0, h = 0, c = 0;
   size_t n = 0;
   if (stbi_is_hdr_from_memory(bytes, len)) {
+    try {
+      check_radiance_data(bytes, size, "image");
+    } catch (const Error&) {
+      out.failure = "truncated or corrupt Radiance data";
+      return false;
+    }
     float* data = stbi_loadf_from_memory(bytes, len, &w, &h, &c, 0);
     out.bits = 32;
     if (data) {
