@@ -72,10 +72,11 @@ void write_png(const std::string& path, const Image& display);
 Image read_ldr_or_hdr(const std::string& path);
 Image read_ldr_or_hdr_from_memory(const void* data, size_t size, const std::string& name,
                                   size_t max_samples = kMaxImageSamples);
-// Throws pxf::Error when Radiance HDR data is truncated or holds a zero-length run: stb's decoder
-// loops forever on the latter and fills the former with zeros. Call it before any stbi_loadf* of
-// Radiance data (read_ldr_or_hdr_from_memory does).
-void check_radiance_data(const void* data, size_t size, const std::string& name);
+// Throws pxf::Error for image data that stb mishandles: Radiance HDR with a zero-length run (stb
+// loops forever) or cut short (stb fills zeros), a PNG chunk longer than the data (stb allocates the
+// declared length first, up to 2 GiB). Call it before any stbi_load*_from_memory
+// (read_ldr_or_hdr_from_memory does).
+void check_image_data(const void* data, size_t size, const std::string& name);
 
 // Rec. 709 luminance of linear RGB.
 inline float luminance(float r, float g, float b) { return 0.2126f * r + 0.7152f * g + 0.0722f * b; }

@@ -111,8 +111,7 @@ void check_layers(const std::string& path, const std::vector<Layer>& layers) {
 // zero-length literal run, which is what a file cut inside its pixel data reads as (stb returns 0 past
 // the end), and fills other truncated scanlines with zeros. This walks the run-length scanlines the
 // same way first and refuses both.
-void check_radiance_data(const void* bytes, size_t size, const std::string& path) {
-  const auto* data = static_cast<const unsigned char*>(bytes);
+static void check_radiance_data(const unsigned char* data, size_t size, const std::string& path) {
   size_t pos = 0;
   // Past the end stb reads zeros; `pos` counts on, so that a truncation shows as pos > size.
   auto get = [&]() -> unsigned { return pos < size ? data[pos++] : (++pos, 0u); };
@@ -251,6 +250,29 @@ void check_exr_header_sizes(const unsigned char* data, size_t size, const std::s
     }
     pos += static_cast<size_t>(length);
   }
+}
+
+// stb grows its PNG data buffer to each IDAT chunk's declared length before it reads the chunk, so
+// a few bytes declaring a 2 GiB chunk allocate 2 GiB. Chunks are checked against the file first.
+static void check_png_chunks(const unsigned char* data, size_t size, const std::string& path) {
+  static const unsigned char signature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  if (size < 8 || std::memcmp(data, signature, 8) != 0) return;
+  for (size_t pos = 8; pos + 8 <= size;) {
+    const uint32_t length = uint32_t{data[pos]} << 24 | uint32_t{data[pos + 1]} << 16 | uint32_t{data[pos + 2]} << 8 | data[pos + 3];
+    const std::string type(reinterpret_cast<const char*>(data + pos + 4), 4);
+    if (length > size - pos - 8 || size - pos - 8 - length < 4)
+      throw Error(path + ": cannot read image: PNG chunk '" + type + "' of " + std::to_string(length) +
+                  " bytes runs past the end of the file (truncated or corrupt)");
+    if (type == "IEND") return;
+    pos += 12 + static_cast<size_t>(length);
+  }
+}
+
+void check_image_data(const void* bytes, size_t size, const std::string& name) {
+  const auto* data = static_cast<const unsigned char*>(bytes);
+  check_png_chunks(data, size, name);
+  if (size <= static_cast<size_t>(INT_MAX) && stbi_is_hdr_from_memory(data, static_cast<int>(size)))
+    check_radiance_data(data, size, name);
 }
 
 void write_exr(const std::string& path, const Image& image) { write_exr(path, std::vector<Layer>{{"", image}}); }
@@ -403,8 +425,8 @@ Image read_ldr_or_hdr_from_memory(const void* data, size_t size, const std::stri
     for (size_t i = 0; i < img.pixels.size(); ++i) img.pixels[i] = static_cast<float>(pixels[i]) * scale;
     return img;
   };
+  check_image_data(bytes, size, path);
   if (stbi_is_hdr_from_memory(bytes, len)) {
-    check_radiance_data(bytes, size, path);
     return make(stbi_loadf_from_memory(bytes, len, &w, &h, &n, 0), 1.0f);
   }
   if (stbi_is_16_bit_from_memory(bytes, len))

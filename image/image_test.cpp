@@ -198,6 +198,24 @@ TEST(ImageHdr, TruncatedRunLengthDataIsAnErrorNotAHang) {
   }
 }
 
+// A 175-byte PNG (found by the fuzzer) whose chunk declares 2 GiB made stb allocate 2 GiB before it
+// noticed the data was not there; every cut of a valid PNG is refused the same way.
+TEST(ImagePng, ChunksLongerThanTheFileAreRefusedBeforeStbAllocates) {
+  const std::string crasher = std::string(PXF_SOURCE_DIR) + "/fuzz/crashers/png_reader/oom-idat-chunk-length-2gib.png";
+  try {
+    read_ldr_or_hdr(crasher);
+    ADD_FAILURE() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("runs past the end of the file"), std::string::npos) << e.what();
+  }
+  const std::string path = temp_path("chunks.png");
+  write_png(path, Image::rgb(5, 4, 0.5f));
+  const std::vector<unsigned char> png = file_bytes(path);
+  EXPECT_EQ(read_ldr_or_hdr_from_memory(png.data(), png.size(), "chunks.png").height, 4);
+  for (size_t cut = 9; cut < png.size(); ++cut)
+    EXPECT_THROW(read_ldr_or_hdr_from_memory(png.data(), cut, "cut.png"), Error) << cut;
+}
+
 TEST(ImageIo, WritesAreAtomicAndLeaveNoTemporaryFile) {
   const std::string path = temp_path("atomic.exr");
   write_exr(path, Image::rgb(4, 4, 0.25f));
