@@ -50,9 +50,18 @@ void write_file_completely(const std::string& path, const void* data, size_t siz
 // fsync of a folder, so that renames into it survive a crash (best effort).
 void sync_folder(const std::string& folder);
 
+// The readers refuse images of more float samples (width x height x channels) than this: 8 GiB of
+// pixels, from a header that is corrupt far more often than it is real.
+constexpr size_t kMaxImageSamples = size_t{1} << 31;
+
 void write_exr(const std::string& path, const Image& image);  // half=false: full 32-bit float
 void write_exr(const std::string& path, const std::vector<Layer>& layers);
 std::vector<Layer> read_exr_layers(const std::string& path);
+// The same from a file image in memory (the file reader reads the bytes and calls this); `name`
+// prefixes error messages.
+// `max_samples` bounds width x height x channels; a larger image is refused before anything is allocated.
+std::vector<Layer> read_exr_layers_from_memory(const void* data, size_t size, const std::string& name,
+                                               size_t max_samples = kMaxImageSamples);
 // The named layer, or with "" the unprefixed channels (else a layer named "final", else the first).
 Image read_exr(const std::string& path, const std::string& layer = "");
 
@@ -61,6 +70,13 @@ void write_png(const std::string& path, const Image& display);
 // Loads PNG/JPEG/HDR through stb; 8-bit data is returned as stored (no transfer curve applied),
 // 16-bit data is scaled to [0,1], HDR as linear floats. Channels named R,G,B,A (or Y, YA).
 Image read_ldr_or_hdr(const std::string& path);
+Image read_ldr_or_hdr_from_memory(const void* data, size_t size, const std::string& name,
+                                  size_t max_samples = kMaxImageSamples);
+// Throws pxf::Error for image data that stb mishandles: Radiance HDR with a zero-length run (stb
+// loops forever) or cut short (stb fills zeros), a PNG chunk longer than the data (stb allocates the
+// declared length first, up to 2 GiB). Call it before any stbi_load*_from_memory
+// (read_ldr_or_hdr_from_memory does).
+void check_image_data(const void* data, size_t size, const std::string& name);
 
 // Rec. 709 luminance of linear RGB.
 inline float luminance(float r, float g, float b) { return 0.2126f * r + 0.7152f * g + 0.0722f * b; }

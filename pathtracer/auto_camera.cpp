@@ -92,6 +92,18 @@ Camera frame_scene(const Scene& scene, float aspect) {
 
 Camera frame_bounds(glm::vec3 lo, glm::vec3 hi, float aspect, float fill) {
   Camera camera;
+  // A box too small for float arithmetic at its position (a model of 1e-38 units, or of 1e-9 units
+  // at 1000) would put the eye on the target, or square distances to 0: the camera would be NaN.
+  // Such a box is framed as a cube of the smallest workable size around its center instead.
+  {
+    const glm::vec3 center = 0.5f * lo + 0.5f * hi;
+    const float magnitude = std::max({std::fabs(center.x), std::fabs(center.y), std::fabs(center.z)});
+    const float smallest = std::max(1e-15f, 1e-5f * magnitude);
+    if (!(std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z}) >= smallest)) {
+      lo = center - glm::vec3(0.5f * smallest);
+      hi = center + glm::vec3(0.5f * smallest);
+    }
+  }
   // A tiny floor on each extent keeps a flat or a line-like model's box from degenerating.
   float extent = std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z, 1e-3f});
   glm::vec3 size = glm::max(hi - lo, glm::vec3(1e-4f * extent));

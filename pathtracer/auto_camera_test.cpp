@@ -94,3 +94,31 @@ TEST(AutoCamera, ProjectedAreaOfABox) {
 
 }  // namespace
 }  // namespace pxf
+
+namespace pxf {
+
+// Boxes too small for float arithmetic where they are (found by the glTF fuzzer: a model of 1e-38
+// units gave a NaN camera, and Embree aborted on its rays) are framed as the smallest workable cube
+// around their center: finite rays that look at the model.
+TEST(AutoCamera, BoxesBelowFloatResolutionGiveAFiniteCameraLookingAtThem) {
+  const glm::vec3 cases[][2] = {{glm::vec3(0.0f), glm::vec3(1e-38f)},
+                                {glm::vec3(0.0f, 1.7e-38f, 5.8e-39f), glm::vec3(0.0f, 1.7e-38f, 5.8e-39f)},
+                                {glm::vec3(1000.0f), glm::vec3(1000.0f) + glm::vec3(1e-9f)},
+                                {glm::vec3(1e6f, -1e6f, 3e5f), glm::vec3(1e6f, -1e6f, 3e5f)}};
+  for (const auto& box : cases) {
+    const Camera camera = frame_bounds(box[0], box[1], 1.5f);
+    const glm::vec3 center = 0.5f * box[0] + 0.5f * box[1];
+    for (float px : {0.0f, 32.0f, 64.0f}) {
+      const Ray ray = camera_ray(camera, 64, 64, px, px);
+      ASSERT_TRUE(std::isfinite(ray.origin.x) && std::isfinite(ray.origin.y) && std::isfinite(ray.origin.z));
+      ASSERT_TRUE(std::isfinite(ray.direction.x) && std::isfinite(ray.direction.y) && std::isfinite(ray.direction.z));
+      EXPECT_NEAR(glm::length(ray.direction), 1.0f, 1e-5f);
+    }
+    const Ray middle = camera_ray(camera, 64, 64, 32.0f, 32.0f);
+    const glm::vec3 to_center = center - middle.origin;
+    ASSERT_GT(glm::length(to_center), 0.0f);
+    EXPECT_GT(glm::dot(glm::normalize(to_center), middle.direction), 0.99f) << center.x;
+  }
+}
+
+}  // namespace pxf

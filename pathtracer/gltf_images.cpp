@@ -7,6 +7,9 @@
 #include <cstdint>
 #include <cstring>
 
+#include "image/image.h"
+#include "pathtracer/gltf_accessor.h"
+
 namespace pxf::gltf {
 
 ImageHeader probe_image(const unsigned char* bytes, size_t size) {
@@ -43,6 +46,12 @@ bool decode_image(const unsigned char* bytes, size_t size, DecodedImage& out) {
   int len = static_cast<int>(size);
   int w = 0, h = 0, c = 0;
   size_t n = 0;
+  try {
+    check_image_data(bytes, size, "image");
+  } catch (const Error&) {
+    out.failure = "truncated or corrupt image data";
+    return false;
+  }
   if (stbi_is_hdr_from_memory(bytes, len)) {
     float* data = stbi_loadf_from_memory(bytes, len, &w, &h, &c, 0);
     out.bits = 32;

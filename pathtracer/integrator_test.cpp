@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <limits>
 
 #include "pathtracer/bsdf.h"
 #include "pathtracer/integrator.h"
@@ -357,6 +358,62 @@ TEST(Integrator, NonFiniteSamplesAreDroppedAndCounted) {
   EXPECT_EQ(count_nonfinite(renderer.lv_image()) + count_nonfinite(renderer.hv_image()) +
                 count_nonfinite(renderer.variance_image()),
             0u);
+}
+
+// Radiance from 1e-30 to 1e30 in one image, with NaN and Inf texels in a base color texture and an
+// emissive texture: the non-finite samples are dropped and counted, everything else stays finite,
+// and neither end of the range is lost (the dim emitter is not flushed to 0, the bright one is not
+// dropped as if it were infinite).
+TEST(Integrator, RadianceFromTinyToHugeWithNonFiniteTexelsStaysFinite) {
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  Scene scene;
+  Texture base;  // 2x2, nearest: one NaN texel, one Inf texel
+  base.width = base.height = 2;
+  base.nearest = true;
+  base.texels = {glm::vec4(0.5f, 0.5f, 0.5f, 1), glm::vec4(nan, 0.5f, 0.5f, 1), glm::vec4(inf, 0.5f, 0.5f, 1),
+                 glm::vec4(0.2f, 0.4f, 0.6f, 1)};
+  Texture glow = base;  // emissive: Inf in one quarter
+  glow.texels = {glm::vec4(1), glm::vec4(1), glm::vec4(1), glm::vec4(inf, inf, inf, 1)};
+  scene.textures = {base, glow};
+  Material floor = make_diffuse(glm::vec3(1.0f));
+  floor.base_color_texture.texture = 0;
+  Material bright = make_diffuse(glm::vec3(0.0f)), dim = bright, glowing = bright;
+  bright.emissive = glm::vec3(1e30f);
+  dim.emissive = glm::vec3(1e-30f);
+  glowing.emissive = glm::vec3(1.0f);
+  glowing.emissive_texture.texture = 1;
+  scene.materials = {floor, bright, dim, glowing};
+  scene.meshes.push_back(make_quad(glm::vec3(-2, 0, 2), glm::vec3(4, 0, 0), glm::vec3(0, 0, -4), 0));
+  // Three small emitters facing down the camera's axis, side by side on the floor.
+  for (int m = 1; m <= 3; ++m)
+    scene.meshes.push_back(make_quad(glm::vec3(-1.5f + 1.1f * (m - 1), 0.01f, 0.4f), glm::vec3(0.8f, 0, 0),
+                                     glm::vec3(0, 0, -0.8f), m));
+  scene.environment = uniform_environment(1.0f);
+  scene.camera = look_at_camera(glm::vec3(0, 4, 0.01f), glm::vec3(0, 0, 0), glm::vec3(0, 0, -1), 0.9f);
+  TraceParams params;
+  params.threads = 2;
+  ProgressiveRenderer renderer(scene, params, 32, 32);
+  for (int i = 0; i < 16; ++i) renderer.add_frame();
+
+  const Accumulation& acc = renderer.accumulation();
+  uint64_t accepted = 0;
+  double brightest = 0, dimmest = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < acc.samples.size(); ++i) {
+    accepted += acc.samples[i];
+    ASSERT_TRUE(is_finite(acc.lv_mean[i]) && is_finite(acc.hv_mean[i])) << i;
+    ASSERT_TRUE(std::isfinite(acc.hv_lum_m2[i]) && std::isfinite(acc.hv_lum_mean[i])) << i;
+    const double y = luminance(acc.lv_mean[i] + acc.hv_mean[i]);
+    brightest = std::max(brightest, y);
+    if (y > 0) dimmest = std::min(dimmest, y);
+  }
+  EXPECT_GT(renderer.stats().nan_samples_dropped, 0u);
+  EXPECT_EQ(accepted + renderer.stats().nan_samples_dropped, renderer.stats().paths);
+  EXPECT_GT(brightest, 1e29) << "dimmest " << dimmest << " dropped " << renderer.stats().nan_samples_dropped << " of " << renderer.stats().paths;  // pixels that see the bright emitter (luminance 1e30 there)
+  EXPECT_LT(dimmest, 1e-25);   // ... and the dim one (1e-30 and nothing else: black base color)
+  for (const Image& image : {renderer.lv_image(), renderer.hv_image(), renderer.unfiltered_image(),
+                             renderer.variance_image(), renderer.samples_image()})
+    EXPECT_EQ(count_nonfinite(image), 0u);
+  for (float v : renderer.variance_of_mean()) EXPECT_TRUE(std::isfinite(v));
 }
 
 TEST(Integrator, DarkSceneRendersBlackWithoutTracing) {

@@ -1,3 +1,4 @@
+#include "pathtracer/gltf_images.h"
 #include "pathtracer/texture.h"
 
 #include <gtest/gtest.h>
@@ -136,3 +137,21 @@ TEST(TextureEval, FallbackWhenUnsetOrOutOfRange) {
 
 }  // namespace
 }  // namespace pxf
+
+// A glTF image holding Radiance data cut inside its run-length scanlines made stb loop forever
+// (fuzz/crashers/gltf_scene/hang-truncated-hdr-texture-*): the texture is reported unusable instead.
+TEST(GltfImageDecode, TruncatedRadianceDataFailsInsteadOfHanging) {
+  const std::string header = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 2 +X 8\n";
+  std::string line = {2, 2, 0, 8};
+  for (int c = 0; c < 4; ++c) line += std::string{char(128 + 8), char(100 + c)};
+  const std::string whole = header + line + line;
+  pxf::gltf::DecodedImage image;
+  ASSERT_TRUE(pxf::gltf::decode_image(reinterpret_cast<const unsigned char*>(whole.data()), whole.size(), image))
+      << image.failure;
+  EXPECT_EQ(image.width, 8);
+  EXPECT_EQ(image.height, 2);
+  for (size_t cut : {header.size() + 6, header.size() + line.size(), whole.size() - 1}) {
+    EXPECT_FALSE(pxf::gltf::decode_image(reinterpret_cast<const unsigned char*>(whole.data()), cut, image)) << cut;
+    EXPECT_FALSE(image.failure.empty());
+  }
+}

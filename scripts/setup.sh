@@ -15,6 +15,7 @@ PACKAGES=(
   libgtest-dev
   xvfb xauth                           # explorer test under a virtual display
   slurm-wlm munge                      # Slurm.* test: a single-node Slurm on localhost
+  clang-14 libfuzzer-14-dev libclang-rt-14-dev   # libFuzzer harnesses (scripts/fuzz.sh)
 )
 
 missing=()

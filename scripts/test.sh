@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Sets up and builds pxf, then runs the whole test suite with ctest. Afterwards it builds the
 # core libraries' unit tests (image, pathtracer) with AddressSanitizer + UndefinedBehaviorSanitizer
-# in build-asan/ and runs them (skip with PXF_SKIP_SANITIZERS=1).
+# in build-asan/ and runs them (skip with PXF_SKIP_SANITIZERS=1). Last, a short libFuzzer run of each
+# harness in fuzz/ (PXF_FUZZ_SECONDS per harness, default 40; skip with PXF_SKIP_FUZZ=1) where clang++
+# and libFuzzer work; any crash, leak, sanitizer report or timeout fails the script.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
@@ -14,4 +16,13 @@ if [ "${PXF_SKIP_SANITIZERS:-0}" != "1" ]; then
   cmake --build build-asan -j "$(nproc)" --target image_tests pathtracer_tests
   ASAN_OPTIONS=detect_leaks=0 ctest --test-dir build-asan --output-on-failure -j "$(nproc)" --timeout 900 \
     -L 'image_tests|pathtracer_tests'
+fi
+
+if [ "${PXF_SKIP_FUZZ:-0}" != "1" ]; then
+  if scripts/fuzz.sh --available; then
+    echo "== libFuzzer harnesses, ${PXF_FUZZ_SECONDS:-40} s each (scripts/fuzz.sh)"
+    scripts/fuzz.sh "${PXF_FUZZ_SECONDS:-40}"
+  else
+    echo "== libFuzzer harnesses skipped: clang++ with libFuzzer not available (scripts/setup.sh installs it)"
+  fi
 fi

@@ -399,6 +399,42 @@ TEST(Cli, VeryBrightFiniteInputGivesFiniteOutputs) {
   }
 }
 
+// Radiance from 1e-30 to 1e30 in one scene, samples that overflow float among them: every layer of
+// every output is finite, and stats.json counts exactly the samples the `samples` layer lacks.
+TEST(Cli, ExtremeRadianceGivesFiniteOutputsAndAnExactDroppedSampleCount) {
+  const std::string dir = temp_dir("extreme_radiance");
+  const std::string scene = edited_cornell(dir, [](nlohmann::json& doc) {
+    // A point light at the float limit just above the floor (its light overflows to Inf in many
+    // samples), one wall emitting 1e-30 and another 1e30, beside the ceiling light.
+    doc["extensionsUsed"].push_back("KHR_lights_punctual");
+    doc["extensionsUsed"].push_back("KHR_materials_emissive_strength");
+    doc["extensions"]["KHR_lights_punctual"]["lights"] = {{{"type", "point"}, {"intensity", 3.4e38}}};
+    doc["nodes"].push_back({{"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}, {"translation", {0, 0.05, 0}}});
+    doc["scenes"][0]["nodes"].push_back(doc["nodes"].size() - 1);
+    ASSERT_GE(doc["materials"].size(), 3u);
+    doc["materials"][0]["emissiveFactor"] = {1, 1, 1};
+    doc["materials"][0]["extensions"]["KHR_materials_emissive_strength"] = {{"emissiveStrength", 1e-30}};
+    doc["materials"][1]["emissiveFactor"] = {1, 1, 1};
+    doc["materials"][1]["extensions"]["KHR_materials_emissive_strength"] = {{"emissiveStrength", 1e30}};
+  });
+  if (scene.empty()) GTEST_SKIP() << "assets/cornell not generated";
+  const int width = 24, height = 16, spp = 8;
+  const std::string out = dir + "/out";
+  const Result r = run("render --scene " + scene + " --size " + std::to_string(width) + "x" + std::to_string(height) +
+                       " --spp " + std::to_string(spp) + " --quiet --out " + out);
+  ASSERT_EQ(r.code, 0) << r.err;
+  expect_outputs_finite(out, "extreme radiance");
+  double accepted = 0;
+  for (const Layer& layer : read_exr_layers(out + "/buffers.exr"))
+    if (layer.name == "samples")
+      for (float n : layer.image.pixels) accepted += n;
+  const auto stats = nlohmann::json::parse(slurp(out + "/stats.json"));
+  const double dropped = stats["nan_samples_dropped"].get<double>();
+  EXPECT_GT(dropped, 0.0);
+  EXPECT_EQ(accepted + dropped, double(width) * height * spp);
+  EXPECT_LT(accepted, double(width) * height * spp);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Issue 12: the output set is replaced whole or not at all.
 
