@@ -93,3 +93,13 @@ bool skip_as_case2(sampler2D hv, sampler2D lv, sampler2D guide, ivec2 p, float k
   float lb = max(luminance(clean(texelFetch(hv, p, 0).rgb)) + luminance(clean(texelFetch(lv, p, 0).rgb)), 0.0);
   return v > 0.0 && relative_variance(v, lb) <= max(t, 0.0);
 }
+
+// Albedo demodulation (gl/demodulation.h): the factor HV is divided by before the filter and L_f
+// multiplied by after it. The pixel's mean albedo where every channel is at least kAlbedoEpsilon,
+// else 1 (a black or nearly black albedo is not demodulated: dividing by it would amplify noise
+// and light that is not reflected by that albedo). Mirrors demodulation_factor() in cpu_reference.cpp.
+const float kAlbedoEpsilon = 0.02;
+vec3 demodulation_factor(vec3 albedo) {
+  vec3 a = clean(albedo);
+  return all(greaterThanEqual(a, vec3(kAlbedoEpsilon))) ? a : vec3(1.0);
+}
