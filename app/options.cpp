@@ -32,6 +32,9 @@ void add_preview_options(CommandLine& cli, PreviewOptions& o) {
              "when the filter runs: budget = at power-of-two sample counts while filter + range stay within\n"
              "10 % of the tracing time (default); pow2 = at every power of two; every = each frame; all also\n"
              "the last frame");
+  cli.choice("--demodulate", &o.demodulate, {"on", "off"},
+             "albedo demodulation: filter HV divided by the first non-specular albedo, so textures stay\n"
+             "sharp (default on)");
   cli.option("--seed", &o.seed, "random seed", 0, 2147483647);
   cli.choice("--sampler", &o.sampler, {"sobol", "independent"},
              "random numbers of the path tracer: Owen-scrambled Sobol or independent PCG32 (default)");
@@ -63,6 +66,7 @@ void finish_preview_options(PreviewOptions& o) {
   o.settings.trace.all_hv = o.all_hv;
   o.settings.trace.sampler = o.sampler == "independent" ? SamplerType::Independent : SamplerType::Sobol;
   o.settings.filter.t = o.settings.threshold;
+  o.settings.demodulate = o.demodulate == "on";
 }
 
 Scene load_scene_for(SceneOptions& options, PreviewOptions& preview, const CommandLine& cli) {
