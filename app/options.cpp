@@ -34,7 +34,7 @@ void add_preview_options(CommandLine& cli, PreviewOptions& o) {
              "the last frame");
   cli.choice("--demodulate", &o.demodulate, {"on", "off"},
              "albedo demodulation: filter HV divided by the first non-specular albedo, so textures stay\n"
-             "sharp (default on)");
+             "sharp (default off: README \"Albedo demodulation\")");
   cli.option("--seed", &o.seed, "random seed", 0, 2147483647);
   cli.choice("--sampler", &o.sampler, {"sobol", "independent"},
              "random numbers of the path tracer: Owen-scrambled Sobol or independent PCG32 (default)");

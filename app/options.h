@@ -24,7 +24,7 @@ struct PreviewOptions {
   int seed = 1;
   bool all_hv = false;
   std::string sampler = "independent";
-  std::string demodulate = "on";  // "on" | "off": PreviewSettings::demodulate
+  std::string demodulate = "off";  // "on" | "off": PreviewSettings::demodulate
 };
 
 void add_scene_options(CommandLine& cli, SceneOptions& options, bool headless);

@@ -30,8 +30,9 @@ struct PreviewSettings {
   bool filter_enabled = true;  // false = plain path tracing (--filter none)
   FilterParams filter;         // kind and sigmas; filter.t is kept equal to threshold
   // Albedo demodulation: filter HV divided by the first non-specular albedo and multiply L_f back
-  // (gl/demodulation.h), so the filter does not blur textures. Default: README "Albedo demodulation".
-  bool demodulate = true;
+  // (gl/demodulation.h), so the filter does not blur textures. Off by default: at equal time it did
+  // not beat filtering radiance with the default grid filter (README "Albedo demodulation").
+  bool demodulate = false;
   FilterSchedule schedule = FilterSchedule::Budget;
   TonemapParams tonemap;
   RangeSettings range;

@@ -457,10 +457,9 @@ BlendOutput cpu_blend(const Image& lv, const Image& hv, const Image& var_u, cons
 }
 
 std::array<float, 3> demodulation_factor(float r, float g, float b) {
-  const std::array<float, 3> a{clean(r), clean(g), clean(b)};
-  for (float c : a)
-    if (!(c >= kAlbedoEpsilon)) return {1.0f, 1.0f, 1.0f};
-  return a;
+  const float k = luminance(clean(r), clean(g), clean(b));
+  if (!(k >= kAlbedoEpsilon)) return {1.0f, 1.0f, 1.0f};
+  return {k, k, k};
 }
 
 DemodulatedInputs cpu_demodulate(const Image& hv, const Image& var_u, const Image& lv, const Image& albedo,

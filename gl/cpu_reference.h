@@ -53,7 +53,7 @@ bool skip_as_case2(const Image& hv, const Image& var_u, const Image& lv, const I
 bool case2_skip_decision(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
                          const Image& depth, const FilterParams& p, int x, int y);
 
-// Albedo demodulation (gl/demodulation.h). The factor: the albedo where every channel is at least
+// Albedo demodulation (gl/demodulation.h). The factor: grey Y(albedo) where that is at least
 // kAlbedoEpsilon, else (1, 1, 1) (that pixel is not demodulated).
 std::array<float, 3> demodulation_factor(float r, float g, float b);
 struct DemodulatedInputs {

@@ -2,12 +2,14 @@
 // the albedo of the first non-specular vertex (irradiance-like, free of texture detail) and its
 // output is multiplied back by each pixel's own albedo before the blend, so textures stay sharp.
 //   demodulate: L_u' = L_u / a, Var[L_u'] = Var[L_u] / Y(a)^2
-//   remodulate: L_f  = a L_f', Var[L_f]  = Y(a)^2 Var[L_f']
-// a = demodulation_factor(mean albedo) (shaders/common.glsl): the albedo where every channel is at
-// least kAlbedoEpsilon (0.02), else 1 (that pixel is not demodulated). The variance is a luminance
-// variance, scaled by Y(a)^2: exact for a grey albedo, and for any albedo when the noise is that of
-// an irradiance times the albedo (L_u = a E, Y(L_u / a) = Y(E)). On an unfiltered pixel the two
-// steps give back L_u and Var[L_u]; the blend sees L_f and Var[L_f] in radiance units, so its
+//   remodulate: L_f  = a L_f', Var[L_f]  = Y(a)^2 Var[L_f']   (a grey: Y(a) = a)
+// a = demodulation_factor(mean albedo) (shaders/common.glsl): grey, the albedo's luminance where
+// that is at least kAlbedoEpsilon (0.05), else 1 (that pixel is not demodulated). Grey because a
+// per-channel division amplifies, in the channels a saturated texture nearly lacks, light that the
+// albedo does not shape (specular highlights): on envmap that gave pink speckles and a red halo and
+// doubled the error. So luminance texture is kept, chroma texture within the filter's range
+// tolerance is still smoothed. With a grey factor the variance scaling is exact. On an unfiltered
+// pixel the two steps give back L_u and Var[L_u]; the blend sees L_f and Var[L_f] in radiance units, so its
 // perceived-variance logic is unchanged. The filter's case-2 skip is decided on the original
 // buffers (shaders/demodulate.frag). CPU reference: cpu_demodulate / cpu_remodulate.
 // Usage:

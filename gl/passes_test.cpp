@@ -532,7 +532,8 @@ Image albedo_image_for_test() {
       const bool odd = ((x / 2) + (y / 2)) % 2 == 1;
       const float color[3] = {odd ? 0.8f : 0.15f, odd ? 0.6f : 0.3f, odd ? 0.9f : 0.05f};
       for (int c = 0; c < 3; ++c) a.at(x, y, c) = x == 3 ? 0.0f : color[c];
-      if (x == 5) a.at(x, y, 1) = 0.5f * kAlbedoEpsilon;  // one channel below the epsilon
+      if (x == 5)  // luminance below the epsilon: not demodulated
+        for (int c = 0; c < 3; ++c) a.at(x, y, c) = 0.5f * kAlbedoEpsilon;
     }
   a.at(7, 2, 0) = kNaN;
   a.at(8, 2, 2) = kInf;
@@ -625,13 +626,16 @@ TEST(Demodulation, WithoutFilteringGivesBackTheInputs) {
     else
       EXPECT_NEAR(got, v, 1e-6f * v) << i;
   }
-  EXPECT_EQ(demodulation_factor(0.5f, 0.01f, 0.5f), (std::array<float, 3>{1.0f, 1.0f, 1.0f}));
-  EXPECT_EQ(demodulation_factor(0.5f, 0.25f, 0.02f), (std::array<float, 3>{0.5f, 0.25f, 0.02f}));
+  const float k = luminance(0.8f, 0.2f, 0.01f);  // a saturated red: one grey factor, its luminance
+  EXPECT_EQ(demodulation_factor(0.8f, 0.2f, 0.01f), (std::array<float, 3>{k, k, k}));
+  EXPECT_EQ(demodulation_factor(0.05f, 0.03f, 0.05f), (std::array<float, 3>{1.0f, 1.0f, 1.0f}));  // Y < epsilon
+  EXPECT_EQ(demodulation_factor(kNaN, 0.5f, 0.5f), demodulation_factor(0.0f, 0.5f, 0.5f));
 }
 
 // A textured plane under constant irradiance E, seen through a guide that does not show the
 // texture (a flat range color): L_u = a(x, y) E. Filtering radiance averages the texture away;
-// with demodulation the filter sees the constant E and the texture comes back exactly.
+// with demodulation the filter sees the constant E and the texture comes back exactly. The texture
+// varies in luminance (its two colors have the same chromaticity): the factor is grey.
 TEST(Demodulation, TexturedConstantIrradiancePlaneKeepsItsTexture) {
   test::osmesa_context();
   const Image albedo = [] {
@@ -639,9 +643,10 @@ TEST(Demodulation, TexturedConstantIrradiancePlaneKeepsItsTexture) {
     for (int y = 0; y < H; ++y)
       for (int x = 0; x < W; ++x) {
         const bool odd = ((x / 3) + (y / 3)) % 2 == 1;
-        a.at(x, y, 0) = odd ? 0.9f : 0.1f;
-        a.at(x, y, 1) = odd ? 0.7f : 0.2f;
-        a.at(x, y, 2) = odd ? 0.3f : 0.6f;
+        const float level = odd ? 1.0f : 0.12f;
+        a.at(x, y, 0) = 0.9f * level;
+        a.at(x, y, 1) = 0.7f * level;
+        a.at(x, y, 2) = 0.3f * level;
       }
     return a;
   }();

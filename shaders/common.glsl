@@ -95,11 +95,13 @@ bool skip_as_case2(sampler2D hv, sampler2D lv, sampler2D guide, ivec2 p, float k
 }
 
 // Albedo demodulation (gl/demodulation.h): the factor HV is divided by before the filter and L_f
-// multiplied by after it. The pixel's mean albedo where every channel is at least kAlbedoEpsilon,
-// else 1 (a black or nearly black albedo is not demodulated: dividing by it would amplify noise
-// and light that is not reflected by that albedo). Mirrors demodulation_factor() in cpu_reference.cpp.
-const float kAlbedoEpsilon = 0.02;
+// multiplied by after it: grey, the luminance Y(a) of the pixel's mean albedo where it is at least
+// kAlbedoEpsilon, else 1 (a nearly black albedo is not demodulated). Grey, not per channel: a
+// channel near 0 (a saturated texture) would amplify that channel of light the albedo does not
+// shape (specular highlights, neighbours' light) many times over. Mirrors demodulation_factor()
+// in cpu_reference.cpp.
+const float kAlbedoEpsilon = 0.05;
 vec3 demodulation_factor(vec3 albedo) {
-  vec3 a = clean(albedo);
-  return all(greaterThanEqual(a, vec3(kAlbedoEpsilon))) ? a : vec3(1.0);
+  float k = luminance(clean(albedo));
+  return k >= kAlbedoEpsilon ? vec3(k) : vec3(1.0);
 }
