@@ -3,7 +3,9 @@
 //   pxf bench                 per-stage times, filtering overhead, equal-time NRMSE, spp to match
 //   pxf bench --pathtracer    paths/s, rays/s, ms/frame and the raw Embree ray rate
 //   pxf bench --pathtracer --sampler-error | --variance-ratio   the samplers (app/sampler_bench.h)
+//   pxf bench --threshold-fidelity   the blend's threshold against the empirical variance (app/fidelity_bench.h)
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -14,6 +16,7 @@
 #include "app/commands.h"
 #include "app/options.h"
 #include "app/plot.h"
+#include "app/fidelity_bench.h"
 #include "app/sampler_bench.h"
 #include "app/preview.h"
 #include "gl/context.h"
@@ -236,7 +239,8 @@ std::vector<int> parse_counts(const std::string& option, const std::string& text
 }
 
 // One scene's row of the per-stage table (thesis Table 3.2): medians over `frames` frames of the
-// scheduled run, and the overhead of the filtered run over the unfiltered one.
+// scheduled run, and the overhead of the filtered run over the unfiltered one. The two runs advance
+// frame by frame in turn, so that background load on a shared machine hits both alike.
 struct StageRow {
   std::string scene;
   int width = 0, height = 0, filter_runs = 0;
@@ -246,22 +250,22 @@ struct StageRow {
 
 StageRow measure_stages(const BenchSetup& b, const std::string& scene_name, int frames) {
   Preview filtered(b.scene, b.filtered, b.width, b.height);
+  Preview plain(b.scene, b.plain, b.width, b.height);
   std::vector<double> pt, filter_app, display;
   StageRow row;
-  const auto start = Clock::now();
   for (int i = 0; i < frames; ++i) {
+    const auto start = Clock::now();
     filtered.add_frame(i + 1 == frames, false);
+    row.filtered_ms += elapsed_ms(start);
+    const auto plain_start = Clock::now();
+    plain.add_frame(i + 1 == frames, false);
+    row.plain_ms += elapsed_ms(plain_start);
     const StageTimes& t = filtered.last_times();
     pt.push_back(t.path_tracing);
     if (t.filter > 0) filter_app.push_back(t.filter + t.upload);
     if (t.blend > 0) display.push_back(t.blend + t.tonemap);
     row.range_ms += t.range;
   }
-  row.filtered_ms = elapsed_ms(start);
-  Preview plain(b.scene, b.plain, b.width, b.height);
-  const auto plain_start = Clock::now();
-  for (int i = 0; i < frames; ++i) plain.add_frame(i + 1 == frames, false);
-  row.plain_ms = elapsed_ms(plain_start);
   row.scene = scene_name;
   row.width = b.width;
   row.height = b.height;
@@ -364,6 +368,7 @@ int run_variant_bench(const BenchSetup& b, const Image& reference_hv, int spp, i
   std::vector<double> pt_ms;
   std::vector<Image> filtered(names.size());
   std::vector<uint32_t> filtered_pixels(names.size());
+  std::array<std::vector<double>, 4> grid_step_ms;  // what the default variant's steps cost
   for (int round = -1; round < rounds; ++round) {
     const auto start = Clock::now();
     timing_tracer.add_frame();
@@ -371,6 +376,8 @@ int run_variant_bench(const BenchSetup& b, const Image& reference_hv, int spp, i
     for (size_t k = 0; k < names.size(); ++k) {
       filter.run(preview.inputs(), preview.range().guide(), params[k]);
       if (round >= 0) ms[k].push_back(filter.last_ms());
+      if (round >= 0 && params[k].kind == FilterKind::Grid)
+        for (size_t i = 0; i < grid_step_ms.size(); ++i) grid_step_ms[i].push_back(filter.grid()->last_step_ms()[i]);
       if (round == 0) filtered[k] = filter.filtered_image(), filtered_pixels[k] = filter.filtered_pixels();
     }
   }
@@ -398,6 +405,12 @@ int run_variant_bench(const BenchSetup& b, const Image& reference_hv, int spp, i
         << application_ms / frame_ms << "," << nrmse << "," << filtered_pixels[k] << "\n";
     points.push_back({names[k], {application_ms / frame_ms}, {nrmse}, true});
     write_png(b.out + "/variant_" + names[k] + ".png", cpu_tonemap(filtered[k], tonemap));
+  }
+  if (!grid_step_ms[0].empty()) {
+    std::printf("   grid steps, median ms:");
+    for (size_t i = 0; i < grid_step_ms.size(); ++i)
+      std::printf(" %s %.1f", GridFilter::kStepNames[i], median_of(grid_step_ms[i]));
+    std::printf("\n");
   }
   write_text(b.out + "/variants.csv", csv.str());
   write_svg_plot(b.out + "/variants.svg",
@@ -462,6 +475,7 @@ int run_bench(const Args& args) {
   PreviewOptions preview_options;
   bool pathtracer = false, variants = false, stage_table = false, sampler_error = false, variance_ratio = false;
   bool demodulation_ab = false;
+  bool threshold_fidelity = false;
   int variant_spp = 4, variant_rounds = 5;
   std::string extra_taps_text;
   std::string reference_path, out = "bench-out", budgets_text = "8,32,128,256";
@@ -496,12 +510,17 @@ int run_bench(const Args& args) {
            "--reference-spp Sobol reference of another seed, and paths/s of both back to back");
   cli.flag("--variance-ratio", &variance_ratio,
            "with --pathtracer: estimated / empirical Var[L_u] of the pixel mean over --seeds seeds at --spp");
-  cli.option("--spp", &spp_text, "LIST", "spp of --sampler-error (default 8,32,128) or --variance-ratio (4,16,64,256)");
-  cli.option("--seeds", &seeds, "seeds of --variance-ratio (default 32)", 2, 4096);
+  cli.flag("--threshold-fidelity", &threshold_fidelity,
+           "empirical perceived variance of the final image over --seeds seeds at --spp (default 16,64,256) "
+           "against t = 0.001 and 0.01, by blend case (the --filter's; bilateral and bilateral-depth give the "
+           "blend the covariance of L_u and L_f)");
+  cli.option("--spp", &spp_text, "LIST",
+             "spp of --sampler-error (default 8,32,128), --variance-ratio (4,16,64,256) or --threshold-fidelity (16,64,256)");
+  cli.option("--seeds", &seeds, "seeds of --variance-ratio and --threshold-fidelity (default 32)", 2, 4096);
   cli.flag("--demodulation-ab", &demodulation_ab,
            "instead of 1-4: albedo demodulation off vs on at equal wall time (--budgets, --rounds rounds, back\n"
            "to back with the unfiltered run); writes demodulation.csv and demod_*.png");
-  cli.option("--rounds", &rounds, "rounds of --sampler-error and --demodulation-ab (default 7)", 1, 1000);
+  cli.option("--rounds", &rounds, "rounds of --sampler-error (default 7) and --demodulation-ab (default 3)", 1, 1000);
   cli.option("--timed-frames", &timed, "timed frames of --pathtracer (after 3 warm-up frames)", 1, 100000);
   cli.option("--reference", &reference_path, "REF.exr", "reference image (default: render and cache one)");
   cli.option("--reference-spp", &reference_spp, "samples of the rendered reference (default 2048)", 1, 1 << 20);
@@ -541,6 +560,14 @@ int run_bench(const Args& args) {
     return 0;
   }
   if (pathtracer) return run_pathtracer_bench(b, timed);
+  if (threshold_fidelity) {
+    auto context = create_gl_context(parse_gl_backend(scene_options.gl));
+    const FidelityBenchSetup fb{b.scene, std::filesystem::path(scene_options.scene).stem().string(), b.filtered,
+                                b.width, b.height, out};
+    run_threshold_fidelity_bench(fb, parse_counts("--spp", spp_text.empty() ? "16,64,256" : spp_text), {0.001f, 0.01f},
+                                 seeds);
+    return 0;
+  }
 
   auto context = create_gl_context(parse_gl_backend(scene_options.gl));
   std::printf("bench: %s %dx%d, t=%g, filter %s, sigma_s=%g sigma_c=%g sigma_d=%g, GL %s (%s)\n",

@@ -26,7 +26,7 @@ int run_explore(const Args& args) {
              0.001, 1e7);
   cli.option("--zoom", &o.zoom, "display zoom of the image (default: fit the window)", 0, 16);
   cli.option("--out", &o.out, "DIR", "capture folder (default out)");
-  cli.option("--frames", &o.frames, "quit after N displayed frames (testing)", 0, 1 << 30);
+  cli.option("--frames", &o.frames, "quit after N displayed frames, with --spp or --time not before they are reached (testing)", 0, 1 << 30);
   cli.option("--screenshot", &o.screenshot, "FILE.png", "save the whole window (UI included) before quitting");
   cli.flag("--capture", &o.capture_on_exit, "capture into --out before quitting (with --frames)");
   if (!cli.parse(args)) return 0;

@@ -5,11 +5,13 @@
 #include <cmath>
 #include <cstdio>
 #include <deque>
+#include <future>
 #include <memory>
 #include <vector>
 
 #include "app/explorer_camera.h"
 #include "app/explorer_views.h"
+#include "app/frame_budget.h"
 #include "app/preview.h"
 #include "app/render_output.h"
 #include "pathtracer/auto_camera.h"
@@ -30,7 +32,6 @@ using Clock = std::chrono::steady_clock;
 
 constexpr float kPanelWidth = 430.0f;
 constexpr double kTraceBudgetMs = 30.0;  // path tracing per displayed frame when it is fast
-constexpr int kMaxFramesPerDisplay = 32;
 constexpr size_t kPlotLength = 600;
 constexpr float kDividerGrabPixels = 6.0f;
 
@@ -78,7 +79,7 @@ struct PixelProbe {
   bool has_filtered = false;
 };
 
-PixelProbe probe_pixel(const Preview& preview, int x, int y) {
+PixelProbe probe_pixel(const Preview& preview, const std::vector<uint32_t>& samples, int x, int y) {
   PixelProbe p;
   p.x = x;
   p.y = y;
@@ -89,7 +90,8 @@ PixelProbe probe_pixel(const Preview& preview, int x, int y) {
   p.filtered_var = p.has_filtered ? read_texel(preview.filtered_output(), x, y) : p.hv_var;
   p.guide = read_texel(preview.range().guide(), x, y);
   p.case_code = read_texel(preview.blend().case_texture(), x, y).r;
-  p.n = preview.renderer().accumulation().samples[static_cast<size_t>(y) * preview.width() + x];
+  const size_t i = static_cast<size_t>(y) * preview.width() + x;
+  p.n = i < samples.size() ? samples[i] : 0;
   // SPEC 3.4: L_b = Y(L_f) + Y(L_lv); u and f relative to it (0 where the variance is unknown).
   p.background = luminance(p.filtered_var) + luminance(p.lv);
   const float b2 = p.background * p.background;
@@ -124,6 +126,7 @@ class Explorer {
     init_imgui();
   }
   ~Explorer() {
+    stop_tracing(/*cancel=*/true);
     ImGui_ImplOpenGL3_Shutdown();
     ImGui_ImplGlfw_Shutdown();
     ImGui::DestroyContext();
@@ -132,6 +135,7 @@ class Explorer {
   int run() {
     started_ = Clock::now();
     for (int frame = 0; !context_.should_close(); ++frame) {
+      const auto frame_start = Clock::now();
       glfwPollEvents();
       load_dropped_scenes();
       ImGui_ImplOpenGL3_NewFrame();
@@ -145,8 +149,14 @@ class Explorer {
       render_views();
       ImGui::Render();
       draw_to_window();
-      const bool last = options_.frames > 0 && frame + 1 >= options_.frames;
+      // --frames (tests): not before the --spp / --time capture is finished.
+      const bool run_done =
+          (options_.spp <= 0 && options_.time_s <= 0) || (finished_ && !tracing_ && !preview_->passes_pending());
+      const bool last = options_.frames > 0 && frame + 1 >= options_.frames && run_done;
       if (last) finish_run();
+      // The longest display frame before the swap (which may wait for vsync), from the third
+      // traced frame on: the first runs of each pass include compiling its shaders.
+      if (preview_->samples() > 2) longest_frame_ms_ = std::max(longest_frame_ms_, ms_between(frame_start, Clock::now()));
       context_.present();
       if (last) break;
     }
@@ -156,9 +166,11 @@ class Explorer {
  private:
   // --- scene ---------------------------------------------------------------------------------
   void load(const std::string& path, bool first) {
+    stop_tracing(/*cancel=*/true);
     try {
       auto scene = std::make_unique<Scene>(load_scene(path, first ? options_.scene.env : "", options_.scene.env_strength,
-                                                      parse_default_light(options_.scene.default_light)));
+                                                      parse_default_light(options_.scene.default_light),
+                                                      load_limits(options_.scene)));
       print_scene_messages(*scene);
       if (!options_.all_hv_given) settings_.trace.all_hv = scene->defaults.all_hv;
       if (first) size_image(*scene);
@@ -270,7 +282,7 @@ class Explorer {
   // Magnifier (nearest-neighbour crop of the shown view) and every buffer's value at the cursor.
   void inspector_tooltip(int x, int y) {
     if (x < 0 || y < 0 || x >= width_ || y >= height_) return;
-    const PixelProbe p = probe_pixel(*preview_, x, y);
+    const PixelProbe p = probe_pixel(*preview_, samples_snapshot_, x, y);
     ImGui::BeginTooltip();
     constexpr float kHalf = 8.0f;
     const ImVec2 uv0((x - kHalf) / width_, (y - kHalf) / height_), uv1((x + kHalf + 1) / width_, (y + kHalf + 1) / height_);
@@ -320,6 +332,7 @@ class Explorer {
                 width_, height_, paths_per_second_ / 1e6);
     ImGui::Text("ms: trace %.1f/frame  range %.1f  filter %.1f", stage_ms_.path_tracing, stage_ms_.range,
                 preview_->filter().last_ms());
+    ImGui::Text("    longest display frame %.0f ms (budget %.0f; tracing on a worker)", longest_frame_ms_, kUiBudgetMs);
     ImGui::Text("    blend %.2f  tone map %.2f   filter runs %d%s", stage_ms_.blend, stage_ms_.tonemap,
                 preview_->filter_runs(), preview_->filter_stopped() ? " (stopped: all case 2)" : "");
     const auto& counts = preview_->case_counts();
@@ -511,8 +524,12 @@ class Explorer {
   }
 
   // Camera moves reset the accumulation; while moving the filter is skipped so the preview keeps
-  // up, and it runs again on the current samples as soon as the camera rests.
+  // up, and it runs again on the current samples as soon as the camera rests. A camera move
+  // cancels the frame being traced (it would be discarded anyway); other changes wait for it, and
+  // for the queued passes, without blocking.
   void apply_changes() {
+    if (camera_changed_ && tracing_) stop_tracing(/*cancel=*/true);
+    if (tracing_ || preview_->passes_pending()) return;
     if (camera_changed_) preview_->set_camera(controller_->camera());
     camera_changed_ = false;
     const bool moving = fast_while_moving_ && (dragging_camera_ || flying_);
@@ -532,34 +549,81 @@ class Explorer {
     return !next_frame_fits(preview_->predict_next_frame(options_.time_s * 1000.0, elapsed));
   }
 
-  // One path-traced frame per display frame, more while they fit in the time budget. At the
-  // --spp limit the capture is finished exactly like `pxf render` (last-frame filter run).
+  // --- tracing on a worker thread, GL passes within the frame budget (app/frame_budget.h) ------
+  // The UI thread never waits for a whole path-traced frame: the tracer runs on a worker, and
+  // each display frame waits at most kTraceBudgetMs for it (so small images still get several
+  // frames per display frame), then runs the GL steps that fit in kUiBudgetMs. Tracing and the GL
+  // passes never overlap, as in `pxf render`, so the samples, schedule and buffers are the same.
+  void start_trace() {
+    tracing_ = true;
+    trace_result_ = std::async(std::launch::async, [this] { return preview_->trace_frame(); });
+  }
+
+  // Waits for the worker (cancelled first if asked: it then stops within a few tiles).
+  void stop_tracing(bool cancel) {
+    if (!tracing_) return;
+    if (cancel) preview_->cancel_trace();
+    const bool complete = trace_result_.get();
+    tracing_ = false;
+    if (complete) frame_traced();
+  }
+
+  void frame_traced() {
+    const int samples = preview_->samples();
+    const bool last = options_.spp > 0 && samples == options_.spp;
+    preview_->queue_passes(last, /*display=*/true);
+    finished_ = last;
+    samples_snapshot_ = preview_->renderer().accumulation().samples;
+    ++frames_since_display_;
+    frame_stats_pending_ = true;  // averaged once its passes have run
+  }
+
+  // Runs queued GL steps while they fit in the budget (ui_ms of this display frame already used).
+  void run_passes(double used_ms, bool fresh) {
+    double gl_ms = 0;  // of the steps run
+    for (int steps = 0; preview_->passes_pending(); ++steps) {
+      if (!step_fits_display_frame(used_ms + gl_ms, fresh && steps == 0, preview_->predict_pass_ms(preview_->next_pass())))
+        break;
+      const auto start = Clock::now();
+      preview_->run_next_pass();
+      gl_ms += ms_between(start, Clock::now());
+    }
+  }
+
   void trace() {
-    const int before = preview_->samples();
-    if (before < last_samples_) history_.clear();  // the accumulation was reset
-    if (before == 0) accumulation_start_ = Clock::now();  // --time counts from here
-    if (paused_ || spp_reached()) {
-      if (!finished_ && spp_reached()) preview_->finish(), finished_ = true;
-      last_samples_ = preview_->samples();
-      return;
-    }
-    finished_ = false;
-    const double per_frame = std::max(stage_ms_.path_tracing, 0.1);
-    int frames = std::clamp(static_cast<int>(kTraceBudgetMs / per_frame), 1, kMaxFramesPerDisplay);
-    if (options_.spp > 0) frames = std::min(frames, options_.spp - before);
     const auto start = Clock::now();
-    for (int i = 0; i < frames; ++i) {
-      if (i > 0 && spp_reached()) break;  // --time
-      const bool last = options_.spp > 0 && before + i + 1 == options_.spp;
-      preview_->add_frame(/*last_frame=*/last, /*display=*/i + 1 == frames);
-      finished_ = last;
-      average_stage_times(preview_->last_times());
+    auto used_ms = [&] { return ms_between(start, Clock::now()); };
+    if (preview_->samples() < last_samples_) history_.clear();  // the accumulation was reset
+    bool fresh = true;  // nothing waited for or run yet in this display frame
+    for (;;) {
+      if (tracing_) {
+        const auto wait = std::chrono::duration<double, std::milli>(std::max(0.0, kTraceBudgetMs - used_ms()));
+        if (trace_result_.wait_for(wait) != std::future_status::ready) break;
+        stop_tracing(/*cancel=*/false);
+        fresh = false;
+      }
+      run_passes(used_ms(), fresh);
+      fresh = false;
+      if (preview_->passes_pending()) break;
+      if (frame_stats_pending_) average_stage_times(preview_->last_times()), frame_stats_pending_ = false;
+      if (camera_changed_ || settings_changed_) break;
+      if (preview_->samples() == 0) accumulation_start_ = Clock::now();  // --time counts from here
+      if (paused_ || spp_reached()) {
+        if (!finished_ && spp_reached()) preview_->finish(), finished_ = true;
+        break;
+      }
+      finished_ = false;
+      start_trace();
+      if (used_ms() >= kTraceBudgetMs) break;
     }
-    const double ms = ms_between(start, Clock::now());
-    paths_per_second_ = 0.8 * paths_per_second_ + 0.2 * (frames * double(width_) * height_ / (ms / 1000.0));
-    const auto& counts = preview_->case_counts();
-    history_.push_back(float(counts[kCaseNoFiltered] + counts[kCaseUnfiltered]) / (width_ * height_));
-    if (history_.size() > kPlotLength) history_.pop_front();
+    if (frames_since_display_ > 0) {
+      if (stage_ms_.path_tracing > 0)
+        paths_per_second_ = 0.8 * paths_per_second_ + 0.2 * (double(width_) * height_ / (stage_ms_.path_tracing / 1000.0));
+      const auto& counts = preview_->case_counts();
+      history_.push_back(float(counts[kCaseNoFiltered] + counts[kCaseUnfiltered]) / (width_ * height_));
+      if (history_.size() > kPlotLength) history_.pop_front();
+      frames_since_display_ = 0;
+    }
     last_samples_ = preview_->samples();
   }
 
@@ -601,6 +665,8 @@ class Explorer {
       options_.preview.all_hv = settings_.trace.all_hv;
       options_.preview.demodulate = settings_.demodulate ? "on" : "off";
       options_.scene.width = width_, options_.scene.height = height_;
+      stop_tracing(/*cancel=*/false);  // the frame in flight and its passes first
+      while (preview_->passes_pending()) preview_->run_next_pass();
       preview_->finish();  // like an interrupted `pxf render`: the last-frame filter run, blend, tone map
       RenderReport report;
       report.scene = &options_.scene;
@@ -645,7 +711,12 @@ class Explorer {
   StageTimes stage_ms_;
   double paths_per_second_ = 0;
   std::deque<float> history_;
-  int last_samples_ = 0, auto_scale_counter_ = 0;
+  int last_samples_ = 0, auto_scale_counter_ = 0, frames_since_display_ = 0;
+  bool tracing_ = false;               // a worker is running Preview::trace_frame
+  bool frame_stats_pending_ = false;
+  std::future<bool> trace_result_;
+  std::vector<uint32_t> samples_snapshot_;  // per-pixel n for the inspector (the worker writes n)
+  double longest_frame_ms_ = 0;        // longest display frame (the UI budget, kUiBudgetMs)
   std::string out_dir_, scene_path_, scene_error_, status_message_;
   Clock::time_point started_;
   Clock::time_point accumulation_start_ = Clock::now();

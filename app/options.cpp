@@ -15,6 +15,11 @@ void add_scene_options(CommandLine& cli, SceneOptions& o, bool headless) {
              "environment for a scene without lights: sky (default), studio, none (black)");
   cli.option("--env-strength", &o.env_strength, "environment radiance scale", 0.0f, 1e6f);
   cli.size_option("--size", &o.width, &o.height, "image size (default: the scene's, else 512x512)");
+  cli.option("--max-texture-size", &o.max_texture_size,
+             "refuse scenes with a texture wider or taller than this many texels (default 16384)", 1, 1 << 30);
+  cli.option("--max-triangles", &o.max_triangles,
+             "refuse scenes that instance more triangles than this (default 100000000); scenes whose\n"
+             "estimated memory exceeds the available memory are refused too", 1, 2147483647);
   if (headless)
     cli.choice("--gl", &o.gl, {"auto", "osmesa", "egl"}, "headless GL back end (auto: OSMesa, else EGL)");
   else
@@ -37,7 +42,7 @@ void add_preview_options(CommandLine& cli, PreviewOptions& o) {
              "sharp (default off: README \"Albedo demodulation\")");
   cli.option("--seed", &o.seed, "random seed", 0, 2147483647);
   cli.choice("--sampler", &o.sampler, {"sobol", "independent"},
-             "random numbers of the path tracer: Owen-scrambled Sobol or independent PCG32 (default)");
+             "random numbers of the path tracer: Owen-scrambled Sobol (default) or independent PCG32");
   cli.option("--replicates", &s.trace.replicates,
              "independently scrambled Sobol replicates for the variance estimate (default 1 = none)", 1, 64);
   cli.option("--threads", &s.trace.threads, "path-tracing threads (0 = all cores)", 0, 1024);
@@ -69,8 +74,16 @@ void finish_preview_options(PreviewOptions& o) {
   o.settings.demodulate = o.demodulate == "on";
 }
 
+LoadLimits load_limits(const SceneOptions& options) {
+  LoadLimits limits;
+  limits.max_texture_size = options.max_texture_size;
+  limits.max_triangles = static_cast<uint64_t>(options.max_triangles);
+  return limits;
+}
+
 Scene load_scene_for(SceneOptions& options, PreviewOptions& preview, const CommandLine& cli) {
-  Scene scene = load_scene(options.scene, options.env, options.env_strength, parse_default_light(options.default_light));
+  Scene scene = load_scene(options.scene, options.env, options.env_strength, parse_default_light(options.default_light),
+                           load_limits(options));
   print_scene_messages(scene);
   if (options.width == 0) {
     options.width = scene.defaults.width > 0 ? scene.defaults.width : 512;

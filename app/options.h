@@ -4,6 +4,7 @@
 
 #include "app/cli.h"
 #include "app/preview.h"
+#include "pathtracer/pathtracer.h"
 #include "pathtracer/scene.h"
 
 namespace pxf {
@@ -15,7 +16,12 @@ struct SceneOptions {
   std::string default_light = "sky";  // default_light_names(): lights a scene that has no light
   int width = 0, height = 0;      // 0 = the scene's default, else 512x512
   std::string gl = "auto";
+  int max_texture_size = LoadLimits::kDefaultMaxTextureSize;
+  int max_triangles = static_cast<int>(LoadLimits::kDefaultMaxTriangles);
 };
+
+// The loader's limits from the scene options (memory: what the system reports).
+LoadLimits load_limits(const SceneOptions& options);
 
 struct PreviewOptions {
   PreviewSettings settings;
@@ -23,7 +29,7 @@ struct PreviewOptions {
   std::string schedule = "budget";
   int seed = 1;
   bool all_hv = false;
-  std::string sampler = "independent";
+  std::string sampler = "sobol";
   std::string demodulate = "off";  // "on" | "off": PreviewSettings::demodulate
 };
 

@@ -162,8 +162,7 @@ void Preview::converge_range_buffer() {
 // adds one more only while filter + range stay within kPassShare of the tracing time. A camera
 // change so costs one range frame up front, and the guide sharpens as the budget allows.
 void Preview::advance_range_buffer() {
-  if (!settings_.filter_enabled || schedule_.hv_empty || range_.frames() == 0 || range_.converged()) return;
-  if (schedule_.pass_ms + range_.last_ms() > kPassShare * schedule_.tracing_ms) return;
+  if (!range_due()) return;
   const double before = last_.range;
   step_range_buffer();
   schedule_.pass_ms += last_.range - before;
@@ -227,8 +226,11 @@ void Preview::update_hv_empty() {
 void Preview::blend_and_tonemap() {
   const double upload_before = last_.upload;
   upload();
+  // The filter's centre weight is that of the demodulated run too: with a grey factor a,
+  // Cov[L_u, a L_f'] = a w Var[L_u] / a = w Var[L_u], the blend's covariance term is unchanged.
   blend_.run(inputs_, have_filtered_ ? &filtered_output() : nullptr, &range_.guide(),
-             BlendParams{settings_.threshold, range_weights(settings_.filter)});
+             BlendParams{settings_.threshold, range_weights(settings_.filter)},
+             have_filtered_ ? filter_.centre_weight() : nullptr);
   last_.blend += blend_.last_ms();
   tonemap_.run(blend_.output(), settings_.tonemap);
   last_.tonemap += tonemap_.last_ms();
@@ -239,27 +241,80 @@ void Preview::blend_and_tonemap() {
 void Preview::redisplay() { blend_and_tonemap(); }
 
 void Preview::add_frame(bool last_frame, bool display) {
+  trace_frame();
+  queue_passes(last_frame, display);
+  while (passes_pending()) run_next_pass();
+}
+
+bool Preview::trace_frame() {
+  pending_.clear();
   last_ = StageTimes{};
   const auto start = BenchClock::now();
-  renderer_->add_frame();
+  const bool complete = renderer_->add_frame();
   last_.path_tracing = elapsed_ms(start);
   uploaded_ = false;
+  if (!complete) return false;  // cancelled: the renderer reset its samples; the caller resets too
   schedule_.tracing_ms += last_.path_tracing;
   constexpr size_t kRecentFrames = 8;
   if (recent_frame_ms_.size() == kRecentFrames) recent_frame_ms_.erase(recent_frame_ms_.begin());
   recent_frame_ms_.push_back(last_.path_tracing);
+  total_.path_tracing += last_.path_tracing;
+  return true;
+}
 
+void Preview::queue_passes(bool last_frame, bool display) {
   update_hv_empty();
-  advance_range_buffer();
-  schedule_.have_filtered = have_filtered_;
-  if (last_frame) {
-    finish_passes();
-  } else {
-    if (settings_.filter_enabled && filter_due(settings_.schedule, samples(), false, schedule_) && filter_worthwhile())
-      run_filter();
-    if (display) blend_and_tonemap();
+  pending_last_frame_ = last_frame;
+  pending_ = {PassStep::RangeFrame, PassStep::Filter};
+  if (last_frame || display) pending_.push_back(PassStep::Display);
+}
+
+double Preview::predict_pass_ms(PassStep step) const {
+  switch (step) {
+    case PassStep::RangeFrame:
+      return range_due() ? range_.last_ms() : 0.0;
+    case PassStep::Filter:
+      return filter_due_now() ? schedule_.last_run_ms : 0.0;
+    case PassStep::Display:
+      return display_ms_;
   }
-  total_ += last_;
+  return 0.0;
+}
+
+void Preview::run_next_pass() {
+  if (pending_.empty()) return;
+  const PassStep step = pending_.front();
+  pending_.pop_front();
+  const StageTimes before = last_;
+  switch (step) {
+    case PassStep::RangeFrame:
+      advance_range_buffer();
+      schedule_.have_filtered = have_filtered_;
+      break;
+    case PassStep::Filter:
+      if (filter_due_now() && filter_worthwhile()) run_filter();
+      break;
+    case PassStep::Display:
+      blend_and_tonemap();
+      break;
+  }
+  StageTimes added = last_;
+  added.path_tracing = 0;
+  added.upload -= before.upload, added.range -= before.range, added.filter -= before.filter;
+  added.blend -= before.blend, added.tonemap -= before.tonemap;
+  total_ += added;
+}
+
+bool Preview::range_due() const {
+  return settings_.filter_enabled && !schedule_.hv_empty && range_.frames() != 0 && !range_.converged() &&
+         schedule_.pass_ms + range_.last_ms() <= kPassShare * schedule_.tracing_ms;
+}
+
+bool Preview::filter_due_now() const {
+  if (!settings_.filter_enabled) return false;
+  if (pending_last_frame_)
+    return filtered_samples_ != samples() && filter_due(settings_.schedule, samples(), true, schedule_);
+  return filter_due(settings_.schedule, samples(), false, schedule_);
 }
 
 void Preview::finish_passes() {

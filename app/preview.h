@@ -7,10 +7,12 @@
 //   preview.display_image(); preview.buffers();   // tone-mapped image; every buffer as EXR layers
 #pragma once
 #include <array>
+#include <deque>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "app/frame_budget.h"
 #include "app/schedule.h"
 #include "gl/blend_pass.h"
 #include "gl/demodulation.h"
@@ -70,6 +72,18 @@ class Preview {
   // Traces one path per pixel, then runs the passes that are due. `display`: also blend and tone
   // map (the explorer displays every frame; a headless render only its last one).
   void add_frame(bool last_frame = false, bool display = true);
+  // add_frame in steps, for the explorer, which traces on a worker thread and spreads the GL passes
+  // over display frames (app/frame_budget.h): trace_frame() touches only the path tracer (safe on
+  // another thread while nothing else uses this Preview; returns false if cancel_trace() stopped
+  // it, and the samples are then reset), queue_passes() queues what add_frame would run after it,
+  // run_next_pass() runs one queued step on the GL thread. add_frame is exactly these in sequence.
+  bool trace_frame();
+  void queue_passes(bool last_frame, bool display);
+  bool passes_pending() const { return !pending_.empty(); }
+  PassStep next_pass() const { return pending_.front(); }
+  double predict_pass_ms(PassStep step) const;  // 0 when the step would do nothing now
+  void run_next_pass();
+  void cancel_trace() { renderer_->cancel_frame(); }  // thread-safe
   // Ends a capture (also an interrupted one): the last-frame filter run if due, blend, tone map.
   void finish();
   // Changes settings. Path-tracing changes reset the accumulation; filter, threshold and display
@@ -133,6 +147,8 @@ class Preview {
   void update_hv_empty();
   void blend_and_tonemap();
   void finish_passes();
+  bool range_due() const;       // one more range frame fits the pass budget
+  bool filter_due_now() const;  // the queued Filter step would run the filter
 
   int width_, height_;
   PreviewSettings settings_;
@@ -155,6 +171,8 @@ class Preview {
   std::array<uint32_t, kBlendCaseCount> case_counts_{};
   std::vector<double> recent_frame_ms_;  // path tracing of the last frames, for predictions
   double display_ms_ = 0;                // upload + blend + tone map of the newest display
+  std::deque<PassStep> pending_;         // queue_passes() not yet run
+  bool pending_last_frame_ = false;
 };
 
 }  // namespace pxf

@@ -87,6 +87,56 @@ TEST(BlendFactorCpu, GridAndRandomExtremes) {
   }
 }
 
+// The covariance term: g(s) = s^2 u + (1-s)^2 f + 2 s (1-s) w u, with the filter's centre weight w.
+double blend_variance(double s, double u, double f, double w) {
+  const double c = std::min(w * u, std::sqrt(u * f));
+  return s * s * u + (1 - s) * (1 - s) * f + 2 * s * (1 - s) * c;
+}
+
+TEST(BlendFactorCpu, CovarianceTermZeroWeightIsThePlainBlend) {
+  for (float t : thresholds())
+    for (float u : magnitudes())
+      for (float f : magnitudes()) {
+        const BlendDecision a = blend_decision(u, f, t), b = blend_decision(u, f, t, 0.0f);
+        EXPECT_EQ(a.s, b.s);
+        EXPECT_EQ(a.blend_case, b.blend_case);
+      }
+}
+
+TEST(BlendFactorCpu, CovarianceTermHitsTheThreshold) {
+  // By hand: u = 0.04, f = 0.01, w = 0.25, t = 0.01. Without the term s = 0.4, whose true variance
+  // is 0.0064 + 0.0036 + 0.0048 = 0.0148 = 1.48 t; with it the minimum of g is f itself, s = 0.
+  EXPECT_NEAR(blend_decision(0.04f, 0.01f, 0.01f).s, 0.4f, 1e-6f);
+  EXPECT_NEAR(blend_variance(0.4, 0.04, 0.01, 0.25), 0.0148, 1e-9);
+  EXPECT_NEAR(blend_decision(0.04f, 0.01f, 0.01f, 0.25f).s, 0.0f, 1e-6f);
+  // u = 0.04, f = 0.005: s = -0.2 + sqrt(0.006 / 0.025) = 0.28990.
+  const BlendDecision d = blend_decision(0.04f, 0.005f, 0.01f, 0.25f);
+  EXPECT_EQ(d.blend_case, kCaseMixed);
+  EXPECT_NEAR(d.s, -0.2 + std::sqrt(0.24), 1e-6);
+  // w = 1 and f = u: the filter returned the pixel itself, g(s) = u > t for every s: case 1.
+  EXPECT_EQ(blend_decision(0.04f, 0.04f, 0.01f, 1.0f).blend_case, kCaseFilteredOnly);
+  // Random u, f >= w^2 u (the filter's variance holds the centre's share), t and w: s in [0, 1]; in
+  // case 3 g(s) = t unless s was clamped to 1; in case 1 t lies below g on all of [0, 1] (sampled).
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> e(-6.0f, 2.0f), unit(0.0f, 1.0f);
+  int mixed = 0;
+  for (int i = 0; i < 100000; ++i) {
+    const float u = std::pow(10.0f, e(rng)), w = unit(rng), t = std::pow(10.0f, e(rng) / 2.0f - 1.0f);
+    const float f = w * w * u + std::pow(10.0f, e(rng));
+    const BlendDecision d = blend_decision(u, f, t, w);
+    SCOPED_TRACE(testing::Message() << "u=" << u << " f=" << f << " t=" << t << " w=" << w);
+    ASSERT_TRUE(d.s >= 0.0f && d.s <= 1.0f);
+    if (d.blend_case == kCaseMixed && d.s < 1.0f) {
+      ++mixed;
+      ASSERT_NEAR(blend_variance(d.s, u, f, w), t, 1e-4 * t + 1e-6 * std::max(u, f));
+    }
+    if (d.blend_case == kCaseFilteredOnly)
+      for (int k = 0; k <= 100; ++k) ASSERT_GT(blend_variance(k / 100.0, u, f, w), t * (1 - 1e-4));
+    if (d.blend_case == kCaseUnfiltered) ASSERT_LE(u, t);
+  }
+  EXPECT_GT(mixed, 1000);
+}
+
 // s from the shader for (u, f) pairs: L_lv = 0, L_f = (1,1,1) so L_b = 1, Var[L_u] = u, Var[L_f] = f.
 TEST(BlendFactorShader, MatchesCpuOnGridAndBoundaries) {
   test::osmesa_context();

@@ -15,17 +15,20 @@ BlendPass::BlendPass(int width, int height)
 
 void BlendPass::run(const PreviewInputs& inputs, const FilterPass* filtered, const Texture2D& guide,
                     const BlendParams& params) {
-  run(inputs, filtered && filtered->has_output() ? &filtered->output() : nullptr, &guide, params);
+  const bool has = filtered && filtered->has_output();
+  run(inputs, has ? &filtered->output() : nullptr, &guide, params, has ? filtered->centre_weight() : nullptr);
 }
 
 void BlendPass::run(const PreviewInputs& inputs, const Texture2D* filtered, const Texture2D* guide,
-                    const BlendParams& params) {
+                    const BlendParams& params, const Texture2D* centre_weight) {
   auto other_size = [&](const Texture2D* tex) { return tex && (tex->width() != width_ || tex->height() != height_); };
-  if (inputs.width() != width_ || inputs.height() != height_ || other_size(filtered) || other_size(guide))
+  if (inputs.width() != width_ || inputs.height() != height_ || other_size(filtered) || other_size(guide) ||
+      other_size(centre_weight))
     throw Error("blend pass: input size differs from the pass size");
   timer_.begin();
   program_.set("has_filtered", filtered ? 1 : 0);
   program_.set("has_guide", guide ? 1 : 0);
+  program_.set("has_centre_weight", filtered && centre_weight ? 1 : 0);
   program_.set("k_c", params.range.k_c);
   program_.set("k_d", params.range.k_d);
   program_.set("t", params.t);
@@ -37,6 +40,7 @@ void BlendPass::run(const PreviewInputs& inputs, const Texture2D* filtered, cons
   // Unused units still get a texture, so every sampler is valid.
   if (filtered) filtered->bind(2); else inputs.hv().bind(2);
   if (guide) guide->bind(3); else inputs.hv().bind(3);
+  if (centre_weight) centre_weight->bind(4); else inputs.hv().bind(4);
   program_.use();
   quad_.draw(fbo_, width_, height_);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);

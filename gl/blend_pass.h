@@ -23,7 +23,10 @@ class BlendPass {
   void run(const PreviewInputs& inputs, const FilterPass* filtered, const Texture2D& guide, const BlendParams& params);
   // Same with a raw L_f texture (rgb L_f, a Var[L_f]); guide == nullptr: u from each pixel's own
   // variance (no pooling). Used by tests and custom filters.
-  void run(const PreviewInputs& inputs, const Texture2D* filtered, const Texture2D* guide, const BlendParams& params);
+  // centre_weight (r: the filter's normalized centre weight, FilterPass::centre_weight()) adds the
+  // covariance of L_u and L_f to the blend's variance; nullptr leaves it out.
+  void run(const PreviewInputs& inputs, const Texture2D* filtered, const Texture2D* guide, const BlendParams& params,
+           const Texture2D* centre_weight = nullptr);
 
   const Texture2D& output() const { return output_; }       // rgb L, a s
   const Texture2D& case_texture() const { return case_; }   // r: BlendCase code

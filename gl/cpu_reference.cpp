@@ -242,6 +242,7 @@ struct KernelSums {
     out.variance.at(x, y, 0) =
         w_known > 0 ? static_cast<float>(variance_factor * (w2_var_known + w2_unknown * (w_var_known / w_known)) / (w * w))
                     : kVarUnknown;
+    if (!out.centre_weight.pixels.empty()) out.centre_weight.at(x, y, 0) = static_cast<float>(1.0 / w);
   }
 };
 
@@ -315,6 +316,24 @@ BlendDecision blend_decision(float u, float f, float t) {
   return {std::clamp(s, 0.0f, 1.0f), kCaseMixed};
 }
 
+BlendDecision blend_decision(float u, float f, float t, float w) {
+  const BlendDecision plain = blend_decision(u, f, t);
+  if (!(w > 0.0f) || plain.blend_case == kCaseUnfiltered || !std::isfinite(u) || !std::isfinite(f)) return plain;
+  if (!(t >= 0.0f)) t = 0.0f;
+  u = std::max(u, 0.0f);
+  f = std::max(f, 0.0f);
+  // Scaled by hi = max(u, f) > t as above; double keeps the products of the scaled values.
+  const double hi = std::max(u, f), uh = u / hi, fh = f / hi, th = t / hi;
+  const double c = std::min(static_cast<double>(std::min(w, 1.0f)) * uh, std::sqrt(uh * fh));
+  const double a = uh + fh - 2.0 * c;  // >= (sqrt(uh) - sqrt(fh))^2 >= 0
+  if (!(a > 1e-12)) return {0.0f, kCaseFilteredOnly};  // g(s) = f = u > t for every s
+  // g's minimum lies at s* = (f - c) / a, below 0 where c > f: then the lowest g on [0, 1] is g(0) = f.
+  const double s_min = (fh - c) / a, g_min = std::max(0.0, (uh * fh - c * c) / a);
+  if (th < (s_min >= 0.0 ? g_min : fh)) return {0.0f, kCaseFilteredOnly};
+  const double s = s_min + std::sqrt((th - g_min) / a);
+  return {static_cast<float>(std::clamp(s, 0.0, 1.0)), kCaseMixed};
+}
+
 namespace {
 
 // One bilateral pass over `signal` (rgb) with variance `signal_var`, kernel extent (ex, ey) times
@@ -323,7 +342,7 @@ FilterOutput filter_once(const Image& signal, const Image& signal_var, const Ima
                          const Image& lv, const Image& range_color, const Image& depth, const FilterParams& p,
                          int ex, int ey, bool final_pass) {
   const int w = hv.width, h = hv.height;
-  FilterOutput out{Image::rgb(w, h), Image::gray(w, h)};
+  FilterOutput out{Image::rgb(w, h), Image::gray(w, h), Image::gray(w, h, "Y", 1.0f)};
   const int radius = std::min(kMaxFilterRadius, static_cast<int>(std::ceil(3.0f * std::max(p.sigma_s, 0.0f))));
   const float ks = inv_two_sigma2(p.sigma_s);
   const RangeWeights range = range_weights(p);
@@ -419,7 +438,9 @@ FilterOutput cpu_filter(const Image& hv, const Image& var_u, const Image& lv, co
   if (p.kind == FilterKind::Grid) return cpu_grid_filter(hv, var_u, lv, range_color, depth, p);
   if (p.kind != FilterKind::Separable) return filter_once(hv, var_u, hv, var_u, lv, range_color, depth, p, 1, 1, true);
   FilterOutput rows = filter_once(hv, var_u, hv, var_u, lv, range_color, depth, p, 1, 0, false);
-  return filter_once(rows.filtered, rows.variance, hv, var_u, lv, range_color, depth, p, 0, 1, true);
+  FilterOutput out = filter_once(rows.filtered, rows.variance, hv, var_u, lv, range_color, depth, p, 0, 1, true);
+  out.centre_weight = Image();  // the second pass's centre weight alone would understate it: none
+  return out;
 }
 
 BlendOutput cpu_blend(const Image& lv, const Image& hv, const Image& var_u, const FilterOutput* filtered,
@@ -445,7 +466,8 @@ BlendOutput cpu_blend(const Image& lv, const Image& hv, const Image& var_u, cons
           float lb = std::max(lum(lf.c) + lum(l.c), 0.0f);
           if (pool) vu = pooled_var_u(var_u, *range_color, *depth, x, y, params.range);
           float u = vu > 0.0f ? relative_variance(vu, lb) : zero_variance_u(lum(lf.c), lb);
-          d = blend_decision(u, relative_variance(vf, lb), params.t);
+          const float w_centre = filtered->centre_weight.pixels.empty() ? 0.0f : filtered->centre_weight.at(x, y, 0);
+          d = blend_decision(u, relative_variance(vf, lb), params.t, w_centre);
         }
       }
       for (int c = 0; c < 3; ++c)

@@ -19,6 +19,12 @@ struct BlendDecision {
 // after scaling by max(u, f) so that no intermediate overflows: case 2 (u <= t) first, then
 // case 1 (D < 0), else case 3. NaN u or f count as +inf, NaN or negative t as 0.
 BlendDecision blend_decision(float u, float f, float t);
+// The same with the covariance of L_u and L_f: the filter averages each pixel's own samples with
+// normalized centre weight w (0..1), so Cov[L_u, L_f] = w Var[L_u] and the blend's relative
+// variance is g(s) = s^2 u + (1-s)^2 f + 2 s (1-s) w u. Case 2 as above; case 1 where t is below
+// the minimum of g on [0, 1]: (u f - c^2) / (u + f - 2c) with c = w u (clamped to sqrt(u f),
+// Cauchy-Schwarz), or f where that minimum lies at s < 0 (c > f); case 3 the larger root of g(s) = t. w <= 0 (or NaN), or u or f infinite: blend_decision(u, f, t).
+BlendDecision blend_decision(float u, float f, float t, float w);
 inline float blend_factor(float u, float f, float t) { return blend_decision(u, f, t).s; }
 // var / lb^2 without overflow in the intermediate: 0 when var <= 0, +inf when lb <= 0.
 float relative_variance(float var, float lb);
@@ -35,6 +41,9 @@ float pooled_var_u(const Image& var_u, const Image& range_color, const Image& de
 struct FilterOutput {
   Image filtered;  // "R,G,B": L_f (L_u where skipped)
   Image variance;  // "Y": Var[L_f]; kVarUnknown, or kVarSkipped where skipped
+  // "Y": the normalized weight of the pixel's own L_u in its L_f (1 / sum w for the full bilateral
+  // kernel, 1 where skipped), for the blend's covariance term; empty for the other variants.
+  Image centre_weight;
 };
 FilterOutput cpu_filter(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
                         const Image& depth, const FilterParams& params);

@@ -17,7 +17,7 @@
 //   demod.demodulate(inputs, guide, filter_params);
 //   filter.run(demod.filter_inputs(), guide, filter_params);
 //   demod.remodulate(filter.output(), inputs);
-//   blend.run(inputs, &demod.output(), &guide, blend_params);
+//   blend.run(inputs, &demod.output(), &guide, blend_params, filter.centre_weight());  // w unchanged
 #pragma once
 #include "gl/inputs.h"
 #include "gl/preview_params.h"

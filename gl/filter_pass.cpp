@@ -8,8 +8,10 @@ namespace pxf {
 
 FilterPass::FilterPass(int width, int height)
     : width_(width), height_(height), program_(Program::from_embedded("fullscreen.vert", "bilateral.frag")),
-      output_(width, height, TextureFormat::RGBA32F), counter_(sizeof(uint32_t)) {
+      output_(width, height, TextureFormat::RGBA32F), centre_weight_(width, height, TextureFormat::R32F),
+      counter_(sizeof(uint32_t)) {
   fbo_.attach(0, output_);
+  fbo_.attach(1, centre_weight_);
   fbo_.check("filter pass");
 }
 
@@ -23,6 +25,7 @@ void FilterPass::run(const PreviewInputs& inputs, const Texture2D& guide, const 
   inputs.hv().bind(0);
   inputs.lv().bind(1);
   guide.bind(2);
+  centre_weight_valid_ = p.kind == FilterKind::Bilateral || p.kind == FilterKind::BilateralDepth;
   if (p.kind == FilterKind::Atrous)
     run_atrous(inputs, p);
   else if (p.kind == FilterKind::Subsampled)
@@ -127,6 +130,7 @@ uint32_t FilterPass::filtered_pixels() const {
   return n;
 }
 
+Image FilterPass::centre_weight_image() const { return centre_weight_.download({"Y"}); }
 Image FilterPass::filtered_image() const { return output_.download({"R", "G", "B"}); }
 
 Image FilterPass::raw_variance_image() const {

@@ -27,9 +27,16 @@ class FilterPass {
   bool has_output() const { return runs_ > 0; }
   int runs() const { return runs_; }
   const Texture2D& output() const { return output_; }  // rgb L_f, a Var[L_f] or a sentinel
+  // r: the normalized weight of each pixel's own L_u in its L_f, for the blend's covariance term.
+  // Written by the full-kernel bilateral variants (bilateral, bilateral-depth) only; nullptr after
+  // the others (the blend then leaves Cov[L_u, L_f] out).
+  const Texture2D* centre_weight() const { return has_output() && centre_weight_valid_ ? &centre_weight_ : nullptr; }
+  Image centre_weight_image() const;  // "Y"
   // Pixels actually filtered (not skipped) by the last run; 0 = every pixel was in case 2.
   uint32_t filtered_pixels() const;
   double last_ms() const { return timer_.last_ms(); }
+  // The grid variant's step times of its last run (GridFilter::last_step_ms); nullptr before one.
+  const GridFilter* grid() const { return grid_.get(); }
 
   Image filtered_image() const;  // "R,G,B" L_f
   Image variance_image() const;  // "Y" Var[L_f], 0 where unknown or skipped
@@ -49,6 +56,8 @@ class FilterPass {
   Buffer subsampled_taps_;      // subsampled_tap_table() of the last run's sigma_s and tap count
   std::pair<float, int> subsampled_key_{-1.0f, 0};
   Texture2D output_;
+  Texture2D centre_weight_;  // attachment 1 of fbo_
+  bool centre_weight_valid_ = false;
   Framebuffer fbo_;
   Buffer counter_;
   // Intermediate results: the separable's horizontal pass (scratch_[0]); the à-trous passes

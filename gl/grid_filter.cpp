@@ -22,6 +22,7 @@ void GridFilter::run(const FilterParams& p, const Framebuffer& target) {
   const glm::ivec2 grid_xy(layout_.nx, layout_.ny);
   const float inv_cell_s = 1.0f / layout_.cell_s;
   const uint32_t initial_bounds[2] = {0x7f7fffffu, 0u};  // FLT_MAX, +0
+  step_timer_.begin();
   bounds_buffer_.upload(initial_bounds, sizeof initial_bounds);
   bounds_buffer_.bind_storage(4);
 
@@ -30,15 +31,19 @@ void GridFilter::run(const FilterParams& p, const Framebuffer& target) {
   glDispatchCompute((strips + 63) / 64, 1, 1);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
 
+  step_ms_[0] = step_timer_.end();
+  step_timer_.begin();
   splat_.set("grid_xy", grid_xy);
   splat_.set("cell_s", layout_.cell_s);
   splat_.set("inv_cell_s", inv_cell_s);
-  splat_.set("sigma_c", p.sigma_c);
+  splat_.set("min_cell_z", grid_min_cell_z(p.sigma_c));
   splat_.use();
   grid_[0].bind_storage(1);
   glDispatchCompute((layout_.nx + 7) / 8, (layout_.ny + 7) / 8, 1);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
 
+  step_ms_[1] = step_timer_.end();
+  step_timer_.begin();
   blur_.set("grid_xy", grid_xy);
   blur_.set("grid_z_cells", layout_.nz);
   blur_.use();
@@ -51,10 +56,12 @@ void GridFilter::run(const FilterParams& p, const Framebuffer& target) {
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
   }
 
+  step_ms_[2] = step_timer_.end();
+  step_timer_.begin();
   const RangeWeights range = range_weights(p);
   slice_.set("grid_xy", grid_xy);
   slice_.set("inv_cell_s", inv_cell_s);
-  slice_.set("sigma_c", p.sigma_c);
+  slice_.set("min_cell_z", grid_min_cell_z(p.sigma_c));
   slice_.set("k_c", range.k_c);
   slice_.set("k_d", range.k_d);
   slice_.set("skip_case2", p.skip_case2 ? 1 : 0);
@@ -62,6 +69,7 @@ void GridFilter::run(const FilterParams& p, const Framebuffer& target) {
   slice_.use();
   grid_[0].bind_storage(1);
   quad_.draw(target, width_, height_);
+  step_ms_[3] = step_timer_.end();
 }
 
 }  // namespace pxf

@@ -5,6 +5,7 @@
 // per-pixel trilinear slice with the case-2 skip (grid_slice.frag), which writes FilterPass's
 // output. Layout and the variance it computes: gl/grid_layout.h, gl/grid_reference.cpp.
 #pragma once
+#include <array>
 #include "gl/grid_layout.h"
 #include "gl/inputs.h"
 #include "gl/resources.h"
@@ -17,6 +18,9 @@ class GridFilter {
   // Expects FilterPass's bindings: HV at texture unit 0, LV at 1, the guide at 2, the filtered-pixel
   // counter at storage binding 0. Draws rgb L_f, a Var[L_f] into `target`.
   void run(const FilterParams& params, const Framebuffer& target);
+  // ms of the last run's steps (bounds, splat, blur, slice) while GL timing is on (the bench), else 0.
+  static constexpr const char* kStepNames[4] = {"bounds", "splat", "blur", "slice"};
+  const std::array<double, 4>& last_step_ms() const { return step_ms_; }
 
  private:
   void resize_grid(const GridLayout& layout);
@@ -27,6 +31,8 @@ class GridFilter {
   Buffer grid_[2];  // ping-pong: splat (and blur z) into 0, blur x -> 1, y -> 0, slice from 0
   GridLayout layout_;
   FullscreenPass quad_;
+  StageTimer step_timer_;
+  std::array<double, 4> step_ms_{};
 };
 
 }  // namespace pxf

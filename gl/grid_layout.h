@@ -18,12 +18,18 @@
 
 namespace pxf {
 
-// Range cells along z. The range color's luminance spans [0, 1] (albedo x shading), i.e. 50 cells
+// Cells are kGridCellPerSigma sigmas wide, in x and y (sigma_s) and in z (sigma_c). The effective
+// kernel along an axis is the nearest-cell splat (a box: variance 1/12 cell^2), the blur (1/2 cell^2)
+// and the slice's linear interpolation (a tent: 1/6 cell^2), 3/4 cell^2 in all, i.e. a standard
+// deviation of 1.08 sigma at 1.25 (the 5-tap blur on cells of one sigma gave 1.12 sigma, with 2.9x
+// the blur work: 1.8x the cells, 5 taps instead of 3).
+constexpr float kGridCellPerSigma = 1.25f;
+// Range cells along z. The range color's luminance spans [0, 1] (albedo x shading), i.e. 40 cells
 // at the default sigma_c = 0.02; a wider span stretches the cells (cell_z grows) instead of
 // growing the grid, which widens the range kernel proportionally.
-constexpr int kGridRangeCells = 48;
-// Spatial cells are sigma_s pixels wide, but at least this: below it the grid would have more cells
-// than the image has pixels, and the exact kernel is cheap anyway.
+constexpr int kGridRangeCells = 40;
+// Spatial cells are at least this wide: below it the grid would have more cells than the image has
+// pixels, and the exact kernel is cheap anyway.
 constexpr float kGridMinCellPx = 4.0f;
 
 struct GridLayout {
@@ -36,29 +42,34 @@ struct GridLayout {
 // that the slice's corners floor(u) and floor(u) + 1 both exist (same in y).
 inline GridLayout grid_layout(int width, int height, const FilterParams& p) {
   GridLayout g;
-  g.cell_s = std::max(p.sigma_s, kGridMinCellPx);
+  g.cell_s = std::max(p.sigma_s * kGridCellPerSigma, kGridMinCellPx);
   g.nx = static_cast<int>(std::floor(float(std::max(width, 1) - 1) / g.cell_s)) + 2;
   g.ny = static_cast<int>(std::floor(float(std::max(height, 1) - 1) / g.cell_s)) + 2;
   return g;
 }
 
-// Range cell size from the guide's luminance span [y_min, y_max]: sigma_c, stretched so that the
-// span fits the kGridRangeCells cells (z in [0, nz - 1]).
+// Smallest range cell: kGridCellPerSigma sigma_c (the shaders get it as a uniform).
+inline float grid_min_cell_z(float sigma_c) { return std::max(sigma_c * kGridCellPerSigma, 1.0e-6f); }
+
+// Range cell size from the guide's luminance span [y_min, y_max]: grid_min_cell_z, stretched so that
+// the span fits the kGridRangeCells cells (z in [0, nz - 1]).
 inline float grid_cell_z(float y_min, float y_max, float sigma_c) {
-  return std::max(std::max(sigma_c, 1.0e-6f), (y_max - y_min) / float(kGridRangeCells - 1));
+  return std::max(grid_min_cell_z(sigma_c), (y_max - y_min) / float(kGridRangeCells - 1));
 }
 
-// The grid blur, along each axis in turn: the B3-spline taps 1/16 [1 4 6 4 1] (a standard deviation
-// of one cell, as Chen et al. blur with a Gaussian of one cell). Taps outside the grid are left out.
-constexpr float kGridBlurTaps[5] = {1.0f / 16, 4.0f / 16, 6.0f / 16, 4.0f / 16, 1.0f / 16};
+// The grid blur, along each axis in turn: the binomial taps 1/4 [1 2 1] (a variance of 1/2 cell^2;
+// Chen et al. blur with a Gaussian of one cell, which needs 5 taps). Taps outside the grid are left
+// out.
+constexpr int kGridBlurRadius = 1;
+constexpr float kGridBlurTaps[2 * kGridBlurRadius + 1] = {0.25f, 0.5f, 0.25f};
 
 // Var[L_f] correction for the interpolation along one spatial axis at fraction a (see
 // grid_reference.cpp): the two interpolated cells are correlated (the blur spreads each pixel into
 // both), which the squared interpolation weights ignore. With G0 = sum g^2 and G1 = sum g(k) g(k+1)
-// of the blur taps, the exact variance over uniformly occupied cells is (a0^2 + a1^2) G0 + 2 a0 a1 G1
-// against (a0^2 + a1^2) G0 propagated.
+// of the blur taps (6/16 and 4/16 for 1/4 [1 2 1]), the exact variance over uniformly occupied cells
+// is (a0^2 + a1^2) G0 + 2 a0 a1 G1 against (a0^2 + a1^2) G0 propagated.
 inline float grid_interpolation_correction(float a) {
-  constexpr float g0 = 70.0f / 256.0f, g1 = 56.0f / 256.0f;
+  constexpr float g0 = 6.0f / 16.0f, g1 = 4.0f / 16.0f;
   const float b = 1.0f - a;
   return 1.0f + 2.0f * a * b * g1 / (g0 * (a * a + b * b));
 }

@@ -70,8 +70,8 @@ Grid splat(const Image& hv, const Image& var_u, const Image& range_color, const 
                                     : Cell{clean(hv.at(x, y, 0)), clean(hv.at(x, y, 1)), clean(hv.at(x, y, 2)), 1.0f,
                                            0.0f, 1.0f, 0.0f, 0.0f};
       // The z pass of the blur, per pixel (as grid_splat.comp does).
-      for (int t = 0; t < 5; ++t) {
-        const int q = k + t - 2;
+      for (int t = 0; t <= 2 * kGridBlurRadius; ++t) {
+        const int q = k + t - kGridBlurRadius;
         if (q < 0 || q >= kGridRangeCells) continue;
         Cell& c = g.cells[g.index(nearest_cell(float(x) * inv_cell_s), nearest_cell(float(y) * inv_cell_s), q)];
         add_weighted(c, pixel, kGridBlurTaps[t]);
@@ -90,9 +90,9 @@ void blur(Grid& g, int axis) {
       for (int i = 0; i < l.nx; ++i) {
         const int c[3] = {i, j, k};
         Cell sum{};
-        for (int t = 0; t < 5; ++t) {
+        for (int t = 0; t <= 2 * kGridBlurRadius; ++t) {
           int q[3] = {i, j, k};
-          q[axis] = c[axis] + t - 2;
+          q[axis] = c[axis] + t - kGridBlurRadius;
           if (q[axis] < 0 || q[axis] >= n[axis]) continue;
           add_weighted(sum, g.cells[g.index(q[0], q[1], q[2])], kGridBlurTaps[t]);
         }

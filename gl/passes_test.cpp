@@ -100,6 +100,11 @@ TEST_P(FilterVsCpu, MatchesReference) {
   FilterOutput ref = cpu_filter(s.hv, s.var, s.lv, s.range, s.depth, p);
   expect_close(filter.filtered_image(), ref.filtered, 1e-4f, 1e-7f, "L_f");
   expect_close(filter.raw_variance_image(), ref.variance, 1e-4f, 1e-12f, "Var[L_f]");
+  // The centre weight for the blend's covariance term: the full-kernel variants only.
+  ASSERT_EQ(filter.centre_weight() != nullptr, !ref.centre_weight.pixels.empty());
+  if (filter.centre_weight()) {
+    expect_close(filter.centre_weight_image(), ref.centre_weight, 1e-4f, 1e-7f, "centre weight");
+  }
   size_t skipped = 0;
   for (float v : ref.variance.pixels) skipped += v == kVarSkipped;
   if (skip) {
@@ -459,6 +464,43 @@ TEST(BlendVsCpu, MatchesReferenceWithFilteredInput) {
   }
 }
 
+// The full bilateral's centre weight feeds the blend's covariance term: GPU against CPU, and the
+// term changes s where the blend mixes (it can only lower s or keep it).
+TEST(BlendVsCpu, CovarianceTermFromTheFiltersCentreWeight) {
+  test::osmesa_context();
+  Scenario s = make_scenario(13);
+  GpuFixture gpu(s);
+  FilterParams fp;
+  fp.kind = FilterKind::BilateralDepth;
+  fp.sigma_s = 2.0f;
+  FilterPass filter(W, H);
+  BlendPass blend(W, H);
+  FilterOutput ref_f = cpu_filter(s.hv, s.var, s.lv, s.range, s.depth, fp);
+  FilterOutput ref_plain = ref_f;
+  ref_plain.centre_weight = Image();
+  size_t changed = 0;
+  for (float t : {0.001f, 0.02f, 0.2f}) {
+    SCOPED_TRACE(testing::Message() << "t=" << t);
+    fp.t = t;
+    filter.run(gpu.inputs, gpu.guide, fp);
+    ASSERT_NE(filter.centre_weight(), nullptr);
+    const BlendParams bp{t, range_weights(fp)};
+    blend.run(gpu.inputs, &filter, gpu.guide, bp);
+    ref_f = cpu_filter(s.hv, s.var, s.lv, s.range, s.depth, fp);
+    BlendOutput ref = cpu_blend(s.lv, s.hv, s.var, &ref_f, bp, &s.range, &s.depth);
+    ref_plain = ref_f;
+    ref_plain.centre_weight = Image();
+    BlendOutput plain = cpu_blend(s.lv, s.hv, s.var, &ref_plain, bp, &s.range, &s.depth);
+    expect_close(blend.s_image(), ref.s, 1e-4f, 1e-4f, "s");
+    expect_close(blend.case_image(), ref.blend_case, 0.0f, 0.0f, "case");
+    for (size_t i = 0; i < ref.s.pixels.size(); ++i) {
+      EXPECT_LE(ref.s.pixels[i], plain.s.pixels[i] + 1e-6f) << i;
+      changed += ref.s.pixels[i] < plain.s.pixels[i] - 1e-3f;
+    }
+  }
+  EXPECT_GT(changed, 0u);
+}
+
 TEST(BlendVsCpu, NoFilteredValueMeansUnfiltered) {
   test::osmesa_context();
   Scenario s = make_scenario(5);
@@ -593,7 +635,9 @@ TEST_P(DemodulationVsCpu, MatchesReference) {
   // The blend sees the remodulated L_f and Var[L_f].
   const BlendParams bp{p.t, range_weights(p)};
   BlendPass blend(W, H);
-  blend.run(gpu.inputs, &demod.output(), &gpu.guide, bp);
+  // The filter's centre weight (bilateral variants) is unchanged by demodulation: Cov[L_u, L_f] =
+  // w Var[L_u] with a grey factor.
+  blend.run(gpu.inputs, &demod.output(), &gpu.guide, bp, filter.centre_weight());
   const BlendOutput rb = cpu_blend(s.lv, s.hv, s.var, &ref, bp, &s.range, &s.depth);
   expect_close(blend.final_image(), rb.final_rgb, 2e-4f, 1e-6f, "final");
   expect_close(blend.case_image(), rb.blend_case, 0.0f, 0.0f, "case");

@@ -78,13 +78,21 @@ void RangePass::set_scene(const Scene& scene) {
   textures_.clear();
   materials_ = scene.materials;
   has_specular_material_ = false;
-  for (const Texture& t : scene.textures) {
-    if (t.width <= 0 || t.height <= 0 || t.texels.size() < static_cast<size_t>(t.width) * t.height) {
-      textures_.emplace_back();  // invalid: the white texture is bound instead
+  // The range color reads base color textures only; 8-bit ones stay 8-bit (GL decodes sRGB).
+  std::vector<bool> base_color(scene.textures.size(), false);
+  for (const Material& m : scene.materials)
+    if (m.base_color_texture.valid() && m.base_color_texture.texture < static_cast<int>(base_color.size()))
+      base_color[m.base_color_texture.texture] = true;
+  for (size_t i = 0; i < scene.textures.size(); ++i) {
+    const Texture& t = scene.textures[i];
+    if (!base_color[i] || !t.valid()) {
+      textures_.emplace_back();  // unused or invalid: the white texture is bound instead
       continue;
     }
-    Texture2D tex(t.width, t.height, TextureFormat::RGBA32F);
-    tex.upload(&t.texels[0].x, 4);
+    Texture2D tex(t.width, t.height,
+                  t.is_8bit() ? (t.srgb ? TextureFormat::SRGB8_ALPHA8 : TextureFormat::RGBA8) : TextureFormat::RGBA32F);
+    if (t.is_8bit()) tex.upload_rgba8(t.texels8->data());
+    else tex.upload(&t.texels[0].x, 4);
     tex.set_filter(!t.nearest);  // bilinear without mipmaps, as the path tracer samples
     tex.set_wrap(gl_wrap(t.wrap_s), gl_wrap(t.wrap_t));
     textures_.push_back(std::move(tex));

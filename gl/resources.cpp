@@ -38,6 +38,7 @@ FormatInfo info(TextureFormat f) {
     case TextureFormat::RG32F: return {GL_RG32F, GL_RG, GL_FLOAT, 2};
     case TextureFormat::RGBA32F: return {GL_RGBA32F, GL_RGBA, GL_FLOAT, 4};
     case TextureFormat::RGBA8: return {GL_RGBA8, GL_RGBA, GL_FLOAT, 4};
+    case TextureFormat::SRGB8_ALPHA8: return {GL_SRGB8_ALPHA8, GL_RGBA, GL_FLOAT, 4};
     case TextureFormat::Depth32F: return {GL_DEPTH_COMPONENT32F, GL_DEPTH_COMPONENT, GL_FLOAT, 1};
   }
   return {GL_RGBA32F, GL_RGBA, GL_FLOAT, 4};
@@ -153,6 +154,11 @@ Texture2D::~Texture2D() {
 void Texture2D::upload(const float* data, int components) {
   glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
   glTextureSubImage2D(name_.id, 0, 0, 0, width_, height_, components_format(components), GL_FLOAT, data);
+}
+
+void Texture2D::upload_rgba8(const unsigned char* data) {
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glTextureSubImage2D(name_.id, 0, 0, 0, width_, height_, GL_RGBA, GL_UNSIGNED_BYTE, data);
 }
 
 void Texture2D::upload(const Image& image) {

@@ -79,7 +79,7 @@ class Program {
   std::string files_;
 };
 
-enum class TextureFormat { R32F, RG32F, RGBA32F, RGBA8, Depth32F };
+enum class TextureFormat { R32F, RG32F, RGBA32F, RGBA8, SRGB8_ALPHA8, Depth32F };
 int texture_format_channels(TextureFormat format);
 
 class Texture2D {
@@ -99,6 +99,8 @@ class Texture2D {
   // Uploads `components` floats per texel (1..4), top row first, into the whole level 0
   // (one glTextureSubImage2D). Missing components read as 0 (alpha 1).
   void upload(const float* data, int components);
+  // 4 bytes a texel, RGBA (RGBA8 and SRGB8_ALPHA8 textures).
+  void upload_rgba8(const unsigned char* data);
   // Upload of an image of the same size; its channel count picks the components.
   void upload(const Image& image);
   // Read-back of level 0 as floats with the given channel names (1..4 of them).

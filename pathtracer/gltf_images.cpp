@@ -4,10 +4,35 @@
 #include <tiny_gltf.h>
 
 #include <climits>
-
-#include "pathtracer/gltf_accessor.h"
+#include <cstdint>
+#include <cstring>
 
 namespace pxf::gltf {
+
+ImageHeader probe_image(const unsigned char* bytes, size_t size) {
+  ImageHeader header;
+  if (size == 0 || size > static_cast<size_t>(INT_MAX)) return header;
+  int len = static_cast<int>(size);
+  if (!stbi_info_from_memory(bytes, len, &header.width, &header.height, &header.channels)) {
+    // stb refuses PNG headers whose image would exceed 1 GiB; the size is still worth reporting.
+    static const unsigned char kPng[] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n', 0, 0, 0, 13, 'I', 'H', 'D', 'R'};
+    if (size < 26 || std::memcmp(bytes, kPng, sizeof kPng) != 0) return ImageHeader{};
+    auto u32 = [&](size_t at) {
+      return (uint32_t(bytes[at]) << 24) | (uint32_t(bytes[at + 1]) << 16) | (uint32_t(bytes[at + 2]) << 8) | bytes[at + 3];
+    };
+    const uint32_t w = u32(16), h = u32(20);
+    if (w == 0 || h == 0 || w > INT_MAX || h > INT_MAX) return ImageHeader{};
+    header.width = static_cast<int>(w);
+    header.height = static_cast<int>(h);
+    header.channels = 4;
+    header.bits = bytes[24] == 16 ? 16 : 8;
+    header.ok = true;
+    return header;
+  }
+  header.bits = stbi_is_hdr_from_memory(bytes, len) ? 32 : stbi_is_16_bit_from_memory(bytes, len) ? 16 : 8;
+  header.ok = header.width > 0 && header.height > 0;
+  return header;
+}
 
 bool decode_image(const unsigned char* bytes, size_t size, DecodedImage& out) {
   out = DecodedImage{};
@@ -36,11 +61,11 @@ bool decode_image(const unsigned char* bytes, size_t size, DecodedImage& out) {
       stbi_image_free(data);
     }
   } else {
-    stbi_uc* data = stbi_load_from_memory(bytes, len, &w, &h, &c, 0);
+    // Expanded to RGBA by stb: gray to (g, g, g), a missing alpha to 255.
+    stbi_uc* data = stbi_load_from_memory(bytes, len, &w, &h, &c, 4);
     if (data) {
-      n = static_cast<size_t>(w) * h * c;
-      out.values.resize(n);
-      for (size_t i = 0; i < n; ++i) out.values[i] = data[i] / 255.0f;
+      n = static_cast<size_t>(w) * h * 4;
+      out.bytes.assign(data, data + n);
       stbi_image_free(data);
     }
   }
@@ -57,35 +82,34 @@ bool decode_image(const unsigned char* bytes, size_t size, DecodedImage& out) {
   return true;
 }
 
+bool keep_image_bytes(ImageStore& store, int index, const unsigned char* bytes, int size) {
+  if (index < 0) return true;
+  if (store.encoded_.size() <= static_cast<size_t>(index)) store.encoded_.resize(index + 1);
+  if (bytes && size > 0) store.encoded_[index].assign(bytes, bytes + size);
+  return true;
+}
+
 namespace {
 
 // tinygltf's image callback. Images in buffer views are skipped here (their bytes are not yet
-// validated); everything else is decoded now. Always returns true so a bad texture never fails the
-// whole load.
+// validated); the others' bytes are kept for decoding once the loader knows which are used.
+// Always returns true so a bad texture never fails the whole load.
 bool load_image_callback(tinygltf::Image* image, const int image_index, std::string*, std::string*, int, int,
                          const unsigned char* bytes, int size, void* user) {
-  auto* store = static_cast<ImageStore*>(user);
-  if (image_index < 0) return true;
-  if (store->images.size() <= static_cast<size_t>(image_index)) store->images.resize(image_index + 1);
   if (image->bufferView >= 0) return true;
-  decode_image(bytes, size > 0 ? static_cast<size_t>(size) : 0, store->images[image_index]);
-  image->width = store->images[image_index].width;
-  image->height = store->images[image_index].height;
-  return true;
+  return keep_image_bytes(*static_cast<ImageStore*>(user), image_index, bytes, size);
 }
 
 }  // namespace
 
 void ImageStore::install(tinygltf::TinyGLTF& loader) { loader.SetImageLoader(load_image_callback, this); }
 
-void ImageStore::decode_buffer_view_images(const tinygltf::Model& model, const std::string& file) {
-  images.resize(model.images.size());
-  for (size_t i = 0; i < model.images.size(); ++i) {
-    const tinygltf::Image& image = model.images[i];
-    if (image.bufferView < 0) continue;
-    ByteRange bytes = buffer_view_bytes(model, image.bufferView, file, "image " + std::to_string(i));
-    decode_image(bytes.data, bytes.size, images[i]);
-  }
+ByteRange ImageStore::bytes(const tinygltf::Model& model, int index, const std::string& file) const {
+  if (index < 0 || index >= static_cast<int>(model.images.size())) return {};
+  const tinygltf::Image& image = model.images[index];
+  if (image.bufferView >= 0) return buffer_view_bytes(model, image.bufferView, file, "image " + std::to_string(index));
+  if (index >= static_cast<int>(encoded_.size()) || encoded_[index].empty()) return {};
+  return {encoded_[index].data(), encoded_[index].size()};
 }
 
 }  // namespace pxf::gltf

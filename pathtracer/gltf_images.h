@@ -1,9 +1,13 @@
 // Image decoding for the glTF loader. tinygltf hands us encoded bytes (external files and data
-// URIs); images stored in buffer views are decoded after the loader has validated the view, because
-// tinygltf does not bounds-check them. Decoding failures become warnings, never errors.
+// URIs), which the store keeps; images stored in buffer views are read after the loader has
+// validated the view, because tinygltf does not bounds-check them. Only the images a material
+// uses are decoded, after their headers have been checked against the limits, and in parallel.
+// Decoding failures become warnings, never errors.
 #pragma once
 #include <string>
 #include <vector>
+
+#include "pathtracer/gltf_accessor.h"
 
 namespace tinygltf {
 class Model;
@@ -14,20 +18,36 @@ namespace pxf::gltf {
 
 struct DecodedImage {
   int width = 0, height = 0, channels = 0;
-  int bits = 8;               // 8, 16 or 32 (HDR float)
-  std::vector<float> values;  // as stored, 8/16-bit scaled to [0,1], HDR as linear floats
+  int bits = 8;                       // 8, 16 or 32 (HDR float)
+  std::vector<unsigned char> bytes;   // 8-bit images: the codes as stored, expanded to RGBA
+  std::vector<float> values;          // 16-bit scaled to [0,1], HDR as linear floats
   bool decoded = false;
-  std::string failure;        // why decoding failed (empty when decoded)
+  std::string failure;                // why decoding failed (empty when decoded)
 };
 
-// Holds the decoded images by glTF image index.
-struct ImageStore {
-  std::vector<DecodedImage> images;
-  // Installs the callback that decodes uri/data-URI images into this store.
-  void install(tinygltf::TinyGLTF& loader);
-  // Decodes images stored in buffer views (after load); throws pxf::Error for an invalid view.
-  void decode_buffer_view_images(const tinygltf::Model& model, const std::string& file);
+// What an image's header says, without decoding it.
+struct ImageHeader {
+  int width = 0, height = 0, channels = 0;
+  int bits = 8;     // 8, 16 or 32 (HDR float)
+  bool ok = false;  // false: not an image stb can read
 };
+
+// The encoded bytes of the model's images, by glTF image index.
+class ImageStore {
+ public:
+  // Installs the callback that keeps uri/data-URI images' bytes in this store.
+  void install(tinygltf::TinyGLTF& loader);
+  // Image `index`'s encoded bytes: those tinygltf read for a uri, or its validated buffer view
+  // (throws pxf::Error for an invalid view); empty when the file was missing.
+  ByteRange bytes(const tinygltf::Model& model, int index, const std::string& file) const;
+
+ private:
+  friend bool keep_image_bytes(ImageStore& store, int index, const unsigned char* bytes, int size);
+  std::vector<std::vector<unsigned char>> encoded_;
+};
+
+// Reads the header of PNG/JPEG/HDR/... bytes.
+ImageHeader probe_image(const unsigned char* bytes, size_t size);
 
 // Decodes PNG/JPEG/HDR/... bytes with stb; false (and `failure` set) on error.
 bool decode_image(const unsigned char* bytes, size_t size, DecodedImage& out);

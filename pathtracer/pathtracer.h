@@ -20,7 +20,7 @@ struct TraceParams {
   bool all_hv = false;      // every contribution goes to HV (environment-lit scenes)
   uint64_t seed = 1;
   int threads = 0;          // 0 = all cores
-  SamplerType sampler = SamplerType::Independent;  // see pathtracer/sampler.h for the dimension table
+  SamplerType sampler = SamplerType::Sobol;  // see pathtracer/sampler.h for the dimension table
   // Independently scrambled interleaved Sobol replicates (frame k is in replicate k mod K): their
   // means give Var[L_u] of the pixel mean under QMC. 1 = one sequence and the estimate s^2 / n.
   // Default 1: K > 1 makes the estimate exact on average but costs unfiltered error (each
@@ -28,16 +28,42 @@ struct TraceParams {
   int replicates = 1;
 };
 
+// What a scene may demand. The loader counts the instanced triangles (every mesh once per node
+// that references it) and reads the used images' headers before it reads any geometry or decodes
+// any texture; over a cap, or with an estimate over the available memory, it refuses.
+struct LoadLimits {
+  static constexpr int kDefaultMaxTextureSize = 16384;
+  static constexpr uint64_t kDefaultMaxTriangles = 100'000'000;
+  int max_texture_size = kDefaultMaxTextureSize;  // texels, per side
+  uint64_t max_triangles = kDefaultMaxTriangles;  // instanced triangles in the whole scene
+  uint64_t available_memory = 0;                  // bytes; 0 = what the system reports now
+};
+
+// Memory the system can give without swapping: MemAvailable from /proc/meminfo, else
+// sysconf's available physical pages; 0 when neither is known.
+uint64_t available_memory_bytes();
+
+// The loader's memory estimate for a scene, in bytes: what the loaded scene, the BVH, the raster
+// pass's copies and the decoding need at the peak (docs/scenes.md, "Resource limits").
+struct LoadEstimate {
+  uint64_t vertices = 0, triangles = 0;  // instanced
+  uint64_t texture_bytes = 0;            // stored texels of the used textures
+  uint64_t largest_decode_bytes = 0;     // the largest image's decoding buffers
+  uint64_t bytes() const;
+};
+
 // Loads a glTF/GLB file or a built-in scene name ("cornell", ...); throws pxf::Error naming the
 // file and the problem. `env_path` (optional) replaces the environment with an equirectangular
 // EXR or Radiance .hdr (checked before the scene loads). A scene without any light gets the
 // built-in `default_light` environment (Scene::notes says so); with None a warning says it is black.
+// Before anything large is allocated, the loader checks `limits` (see LoadLimits) and refuses
+// with a one-line error naming the file and the limit.
 Scene load_scene(const std::string& name_or_path, const std::string& env_path = "", float env_strength = 1.0f,
-                 DefaultLight default_light = DefaultLight::None);
+                 DefaultLight default_light = DefaultLight::None, const LoadLimits& limits = {});
 // The same from a glTF/GLB already in memory (the fuzzer's entry point); `name` prefixes errors and
 // relative uris resolve against `base_dir`.
 Scene load_scene_from_memory(const std::vector<unsigned char>& bytes, const std::string& name,
-                             const std::string& base_dir);
+                             const std::string& base_dir, const LoadLimits& limits = {});
 // The built-in scenes: name and one-line description.
 struct BuiltinScene { std::string name, description, path; };
 std::vector<BuiltinScene> builtin_scenes();
@@ -115,7 +141,12 @@ class ProgressiveRenderer {
   void reset();                          // clears accumulation (camera, scene or params changed)
   void set_camera(const Camera& camera); // resets
   void set_params(const TraceParams& params);  // resets
-  void add_frame();                      // traces one path per pixel, frame index = first_frame() + frames()
+  // Traces one path per pixel, frame index = first_frame() + frames(). Returns false when
+  // cancel_frame() stopped it: the frame is then incomplete and the accumulation is reset.
+  bool add_frame();
+  // Thread-safe: a running add_frame() (on another thread) stops after the tiles in flight. For a
+  // caller about to reset anyway (the explorer's camera moves), so that it need not wait a frame.
+  void cancel_frame();
   int frames() const;                    // frames traced (or restored) since the last reset
   // Where the frame sequence starts (a shard of frames A:B starts at A); resets.
   void set_first_frame(uint32_t first);

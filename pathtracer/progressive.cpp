@@ -24,6 +24,7 @@ struct ProgressiveRenderer::Impl {
   int width, height;
   std::unique_ptr<PathTracer> tracer;
   std::unique_ptr<tbb::task_arena> arena;  // kept across frames: its worker threads stay warm
+  std::atomic<bool> cancel{false};
   Accumulation acc;
   TraceStats stats;
   int frames = 0;
@@ -53,6 +54,7 @@ struct ProgressiveRenderer::Impl {
     auto render_tiles = [&](const tbb::blocked_range<int>& range) {
       uint64_t tile_rays = 0, tile_paths = 0, tile_dropped = 0;
       for (int tile = range.begin(); tile != range.end(); ++tile) {
+        if (cancel.load(std::memory_order_relaxed)) break;
         int x0 = (tile % tiles_x) * kTileSize, y0 = (tile / tiles_x) * kTileSize;
         const PixelRect rect{x0, y0, std::min(x0 + kTileSize, width), std::min(y0 + kTileSize, height)};
         PathSample samples[kTileSize * kTileSize];
@@ -91,6 +93,7 @@ ProgressiveRenderer::ProgressiveRenderer(const Scene& scene, const TraceParams& 
 ProgressiveRenderer::~ProgressiveRenderer() = default;
 
 void ProgressiveRenderer::reset() {
+  impl_->cancel.store(false);  // a cancel meant for a frame that finished first
   resize_accumulation(impl_->acc, impl_->width, impl_->height, impl_->accumulation_replicates());
   impl_->stats = TraceStats{};
   impl_->frames = 0;
@@ -107,15 +110,22 @@ void ProgressiveRenderer::set_params(const TraceParams& params) {
   reset();
 }
 
-void ProgressiveRenderer::add_frame() {
+bool ProgressiveRenderer::add_frame() {
   auto start = std::chrono::steady_clock::now();
   if (impl_->tracer->dark())
     impl_->add_dark_frame();
   else
     impl_->render_frame();
+  if (impl_->cancel.exchange(false)) {  // some tiles were left out: the frame cannot be kept
+    reset();
+    return false;
+  }
   ++impl_->frames;
   impl_->stats.last_frame_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return true;
 }
+
+void ProgressiveRenderer::cancel_frame() { impl_->cancel.store(true); }
 
 int ProgressiveRenderer::frames() const { return impl_->frames; }
 uint32_t ProgressiveRenderer::first_frame() const { return impl_->first_frame; }

@@ -3,6 +3,7 @@
 // This header has no Embree, GL or tinygltf dependency.
 #pragma once
 #include <glm/glm.hpp>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -11,15 +12,36 @@ namespace pxf {
 
 enum class Wrap { Repeat, ClampToEdge, MirroredRepeat };
 
-// Linear-space texels (sRGB textures are decoded at load), 4 channels RGBA, top row first.
+// 4 channels RGBA, top row first, in one of two storages:
+// - `texels8` (4 bytes a texel) for 8-bit sources, as stored in the file: RGB sRGB-encoded when
+//   `srgb` (decoded to linear at lookup through a 256-entry table), else linear k/255; alpha is
+//   always linear k/255. Lookups give exactly the values a float copy decoded at load would hold.
+//   The codes never change after loading, so copies of a texture (and of a Scene) share them, and
+//   an image used both as sRGB color and as linear data is stored once.
+// - `texels` (linear floats) for 16-bit and HDR sources and environment maps.
+// Exactly one of them is filled (both empty: an invalid texture).
 struct Texture {
   std::string name;
   int width = 0;
   int height = 0;
   std::vector<glm::vec4> texels;
+  std::shared_ptr<const std::vector<unsigned char>> texels8;
+  bool srgb = false;  // texels8 only: RGB is sRGB-encoded
   Wrap wrap_s = Wrap::Repeat;
   Wrap wrap_t = Wrap::Repeat;
   bool nearest = false;  // magFilter NEAREST; otherwise bilinear
+
+  size_t texel_count() const { return width > 0 && height > 0 ? static_cast<size_t>(width) * height : 0; }
+  bool is_8bit() const { return texels8 && !texels8->empty(); }
+  // True when the storage holds width x height texels.
+  bool valid() const {
+    size_t n = texel_count();
+    return n > 0 && (texels.size() >= n || (texels8 && texels8->size() >= 4 * n));
+  }
+  // Texel i (row-major) as linear RGBA; i < texel_count() of a valid texture.
+  glm::vec4 texel(size_t i) const;
+  // Bytes of texel storage (shared 8-bit codes counted in full).
+  size_t memory_bytes() const { return texels.size() * sizeof(glm::vec4) + (texels8 ? texels8->size() : 0); }
 };
 
 // A material's reference to a texture (glTF textureInfo + KHR_texture_transform).

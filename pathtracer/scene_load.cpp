@@ -15,9 +15,12 @@
 #include <set>
 #include <sstream>
 
+#include <unistd.h>
+
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtc/type_ptr.hpp>
+#include <tbb/parallel_for.h>
 
 #include "image/image.h"
 #include "pathtracer/auto_camera.h"
@@ -179,7 +182,7 @@ glm::mat4 rigid_frame(const glm::mat4& m) {
 
 class GltfLoader {
  public:
-  explicit GltfLoader(std::string file) : file_(std::move(file)) {}
+  GltfLoader(std::string file, const LoadLimits& limits) : file_(std::move(file)), limits_(limits) {}
 
   Scene load() {
     read_model();
@@ -194,8 +197,11 @@ class GltfLoader {
  private:
   Scene build() {
     check_extensions();
-    images_.decode_buffer_view_images(model_, file_);
-    load_materials();
+    load_materials();    // registers the used textures; nothing is decoded yet
+    count_instances();   // the triangle cap, before any geometry is read
+    probe_textures();    // the texture size cap, from the image headers
+    check_memory();      // the estimate against the available memory
+    decode_textures();
     traverse_scene();
     read_scene_defaults();  // before the camera: the default image aspect frames the model
     finish_camera();
@@ -336,17 +342,8 @@ class GltfLoader {
     }
     if (texture.source >= static_cast<int>(model_.images.size()))
       fail("texture " + std::to_string(index) + " references image " + std::to_string(texture.source) + " out of range");
-    const tinygltf::Image& image = model_.images[texture.source];
-    const gltf::DecodedImage* decoded =
-        texture.source < static_cast<int>(images_.images.size()) ? &images_.images[texture.source] : nullptr;
-    if (!decoded || !decoded->decoded) {
-      std::string what = !image.uri.empty() ? "'" + image.uri + "'" : "image " + std::to_string(texture.source);
-      std::string why = decoded && !decoded->failure.empty() ? " (" + decoded->failure + ")" : " (missing or unreadable)";
-      warn("texture image " + what + " could not be loaded" + why + "; material '" + material +
-           "' renders without its " + slot + " texture");
-      return -1;
-    }
-    scene_.textures.push_back(make_texture(*decoded, srgb, texture, image));
+    scene_.textures.push_back(texture_settings(texture, model_.images[texture.source]));
+    pending_.push_back({texture.source, srgb, material, slot});
     slot_index = static_cast<int>(scene_.textures.size()) - 1;
     return slot_index;
   }
@@ -359,12 +356,10 @@ class GltfLoader {
     }
   }
 
-  Texture make_texture(const gltf::DecodedImage& decoded, bool srgb, const tinygltf::Texture& texture,
-                       const tinygltf::Image& image) {
+  // A texture's name and sampler; its texels come from decode_textures.
+  Texture texture_settings(const tinygltf::Texture& texture, const tinygltf::Image& image) {
     Texture out;
     out.name = !image.uri.empty() && image.uri.rfind("data:", 0) != 0 ? image.uri : image.name;
-    out.width = decoded.width;
-    out.height = decoded.height;
     if (texture.sampler >= 0) {
       if (texture.sampler >= static_cast<int>(model_.samplers.size()))
         fail("sampler " + std::to_string(texture.sampler) + " out of range");
@@ -373,19 +368,26 @@ class GltfLoader {
       out.wrap_t = wrap_mode(sampler.wrapT);
       out.nearest = sampler.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST;
     }
+    return out;
+  }
+
+  // 8-bit images keep their codes (RGBA8, sRGB decoded at lookup), shared by the textures that use
+  // the image (`codes`, made on first use); 16-bit and HDR images become linear floats.
+  static void fill_texels(Texture& out, gltf::DecodedImage& decoded, bool srgb,
+                          std::shared_ptr<const std::vector<unsigned char>>& codes) {
+    out.width = decoded.width;
+    out.height = decoded.height;
     size_t texel_count = static_cast<size_t>(decoded.width) * decoded.height;
+    if (decoded.bits == 8) {
+      out.srgb = srgb;
+      if (!codes) codes = std::make_shared<const std::vector<unsigned char>>(std::move(decoded.bytes));
+      out.texels8 = codes;
+      return;
+    }
     out.texels.resize(texel_count);
     int c = decoded.channels;
-    // The sRGB curve per texel dominates texture load time; 8-bit images (values k/255) use a table.
-    static const std::vector<float> srgb_table = [] {
-      std::vector<float> table(256);
-      for (int k = 0; k < 256; ++k) table[k] = linear_from_srgb(k / 255.0f);
-      return table;
-    }();
-    bool use_table = srgb && decoded.bits == 8;
     auto color = [&](float v) {
       float x = std::isfinite(v) ? std::max(v, 0.0f) : 0.0f;
-      if (use_table) return srgb_table[std::min(255, static_cast<int>(x * 255.0f + 0.5f))];
       return srgb ? linear_from_srgb(x) : x;
     };
     for (size_t i = 0; i < texel_count; ++i) {
@@ -400,7 +402,91 @@ class GltfLoader {
       if (!std::isfinite(t.w)) t.w = 1.0f;
       out.texels[i] = t;
     }
-    return out;
+  }
+
+  // The used images' headers: size cap, and the texel bytes for the memory estimate.
+  void probe_textures() {
+    std::map<int, gltf::ImageHeader> headers;
+    for (const PendingTexture& p : pending_) {
+      auto [it, inserted] = headers.try_emplace(p.image);
+      if (inserted) {
+        gltf::ByteRange bytes = images_.bytes(model_, p.image, file_);
+        it->second = gltf::probe_image(bytes.data, bytes.size);
+        const gltf::ImageHeader& h = it->second;
+        if (h.ok && (h.width > limits_.max_texture_size || h.height > limits_.max_texture_size))
+          fail(image_label(p.image) + " is " + std::to_string(h.width) + "x" + std::to_string(h.height) +
+               ", over the texture size limit of " + std::to_string(limits_.max_texture_size) +
+               " (raise it with --max-texture-size)");
+      }
+      const gltf::ImageHeader& h = it->second;
+      if (!h.ok) continue;
+      const uint64_t texels = static_cast<uint64_t>(h.width) * static_cast<uint64_t>(h.height);
+      estimate_.texture_bytes += texels * (h.bits == 8 ? 4 : 16);
+      // stb's buffer and our copy for 8-bit images; stb's buffer and the float values otherwise.
+      const uint64_t decode = h.bits == 8 ? 8 * texels : texels * h.channels * (h.bits / 8 + 4);
+      estimate_.largest_decode_bytes = std::max(estimate_.largest_decode_bytes, decode);
+    }
+  }
+
+  std::string image_label(int index) const {
+    const tinygltf::Image& image = model_.images[index];
+    if (!image.uri.empty() && image.uri.rfind("data:", 0) != 0) return "image " + std::to_string(index) + " '" + image.uri + "'";
+    if (!image.name.empty()) return "image " + std::to_string(index) + " '" + image.name + "'";
+    return "image " + std::to_string(index);
+  }
+
+  // Decodes every used image once, in parallel, fills the textures, then drops those whose image
+  // could not be decoded (a warning each, naming the material that loses it) and renumbers the
+  // materials' references.
+  void decode_textures() {
+    std::vector<int> images;
+    for (const PendingTexture& p : pending_) images.push_back(p.image);
+    std::sort(images.begin(), images.end());
+    images.erase(std::unique(images.begin(), images.end()), images.end());
+    std::vector<gltf::ByteRange> bytes(images.size());
+    for (size_t k = 0; k < images.size(); ++k) bytes[k] = images_.bytes(model_, images[k], file_);
+    std::vector<gltf::DecodedImage> decoded(images.size());
+    tbb::parallel_for(size_t(0), images.size(), [&](size_t k) {
+      if (bytes[k].size > 0) gltf::decode_image(bytes[k].data, bytes[k].size, decoded[k]);
+    });
+    auto slot_of = [&](int image) {
+      return static_cast<size_t>(std::lower_bound(images.begin(), images.end(), image) - images.begin());
+    };
+    // Per image: its textures in order (one image's textures share its storage).
+    std::vector<std::vector<size_t>> users(images.size());
+    for (size_t t = 0; t < pending_.size(); ++t) users[slot_of(pending_[t].image)].push_back(t);
+    tbb::parallel_for(size_t(0), images.size(), [&](size_t k) {
+      if (!decoded[k].decoded) return;
+      std::shared_ptr<const std::vector<unsigned char>> codes;
+      for (size_t t : users[k]) fill_texels(scene_.textures[t], decoded[k], pending_[t].srgb, codes);
+      std::vector<unsigned char>().swap(decoded[k].bytes);  // moved from, or no longer needed
+      std::vector<float>().swap(decoded[k].values);
+    });
+    std::vector<int> renumber(pending_.size(), -1);
+    std::vector<Texture> kept;
+    for (size_t t = 0; t < pending_.size(); ++t) {
+      const PendingTexture& p = pending_[t];
+      const gltf::DecodedImage& d = decoded[slot_of(p.image)];
+      if (!d.decoded) {
+        const tinygltf::Image& image = model_.images[p.image];
+        std::string what = !image.uri.empty() ? "'" + image.uri + "'" : "image " + std::to_string(p.image);
+        std::string why = !d.failure.empty() ? " (" + d.failure + ")" : " (missing or unreadable)";
+        warn("texture image " + what + " could not be loaded" + why + "; material '" + p.material +
+             "' renders without its " + p.slot + " texture");
+        continue;
+      }
+      renumber[t] = static_cast<int>(kept.size());
+      kept.push_back(std::move(scene_.textures[t]));
+    }
+    scene_.textures = std::move(kept);
+    pending_.clear();
+    for (Material& m : scene_.materials)
+      for (TextureRef* ref : {&m.base_color_texture, &m.metallic_roughness_texture, &m.normal_texture, &m.emissive_texture,
+                              &m.transmission_texture, &m.specular_texture, &m.specular_color_texture})
+        if (ref->texture >= 0) {
+          ref->texture = renumber[ref->texture];
+          if (ref->texture < 0) *ref = TextureRef{};
+        }
   }
 
   // -- materials --------------------------------------------------------------------------------
@@ -473,24 +559,138 @@ class GltfLoader {
     m.attenuation = -glm::log(color) / static_cast<float>(distance);
   }
 
+  // -- limits -----------------------------------------------------------------------------------
+
+  // Triangles and vertices primitive `p` will instance once, from its accessors' counts (0 where
+  // the accessors are invalid: reading them fails later with the precise error).
+  void primitive_counts(const tinygltf::Primitive& p, uint64_t& vertices, uint64_t& triangles) const {
+    vertices = triangles = 0;
+    auto count_of = [&](int accessor) -> uint64_t {
+      return accessor >= 0 && accessor < static_cast<int>(model_.accessors.size()) ? model_.accessors[accessor].count : 0;
+    };
+    const int mode = p.mode < 0 ? TINYGLTF_MODE_TRIANGLES : p.mode;
+    vertices = count_of(attribute(p, "POSITION"));
+    const uint64_t n = p.indices >= 0 ? count_of(p.indices) : vertices;
+    if (mode == TINYGLTF_MODE_TRIANGLES) triangles = n / 3;
+    else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP || mode == TINYGLTF_MODE_TRIANGLE_FAN) triangles = n >= 3 ? n - 2 : 0;
+  }
+
+  static uint64_t saturating_add(uint64_t a, uint64_t b) { return a > UINT64_MAX - b ? UINT64_MAX : a + b; }
+
+  // The instanced totals of the scene, each node's subtree counted once (a node referenced from
+  // many parents is not walked again, so a hierarchy that instances exponentially is cheap to
+  // count), checked against the triangle cap before any geometry is read.
+  void count_instances() {
+    struct Counts {
+      uint64_t vertices = 0, triangles = 0, nodes = 0;
+    };
+    std::vector<Counts> mesh_counts(model_.meshes.size());
+    for (size_t m = 0; m < model_.meshes.size(); ++m)
+      for (const tinygltf::Primitive& p : model_.meshes[m].primitives) {
+        uint64_t v, t;
+        primitive_counts(p, v, t);
+        mesh_counts[m].vertices = saturating_add(mesh_counts[m].vertices, v);
+        mesh_counts[m].triangles = saturating_add(mesh_counts[m].triangles, t);
+      }
+    const size_t node_count = model_.nodes.size();
+    std::vector<Counts> subtree(node_count);
+    std::vector<char> state(node_count, 0);  // 0 new, 1 on the current path, 2 done
+    Counts total;
+    for (int root : scene_roots()) {
+      if (root < 0 || root >= static_cast<int>(node_count)) continue;  // traverse_scene names it
+      std::vector<std::pair<int, size_t>> stack;  // node, next child
+      if (state[root] == 0) {
+        state[root] = 1;
+        stack.push_back({root, 0});
+      }
+      while (!stack.empty()) {
+        auto& [index, next] = stack.back();
+        const std::vector<int>& children = model_.nodes[index].children;
+        if (next < children.size()) {
+          const int child = children[next++];
+          if (child < 0 || child >= static_cast<int>(node_count)) continue;
+          if (state[child] == 1) continue;  // a cycle: traverse_scene reports it
+          if (state[child] == 0) {
+            state[child] = 1;
+            stack.push_back({child, 0});
+          }
+          continue;
+        }
+        Counts c;
+        c.nodes = 1;
+        const int mesh = model_.nodes[index].mesh;
+        if (mesh >= 0 && mesh < static_cast<int>(mesh_counts.size())) {
+          c.vertices = mesh_counts[mesh].vertices;
+          c.triangles = mesh_counts[mesh].triangles;
+        }
+        for (int child : children)
+          if (child >= 0 && child < static_cast<int>(node_count) && state[child] == 2) {
+            c.vertices = saturating_add(c.vertices, subtree[child].vertices);
+            c.triangles = saturating_add(c.triangles, subtree[child].triangles);
+            c.nodes = saturating_add(c.nodes, subtree[child].nodes);
+          }
+        subtree[index] = c;
+        state[index] = 2;
+        stack.pop_back();
+      }
+      total.vertices = saturating_add(total.vertices, subtree[root].vertices);
+      total.triangles = saturating_add(total.triangles, subtree[root].triangles);
+      total.nodes = saturating_add(total.nodes, subtree[root].nodes);
+    }
+    estimate_.vertices = total.vertices;
+    estimate_.triangles = total.triangles;
+    if (total.triangles > limits_.max_triangles)
+      fail("the scene instances " + count_text(total.triangles) + " triangles, over the limit of " +
+           count_text(limits_.max_triangles) + " (raise it with --max-triangles)");
+    // Node visits cost time even without meshes; a hierarchy that revisits shared subtrees this
+    // often is an attack, not a scene.
+    if (total.nodes > limits_.max_triangles)
+      fail("the node hierarchy instances " + count_text(total.nodes) + " nodes, over the limit of " +
+           count_text(limits_.max_triangles) + " (raise it with --max-triangles)");
+  }
+
+  static std::string count_text(uint64_t n) { return n == UINT64_MAX ? "more than 1.8e19" : std::to_string(n); }
+
+  void check_memory() {
+    const uint64_t available = limits_.available_memory > 0 ? limits_.available_memory : available_memory_bytes();
+    if (available == 0) return;  // unknown: nothing to check against
+    const uint64_t needed = estimate_.bytes();
+    if (needed > available)
+      fail("loading needs an estimated " + mib_text(needed) + " (" + count_text(estimate_.triangles) + " triangles, " +
+           mib_text(estimate_.texture_bytes) + " of textures), more than the " + mib_text(available) +
+           " of memory available");
+  }
+
+  static std::string mib_text(uint64_t bytes) {
+    return bytes == UINT64_MAX ? "more than 16 EiB" : format_number(static_cast<double>(bytes) / (1024.0 * 1024.0)) + " MiB";
+  }
+
   // -- node hierarchy ---------------------------------------------------------------------------
 
-  void traverse_scene() {
+  // The default scene's root nodes; without scenes, every node that is nobody's child.
+  std::vector<int> scene_roots() const {
     std::vector<int> roots;
+    if (!model_.scenes.empty()) {
+      const int index = model_.defaultScene >= 0 ? model_.defaultScene : 0;
+      if (index < static_cast<int>(model_.scenes.size())) roots = model_.scenes[index].nodes;
+      return roots;
+    }
+    std::vector<bool> is_child(model_.nodes.size(), false);
+    for (const tinygltf::Node& node : model_.nodes)
+      for (int child : node.children)
+        if (child >= 0 && child < static_cast<int>(is_child.size())) is_child[child] = true;
+    for (size_t i = 0; i < model_.nodes.size(); ++i)
+      if (!is_child[i]) roots.push_back(static_cast<int>(i));
+    return roots;
+  }
+
+  void traverse_scene() {
     if (!model_.scenes.empty()) {
       scene_index_ = model_.defaultScene >= 0 ? model_.defaultScene : 0;
       if (scene_index_ >= static_cast<int>(model_.scenes.size()))
         fail("default scene " + std::to_string(scene_index_) + " out of range");
-      roots = model_.scenes[scene_index_].nodes;
-    } else {
-      // No scene: every node that is nobody's child is a root.
-      std::vector<bool> is_child(model_.nodes.size(), false);
-      for (const tinygltf::Node& node : model_.nodes)
-        for (int child : node.children)
-          if (child >= 0 && child < static_cast<int>(is_child.size())) is_child[child] = true;
-      for (size_t i = 0; i < model_.nodes.size(); ++i)
-        if (!is_child[i]) roots.push_back(static_cast<int>(i));
     }
+    const std::vector<int> roots = scene_roots();
     std::vector<bool> on_path(model_.nodes.size(), false);
     for (int root : roots) visit_node(root, glm::mat4(1.0f), on_path);
   }
@@ -785,7 +985,18 @@ class GltfLoader {
       warn("dropped " + std::to_string(dropped_.degenerate) + " degenerate (zero-area) triangles");
   }
 
+  // A registered texture waiting for its image (scene_.textures has one entry per pending one).
+  struct PendingTexture {
+    int image;
+    bool srgb;
+    std::string material;
+    const char* slot;
+  };
+
   std::string file_;
+  LoadLimits limits_;
+  LoadEstimate estimate_;
+  std::vector<PendingTexture> pending_;
   std::string base_dir_;  // what relative uris are resolved against
   tinygltf::Model model_;
   gltf::ImageStore images_;
@@ -881,6 +1092,32 @@ void check_scene_file(const std::string& path) {
 
 }  // namespace
 
+uint64_t available_memory_bytes() {
+  std::ifstream meminfo("/proc/meminfo");
+  std::string key;
+  uint64_t value = 0;
+  std::string unit;
+  while (meminfo >> key >> value) {
+    std::getline(meminfo, unit);
+    if (key == "MemAvailable:") return value * 1024;  // kB
+  }
+  const long pages = sysconf(_SC_AVPHYS_PAGES), page_size = sysconf(_SC_PAGESIZE);
+  return pages > 0 && page_size > 0 ? static_cast<uint64_t>(pages) * static_cast<uint64_t>(page_size) : 0;
+}
+
+// Per instanced vertex: the loader's attributes (position, normal, tangent, two uv sets, color:
+// 72 B) and the raster pass's vertex, in its staging copy and its GL buffer (2 x 64 B). Per
+// instanced triangle: the indices as read and as triangles, the raster pass's index buffer
+// (3 x 12 B) and the BVH (Embree's build, about 100 B). Textures: their storage, the raster pass's
+// copy (at most as large), and the largest image's decoding buffers.
+uint64_t LoadEstimate::bytes() const {
+  constexpr uint64_t kBytesPerVertex = 72 + 2 * 64, kBytesPerTriangle = 3 * 12 + 100;
+  auto add = [](uint64_t a, uint64_t b) { return a > UINT64_MAX - b ? UINT64_MAX : a + b; };
+  auto mul = [](uint64_t a, uint64_t b) { return b != 0 && a > UINT64_MAX / b ? UINT64_MAX : a * b; };
+  return add(add(mul(vertices, kBytesPerVertex), mul(triangles, kBytesPerTriangle)),
+             add(mul(texture_bytes, 2), largest_decode_bytes));
+}
+
 std::vector<BuiltinScene> builtin_scenes() {
   std::vector<BuiltinScene> scenes;
   for (const BuiltinInfo& info : kBuiltins) {
@@ -892,14 +1129,14 @@ std::vector<BuiltinScene> builtin_scenes() {
 }
 
 Scene load_scene_from_memory(const std::vector<unsigned char>& bytes, const std::string& name,
-                             const std::string& base_dir) {
-  Scene scene = GltfLoader(name).load_from_memory(bytes.data(), bytes.size(), base_dir);
+                             const std::string& base_dir, const LoadLimits& limits) {
+  Scene scene = GltfLoader(name, limits).load_from_memory(bytes.data(), bytes.size(), base_dir);
   scene.source = name;
   return scene;
 }
 
 Scene load_scene(const std::string& name_or_path, const std::string& env_path, float env_strength,
-                 DefaultLight default_light) {
+                 DefaultLight default_light, const LoadLimits& limits) {
   std::string path = name_or_path;
   std::string builtin_env;
   for (const BuiltinScene& builtin : builtin_scenes())
@@ -915,7 +1152,7 @@ Scene load_scene(const std::string& name_or_path, const std::string& env_path, f
   std::optional<Environment> environment;
   if (!env.empty()) environment = load_environment(env, env_strength, env_warnings);
   check_scene_file(path);
-  Scene scene = GltfLoader(path).load();
+  Scene scene = GltfLoader(path, limits).load();
   scene.source = name_or_path;
   scene.warnings.insert(scene.warnings.end(), env_warnings.begin(), env_warnings.end());
   if (environment) scene.environment = std::move(environment);

@@ -644,9 +644,9 @@ TEST(SceneLoadMaterial, KhrExtensionsEmissiveStrengthTransmissionIorSpecular) {
   EXPECT_FLOAT_EQ(m.metallic, 0.0f);
   ASSERT_TRUE(m.transmission_texture.valid() && m.specular_texture.valid() && m.specular_color_texture.valid());
   // The specular/transmission textures are linear; the specular color texture is sRGB-decoded.
-  EXPECT_NEAR(scene.textures[m.specular_texture.texture].texels[0].x, 128 / 255.0f, 1e-6f);
-  EXPECT_NEAR(scene.textures[m.specular_texture.texture].texels[0].w, 64 / 255.0f, 1e-6f);
-  EXPECT_NEAR(scene.textures[m.specular_color_texture.texture].texels[0].x, linear_from_srgb(128 / 255.0f), 1e-6f);
+  EXPECT_NEAR(scene.textures[m.specular_texture.texture].texel(0).x, 128 / 255.0f, 1e-6f);
+  EXPECT_NEAR(scene.textures[m.specular_texture.texture].texel(0).w, 64 / 255.0f, 1e-6f);
+  EXPECT_NEAR(scene.textures[m.specular_color_texture.texture].texel(0).x, linear_from_srgb(128 / 255.0f), 1e-6f);
   EXPECT_EQ(m.specular_texture.texture, m.transmission_texture.texture);  // one linear copy shared
   EXPECT_NE(m.specular_texture.texture, m.specular_color_texture.texture);
   EXPECT_TRUE(scene.warnings.empty()) << warnings_of(scene);
@@ -690,10 +690,10 @@ TEST(SceneLoadTexture, BaseColorIsSrgbDecodedAndMetallicRoughnessIsLinear) {
   const Texture& linear = scene.textures[m.metallic_roughness_texture.texture];
   ASSERT_EQ(color.width, 2);
   ASSERT_EQ(color.height, 1);
-  EXPECT_NEAR(color.texels[0].x, linear_from_srgb(128 / 255.0f), 1e-6f);
-  EXPECT_NEAR(color.texels[0].y, 1.0f, 1e-6f);
-  EXPECT_EQ(color.texels[0].w, 1.0f);
-  EXPECT_NEAR(linear.texels[1].y, 64 / 255.0f, 1e-6f);  // roughness channel as stored
+  EXPECT_NEAR(color.texel(0).x, linear_from_srgb(128 / 255.0f), 1e-6f);
+  EXPECT_NEAR(color.texel(0).y, 1.0f, 1e-6f);
+  EXPECT_EQ(color.texel(0).w, 1.0f);
+  EXPECT_NEAR(linear.texel(1).y, 64 / 255.0f, 1e-6f);  // roughness channel as stored
   EXPECT_NEAR(eval_texture(scene, m.base_color_texture, {0.75f, 0.5f}, {}).z, 1.0f, 1e-6f);
   EXPECT_EQ(color.name, "color.png");
 }
@@ -713,9 +713,60 @@ TEST(SceneLoadTexture, SixteenBitNonPowerOfTwoGrayTexture) {
   ASSERT_EQ(t.width, 3);
   ASSERT_EQ(t.height, 5);
   for (int i = 0; i < 15; ++i) {
-    EXPECT_NEAR(t.texels[i].x, samples[i] / 65535.0f, 1e-7f) << i;
-    EXPECT_EQ(t.texels[i].x, t.texels[i].z);
-    EXPECT_EQ(t.texels[i].w, 1.0f);
+    EXPECT_NEAR(t.texel(i).x, samples[i] / 65535.0f, 1e-7f) << i;
+    EXPECT_EQ(t.texel(i).x, t.texel(i).z);
+    EXPECT_EQ(t.texel(i).w, 1.0f);
+  }
+}
+
+// 8-bit textures keep their codes; every lookup (nearest and bilinear, any wrap) returns exactly
+// what a float texture holding the loader's former per-texel decoding returns: sRGB channels
+// linear_from_srgb(k / 255), linear channels and alpha k / 255, gray expanded, missing alpha 1.
+TEST(SceneLoadTexture, EightBitStorageLooksUpBitExactly) {
+  std::string dir = temp_dir();
+  uint32_t state = 12345;
+  auto next = [&] {
+    state = state * 1664525u + 1013904223u;
+    return (state >> 24) & 255u;
+  };
+  for (int channels = 1; channels <= 4; ++channels) {
+    const int w = 7, h = 5;
+    std::vector<uint32_t> codes(static_cast<size_t>(w) * h * channels);
+    for (uint32_t& c : codes) c = next();
+    codes[0] = 0;
+    codes[1 % codes.size()] = 255;
+    GltfBuilder b;
+    b.doc["samplers"] = {{{"wrapS", 33648}, {"wrapT", 10497}}};
+    int tex = b.texture(b.image(encode_png(w, h, channels, 8, codes)), {{"sampler", 0}});
+    int mat = b.material({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", tex}}}, {"metallicRoughnessTexture", {{"index", tex}}}}}});
+    b.add_quad_scene(mat);
+    Scene scene = load_scene(b.write_gltf(dir + "/t8_" + std::to_string(channels) + ".gltf"));
+    for (bool srgb : {true, false}) {
+      const Material& m = scene.materials[0];
+      const TextureRef& ref = srgb ? m.base_color_texture : m.metallic_roughness_texture;
+      ASSERT_TRUE(ref.valid()) << warnings_of(scene);
+      const Texture& t = scene.textures[ref.texture];
+      EXPECT_TRUE(t.is_8bit());
+      EXPECT_EQ(t.memory_bytes(), static_cast<size_t>(w) * h * 4);
+      Texture reference = t;
+      reference.texels8.reset();
+      for (int i = 0; i < w * h; ++i) {
+        const uint32_t* p = &codes[static_cast<size_t>(i) * channels];
+        auto color = [&](uint32_t k) { return srgb ? linear_from_srgb(k / 255.0f) : k / 255.0f; };
+        glm::vec4 v = channels <= 2 ? glm::vec4(color(p[0]), color(p[0]), color(p[0]), channels == 2 ? p[1] / 255.0f : 1.0f)
+                                    : glm::vec4(color(p[0]), color(p[1]), color(p[2]), channels == 4 ? p[3] / 255.0f : 1.0f);
+        reference.texels.push_back(v);
+      }
+      for (bool nearest : {false, true}) {
+        Texture a = t, r = reference;
+        a.nearest = r.nearest = nearest;
+        for (int k = 0; k < 500; ++k) {
+          glm::vec2 uv(next() / 64.0f - 1.5f + next() / 16384.0f, next() / 64.0f - 1.5f + next() / 16384.0f);
+          glm::vec4 got = sample_texture(a, uv), want = sample_texture(r, uv);
+          ASSERT_EQ(got, want) << channels << " channels, srgb " << srgb << ", uv " << uv.x << " " << uv.y;
+        }
+      }
+    }
   }
 }
 
@@ -730,8 +781,8 @@ TEST(SceneLoadTexture, GlbEmbeddedImageInBufferView) {
   Scene scene = load_scene(b.write_glb(dir + "/img.glb"));
   ASSERT_TRUE(scene.materials[0].base_color_texture.valid()) << warnings_of(scene);
   const Texture& t = scene.textures[scene.materials[0].base_color_texture.texture];
-  EXPECT_EQ(t.texels[0], glm::vec4(1, 0, 0, 1));
-  EXPECT_NEAR(t.texels[1].w, 128 / 255.0f, 1e-6f);  // alpha stays linear
+  EXPECT_EQ(t.texel(0), glm::vec4(1, 0, 0, 1));
+  EXPECT_NEAR(t.texel(1).w, 128 / 255.0f, 1e-6f);  // alpha stays linear
 }
 
 TEST(SceneLoadTexture, SamplerWrapModesAndMagFilter) {
@@ -1288,6 +1339,111 @@ TEST(SceneLoadBuiltin, ListsOnlyExistingScenesAndLoadsThemByName) {
   EXPECT_TRUE(emissive || !scene.lights.empty());
   expect_scene_finite(scene);
   for (const std::string& w : scene.warnings) ADD_FAILURE() << "built-in scene warning: " << w;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Resource limits
+
+// A PNG whose header declares `w` x `h` but that holds no pixel data: a small file asking for a
+// huge decode.
+std::vector<uint8_t> png_header_only(uint32_t w, uint32_t h) {
+  std::vector<uint8_t> png = encode_png(1, 1, 3, 8, {1, 2, 3});
+  // IHDR data starts after the 8-byte signature, the chunk length and type (16..23: width, height).
+  for (int i = 0; i < 4; ++i) {
+    png[16 + i] = static_cast<uint8_t>(w >> (24 - 8 * i));
+    png[20 + i] = static_cast<uint8_t>(h >> (24 - 8 * i));
+  }
+  return png;
+}
+
+TEST(SceneLoadLimits, TextureOverTheSizeCapIsAClearErrorAndTheOverrideLoadsIt) {
+  std::string dir = temp_dir();
+  GltfBuilder b;
+  std::vector<uint8_t> png = png_header_only(20000, 20000);
+  int view = b.view(png.data(), png.size());
+  b.doc["images"].push_back({{"bufferView", view}, {"mimeType", "image/png"}, {"name", "huge"}});
+  b.add_quad_scene(b.material({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", b.texture(0)}}}}}}));
+  const std::string path = b.write_glb(dir + "/huge_texture.glb");
+  std::string msg = error_of([&] { load_scene(path); });
+  EXPECT_EQ(msg.rfind(path + ": ", 0), 0u) << msg;
+  EXPECT_NE(msg.find("image 0 'huge' is 20000x20000, over the texture size limit of 16384 (raise it with --max-texture-size)"),
+            std::string::npos) << msg;
+  // Raised: the header passes; the (missing) pixel data then costs only the texture, with a warning.
+  LoadLimits limits;
+  limits.max_texture_size = 20000;
+  limits.available_memory = uint64_t(1) << 50;
+  Scene scene = load_scene(path, "", 1.0f, DefaultLight::None, limits);
+  EXPECT_FALSE(scene.materials[0].base_color_texture.valid());
+  EXPECT_TRUE(any_warning_contains(scene, "could not be loaded")) << warnings_of(scene);
+
+  // A real texture one texel over the cap, then exactly at it.
+  GltfBuilder small;
+  std::vector<uint32_t> codes(9 * 4 * 3, 200);
+  small.add_quad_scene(small.material({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", small.texture(small.image(encode_png(9, 4, 3, 8, codes)))}}}}}}));
+  const std::string small_path = small.write_gltf(dir + "/nine.gltf");
+  limits.max_texture_size = 8;
+  EXPECT_NE(error_of([&] { load_scene(small_path, "", 1.0f, DefaultLight::None, limits); }).find("is 9x4, over the texture size limit of 8"),
+            std::string::npos);
+  limits.max_texture_size = 9;
+  Scene nine = load_scene(small_path, "", 1.0f, DefaultLight::None, limits);
+  ASSERT_TRUE(nine.materials[0].base_color_texture.valid());
+  EXPECT_EQ(nine.textures[nine.materials[0].base_color_texture.texture].width, 9);
+}
+
+TEST(SceneLoadLimits, EstimateOverTheAvailableMemoryIsRefusedBeforeAllocating) {
+  std::string dir = temp_dir();
+  GltfBuilder b;
+  // 4096 x 4096 declared (64 MiB as RGBA8), a few hundred bytes in the file.
+  std::vector<uint8_t> png = png_header_only(4096, 4096);
+  int view = b.view(png.data(), png.size());
+  b.doc["images"].push_back({{"bufferView", view}, {"mimeType", "image/png"}});
+  b.add_quad_scene(b.material({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", b.texture(0)}}}}}}));
+  const std::string path = b.write_glb(dir + "/big.glb");
+  LoadLimits limits;
+  limits.available_memory = 100ull << 20;  // 100 MiB
+  std::string msg = error_of([&] { load_scene(path, "", 1.0f, DefaultLight::None, limits); });
+  EXPECT_EQ(msg.rfind(path + ": ", 0), 0u) << msg;
+  // 64 MiB stored + 64 MiB raster copy + 128 MiB decoding, and a quad.
+  EXPECT_NE(msg.find("loading needs an estimated 256 MiB (2 triangles, 64 MiB of textures), more than the 100 MiB of memory available"),
+            std::string::npos) << msg;
+  limits.available_memory = 300ull << 20;
+  EXPECT_NO_THROW(load_scene(path, "", 1.0f, DefaultLight::None, limits));
+  // The estimate itself, by its documented parts.
+  LoadEstimate e;
+  e.vertices = 4;
+  e.triangles = 2;
+  e.texture_bytes = 1000;
+  e.largest_decode_bytes = 500;
+  EXPECT_EQ(e.bytes(), 4u * 200 + 2u * 136 + 2u * 1000 + 500);
+  e.triangles = UINT64_MAX / 2;
+  EXPECT_EQ(e.bytes(), UINT64_MAX);  // saturates rather than wrapping
+  EXPECT_GT(available_memory_bytes(), 0u);
+}
+
+TEST(SceneLoadLimits, InstancedTrianglesOverTheCapAreAClearError) {
+  std::string dir = temp_dir();
+  GltfBuilder b;
+  int mesh = b.mesh(b.quad_primitive());
+  std::vector<int> roots;
+  for (int i = 0; i < 10; ++i) roots.push_back(b.node({{"mesh", mesh}, {"translation", {i * 2.0, 0, 0}}}));
+  b.scene(roots);
+  const std::string path = b.write_gltf(dir + "/ten.gltf");
+  LoadLimits limits;
+  limits.max_triangles = 19;
+  std::string msg = error_of([&] { load_scene(path, "", 1.0f, DefaultLight::None, limits); });
+  EXPECT_NE(msg.find("the scene instances 20 triangles, over the limit of 19 (raise it with --max-triangles)"), std::string::npos) << msg;
+  limits.max_triangles = 20;
+  EXPECT_EQ(load_scene(path, "", 1.0f, DefaultLight::None, limits).triangle_count(), 20u);
+
+  // 64 levels, each node referencing the next twice: 2^64 instances, counted without walking them.
+  GltfBuilder d;
+  int leaf = d.node({{"mesh", d.mesh(d.quad_primitive())}});
+  int next = leaf;
+  for (int level = 0; level < 64; ++level) next = d.node({{"children", {next, next}}});
+  d.scene({next});
+  const std::string deep = d.write_gltf(dir + "/doubling.gltf");
+  msg = error_of([&] { load_scene(deep); });
+  EXPECT_NE(msg.find("the scene instances more than 1.8e19 triangles, over the limit of 100000000"), std::string::npos) << msg;
 }
 
 }  // namespace

@@ -1,6 +1,9 @@
 #include "pathtracer/texture.h"
 
+#include <array>
 #include <cmath>
+
+#include "image/image.h"
 
 namespace pxf {
 
@@ -25,6 +28,36 @@ int wrap_texel_index(int i, int size, Wrap wrap) {
 
 namespace {
 
+struct Texel8Tables {
+  std::array<float, 256> srgb, linear;
+  Texel8Tables() {
+    for (int k = 0; k < 256; ++k) {
+      linear[k] = k / 255.0f;
+      srgb[k] = linear_from_srgb(k / 255.0f);
+    }
+  }
+};
+const Texel8Tables& texel8_tables() {
+  static const Texel8Tables tables;
+  return tables;
+}
+
+}  // namespace
+
+float texel8_to_linear(unsigned char k, bool srgb) {
+  return srgb ? texel8_tables().srgb[k] : texel8_tables().linear[k];
+}
+
+glm::vec4 Texture::texel(size_t i) const {
+  if (!is_8bit()) return texels[i];
+  const Texel8Tables& tables = texel8_tables();
+  const float* rgb = srgb ? tables.srgb.data() : tables.linear.data();
+  const unsigned char* p = texels8->data() + 4 * i;
+  return glm::vec4(rgb[p[0]], rgb[p[1]], rgb[p[2]], tables.linear[p[3]]);
+}
+
+namespace {
+
 // Keeps huge or non-finite coordinates from overflowing the integer texel arithmetic.
 float sanitize_coordinate(float x) {
   if (!std::isfinite(x)) return 0.0f;
@@ -33,18 +66,16 @@ float sanitize_coordinate(float x) {
   return x;
 }
 
-const glm::vec4& texel(const Texture& t, int x, int y) {
+glm::vec4 texel(const Texture& t, int x, int y) {
   x = wrap_texel_index(x, t.width, t.wrap_s);
   y = wrap_texel_index(y, t.height, t.wrap_t);
-  return t.texels[static_cast<size_t>(y) * t.width + x];
+  return t.texel(static_cast<size_t>(y) * t.width + x);
 }
 
 }  // namespace
 
 glm::vec4 sample_texture(const Texture& texture, glm::vec2 uv) {
-  if (texture.width <= 0 || texture.height <= 0 ||
-      texture.texels.size() < static_cast<size_t>(texture.width) * texture.height)
-    return glm::vec4(1.0f);
+  if (!texture.valid()) return glm::vec4(1.0f);
   // Continuous texel coordinates; texel centers sit at integer + 0.5.
   float x = sanitize_coordinate(uv.x) * texture.width;
   float y = sanitize_coordinate(uv.y) * texture.height;

@@ -1,5 +1,6 @@
 // Texture sampling shared by the integrator and the loader: wrap modes, bilinear or nearest
-// filtering, KHR_texture_transform. Texels are linear (sRGB textures are decoded at load time).
+// filtering, KHR_texture_transform. Lookups return linear values: 8-bit sRGB texels are decoded
+// through a 256-entry table.
 #pragma once
 #include <glm/glm.hpp>
 #include "pathtracer/scene.h"
@@ -27,6 +28,10 @@ inline glm::vec4 eval_texture(const Scene& scene, const TextureRef& ref, glm::ve
 // The 3x3 matrix of KHR_texture_transform: T(offset) * R(rotation) * S(scale), as the extension
 // defines it (rotation counter-clockwise in UV space, radians).
 glm::mat3 texture_transform_matrix(glm::vec2 offset, float rotation, glm::vec2 scale);
+
+// The linear value of 8-bit code k: linear_from_srgb(k / 255) when `srgb`, else k / 255 (exactly
+// the float the loader used to store).
+float texel8_to_linear(unsigned char k, bool srgb);
 
 // Integer texel index for coordinate `i` (may be outside [0, size)) under `wrap`.
 int wrap_texel_index(int i, int size, Wrap wrap);

@@ -20,6 +20,7 @@ uniform float t;
 
 layout(std430, binding = 0) buffer Counter { uint filtered_pixels; };
 layout(location = 0) out vec4 out_filtered;  // rgb L_f, a Var[L_f] (kVarUnknown, kVarSkipped)
+layout(location = 1) out float out_centre_weight;  // 1 / sum w: the pixel's own share of L_f
 
 void main() {
   ivec2 p = ivec2(gl_FragCoord.xy);
@@ -28,6 +29,7 @@ void main() {
   vec3 lu_p = clean(hv_p.rgb);
   if (final_pass != 0 && skip_case2 != 0 && skip_as_case2(hv_tex, lv_tex, guide_tex, p, k_c, k_d, t)) {
     out_filtered = vec4(lu_p, kVarSkipped);
+    out_centre_weight = 1.0;
     return;
   }
   if (final_pass != 0) atomicAdd(filtered_pixels, 1u);
@@ -63,4 +65,5 @@ void main() {
   // samples were equal) count with the kernel-weighted mean of the known ones.
   float var_f = swk > 0.0 ? (sw2v + sw2u * (swv / swk)) / (sw * sw) : kVarUnknown;
   out_filtered = vec4(swl / sw, var_f);
+  out_centre_weight = 1.0 / sw;
 }

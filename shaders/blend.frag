@@ -6,7 +6,9 @@ layout(binding = 0) uniform sampler2D hv_tex;        // rgb L_u, a Var[L_u]
 layout(binding = 1) uniform sampler2D lv_tex;        // rgb L_lv
 layout(binding = 2) uniform sampler2D filtered_tex;  // rgb L_f, a Var[L_f] (or a sentinel)
 layout(binding = 3) uniform sampler2D guide_tex;     // rgb range color, a distance (pooling)
+layout(binding = 4) uniform sampler2D centre_weight_tex;  // r: the filter's centre weight w
 uniform int has_filtered;
+uniform int has_centre_weight;  // 0: Cov[L_u, L_f] not known, left out (w = 0)
 uniform int has_guide;  // 0: u from the pixel's own variance only
 uniform float k_c;      // range weights of the variance pooling (the filter's)
 uniform float k_d;
@@ -39,7 +41,8 @@ void main() {
       float lb = max(luminance(lf) + luminance(lv), 0.0);
       if (has_guide != 0) vu = pooled_var_u(hv_tex, guide_tex, p, k_c, k_d);
       float u = vu > 0.0 ? relative_variance(vu, lb) : zero_variance_u(luminance(lf), lb);
-      s = blend_factor(u, relative_variance(vf, lb), t, blend_case);
+      float w = has_centre_weight != 0 ? texelFetch(centre_weight_tex, p, 0).r : 0.0;
+      s = blend_factor_covariance(u, relative_variance(vf, lb), t, w, blend_case);
     }
   }
   atomicAdd(case_counts[blend_case], 1u);

@@ -85,12 +85,38 @@ float blend_factor(float u, float f, float t, out int blend_case) {
   return clamp(fh / (uh + fh) + sqrt(q), 0.0, 1.0);
 }
 
+// blend_factor with the covariance of L_u and L_f, Cov = w Var[L_u] (w: the filter's centre
+// weight): g(s) = s^2 u + (1-s)^2 f + 2 s (1-s) w u. Mirrors blend_decision(u, f, t, w) in
+// gl/cpu_reference.cpp; w <= 0, or u or f infinite: blend_factor.
+float blend_factor_covariance(float u, float f, float t, float w, out int blend_case) {
+  float plain = blend_factor(u, f, t, blend_case);
+  if (!(w > 0.0) || blend_case == 2 || isinf(u) || isinf(f) || isnan(u) || isnan(f)) return plain;
+  if (!(t >= 0.0)) t = 0.0;
+  u = max(u, 0.0);
+  f = max(f, 0.0);
+  float hi = max(u, f), uh = u / hi, fh = f / hi, th = t / hi;
+  float c = min(min(w, 1.0) * uh, sqrt(uh * fh));
+  float a = uh + fh - 2.0 * c;
+  blend_case = 1;
+  if (!(a > 1e-6)) return 0.0;
+  float s_min = (fh - c) / a, g_min = max((uh * fh - c * c) / a, 0.0);
+  if (th < (s_min >= 0.0 ? g_min : fh)) return 0.0;
+  blend_case = 3;
+  return clamp(s_min + sqrt((th - g_min) / a), 0.0, 1.0);
+}
+
 // The filter's case-2 skip (FilterParams::skip_case2, final pass only): the blend's u (pooled
 // variance) with the unfiltered background; a zero variance (all samples equal, no neighbour known)
 // is not trusted. Mirrors skip_as_case2() in gl/cpu_reference.cpp.
+// The pooled variance is at least the pixel's own, so a pixel whose own variance already exceeds
+// t is not skipped without looking at its neighbours: the same answer for a fraction of the cost
+// (at low spp nearly every pixel leaves here, and the 3x3 pooling cost more than a grid slice).
 bool skip_as_case2(sampler2D hv, sampler2D lv, sampler2D guide, ivec2 p, float k_c, float k_d, float t) {
+  vec4 hv_p = texelFetch(hv, p, 0);
+  float lb = max(luminance(clean(hv_p.rgb)) + luminance(clean(texelFetch(lv, p, 0).rgb)), 0.0);
+  float own = clean_var(hv_p.a);
+  if (own > 0.0 && relative_variance(own, lb) > max(t, 0.0)) return false;
   float v = pooled_var_u(hv, guide, p, k_c, k_d);
-  float lb = max(luminance(clean(texelFetch(hv, p, 0).rgb)) + luminance(clean(texelFetch(lv, p, 0).rgb)), 0.0);
   return v > 0.0 && relative_variance(v, lb) <= max(t, 0.0);
 }
 

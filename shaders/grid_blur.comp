@@ -1,8 +1,10 @@
 #version 450 core
-// Bilateral grid, step 3: blur along one axis (x or y, one dispatch each; z is blurred in the splat) with the B3-spline
-// taps g = 1/16 [1 4 6 4 1]; taps outside the grid are left out. The value sums (a, and the
+// Bilateral grid, step 3: blur along one axis (x or y, one dispatch each; z is blurred in the splat) with the
+// binomial taps g = 1/4 [1 2 1] (grid_common.glsl); taps outside the grid are left out. The value sums (a, and the
 // linear sums b.zw) take g, the squared-weight sums (b.xy) take g^2: the variance of a linear
 // combination of independent cells. Mirrors blur() in gl/grid_reference.cpp.
+#include "common.glsl"
+#include "grid_common.glsl"
 layout(local_size_x = 64) in;
 
 layout(std430, binding = 1) readonly buffer Source { vec4 src[]; };
@@ -10,8 +12,6 @@ layout(std430, binding = 2) writeonly buffer Target { vec4 dst[]; };
 uniform ivec2 grid_xy;  // nx, ny (nz = kGridRangeCells)
 uniform int grid_z_cells;
 uniform int axis;       // 0: x, 1: y, 2: z
-
-const float kTaps[5] = float[5](1.0 / 16.0, 4.0 / 16.0, 6.0 / 16.0, 4.0 / 16.0, 1.0 / 16.0);
 
 void main() {
   int cell = int(gl_GlobalInvocationID.x);
@@ -22,11 +22,11 @@ void main() {
   int stride = axis == 0 ? 1 : axis == 1 ? grid_xy.x : plane;
   int at = c[axis];
   vec4 a = vec4(0.0), b = vec4(0.0);
-  for (int t = 0; t < 5; ++t) {
-    int q = at + t - 2;
+  for (int t = 0; t <= 2 * kGridBlurRadius; ++t) {
+    int q = at + t - kGridBlurRadius;
     if (q < 0 || q >= n) continue;
     int other = cell + (q - at) * stride;
-    float g = kTaps[t];
+    float g = kGridBlurTaps[t];
     a += g * src[2 * other];
     b += vec4(g * g, g * g, g, g) * src[2 * other + 1];
   }

@@ -15,19 +15,13 @@ layout(std430, binding = 1) readonly buffer Grid { vec4 cells[]; };
 layout(std430, binding = 0) buffer Counter { uint filtered_pixels; };
 uniform ivec2 grid_xy;
 uniform float inv_cell_s;
-uniform float sigma_c;
+uniform float min_cell_z;  // grid_min_cell_z(sigma_c)
 uniform float k_c;  // 1 / (2 sigma_c^2), for skipping
 uniform float k_d;  // 1 / (2 sigma_d^2), for skipping
 uniform int skip_case2;
 uniform float t;
 
 layout(location = 0) out vec4 out_filtered;  // rgb L_f, a Var[L_f] (kVarUnknown, kVarSkipped)
-
-float interpolation_correction(float a) {
-  const float g0 = 70.0 / 256.0, g1 = 56.0 / 256.0;
-  float b = 1.0 - a;
-  return 1.0 + 2.0 * a * b * g1 / (g0 * (a * a + b * b));
-}
 
 void main() {
   ivec2 p = ivec2(gl_FragCoord.xy);
@@ -37,7 +31,7 @@ void main() {
   }
   atomicAdd(filtered_pixels, 1u);
   precise vec2 uv = vec2(p) * inv_cell_s;
-  float z = grid_z(guide_luminance(texelFetch(guide_tex, p, 0)), sigma_c);
+  float z = grid_z(guide_luminance(texelFetch(guide_tex, p, 0)), min_cell_z);
   ivec3 c0 = ivec3(ivec2(floor(uv)), min(int(floor(z)), kGridRangeCells - 2));
   vec3 frac = clamp(vec3(uv, z) - vec3(c0), 0.0, 1.0);
   vec4 a = vec4(0.0), b = vec4(0.0);
@@ -51,7 +45,7 @@ void main() {
         b += vec4(w * w, w * w, w, w) * cells[2 * cell + 1];
       }
   // a.w > 0: the pixel's own nearest cell is a corner with interpolation weight >= 1/2 per axis.
-  float correction = interpolation_correction(frac.x) * interpolation_correction(frac.y);
+  float correction = grid_interpolation_correction(frac.x) * grid_interpolation_correction(frac.y);
   float var_f = b.z > 0.0 ? correction * (b.x + b.y * (b.w / b.z)) / (a.w * a.w) : kVarUnknown;
   out_filtered = vec4(a.rgb / a.w, var_f);
 }

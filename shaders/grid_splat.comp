@@ -2,7 +2,7 @@
 // Bilateral grid, step 2: splat. One invocation per spatial cell (i, j) gathers the pixels whose
 // nearest cell it is (scan order, so the sums match the CPU reference) into its column of
 // kGridRangeCells range cells, each pixel into its nearest range cell with weight 1 (homogeneous
-// coordinates), and at once blurred along z: the pixel goes into range cells k - 2 .. k + 2 with the
+// coordinates), and at once blurred along z: the pixel goes into range cells k - 1 .. k + 1 with the
 // blur taps g (g^2 for the squared-weight sums), which is the z pass of the separable blur done
 // per pixel instead of per cell (far fewer operations: most cells are empty). Per cell, two vec4:
 //   a = (sum L_u, count)
@@ -21,7 +21,7 @@ layout(std430, binding = 1) writeonly buffer Grid { vec4 cells[]; };
 uniform ivec2 grid_xy;      // nx, ny
 uniform float cell_s;       // pixels per spatial cell
 uniform float inv_cell_s;   // 1 / cell_s (computed once on the CPU: same rounding as the reference)
-uniform float sigma_c;
+uniform float min_cell_z;   // grid_min_cell_z(sigma_c)
 
 void main() {
   ivec2 c = ivec2(gl_GlobalInvocationID.xy);
@@ -39,13 +39,13 @@ void main() {
       precise float u = float(x) * inv_cell_s;
       if (nearest_cell(u) != c.x) continue;
       ivec2 p = ivec2(x, y);
-      int k = clamp(nearest_cell(grid_z(guide_luminance(texelFetch(guide_tex, p, 0)), sigma_c)), 0, kGridRangeCells - 1);
+      int k = clamp(nearest_cell(grid_z(guide_luminance(texelFetch(guide_tex, p, 0)), min_cell_z)), 0, kGridRangeCells - 1);
       vec4 hv = texelFetch(hv_tex, p, 0);
       float var = clean_var(hv.a);
       vec4 a = vec4(clean(hv.rgb), 1.0);
       vec4 b = var > 0.0 ? vec4(var, 0.0, 1.0, var) : vec4(0.0, 1.0, 0.0, 0.0);
-      for (int t = 0; t < 5; ++t) {
-        int q = k + t - 2;
+      for (int t = 0; t <= 2 * kGridBlurRadius; ++t) {
+        int q = k + t - kGridBlurRadius;
         if (q < 0 || q >= kGridRangeCells) continue;
         float g = kGridBlurTaps[t];
         acc_a[q] += g * a;

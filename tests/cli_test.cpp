@@ -112,6 +112,32 @@ std::string write_bare_triangle(const std::string& dir) {
   return path;
 }
 
+TEST(Cli, TriangleCapIsAFlagOfRenderAndBench) {
+  const std::string dir = temp_dir("triangle_cap");
+  const std::string scene = write_bare_triangle(dir);
+  const std::string out = dir + "/out";
+  for (const char* command : {"render", "bench"}) {
+    const Result r = run(std::string(command) + " --scene " + scene + " --max-triangles 1 --max-triangles 0 --out " + out);
+    EXPECT_EQ(r.code, 2) << command << ": " << r.err;  // 0 is outside the flag's range
+  }
+  EXPECT_NE(run("render --help").out.find("--max-texture-size"), std::string::npos);
+  const std::string two = dir + "/two.gltf";
+  {
+    std::ifstream in(scene);
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    auto replace = [&](const std::string& from, const std::string& to) { text.replace(text.find(from), from.size(), to); };
+    replace(R"("nodes":[0])", R"("nodes":[0,1])");
+    replace(R"("nodes":[{"mesh":0}])", R"("nodes":[{"mesh":0},{"mesh":0}])");
+    std::ofstream(two) << text;
+  }
+  const Result r = run("render --scene " + two + " --max-triangles 1 --size 16x16 --spp 1 --out " + out);
+  EXPECT_EQ(r.code, 1);
+  EXPECT_EQ(lines(r.err), 1u) << r.err;
+  EXPECT_NE(r.err.find("the scene instances 2 triangles, over the limit of 1 (raise it with --max-triangles)"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_EQ(run("render --scene " + two + " --max-triangles 2 --size 16x16 --spp 1 --out " + out).code, 0);
+}
+
 TEST(Cli, SceneWithoutLightsIsLitByDefaultAndNoneWarnsOfBlack) {
   const std::string dir = temp_dir("bare");
   const std::string scene = write_bare_triangle(dir);

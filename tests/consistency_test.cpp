@@ -51,10 +51,13 @@ TEST(Consistency, BlendMovesToUnfilteredAndErrorFallsAsSamplesGrow) {
                 fractions.back(), errors.back(), bias.back());
   }
   // Rises towards 1, up to the noise of the variance estimates: at a few dozen samples, pixels
-  // near the caustic that have not sampled it yet look quiet (seen: 0.90 of pixels at 32 spp,
-  // 0.85 at 128, 0.98 at 2048 on this 32x32 image). The last few percent are caustic pixels whose
-  // relative variance needs far more samples than a test can afford.
-  for (size_t i = 1; i < fractions.size(); ++i) EXPECT_GE(fractions[i], fractions[i - 1] - 0.07) << i;
+  // near the caustic that have not sampled it yet look quiet, so the fraction dips between 32 and
+  // 128 spp before it rises again (seen on this 32x32 image: 0.92 at 32 spp, 0.83 at 128, 0.98 at
+  // 2048). The dip belongs to the method, not to the sampler: over seeds 1-16, 32 -> 128 spp, it
+  // is 0.093 +- 0.027 (max 0.130) with independent samples and 0.079 +- 0.027 (max 0.124) with
+  // Sobol. The last few percent are caustic pixels whose relative variance needs far more samples
+  // than a test can afford.
+  for (size_t i = 1; i < fractions.size(); ++i) EXPECT_GE(fractions[i], fractions[i - 1] - 0.15) << i;
   EXPECT_GE(fractions.back(), 0.95);
   EXPECT_LT(fractions.front(), fractions.back() - 0.15);
   // The error falls from the first to the last checkpoint, and the filtered image converges to the
@@ -65,3 +68,4 @@ TEST(Consistency, BlendMovesToUnfilteredAndErrorFallsAsSamplesGrow) {
 }
 
 }  // namespace
+

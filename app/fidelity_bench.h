@@ -1,0 +1,24 @@
+// pxf bench --threshold-fidelity: does the blend keep its promise? Over many seeds, per pixel, the
+// empirical perceived variance of the blended HV part of the final image, Var[Y(L - L_lv)] / L_b^2
+// (L_b: the mean over seeds of Y(L)), against the threshold t. Pixels are grouped by the blend case
+// they take in most seeds (case 2: unfiltered, case 3: mixed). Not a test: prints a table and
+// writes CSV into the output folder.
+#pragma once
+#include <string>
+#include <vector>
+#include "app/preview.h"
+
+namespace pxf {
+
+struct FidelityBenchSetup {
+  Scene scene;
+  std::string scene_name;
+  PreviewSettings settings;  // filter, sigmas, seed (the seeds run from settings.trace.seed on)
+  int width = 0, height = 0;
+  std::string out;
+};
+
+void run_threshold_fidelity_bench(const FidelityBenchSetup& b, const std::vector<int>& spps,
+                                  const std::vector<float>& thresholds, int seeds);
+
+}  // namespace pxf

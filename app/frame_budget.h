@@ -1,0 +1,30 @@
+// The explorer's frame budget: no display frame blocks the UI for longer than kUiBudgetMs. The
+// path tracer runs on a worker thread (Preview::trace_frame), so what blocks the UI thread is the GL
+// work after each traced frame: one range-buffer frame, a filter run, the blend and tone map
+// (Preview::queue_passes). These steps are spread over display frames: each display frame runs the
+// queued steps whose predicted costs, added to the UI's own work, still fit the budget. A pure
+// function of the predicted costs, so it is tested with a fake clock (app/frame_budget_test.cpp).
+#pragma once
+#include <vector>
+
+namespace pxf {
+
+// Longest time one display frame may keep the UI thread busy.
+constexpr double kUiBudgetMs = 100.0;
+
+// The GL steps that follow a traced frame, in the order they run.
+enum class PassStep {
+  RangeFrame,  // one antialiasing frame of the range buffer, if the pass budget allows
+  Filter,      // a filter run, if the schedule makes one due
+  Display,     // upload, blend and tone map
+};
+
+// Whether the next queued step (predicted to take next_ms) runs in this display frame, which has
+// already spent used_ms on UI work, on waiting for the tracer and on earlier steps: it must fit in
+// budget_ms. `fresh`: nothing but the frame's UI work ran yet (no wait, no step); then the step
+// always runs, so that the queue drains. A step that does not fit even alone is so deferred to a
+// display frame of its own (the explorer shows the longest GL block; the default filter at
+// 512x512 fits, the exact bilateral filter does not).
+bool step_fits_display_frame(double used_ms, bool fresh, double next_ms, double budget_ms = kUiBudgetMs);
+
+}  // namespace pxf
