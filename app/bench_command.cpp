@@ -161,6 +161,7 @@ struct TimedRun {
   int filter_runs = 0;
   StageTimes times;
   RowError error;  // HDR NRMSE, display NRMSE, FLIP
+  Image image;     // the final linear image
 };
 
 TimedRun run_timed(const BenchSetup& b, const PreviewSettings& settings, double budget_ms, const Image& reference) {
@@ -173,6 +174,7 @@ TimedRun run_timed(const BenchSetup& b, const PreviewSettings& settings, double 
   preview.finish();
   TimedRun run;
   run.used_ms = elapsed_ms(start);
+  run.image = preview.final_image();
   run.spp = preview.samples();
   run.filter_runs = preview.filter_runs();
   run.times = preview.total_times();
@@ -419,12 +421,60 @@ int run_variant_bench(const BenchSetup& b, const Image& reference_hv, int spp, i
   return 0;
 }
 
+// Albedo demodulation off against on at equal wall time: per budget and round, unfiltered, filtered
+// without and filtered with demodulation, back to back. Prints the display NRMSE ratios (median
+// over rounds), writes demodulation.csv and the last round's images demod_<mode>_<budget>.png
+// (tone-mapped with the reference's key and log-average, as the display metrics see them).
+int run_demodulation_ab(const BenchSetup& b, const Image& reference, double pt_ms, const std::vector<int>& budgets,
+                        int rounds) {
+  PreviewSettings off = b.filtered, on = b.filtered;
+  off.demodulate = false;
+  on.demodulate = true;
+  TonemapParams tonemap;
+  tonemap.log_average = static_cast<float>(cpu_log_average(reference, tonemap.delta));
+  write_png(b.out + "/demod_reference.png", cpu_tonemap(reference, tonemap));
+  std::ostringstream csv;
+  csv << "budget_frames,round,unfiltered_spp,unfiltered_display_nrmse_percent,unfiltered_flip,off_spp,"
+         "off_display_nrmse_percent,off_flip,on_spp,on_display_nrmse_percent,on_flip\n";
+  std::printf("\nalbedo demodulation at equal wall time (median of %d rounds; display NRMSE, filtered / unfiltered):\n",
+              rounds);
+  std::printf("   budget | unfiltered spp  display | demod off spp  display  ratio | demod on spp  display  ratio\n");
+  for (int budget : budgets) {
+    std::vector<double> plain_e, off_e, on_e, off_ratio, on_ratio, plain_spp, off_spp, on_spp;
+    for (int round = 0; round < rounds; ++round) {
+      const double budget_ms = budget * pt_ms;
+      const TimedRun u = run_timed(b, b.plain, budget_ms, reference);
+      const TimedRun f0 = run_timed(b, off, budget_ms, reference);
+      const TimedRun f1 = run_timed(b, on, budget_ms, reference);
+      csv << budget << "," << round << "," << u.spp << "," << display_csv(u.error) << "," << f0.spp << ","
+          << display_csv(f0.error) << "," << f1.spp << "," << display_csv(f1.error) << "\n";
+      plain_e.push_back(u.error.display_nrmse), off_e.push_back(f0.error.display_nrmse), on_e.push_back(f1.error.display_nrmse);
+      off_ratio.push_back(f0.error.display_nrmse / u.error.display_nrmse);
+      on_ratio.push_back(f1.error.display_nrmse / u.error.display_nrmse);
+      plain_spp.push_back(u.spp), off_spp.push_back(f0.spp), on_spp.push_back(f1.spp);
+      if (round + 1 == rounds) {
+        const std::string suffix = "_" + std::to_string(budget) + ".png";
+        write_png(b.out + "/demod_unfiltered" + suffix, cpu_tonemap(u.image, tonemap));
+        write_png(b.out + "/demod_off" + suffix, cpu_tonemap(f0.image, tonemap));
+        write_png(b.out + "/demod_on" + suffix, cpu_tonemap(f1.image, tonemap));
+      }
+    }
+    std::printf("   %6d | %14.0f  %6.2f %% | %13.0f  %6.2f %%  %5.2fx | %12.0f  %6.2f %%  %5.2fx\n", budget,
+                median_of(plain_spp), median_of(plain_e), median_of(off_spp), median_of(off_e), median_of(off_ratio),
+                median_of(on_spp), median_of(on_e), median_of(on_ratio));
+  }
+  write_text(b.out + "/demodulation.csv", csv.str());
+  std::printf("\nwrote %s/demodulation.csv, demod_<unfiltered|off|on>_<budget>.png\n", b.out.c_str());
+  return 0;
+}
+
 }  // namespace
 
 int run_bench(const Args& args) {
   SceneOptions scene_options;
   PreviewOptions preview_options;
   bool pathtracer = false, variants = false, stage_table = false, sampler_error = false, variance_ratio = false;
+  bool demodulation_ab = false;
   bool threshold_fidelity = false;
   int variant_spp = 4, variant_rounds = 5;
   std::string extra_taps_text;
@@ -467,7 +517,10 @@ int run_bench(const Args& args) {
   cli.option("--spp", &spp_text, "LIST",
              "spp of --sampler-error (default 8,32,128), --variance-ratio (4,16,64,256) or --threshold-fidelity (16,64,256)");
   cli.option("--seeds", &seeds, "seeds of --variance-ratio and --threshold-fidelity (default 32)", 2, 4096);
-  cli.option("--rounds", &rounds, "timing rounds of --sampler-error (default 7)", 1, 1000);
+  cli.flag("--demodulation-ab", &demodulation_ab,
+           "instead of 1-4: albedo demodulation off vs on at equal wall time (--budgets, --rounds rounds, back\n"
+           "to back with the unfiltered run); writes demodulation.csv and demod_*.png");
+  cli.option("--rounds", &rounds, "rounds of --sampler-error (default 7) and --demodulation-ab (default 3)", 1, 1000);
   cli.option("--timed-frames", &timed, "timed frames of --pathtracer (after 3 warm-up frames)", 1, 100000);
   cli.option("--reference", &reference_path, "REF.exr", "reference image (default: render and cache one)");
   cli.option("--reference-spp", &reference_spp, "samples of the rendered reference (default 2048)", 1, 1 << 20);
@@ -526,6 +579,17 @@ int run_bench(const Args& args) {
                              variant_spp, variant_rounds, extra_taps);
   const Image reference = obtain_reference(b, reference_path, reference_spp, scene_options.scene);
   if (reference.width != b.width || reference.height != b.height) throw Error("reference size differs from --size");
+
+  if (demodulation_ab) {
+    // The budgets' unit: the median path-tracing frame of a short unfiltered warm-up.
+    Preview warm(b.scene, b.plain, b.width, b.height);
+    std::vector<double> frame_ms;
+    for (int i = 0; i < 8; ++i) {
+      warm.add_frame(i == 7, i == 7);
+      frame_ms.push_back(warm.last_times().path_tracing);
+    }
+    return run_demodulation_ab(b, reference, median_of(frame_ms), budgets, cli.given("--rounds") ? rounds : 3);
+  }
 
   // 1. Stage times.
   const FilteredRun filtered = run_filtered(b, frames, reference);

@@ -87,7 +87,7 @@ PixelProbe probe_pixel(const Preview& preview, const std::vector<uint32_t>& samp
   p.lv = read_texel(preview.inputs().lv(), x, y);
   p.hv_var = read_texel(preview.inputs().hv(), x, y);
   p.has_filtered = preview.has_filtered();
-  p.filtered_var = p.has_filtered ? read_texel(preview.filter().output(), x, y) : p.hv_var;
+  p.filtered_var = p.has_filtered ? read_texel(preview.filtered_output(), x, y) : p.hv_var;
   p.guide = read_texel(preview.range().guide(), x, y);
   p.case_code = read_texel(preview.blend().case_texture(), x, y).r;
   const size_t i = static_cast<size_t>(y) * preview.width() + x;
@@ -444,6 +444,7 @@ class Explorer {
     changed |= ImGui::SliderFloat("sigma d", &s.filter.sigma_d, 1e-3f, 1e3f, "%.3g", ImGuiSliderFlags_Logarithmic);
     changed |= name_combo("filter", filter_option_names(), filter_option_name(s),
                           [&](const std::string& n) { set_filter_option(s, n); });
+    changed |= ImGui::Checkbox("albedo demodulation", &s.demodulate);
     changed |= name_combo("schedule", filter_schedule_names(), filter_schedule_names()[static_cast<int>(s.schedule)],
                           [&](const std::string& n) { s.schedule = parse_filter_schedule(n); });
     changed |= ImGui::SliderInt("path length", &s.trace.max_vertices, 2, 32);
@@ -662,6 +663,7 @@ class Explorer {
       options_.preview.filter = filter_option_name(settings_);
       options_.preview.schedule = filter_schedule_names()[static_cast<int>(settings_.schedule)];
       options_.preview.all_hv = settings_.trace.all_hv;
+      options_.preview.demodulate = settings_.demodulate ? "on" : "off";
       options_.scene.width = width_, options_.scene.height = height_;
       stop_tracing(/*cancel=*/false);  // the frame in flight and its passes first
       while (preview_->passes_pending()) preview_->run_next_pass();

@@ -138,13 +138,13 @@ void ViewRenderer::tonemap_like_final(const Texture2D& hdr, Preview& preview, in
 
 const Texture2D& ViewRenderer::render(BufferView view, Preview& preview, int slot) {
   const Framebuffer& target = output_fbos_[slot];
-  const FilterPass* filter = preview.has_filtered() ? &preview.filter() : nullptr;
+  const Texture2D* filtered = preview.has_filtered() ? &preview.filtered_output() : nullptr;
   switch (view) {
     case BufferView::Final: draw_display(preview.tonemap().output(), false, slot); break;
     case BufferView::Lv: tonemap_like_final(preview.inputs().lv(), preview, slot); break;
     case BufferView::Hv: tonemap_like_final(preview.inputs().hv(), preview, slot); break;
     case BufferView::HvFiltered:  // without an L_f yet the blend uses L_u: show that
-      tonemap_like_final(filter ? filter->output() : preview.inputs().hv(), preview, slot);
+      tonemap_like_final(filtered ? *filtered : preview.inputs().hv(), preview, slot);
       break;
     case BufferView::Unfiltered:
       unfiltered_.run(preview.inputs(), nullptr, nullptr, BlendParams{preview.settings().threshold});
@@ -162,8 +162,8 @@ const Texture2D& ViewRenderer::render(BufferView view, Preview& preview, int slo
       draw_scalar(preview.inputs().hv(), 3, scale(view), true, 0.0f, target, width_, height_);
       break;
     case BufferView::VarF:
-      if (filter) {
-        draw_scalar(filter->output(), 3, scale(view), true, 0.0f, target, width_, height_);
+      if (filtered) {
+        draw_scalar(*filtered, 3, scale(view), true, 0.0f, target, width_, height_);
       } else {  // no L_f: every Var[L_f] unknown (the sentinel's color)
         const float unknown[4] = {0.25f, 0.25f, 0.25f, 1.0f};
         glClearNamedFramebufferfv(target.id(), GL_COLOR, 0, unknown);
@@ -210,7 +210,7 @@ void ViewRenderer::update_auto_scale(BufferView view, Preview& preview) {
   if (!s.automatic || !is_scalar_view(view) || view == BufferView::Blend) return;
   Image source;
   if (view == BufferView::VarU) source = preview.inputs().var_image();
-  else if (view == BufferView::VarF && preview.has_filtered()) source = preview.filter().variance_image();
+  else if (view == BufferView::VarF && preview.has_filtered()) source = preview.filtered_variance_image();
   else if (view == BufferView::Depth) source = preview.range().depth_image();
   else return;
   std::vector<float> values;

@@ -37,6 +37,9 @@ void add_preview_options(CommandLine& cli, PreviewOptions& o) {
              "when the filter runs: budget = at power-of-two sample counts while filter + range stay within\n"
              "10 % of the tracing time (default); pow2 = at every power of two; every = each frame; all also\n"
              "the last frame");
+  cli.choice("--demodulate", &o.demodulate, {"on", "off"},
+             "albedo demodulation: filter HV divided by the first non-specular albedo, so textures stay\n"
+             "sharp (default off: README \"Albedo demodulation\")");
   cli.option("--seed", &o.seed, "random seed", 0, 2147483647);
   cli.choice("--sampler", &o.sampler, {"sobol", "independent"},
              "random numbers of the path tracer: Owen-scrambled Sobol (default) or independent PCG32");
@@ -68,6 +71,7 @@ void finish_preview_options(PreviewOptions& o) {
   o.settings.trace.all_hv = o.all_hv;
   o.settings.trace.sampler = o.sampler == "independent" ? SamplerType::Independent : SamplerType::Sobol;
   o.settings.filter.t = o.settings.threshold;
+  o.settings.demodulate = o.demodulate == "on";
 }
 
 LoadLimits load_limits(const SceneOptions& options) {

@@ -30,6 +30,7 @@ struct PreviewOptions {
   int seed = 1;
   bool all_hv = false;
   std::string sampler = "sobol";
+  std::string demodulate = "off";  // "on" | "off": PreviewSettings::demodulate
 };
 
 void add_scene_options(CommandLine& cli, SceneOptions& options, bool headless);

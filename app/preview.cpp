@@ -17,7 +17,7 @@ bool same_filter_params(const PreviewSettings& a, const PreviewSettings& b) {
   return a.filter_enabled == b.filter_enabled && a.filter.kind == b.filter.kind && a.filter.sigma_s == b.filter.sigma_s &&
          a.filter.sigma_c == b.filter.sigma_c && a.filter.sigma_d == b.filter.sigma_d &&
          a.filter.skip_case2 == b.filter.skip_case2 && a.filter.subsampled_taps == b.filter.subsampled_taps &&
-         a.threshold == b.threshold;
+         a.threshold == b.threshold && a.demodulate == b.demodulate;
 }
 }  // namespace
 
@@ -52,6 +52,16 @@ double share_outside_tracing(const StageTimes& t, double wall_ms) {
 
 double pass_share_of_tracing(const StageTimes& t) {
   return t.path_tracing > 0 ? (t.filter + t.range) / t.path_tracing : 0.0;
+}
+
+double hv_energy_share(const Accumulation& acc) {
+  double hv = 0, all = 0;
+  for (size_t i = 0; i < acc.hv_mean.size(); ++i) {
+    const double y_hv = std::max(0.0f, luminance(acc.hv_mean[i].x, acc.hv_mean[i].y, acc.hv_mean[i].z));
+    hv += y_hv;
+    all += y_hv + std::max(0.0f, luminance(acc.lv_mean[i].x, acc.lv_mean[i].y, acc.lv_mean[i].z));
+  }
+  return all > 0 ? hv / all : 0.0;
 }
 
 Preview::Preview(const Scene& scene, const PreviewSettings& settings, int width, int height)
@@ -162,15 +172,46 @@ void Preview::run_filter() {
   const double range_before = last_.range;
   if (range_.frames() == 0) step_range_buffer();
   upload();
-  filter_.run(inputs_, range_.guide(), settings_.filter);
-  last_.filter += filter_.last_ms();
-  schedule_.last_run_ms = filter_.last_ms() + (last_.range - range_before);
+  double filter_ms = 0;
+  filtered_demodulated_ = settings_.demodulate;
+  if (settings_.demodulate) {
+    const auto start = BenchClock::now();
+    if (!demod_) demod_ = std::make_unique<Demodulation>(width_, height_);
+    inputs_.upload_albedo(&renderer_->accumulation().albedo_mean[0].x);
+    demod_->demodulate(inputs_, range_.guide(), settings_.filter);
+    filter_.run(demod_->filter_inputs(), range_.guide(), settings_.filter);
+    demod_->remodulate(filter_.output(), inputs_);
+    filter_ms = elapsed_ms(start);
+  } else {
+    filter_.run(inputs_, range_.guide(), settings_.filter);
+    filter_ms = filter_.last_ms();
+  }
+  last_.filter += filter_ms;
+  schedule_.last_run_ms = filter_ms + (last_.range - range_before);
   schedule_.pass_ms += schedule_.last_run_ms;
   ++filter_runs_;
   filtered_samples_ = samples();
   have_filtered_ = true;
   // Every pixel skipped = every pixel already in case 2: the filter is not needed any more.
   if (settings_.filter.skip_case2 && filter_.filtered_pixels() == 0) schedule_.all_pixels_case2 = true;
+}
+
+bool Preview::filter_worthwhile() {
+  if (hv_energy_share(renderer_->accumulation()) >= kMinHvShare) return true;
+  ++low_hv_skips_;
+  return false;
+}
+
+const Texture2D& Preview::filtered_output() const {
+  return filtered_demodulated_ && demod_ ? demod_->output() : filter_.output();
+}
+
+Image Preview::filtered_image() const {
+  return filtered_demodulated_ && demod_ ? demod_->filtered_image() : filter_.filtered_image();
+}
+
+Image Preview::filtered_variance_image() const {
+  return filtered_demodulated_ && demod_ ? demod_->variance_image() : filter_.variance_image();
 }
 
 void Preview::update_hv_empty() {
@@ -185,8 +226,11 @@ void Preview::update_hv_empty() {
 void Preview::blend_and_tonemap() {
   const double upload_before = last_.upload;
   upload();
-  blend_.run(inputs_, have_filtered_ ? &filter_ : nullptr, range_.guide(),
-             BlendParams{settings_.threshold, range_weights(settings_.filter)});
+  // The filter's centre weight is that of the demodulated run too: with a grey factor a,
+  // Cov[L_u, a L_f'] = a w Var[L_u] / a = w Var[L_u], the blend's covariance term is unchanged.
+  blend_.run(inputs_, have_filtered_ ? &filtered_output() : nullptr, &range_.guide(),
+             BlendParams{settings_.threshold, range_weights(settings_.filter)},
+             have_filtered_ ? filter_.centre_weight() : nullptr);
   last_.blend += blend_.last_ms();
   tonemap_.run(blend_.output(), settings_.tonemap);
   last_.tonemap += tonemap_.last_ms();
@@ -248,7 +292,7 @@ void Preview::run_next_pass() {
       schedule_.have_filtered = have_filtered_;
       break;
     case PassStep::Filter:
-      if (filter_due_now()) run_filter();
+      if (filter_due_now() && filter_worthwhile()) run_filter();
       break;
     case PassStep::Display:
       blend_and_tonemap();
@@ -275,7 +319,7 @@ bool Preview::filter_due_now() const {
 
 void Preview::finish_passes() {
   if (settings_.filter_enabled && filtered_samples_ != samples() &&
-      filter_due(settings_.schedule, samples(), true, schedule_))
+      filter_due(settings_.schedule, samples(), true, schedule_) && filter_worthwhile())
     run_filter();
   blend_and_tonemap();
 }
@@ -307,15 +351,16 @@ std::vector<Layer> Preview::buffers() {
   layers.push_back({"final", blend_.final_image()});
   layers.push_back({"lv", inputs_.lv_image()});
   layers.push_back({"hv", inputs_.hv_image()});
-  layers.push_back({"hv_filtered", have_filtered_ ? filter_.filtered_image() : inputs_.hv_image()});
+  layers.push_back({"hv_filtered", have_filtered_ ? filtered_image() : inputs_.hv_image()});
   layers.push_back({"var_u", inputs_.var_image()});
-  layers.push_back({"var_f", have_filtered_ ? filter_.variance_image() : Image::gray(width_, height_)});
+  layers.push_back({"var_f", have_filtered_ ? filtered_variance_image() : Image::gray(width_, height_)});
   layers.push_back({"blend", blend_.s_image()});
   layers.push_back({"case", blend_.case_image()});
   layers.push_back({"range_color", range_.range_color_image()});
   layers.push_back({"depth", range_.depth_image()});
   layers.push_back({"samples", renderer_->samples_image()});
   layers.push_back({"emitter", renderer_->emitter_coverage_image()});
+  layers.push_back({"albedo", renderer_->albedo_image()});
   return layers;
 }
 

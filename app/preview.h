@@ -15,6 +15,7 @@
 #include "app/frame_budget.h"
 #include "app/schedule.h"
 #include "gl/blend_pass.h"
+#include "gl/demodulation.h"
 #include "gl/filter_pass.h"
 #include "gl/inputs.h"
 #include "gl/preview_params.h"
@@ -30,6 +31,10 @@ struct PreviewSettings {
   float threshold = 0.001f;  // t: allowed perceived (relative) variance
   bool filter_enabled = true;  // false = plain path tracing (--filter none)
   FilterParams filter;         // kind and sigmas; filter.t is kept equal to threshold
+  // Albedo demodulation: filter HV divided by the first non-specular albedo and multiply L_f back
+  // (gl/demodulation.h), so the filter does not blur textures. Off by default: at equal time it did
+  // not beat filtering radiance with the default grid filter (README "Albedo demodulation").
+  bool demodulate = false;
   FilterSchedule schedule = FilterSchedule::Budget;
   TonemapParams tonemap;
   RangeSettings range;
@@ -52,6 +57,12 @@ struct StageTimes {
 double share_outside_tracing(const StageTimes& t, double wall_ms);
 // Filter + range time as a share of the path-tracing time (the budget schedule's bound).
 double pass_share_of_tracing(const StageTimes& t);
+
+// HV's share of the image's energy: sum of Y(L_u) over sum of Y(L_u) + Y(L_lv), 0 for a black
+// image. Below kMinHvShare the filter does not run: HV then carries too little of the image for
+// its noise to matter next to LV's, and a run would cost time for no visible change.
+double hv_energy_share(const Accumulation& acc);
+constexpr double kMinHvShare = 0.01;
 
 class Preview {
  public:
@@ -102,6 +113,8 @@ class Preview {
   // finish after it (last filter run if due, upload, blend, tone map), from measured costs.
   TimeBudget predict_next_frame(double budget_ms, double elapsed_ms) const;
   bool filter_stopped() const { return schedule_.all_pixels_case2; }
+  // Filter runs left out because HV's energy share was below kMinHvShare.
+  int filter_runs_skipped_low_hv() const { return low_hv_skips_; }
   // Pixels per BlendCase (gl/preview_params.h) of the last displayed frame.
   const std::array<uint32_t, kBlendCaseCount>& case_counts() const { return case_counts_; }
 
@@ -112,17 +125,23 @@ class Preview {
   const BlendPass& blend() const { return blend_; }
   const TonemapPass& tonemap() const { return tonemap_; }
   bool has_filtered() const { return have_filtered_; }
+  // The newest L_f as the blend sees it (rgb L_f, a Var[L_f] or a sentinel): the filter's output,
+  // remodulated when it was demodulated. Valid when has_filtered().
+  const Texture2D& filtered_output() const;
+  Image filtered_image() const;           // "R,G,B" L_f
+  Image filtered_variance_image() const;  // "Y" Var[L_f], 0 where unknown or skipped
 
   Image display_image() const;        // tone-mapped sRGB "R,G,B" in [0,1]
   Image final_image() const;          // linear radiance after the blend
   // Every buffer as EXR layers: final, lv, hv, hv_filtered, var_u, var_f, blend, case,
-  // range_color, depth, emitter, samples: the range layers are the guide the filter used (the range
+  // range_color, depth, emitter, samples, albedo: the range layers are the guide the filter used (the range
   // pass runs to convergence only if it never ran).
   std::vector<Layer> buffers();
 
  private:
   void upload();
   void run_filter();
+  bool filter_worthwhile();  // HV's energy share reaches kMinHvShare (else counts a skip)
   bool step_range_buffer();     // one antialiasing frame of the range pass; false once converged
   void advance_range_buffer();  // one more range frame if the pass budget allows
   void update_hv_empty();
@@ -137,6 +156,8 @@ class Preview {
   PreviewInputs inputs_;
   RangePass range_;
   FilterPass filter_;
+  std::unique_ptr<Demodulation> demod_;  // created on first use
+  bool filtered_demodulated_ = false;    // the newest L_f went through demod_
   BlendPass blend_;
   TonemapPass tonemap_;
   std::vector<float> variance_;  // staging for Var[L_u]
@@ -144,6 +165,7 @@ class Preview {
   bool have_filtered_ = false;
   bool uploaded_ = false;  // inputs hold the current samples
   int filter_runs_ = 0;
+  int low_hv_skips_ = 0;
   int filtered_samples_ = -1;  // sample count of the newest L_f
   StageTimes last_, total_;
   std::array<uint32_t, kBlendCaseCount> case_counts_{};

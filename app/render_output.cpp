@@ -51,6 +51,7 @@ nlohmann::json stats_json(Preview& preview, const RenderReport& r) {
                    {"spp", preview.samples()},
                    {"threshold", s.threshold},
                    {"filter", filter_option_name(s)},
+                   {"demodulate", s.demodulate},
                    {"schedule", r.preview->schedule},
                    {"sigma_s", s.filter.sigma_s},
                    {"sigma_c", s.filter.sigma_c},
@@ -75,6 +76,8 @@ nlohmann::json stats_json(Preview& preview, const RenderReport& r) {
   j["rays"] = trace.rays;
   j["filter_runs"] = preview.filter_runs();
   j["filter_stopped_all_case2"] = preview.filter_stopped();
+  j["filter_runs_skipped_low_hv"] = preview.filter_runs_skipped_low_hv();
+  j["hv_energy_share"] = hv_energy_share(preview.renderer().accumulation());
   j["nan_samples_dropped"] = trace.nan_samples_dropped;
   j["interrupted"] = r.interrupted;
   const auto& counts = preview.case_counts();

@@ -248,12 +248,18 @@ struct KernelSums {
 
 }  // namespace
 
-bool skip_as_case2(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
-                   const Image& depth, const FilterParams& p, int x, int y, FilterOutput& out) {
+bool case2_skip_decision(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
+                         const Image& depth, const FilterParams& p, int x, int y) {
   const float v = pooled_var_u(var_u, range_color, depth, x, y, range_weights(p));
   const Px lu = rgb_at(hv, x, y), l = rgb_at(lv, x, y);
   const float lb = std::max(lum(lu.c) + lum(l.c), 0.0f);
-  if (!(v > 0.0f) || relative_variance(v, lb) > std::max(p.t, 0.0f)) return false;
+  return v > 0.0f && relative_variance(v, lb) <= std::max(p.t, 0.0f);
+}
+
+bool skip_as_case2(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
+                   const Image& depth, const FilterParams& p, int x, int y, FilterOutput& out) {
+  if (!case2_skip_decision(hv, var_u, lv, range_color, depth, p, x, y)) return false;
+  const Px lu = rgb_at(hv, x, y);
   for (int c = 0; c < 3; ++c) out.filtered.at(x, y, c) = lu.c[c];
   out.variance.at(x, y, 0) = kVarSkipped;
   return true;
@@ -468,6 +474,44 @@ BlendOutput cpu_blend(const Image& lv, const Image& hv, const Image& var_u, cons
         out.final_rgb.at(x, y, c) = clean(l.c[c] + d.s * lu.c[c] + (1.0f - d.s) * lf.c[c]);
       out.s.at(x, y, 0) = d.s;
       out.blend_case.at(x, y, 0) = static_cast<float>(d.blend_case);
+    }
+  return out;
+}
+
+std::array<float, 3> demodulation_factor(float r, float g, float b) {
+  const float k = luminance(clean(r), clean(g), clean(b));
+  if (!(k >= kAlbedoEpsilon)) return {1.0f, 1.0f, 1.0f};
+  return {k, k, k};
+}
+
+DemodulatedInputs cpu_demodulate(const Image& hv, const Image& var_u, const Image& lv, const Image& albedo,
+                                 const Image& range_color, const Image& depth, const FilterParams& p) {
+  const int w = hv.width, h = hv.height;
+  DemodulatedInputs out{Image::rgb(w, h), Image::gray(w, h), Image::rgb(w, h)};
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const auto a = demodulation_factor(albedo.at(x, y, 0), albedo.at(x, y, 1), albedo.at(x, y, 2));
+      const float k = luminance(a[0], a[1], a[2]);
+      const Px lu = rgb_at(hv, x, y);
+      for (int c = 0; c < 3; ++c) out.hv.at(x, y, c) = lu.c[c] / a[c];
+      const float v = clean_var(var_u.at(x, y, 0));
+      out.var_u.at(x, y, 0) = v >= 0.0f ? (v / k) / k : v;
+      const bool skip = p.skip_case2 && case2_skip_decision(hv, var_u, lv, range_color, depth, p, x, y);
+      for (int c = 0; c < 3; ++c) out.lv.at(x, y, c) = skip ? kMaxInput : -kMaxInput;
+    }
+  return out;
+}
+
+FilterOutput cpu_remodulate(const FilterOutput& filtered, const Image& albedo) {
+  FilterOutput out = filtered;
+  for (int y = 0; y < albedo.height; ++y)
+    for (int x = 0; x < albedo.width; ++x) {
+      const auto a = demodulation_factor(albedo.at(x, y, 0), albedo.at(x, y, 1), albedo.at(x, y, 2));
+      const float k = luminance(a[0], a[1], a[2]);
+      const Px lf = rgb_at(filtered.filtered, x, y);
+      for (int c = 0; c < 3; ++c) out.filtered.at(x, y, c) = clean(a[c] * lf.c[c]);
+      const float v = filtered.variance.at(x, y, 0);
+      out.variance.at(x, y, 0) = v >= 0.0f ? (v * k) * k : v;
     }
   return out;
 }

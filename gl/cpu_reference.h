@@ -5,6 +5,7 @@
 // "R,G,B" + depth one channel. Every function sanitizes exactly like the shaders (non-finite
 // inputs read as 0, magnitudes clamped to kMaxInput), so outputs are always finite.
 #pragma once
+#include <array>
 #include "gl/preview_params.h"
 #include "image/image.h"
 
@@ -56,6 +57,24 @@ float clean_var(float v);
 // (L_f = L_u, Var = kVarSkipped) into `out` and returns true where the pixel is skipped.
 bool skip_as_case2(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
                    const Image& depth, const FilterParams& p, int x, int y, FilterOutput& out);
+
+// The filter's case-2 skip decision alone (what skip_as_case2 tests).
+bool case2_skip_decision(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
+                         const Image& depth, const FilterParams& p, int x, int y);
+
+// Albedo demodulation (gl/demodulation.h). The factor: grey Y(albedo) where that is at least
+// kAlbedoEpsilon, else (1, 1, 1) (that pixel is not demodulated).
+std::array<float, 3> demodulation_factor(float r, float g, float b);
+struct DemodulatedInputs {
+  Image hv;     // "R,G,B": L_u / a
+  Image var_u;  // "Y": Var[L_u] / Y(a)^2 (sentinels kept)
+  Image lv;     // "R,G,B": the skip decision on the original buffers: +kMaxInput skip, -kMaxInput filter
+};
+// The filter's inputs under demodulation; albedo "R,G,B" (the mean first non-specular albedo).
+DemodulatedInputs cpu_demodulate(const Image& hv, const Image& var_u, const Image& lv, const Image& albedo,
+                                 const Image& range_color, const Image& depth, const FilterParams& params);
+// L_f = a L_f', Var[L_f] = Y(a)^2 Var[L_f'] (sentinels kept).
+FilterOutput cpu_remodulate(const FilterOutput& filtered, const Image& albedo);
 
 struct BlendOutput {
   Image final_rgb;   // "R,G,B"

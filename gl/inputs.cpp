@@ -6,7 +6,7 @@ namespace pxf {
 
 PreviewInputs::PreviewInputs(int width, int height)
     : width_(width), height_(height), lv_(width, height, TextureFormat::RGBA32F),
-      hv_(width, height, TextureFormat::RGBA32F) {}
+      hv_(width, height, TextureFormat::RGBA32F), albedo_(width, height, TextureFormat::RGBA32F) {}
 
 void PreviewInputs::upload(const float* lv_rgb, const float* hv_rgb, const float* var_of_mean,
                            const uint32_t* samples) {
@@ -33,8 +33,17 @@ void PreviewInputs::upload(const Image& lv, const Image& hv, const Image& var) {
   upload(lv.pixels.data(), hv.pixels.data(), var.pixels.data());
 }
 
+void PreviewInputs::upload_albedo(const float* albedo_rgb) { albedo_.upload(albedo_rgb, 3); }
+
+void PreviewInputs::upload_albedo(const Image& albedo) {
+  if (albedo.width != width_ || albedo.height != height_ || albedo.num_channels() != 3)
+    throw Error("preview inputs: the albedo must be an RGB image of the textures' size");
+  upload_albedo(albedo.pixels.data());
+}
+
 Image PreviewInputs::lv_image() const { return lv_.download({"R", "G", "B"}); }
 Image PreviewInputs::hv_image() const { return hv_.download({"R", "G", "B"}); }
+Image PreviewInputs::albedo_image() const { return albedo_.download({"R", "G", "B"}); }
 Image PreviewInputs::var_image() const {
   Image rgba = hv_.download({"R", "G", "B", "A"});
   Image out = Image::gray(width_, height_);

@@ -25,18 +25,24 @@ class PreviewInputs {
               const uint32_t* samples = nullptr);
   // The same from images: lv, hv "R,G,B"; var one channel.
   void upload(const Image& lv, const Image& hv, const Image& var);
+  // The per-pixel mean albedo of the first non-specular vertex (Accumulation::albedo_mean, 3 floats
+  // per pixel), for albedo demodulation (gl/demodulation.h). Uploaded only when demodulating.
+  void upload_albedo(const float* albedo_rgb);
+  void upload_albedo(const Image& albedo);  // "R,G,B"
 
   const Texture2D& lv() const { return lv_; }  // rgb L_lv
   const Texture2D& hv() const { return hv_; }  // rgb L_u, a Var[L_u] (kVarUnknown where n < 2)
+  const Texture2D& albedo() const { return albedo_; }  // rgb mean albedo (upload_albedo)
   double last_upload_ms() const { return timer_.last_ms(); }
 
   Image lv_image() const;   // "R,G,B"
   Image hv_image() const;   // "R,G,B"
   Image var_image() const;  // "Y": Var[L_u], 0 where unknown
+  Image albedo_image() const;  // "R,G,B"
 
  private:
   int width_, height_;
-  Texture2D lv_, hv_;
+  Texture2D lv_, hv_, albedo_;
   std::vector<float> packed_;  // staging: hv rgb + variance interleaved
   StageTimer timer_;
 };

@@ -8,6 +8,7 @@
 #include <random>
 #include "gl/blend_pass.h"
 #include "gl/cpu_reference.h"
+#include "gl/demodulation.h"
 #include "gl/filter_pass.h"
 #include "gl/inputs.h"
 #include "gl/test_util.h"
@@ -559,6 +560,174 @@ TEST(TonemapVsCpu, MatchesReference) {
       double ref = cpu_log_average(hdr, p.delta);
       EXPECT_NEAR(tonemap.log_average(), ref, 1e-4 * ref);
     }
+  }
+}
+
+// ---- Albedo demodulation (gl/demodulation.h) ----
+
+// A textured albedo: a fine checkerboard of two colors, a black and a nearly black stripe (not
+// demodulated), and a few non-finite texels.
+Image albedo_image_for_test() {
+  Image a = Image::rgb(W, H);
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      const bool odd = ((x / 2) + (y / 2)) % 2 == 1;
+      const float color[3] = {odd ? 0.8f : 0.15f, odd ? 0.6f : 0.3f, odd ? 0.9f : 0.05f};
+      for (int c = 0; c < 3; ++c) a.at(x, y, c) = x == 3 ? 0.0f : color[c];
+      if (x == 5)  // luminance below the epsilon: not demodulated
+        for (int c = 0; c < 3; ++c) a.at(x, y, c) = 0.5f * kAlbedoEpsilon;
+    }
+  a.at(7, 2, 0) = kNaN;
+  a.at(8, 2, 2) = kInf;
+  return a;
+}
+
+// Demodulate, filter (every variant, with and without the case-2 skip), remodulate, blend: the GPU
+// chain against cpu_demodulate -> cpu_filter -> cpu_remodulate -> cpu_blend, and the skip decisions
+// equal to those of the filter without demodulation.
+class DemodulationVsCpu : public ::testing::TestWithParam<std::tuple<FilterKind, bool>> {};
+
+TEST_P(DemodulationVsCpu, MatchesReference) {
+  test::osmesa_context();
+  auto [kind, skip] = GetParam();
+  Scenario s = make_scenario(13);
+  const Image albedo = albedo_image_for_test();
+  GpuFixture gpu(s);
+  gpu.inputs.upload_albedo(albedo);
+  FilterParams p;
+  p.kind = kind;
+  p.skip_case2 = skip;
+  p.t = 0.05f;
+  Demodulation demod(W, H);
+  FilterPass filter(W, H);
+  demod.demodulate(gpu.inputs, gpu.guide, p);
+  filter.run(demod.filter_inputs(), gpu.guide, p);
+  demod.remodulate(filter.output(), gpu.inputs);
+
+  const DemodulatedInputs d = cpu_demodulate(s.hv, s.var, s.lv, albedo, s.range, s.depth, p);
+  expect_close(demod.filter_inputs().hv_image(), d.hv, 1e-5f, 1e-7f, "L_u / a");
+  expect_close(demod.filter_inputs().var_image(), [&] {
+    Image v = d.var_u;
+    for (float& x : v.pixels) x = x > 0 ? x : 0.0f;
+    return v;
+  }(), 1e-5f, 1e-12f, "Var[L_u] / Y(a)^2");
+  const FilterOutput ref = cpu_remodulate(cpu_filter(d.hv, d.var_u, d.lv, s.range, s.depth, p), albedo);
+  expect_close(demod.filtered_image(), ref.filtered, 1e-4f, 1e-7f, "L_f");
+  Image gpu_var = demod.output().download({"R", "G", "B", "A"});
+  Image gpu_raw_var = Image::gray(W, H);
+  for (size_t i = 0; i < gpu_raw_var.pixel_count(); ++i) gpu_raw_var.pixels[i] = gpu_var.pixels[4 * i + 3];
+  expect_close(gpu_raw_var, ref.variance, 1e-4f, 1e-12f, "Var[L_f]");
+
+  // The same pixels are skipped as without demodulation.
+  FilterPass plain(W, H);
+  plain.run(gpu.inputs, gpu.guide, p);
+  EXPECT_EQ(filter.filtered_pixels(), plain.filtered_pixels());
+  const FilterOutput plain_ref = cpu_filter(s.hv, s.var, s.lv, s.range, s.depth, p);
+  size_t skipped = 0;
+  for (size_t i = 0; i < ref.variance.pixels.size(); ++i) {
+    EXPECT_EQ(ref.variance.pixels[i] == kVarSkipped, plain_ref.variance.pixels[i] == kVarSkipped) << i;
+    skipped += ref.variance.pixels[i] == kVarSkipped;
+  }
+  if (skip) {
+    EXPECT_GT(skipped, 0u);
+  }
+
+  // The blend sees the remodulated L_f and Var[L_f].
+  const BlendParams bp{p.t, range_weights(p)};
+  BlendPass blend(W, H);
+  // The filter's centre weight (bilateral variants) is unchanged by demodulation: Cov[L_u, L_f] =
+  // w Var[L_u] with a grey factor.
+  blend.run(gpu.inputs, &demod.output(), &gpu.guide, bp, filter.centre_weight());
+  const BlendOutput rb = cpu_blend(s.lv, s.hv, s.var, &ref, bp, &s.range, &s.depth);
+  expect_close(blend.final_image(), rb.final_rgb, 2e-4f, 1e-6f, "final");
+  expect_close(blend.case_image(), rb.blend_case, 0.0f, 0.0f, "case");
+}
+
+INSTANTIATE_TEST_SUITE_P(Variants, DemodulationVsCpu,
+                         ::testing::Values(std::make_tuple(FilterKind::Grid, false), std::make_tuple(FilterKind::Grid, true),
+                                           std::make_tuple(FilterKind::BilateralDepth, true),
+                                           std::make_tuple(FilterKind::Separable, false),
+                                           std::make_tuple(FilterKind::Atrous, true),
+                                           std::make_tuple(FilterKind::Subsampled, true)));
+
+TEST(Demodulation, WithoutFilteringGivesBackTheInputs) {
+  // Remodulating the demodulated inputs themselves is the identity (up to rounding), sentinels kept.
+  test::osmesa_context();
+  Scenario s = make_scenario(17);
+  const Image albedo = albedo_image_for_test();
+  GpuFixture gpu(s);
+  gpu.inputs.upload_albedo(albedo);
+  Demodulation demod(W, H);
+  demod.demodulate(gpu.inputs, gpu.guide, FilterParams{});
+  demod.remodulate(demod.filter_inputs().hv(), gpu.inputs);
+  expect_close(demod.filtered_image(), gpu.inputs.hv_image(), 1e-6f, 1e-12f, "L_u");
+  const Image back = demod.output().download({"R", "G", "B", "A"});
+  const Image in = gpu.inputs.hv().download({"R", "G", "B", "A"});
+  for (size_t i = 0; i < back.pixel_count(); ++i) {
+    const float v = in.pixels[4 * i + 3], got = back.pixels[4 * i + 3];
+    if (v < 0.0f || !std::isfinite(v))
+      EXPECT_EQ(got, kVarUnknown) << i;
+    else
+      EXPECT_NEAR(got, v, 1e-6f * v) << i;
+  }
+  const float k = luminance(0.8f, 0.2f, 0.01f);  // a saturated red: one grey factor, its luminance
+  EXPECT_EQ(demodulation_factor(0.8f, 0.2f, 0.01f), (std::array<float, 3>{k, k, k}));
+  EXPECT_EQ(demodulation_factor(0.05f, 0.03f, 0.05f), (std::array<float, 3>{1.0f, 1.0f, 1.0f}));  // Y < epsilon
+  EXPECT_EQ(demodulation_factor(kNaN, 0.5f, 0.5f), demodulation_factor(0.0f, 0.5f, 0.5f));
+}
+
+// A textured plane under constant irradiance E, seen through a guide that does not show the
+// texture (a flat range color): L_u = a(x, y) E. Filtering radiance averages the texture away;
+// with demodulation the filter sees the constant E and the texture comes back exactly. The texture
+// varies in luminance (its two colors have the same chromaticity): the factor is grey.
+TEST(Demodulation, TexturedConstantIrradiancePlaneKeepsItsTexture) {
+  test::osmesa_context();
+  const Image albedo = [] {
+    Image a = Image::rgb(W, H);
+    for (int y = 0; y < H; ++y)
+      for (int x = 0; x < W; ++x) {
+        const bool odd = ((x / 3) + (y / 3)) % 2 == 1;
+        const float level = odd ? 1.0f : 0.12f;
+        a.at(x, y, 0) = 0.9f * level;
+        a.at(x, y, 1) = 0.7f * level;
+        a.at(x, y, 2) = 0.3f * level;
+      }
+    return a;
+  }();
+  const float e[3] = {2.0f, 1.5f, 1.0f};
+  Scenario s;
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      for (int c = 0; c < 3; ++c) {
+        s.hv.at(x, y, c) = albedo.at(x, y, c) * e[c];
+        s.lv.at(x, y, c) = 0.0f;
+        s.range.at(x, y, c) = 0.5f;
+      }
+      s.var.at(x, y, 0) = 0.01f * luminance(s.hv.at(x, y, 0), s.hv.at(x, y, 1), s.hv.at(x, y, 2));
+      s.depth.at(x, y, 0) = 3.0f;
+    }
+  GpuFixture gpu(s);
+  gpu.inputs.upload_albedo(albedo);
+  for (FilterKind kind : {FilterKind::Grid, FilterKind::BilateralDepth, FilterKind::Atrous}) {
+    SCOPED_TRACE(filter_kind_name(kind));
+    FilterParams p;
+    p.kind = kind;
+    p.skip_case2 = false;
+    FilterPass filter(W, H);
+    filter.run(gpu.inputs, gpu.guide, p);
+    double blurred = 0, kept = 0;
+    const Image plain = filter.filtered_image();
+    Demodulation demod(W, H);
+    demod.demodulate(gpu.inputs, gpu.guide, p);
+    filter.run(demod.filter_inputs(), gpu.guide, p);
+    demod.remodulate(filter.output(), gpu.inputs);
+    const Image textured = demod.filtered_image();
+    for (size_t i = 0; i < s.hv.pixels.size(); ++i) {
+      blurred = std::max(blurred, double(std::abs(plain.pixels[i] - s.hv.pixels[i]) / s.hv.pixels[i]));
+      kept = std::max(kept, double(std::abs(textured.pixels[i] - s.hv.pixels[i]) / s.hv.pixels[i]));
+    }
+    EXPECT_GT(blurred, 0.5);  // without demodulation the checkerboard is averaged away
+    EXPECT_LT(kept, 1e-5);    // with it every texel comes back
   }
 }
 

@@ -86,6 +86,10 @@ float atrous_variance_correction(int pass);
 constexpr float kVarUnknown = -1.0f;  // n < 2 (Var[L_u]); no known neighbour variance (Var[L_f])
 constexpr float kVarSkipped = -2.0f;  // Var[L_f] of a pixel the filter skipped (case 2)
 
+// Albedo demodulation (gl/demodulation.h): a pixel whose mean albedo's luminance is below this is
+// not demodulated (factor 1), so that dividing never amplifies by more than 1 / kAlbedoEpsilon.
+constexpr float kAlbedoEpsilon = 0.05f;
+
 // Background depth (distance) of the range buffer where no surface is hit.
 constexpr float kBackgroundDepth = 1.0e4f;
 

@@ -36,6 +36,7 @@ void visit_arrays(Acc& acc, Visit&& visit) {
   visit(acc.hv_lum_mean);
   visit(acc.hv_lum_m2);
   visit(acc.samples);
+  visit(acc.albedo_mean);
 }
 
 class Writer {
@@ -117,9 +118,10 @@ void check_pixels(const AccumulationState& state) {
   for (size_t i = 0; i < acc.samples.size(); ++i) {
     // Samples are per frame at most one per pixel (non-finite ones are dropped).
     if (acc.samples[i] > frames) throw Error("state file has more samples in a pixel than frames");
-    const glm::vec3 lv = acc.lv_mean[i], hv = acc.hv_mean[i];
+    const glm::vec3 lv = acc.lv_mean[i], hv = acc.hv_mean[i], a = acc.albedo_mean[i];
     const bool finite = std::isfinite(lv.x) && std::isfinite(lv.y) && std::isfinite(lv.z) && std::isfinite(hv.x) &&
-                        std::isfinite(hv.y) && std::isfinite(hv.z) && std::isfinite(acc.hv_lum_mean[i]) &&
+                        std::isfinite(hv.y) && std::isfinite(hv.z) && std::isfinite(a.x) && std::isfinite(a.y) &&
+                        std::isfinite(a.z) && std::isfinite(acc.hv_lum_mean[i]) &&
                         std::isfinite(acc.hv_lum_m2[i]) && acc.hv_lum_m2[i] >= 0.0;
     if (!finite) throw Error("state file has a non-finite or negative value at pixel " + std::to_string(i));
   }
@@ -137,6 +139,7 @@ void merge_into(Accumulation& into, const Accumulation& from) {
     if (na == 0) {
       into.lv_mean[i] = from.lv_mean[i];
       into.hv_mean[i] = from.hv_mean[i];
+      into.albedo_mean[i] = from.albedo_mean[i];
       into.hv_lum_mean[i] = from.hv_lum_mean[i];
       into.hv_lum_m2[i] = from.hv_lum_m2[i];
       into.samples[i] = nb;
@@ -146,6 +149,7 @@ void merge_into(Accumulation& into, const Accumulation& from) {
     for (int c = 0; c < 3; ++c) {
       into.lv_mean[i][c] = combine_mean(into.lv_mean[i][c], na, from.lv_mean[i][c], nb, n);
       into.hv_mean[i][c] = combine_mean(into.hv_mean[i][c], na, from.hv_mean[i][c], nb, n);
+      into.albedo_mean[i][c] = combine_mean(into.albedo_mean[i][c], na, from.albedo_mean[i][c], nb, n);
     }
     // Chan, Golub and LeVeque's pairwise update of the Welford state.
     const double delta = from.hv_lum_mean[i] - into.hv_lum_mean[i];

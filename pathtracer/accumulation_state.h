@@ -11,7 +11,7 @@
 
 namespace pxf {
 
-constexpr uint32_t kStateFormatVersion = 1;
+constexpr uint32_t kStateFormatVersion = 2;  // 2: the albedo mean (albedo demodulation)
 
 // The frames [begin, end) of the counter-based sample sequence.
 struct FrameRange {

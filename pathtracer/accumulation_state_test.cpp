@@ -32,7 +32,9 @@ AccumulationState render_frames(FrameRange range) {
       if ((p + f) % 11 == 3) continue;  // a dropped (non-finite) sample: counts differ per pixel
       glm::vec3 lv, hv;
       sample_of(p, f, lv, hv);
-      accumulate_sample(state.acc, p, lv, hv);
+      // The albedo of a textured pixel varies with the sample's position in the pixel.
+      const glm::vec3 albedo(0.1f + 0.05f * static_cast<float>((p * 7 + f) % 13), 0.5f, (f % 3) * 0.4f);
+      accumulate_sample(state.acc, p, lv, hv, 0, albedo);
     }
   return state;
 }
@@ -56,6 +58,7 @@ void expect_same_accumulation(const Accumulation& a, const Accumulation& b) {
     for (int c = 0; c < 3; ++c) {
       EXPECT_NEAR(a.lv_mean[i][c], b.lv_mean[i][c], kMeanTolerance * std::abs(b.lv_mean[i][c])) << i;
       EXPECT_NEAR(a.hv_mean[i][c], b.hv_mean[i][c], kMeanTolerance * std::abs(b.hv_mean[i][c])) << i;
+      EXPECT_NEAR(a.albedo_mean[i][c], b.albedo_mean[i][c], kMeanTolerance * std::abs(b.albedo_mean[i][c])) << i;
     }
     EXPECT_NEAR(a.hv_lum_mean[i], b.hv_lum_mean[i], 1e-12 * std::abs(b.hv_lum_mean[i])) << i;
     EXPECT_NEAR(a.hv_lum_m2[i], b.hv_lum_m2[i], 1e-12 * std::abs(b.hv_lum_m2[i])) << i;
@@ -98,8 +101,8 @@ TEST(AccumulationState, EveryCorruptedByteIsRefused) {
 
 TEST(AccumulationState, OtherVersionIsRefusedByName) {
   std::vector<uint8_t> bytes = encode_state(render_frames({0, 2}));
-  bytes[8] = 2;  // the version follows the 8-byte magic
-  EXPECT_NE(decode_error(bytes).find("version 2 is not supported"), std::string::npos) << decode_error(bytes);
+  bytes[8] = 1;  // the version follows the 8-byte magic; version 1 (no albedo mean) is refused
+  EXPECT_NE(decode_error(bytes).find("version 1 is not supported"), std::string::npos) << decode_error(bytes);
   bytes[0] = 'Q';
   EXPECT_NE(decode_error(bytes).find("not a pxf state file"), std::string::npos);
 }

@@ -22,6 +22,7 @@ struct PathState {
   bool prev_delta = true;  // the last interaction was a delta lobe (or the camera)
   float prev_pdf = 0.0f;   // solid-angle pdf of the last non-delta BSDF sample
   glm::vec3 prev_position{0.0f};  // the surface point the ray left (un-offset: the light pdf's origin)
+  bool albedo_set = false;        // PathSample::albedo holds the first non-delta vertex's base color
 };
 
 // Emission leaves a surface toward the ray only on its front face, unless it is double-sided.
@@ -162,12 +163,17 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
     add_contribution(out, s.throughput * eval_emission(scene, material, sp.uv0, sp.uv1) * w, emission_is_lv(s),
                      params.all_hv);
   }
-  if (vertex == params.max_vertices) return false;  // no room for another vertex
+  const bool last_vertex = vertex == params.max_vertices;  // no room for another vertex
+  if (last_vertex && s.albedo_set) return false;
 
   glm::vec3 wo = -path.ray.direction;
-  Bsdf bsdf(eval_material(scene, material, sp.uv0, sp.uv1, sp.color), sp.shading_normal, sp.geometric_normal, wo,
-            sp.front_face);
-  if (bsdf.is_black()) return false;
+  const BsdfParams bsdf_params = eval_material(scene, material, sp.uv0, sp.uv1, sp.color);
+  Bsdf bsdf(bsdf_params, sp.shading_normal, sp.geometric_normal, wo, sp.front_face);
+  if (!s.albedo_set && (bsdf.has_nondelta() || bsdf.is_black())) {
+    out.albedo = bsdf_params.base_color;
+    s.albedo_set = true;
+  }
+  if (last_vertex || bsdf.is_black()) return false;
 
   // Next event estimation (the light vertex is vertex + 1 <= max_vertices).
   float u_light = sampler.get_1d(vertex, VertexDim::LightSelect);
@@ -266,6 +272,7 @@ void resize_accumulation(Accumulation& acc, int width, int height, int replicate
   acc.height = height;
   acc.lv_mean.assign(n, glm::vec3(0.0f));
   acc.hv_mean.assign(n, glm::vec3(0.0f));
+  acc.albedo_mean.assign(n, glm::vec3(0.0f));
   acc.hv_lum_mean.assign(n, 0.0);
   acc.hv_lum_m2.assign(n, 0.0);
   acc.samples.assign(n, 0u);
@@ -275,11 +282,12 @@ void resize_accumulation(Accumulation& acc, int width, int height, int replicate
   acc.replicate_samples.assign(replicate_slots, 0u);
 }
 
-void accumulate_sample(Accumulation& acc, size_t pixel, glm::vec3 lv, glm::vec3 hv, int replicate) {
+void accumulate_sample(Accumulation& acc, size_t pixel, glm::vec3 lv, glm::vec3 hv, int replicate, glm::vec3 albedo) {
   uint32_t n = ++acc.samples[pixel];
   float inv_n = 1.0f / static_cast<float>(n);
   acc.lv_mean[pixel] += (lv - acc.lv_mean[pixel]) * inv_n;
   acc.hv_mean[pixel] += (hv - acc.hv_mean[pixel]) * inv_n;
+  acc.albedo_mean[pixel] += (albedo - acc.albedo_mean[pixel]) * inv_n;
   double y = luminance(hv);
   double delta = y - acc.hv_lum_mean[pixel];
   acc.hv_lum_mean[pixel] += delta / static_cast<double>(n);

@@ -15,6 +15,10 @@ namespace pxf {
 struct PathSample {
   glm::vec3 lv{0.0f};
   glm::vec3 hv{0.0f};
+  // Base color of the first vertex with a non-delta lobe (through perfectly specular chains, not
+  // tinted by them); (1, 1, 1) when the path escapes or ends before such a vertex, so that light
+  // seen directly or through glass is not demodulated (albedo demodulation, gl/demodulation.h).
+  glm::vec3 albedo{1.0f};
   uint32_t rays = 0;
   bool finite() const;
 };
@@ -63,9 +67,10 @@ class PathTracer {
 };
 
 // Adds one accepted sample to pixel `pixel`: running means of LV/HV RGB and Welford (double) of
-// the HV luminance. The caller has already rejected non-finite samples.
+// the HV luminance, running mean of the albedo. The caller has already rejected non-finite samples.
 // `replicate` is the sample's replicate (frame mod acc.replicates).
-void accumulate_sample(Accumulation& acc, size_t pixel, glm::vec3 lv, glm::vec3 hv, int replicate = 0);
+void accumulate_sample(Accumulation& acc, size_t pixel, glm::vec3 lv, glm::vec3 hv, int replicate = 0,
+                       glm::vec3 albedo = glm::vec3(1.0f));
 void resize_accumulation(Accumulation& acc, int width, int height, int replicates = 1);  // and clear
 
 }  // namespace pxf

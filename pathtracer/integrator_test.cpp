@@ -523,6 +523,34 @@ TEST(Integrator, EscapedSpecularChainTakesTheCompressedEnvironment) {
   EXPECT_EQ(dark.trace_specular_chains({8 * size + 8}, glm::vec2(0.5f))[0].range_color, glm::vec3(0.0f));
 }
 
+// The albedo channel: the base color of the first surface with a non-delta lobe, not tinted by
+// the perfectly specular chain before it; 1 where the path escapes before any such surface.
+TEST(Integrator, AlbedoIsTheFirstNonSpecularBaseColor) {
+  // Camera at the origin looking -Z. Lower left: a diffuse quad (0.2, 0.4, 0.6) at z = -2. Lower
+  // right: a tinted mirror in the plane z = -2 - x (normal (1, 0, 1) / sqrt 2), which sends the rays
+  // to +x onto a diffuse wall (0.7, 0.3, 0.1) at x = 3. Upper rows: nothing (the environment).
+  Scene scene;
+  scene.materials = {make_diffuse(glm::vec3(0.2f, 0.4f, 0.6f)), make_mirror(glm::vec3(0.5f, 0.9f, 0.9f)),
+                     make_diffuse(glm::vec3(0.7f, 0.3f, 0.1f))};
+  scene.meshes.push_back(make_quad(glm::vec3(-4, -4, -2), glm::vec3(4, 0, 0), glm::vec3(0, 4, 0), 0));
+  scene.meshes.push_back(make_quad(glm::vec3(0, -4, -2), glm::vec3(4, 0, -4), glm::vec3(0, 4, 0), 1));
+  scene.meshes.push_back(make_quad(glm::vec3(3, -4, -30), glm::vec3(0, 0, 60), glm::vec3(0, 4, 0), 2));
+  scene.environment = uniform_environment(1.0f);
+  scene.camera = look_at_camera(glm::vec3(0), glm::vec3(0, 0, -1), glm::vec3(0, 1, 0), 1.2f);
+  const int size = 32;
+  TraceParams params;
+  params.threads = 2;
+  ProgressiveRenderer renderer(scene, params, size, size);
+  for (int i = 0; i < 8; ++i) renderer.add_frame();
+  const Image albedo = renderer.albedo_image();
+  auto expect_albedo = [&](int x, int y, glm::vec3 expected) {
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(albedo.at(x, y, c), expected[c], 1e-5f) << x << "," << y << " " << c;
+  };
+  expect_albedo(6, 26, glm::vec3(0.2f, 0.4f, 0.6f));  // the diffuse quad
+  expect_albedo(26, 26, glm::vec3(0.7f, 0.3f, 0.1f));  // through the mirror, untinted
+  expect_albedo(16, 2, glm::vec3(1.0f));               // the environment
+}
+
 }  // namespace
 }  // namespace pxf
 

@@ -99,6 +99,7 @@ struct Accumulation {
   int width = 0, height = 0;
   std::vector<glm::vec3> lv_mean;      // mean RGB radiance of LV paths
   std::vector<glm::vec3> hv_mean;      // mean RGB radiance of HV paths
+  std::vector<glm::vec3> albedo_mean;  // mean PathSample::albedo (first non-specular base color)
   std::vector<double> hv_lum_mean;     // Welford state of HV luminance
   std::vector<double> hv_lum_m2;
   std::vector<uint32_t> samples;       // accepted samples per pixel (NaN/Inf samples dropped)
@@ -164,6 +165,7 @@ class ProgressiveRenderer {
 
   Image lv_image() const;          // RGB
   Image hv_image() const;          // RGB
+  Image albedo_image() const;      // RGB: mean first non-specular albedo (PathSample::albedo)
   Image unfiltered_image() const;  // RGB L_lv + L_u: what plain path tracing shows
   Image variance_image() const;    // "Y": Var[L_u], 0 where unknown
   Image samples_image() const;     // "Y": n

@@ -68,7 +68,7 @@ struct ProgressiveRenderer::Impl {
             continue;
           }
           const int x = rect.x0 + i % rect.width(), y = rect.y0 + i / rect.width();
-          accumulate_sample(acc, static_cast<size_t>(y) * width + x, sample.lv, sample.hv, replicate);
+          accumulate_sample(acc, static_cast<size_t>(y) * width + x, sample.lv, sample.hv, replicate, sample.albedo);
         }
       }
       rays += tile_rays;
@@ -166,6 +166,7 @@ Image rgb_image(const std::vector<glm::vec3>& values, int width, int height) {
 
 Image ProgressiveRenderer::lv_image() const { return rgb_image(impl_->acc.lv_mean, impl_->width, impl_->height); }
 Image ProgressiveRenderer::hv_image() const { return rgb_image(impl_->acc.hv_mean, impl_->width, impl_->height); }
+Image ProgressiveRenderer::albedo_image() const { return rgb_image(impl_->acc.albedo_mean, impl_->width, impl_->height); }
 
 Image ProgressiveRenderer::variance_image() const {
   Image image = Image::gray(impl_->width, impl_->height);

@@ -119,3 +119,15 @@ bool skip_as_case2(sampler2D hv, sampler2D lv, sampler2D guide, ivec2 p, float k
   float v = pooled_var_u(hv, guide, p, k_c, k_d);
   return v > 0.0 && relative_variance(v, lb) <= max(t, 0.0);
 }
+
+// Albedo demodulation (gl/demodulation.h): the factor HV is divided by before the filter and L_f
+// multiplied by after it: grey, the luminance Y(a) of the pixel's mean albedo where it is at least
+// kAlbedoEpsilon, else 1 (a nearly black albedo is not demodulated). Grey, not per channel: a
+// channel near 0 (a saturated texture) would amplify that channel of light the albedo does not
+// shape (specular highlights, neighbours' light) many times over. Mirrors demodulation_factor()
+// in cpu_reference.cpp.
+const float kAlbedoEpsilon = 0.05;
+vec3 demodulation_factor(vec3 albedo) {
+  float k = luminance(clean(albedo));
+  return k >= kAlbedoEpsilon ? vec3(k) : vec3(1.0);
+}

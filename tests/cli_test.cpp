@@ -168,11 +168,14 @@ TEST(Cli, RenderWritesEveryOutput) {
   std::vector<std::string> names;
   for (const Layer& l : read_exr_layers(out + "/buffers.exr")) names.push_back(l.name);
   for (const char* layer :
-       {"final", "lv", "hv", "hv_filtered", "var_u", "var_f", "blend", "range_color", "depth", "emitter"})
+       {"final", "lv", "hv", "hv_filtered", "var_u", "var_f", "blend", "range_color", "depth", "emitter", "albedo"})
     EXPECT_NE(std::find(names.begin(), names.end(), layer), names.end()) << layer;
   const auto stats = nlohmann::json::parse(slurp(out + "/stats.json"));
   EXPECT_EQ(stats["settings"]["spp"], 4);
   EXPECT_EQ(stats["filter_runs"], 3);  // 1, 2, 4
+  EXPECT_EQ(stats["settings"]["demodulate"], false);
+  EXPECT_EQ(stats["filter_runs_skipped_low_hv"], 0);
+  EXPECT_GT(stats["hv_energy_share"].get<double>(), 0.01);
   for (const char* stage : {"path_tracing", "upload", "range", "filter", "blend", "tonemap"})
     EXPECT_TRUE(stats["stage_ms_total"].contains(stage)) << stage;
   EXPECT_GT(stats["paths_per_second"].get<double>(), 0.0);
@@ -185,6 +188,10 @@ TEST(Cli, RenderWritesEveryOutput) {
   ASSERT_EQ(with_ref.code, 0) << with_ref.err;
   const auto stats2 = nlohmann::json::parse(slurp(out + "/stats.json"));
   EXPECT_GT(stats2["final_vs_reference"]["nrmse_percent"].get<double>(), 0.0);
+  // --demodulate on is recorded; a bad value is a usage error.
+  ASSERT_EQ(run("render --size 32x24 --spp 2 --demodulate on --quiet --out " + out).code, 0);
+  EXPECT_EQ(nlohmann::json::parse(slurp(out + "/stats.json"))["settings"]["demodulate"], true);
+  EXPECT_EQ(run("render --size 32x24 --spp 2 --demodulate maybe --quiet --out " + out).code, 2);
   EXPECT_GT(stats2["unfiltered_vs_reference"]["nrmse_percent"].get<double>(), 0.0);
 }
 

@@ -1,0 +1,59 @@
+#include "gl/demodulation.h"
+
+#include "gl/gl.h"
+
+namespace pxf {
+
+Demodulation::Demodulation(int width, int height)
+    : width_(width), height_(height), demod_program_(Program::from_embedded("fullscreen.vert", "demodulate.frag")),
+      remod_program_(Program::from_embedded("fullscreen.vert", "remodulate.frag")), filter_inputs_(width, height),
+      output_(width, height, TextureFormat::RGBA32F) {
+  demod_fbo_.attach(0, filter_inputs_.hv());
+  demod_fbo_.attach(1, filter_inputs_.lv());
+  demod_fbo_.check("demodulation");
+  remod_fbo_.attach(0, output_);
+  remod_fbo_.check("remodulation");
+}
+
+void Demodulation::demodulate(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& p) {
+  if (inputs.width() != width_ || inputs.height() != height_ || guide.width() != width_ || guide.height() != height_)
+    throw Error("demodulation: input size differs from the pass size");
+  demod_timer_.begin();
+  const RangeWeights range = range_weights(p);
+  demod_program_.set("k_c", range.k_c);
+  demod_program_.set("k_d", range.k_d);
+  demod_program_.set("t", p.t);
+  demod_program_.set("skip_case2", p.skip_case2 ? 1 : 0);
+  inputs.hv().bind(0);
+  inputs.lv().bind(1);
+  guide.bind(2);
+  inputs.albedo().bind(3);
+  demod_program_.use();
+  quad_.draw(demod_fbo_, width_, height_);
+  demod_timer_.end();
+  check_gl_error("demodulation");
+}
+
+void Demodulation::remodulate(const Texture2D& filtered, const PreviewInputs& inputs) {
+  if (filtered.width() != width_ || filtered.height() != height_ || inputs.width() != width_ ||
+      inputs.height() != height_)
+    throw Error("remodulation: input size differs from the pass size");
+  remod_timer_.begin();
+  filtered.bind(0);
+  inputs.albedo().bind(1);
+  remod_program_.use();
+  quad_.draw(remod_fbo_, width_, height_);
+  remod_timer_.end();
+  check_gl_error("remodulation");
+}
+
+Image Demodulation::filtered_image() const { return output_.download({"R", "G", "B"}); }
+
+Image Demodulation::variance_image() const {
+  Image rgba = output_.download({"R", "G", "B", "A"});
+  Image out = Image::gray(width_, height_);
+  for (size_t i = 0; i < out.pixel_count(); ++i) out.pixels[i] = rgba.pixels[4 * i + 3] > 0 ? rgba.pixels[4 * i + 3] : 0.0f;
+  return out;
+}
+
+}  // namespace pxf

@@ -1,0 +1,53 @@
+// Albedo demodulation around the filter, for every filter variant: the filter smooths HV divided by
+// the albedo of the first non-specular vertex (irradiance-like, free of texture detail) and its
+// output is multiplied back by each pixel's own albedo before the blend, so textures stay sharp.
+//   demodulate: L_u' = L_u / a, Var[L_u'] = Var[L_u] / Y(a)^2
+//   remodulate: L_f  = a L_f', Var[L_f]  = Y(a)^2 Var[L_f']   (a grey: Y(a) = a)
+// a = demodulation_factor(mean albedo) (shaders/common.glsl): grey, the albedo's luminance where
+// that is at least kAlbedoEpsilon (0.05), else 1 (that pixel is not demodulated). Grey because a
+// per-channel division amplifies, in the channels a saturated texture nearly lacks, light that the
+// albedo does not shape (specular highlights): on envmap that gave pink speckles and a red halo and
+// doubled the error. So luminance texture is kept, chroma texture within the filter's range
+// tolerance is still smoothed. With a grey factor the variance scaling is exact. On an unfiltered
+// pixel the two steps give back L_u and Var[L_u]; the blend sees L_f and Var[L_f] in radiance units, so its
+// perceived-variance logic is unchanged. The filter's case-2 skip is decided on the original
+// buffers (shaders/demodulate.frag). CPU reference: cpu_demodulate / cpu_remodulate.
+// Usage:
+//   inputs.upload_albedo(&acc.albedo_mean[0].x);
+//   demod.demodulate(inputs, guide, filter_params);
+//   filter.run(demod.filter_inputs(), guide, filter_params);
+//   demod.remodulate(filter.output(), inputs);
+//   blend.run(inputs, &demod.output(), &guide, blend_params, filter.centre_weight());  // w unchanged
+#pragma once
+#include "gl/inputs.h"
+#include "gl/preview_params.h"
+#include "gl/resources.h"
+
+namespace pxf {
+
+class Demodulation {
+ public:
+  Demodulation(int width, int height);
+  // inputs: L_u, Var[L_u], L_lv and the albedo (PreviewInputs::upload_albedo); guide: the range
+  // buffer; params: the filter's (range weights, skip_case2, t for the skip decision).
+  void demodulate(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& params);
+  const PreviewInputs& filter_inputs() const { return filter_inputs_; }  // the filter's input
+  // filtered: the filter's output on filter_inputs(); albedo from `inputs`.
+  void remodulate(const Texture2D& filtered, const PreviewInputs& inputs);
+  const Texture2D& output() const { return output_; }  // rgb L_f, a Var[L_f] or a sentinel
+  double last_ms() const { return demod_timer_.last_ms() + remod_timer_.last_ms(); }
+
+  Image filtered_image() const;      // "R,G,B" L_f
+  Image variance_image() const;      // "Y" Var[L_f], 0 where unknown or skipped
+
+ private:
+  int width_, height_;
+  Program demod_program_, remod_program_;
+  PreviewInputs filter_inputs_;
+  Texture2D output_;
+  Framebuffer demod_fbo_, remod_fbo_;
+  FullscreenPass quad_;
+  StageTimer demod_timer_, remod_timer_;
+};
+
+}  // namespace pxf
