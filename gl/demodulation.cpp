@@ -50,10 +50,7 @@ void Demodulation::remodulate(const Texture2D& filtered, const PreviewInputs& in
 Image Demodulation::filtered_image() const { return output_.download({"R", "G", "B"}); }
 
 Image Demodulation::variance_image() const {
-  Image rgba = output_.download({"R", "G", "B", "A"});
-  Image out = Image::gray(width_, height_);
-  for (size_t i = 0; i < out.pixel_count(); ++i) out.pixels[i] = rgba.pixels[4 * i + 3] > 0 ? rgba.pixels[4 * i + 3] : 0.0f;
-  return out;
+  return variance_from_alpha(output_);
 }
 
 }  // namespace pxf

@@ -140,10 +140,6 @@ Image FilterPass::raw_variance_image() const {
   return out;
 }
 
-Image FilterPass::variance_image() const {
-  Image out = raw_variance_image();
-  for (float& v : out.pixels) v = v > 0 ? v : 0.0f;
-  return out;
-}
+Image FilterPass::variance_image() const { return variance_from_alpha(output_); }
 
 }  // namespace pxf

@@ -45,10 +45,7 @@ Image PreviewInputs::lv_image() const { return lv_.download({"R", "G", "B"}); }
 Image PreviewInputs::hv_image() const { return hv_.download({"R", "G", "B"}); }
 Image PreviewInputs::albedo_image() const { return albedo_.download({"R", "G", "B"}); }
 Image PreviewInputs::var_image() const {
-  Image rgba = hv_.download({"R", "G", "B", "A"});
-  Image out = Image::gray(width_, height_);
-  for (size_t i = 0; i < out.pixel_count(); ++i) out.pixels[i] = rgba.pixels[4 * i + 3] > 0 ? rgba.pixels[4 * i + 3] : 0.0f;
-  return out;
+  return variance_from_alpha(hv_);
 }
 
 }  // namespace pxf

@@ -170,6 +170,16 @@ void Texture2D::upload(const Image& image) {
   upload(image.pixels.data(), c);
 }
 
+Image variance_from_alpha(const Texture2D& texture) {
+  const Image rgba = texture.download({"R", "G", "B", "A"});
+  Image out = Image::gray(rgba.width, rgba.height);
+  for (size_t i = 0; i < out.pixel_count(); ++i) {
+    const float v = rgba.pixels[4 * i + 3];
+    out.pixels[i] = v > 0 ? v : 0.0f;
+  }
+  return out;
+}
+
 Image Texture2D::download(const std::vector<std::string>& channels) const {
   Image image(width_, height_, channels);
   int c = image.num_channels();

@@ -115,6 +115,10 @@ class Texture2D {
   TextureFormat format_ = TextureFormat::RGBA32F;
 };
 
+// "Y": the alpha channel of an RGBA texture that holds a variance there, 0 where it is a sentinel
+// (unknown, skipped: negative).
+Image variance_from_alpha(const Texture2D& texture);
+
 class Framebuffer {
  public:
   Framebuffer();
