@@ -1,6 +1,7 @@
 #include "app/preview.h"
 
 #include <algorithm>
+#include <cstdio>
 
 #include "pathtracer/bench.h"
 
@@ -64,8 +65,23 @@ double hv_energy_share(const Accumulation& acc) {
   return all > 0 ? hv / all : 0.0;
 }
 
+uint64_t preview_bytes(int width, int height) {
+  return static_cast<uint64_t>(std::max(width, 0)) * static_cast<uint64_t>(std::max(height, 0)) * kPreviewBytesPerPixel;
+}
+
+void check_preview_memory(int width, int height, uint64_t available_bytes) {
+  const uint64_t needed = preview_bytes(width, height);
+  if (available_bytes == 0 || needed <= available_bytes) return;  // 0: unknown, do not refuse
+  constexpr double kGiB = 1024.0 * 1024.0 * 1024.0;
+  char text[200];
+  std::snprintf(text, sizeof text, "--size %dx%d needs about %.1f GiB for the render's buffers (%d B per pixel), %.1f GiB available",
+                width, height, needed / kGiB, static_cast<int>(kPreviewBytesPerPixel), available_bytes / kGiB);
+  throw Error(text);
+}
+
+// The memory check runs first, before any member allocates.
 Preview::Preview(const Scene& scene, const PreviewSettings& settings, int width, int height)
-    : width_(width),
+    : width_((check_preview_memory(width, height, available_memory_bytes()), width)),
       height_(height),
       settings_(settings),
       renderer_(std::make_unique<ProgressiveRenderer>(scene, settings.trace, width, height)),

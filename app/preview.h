@@ -64,6 +64,16 @@ double pass_share_of_tracing(const StageTimes& t);
 double hv_energy_share(const Accumulation& acc);
 constexpr double kMinHvShare = 0.01;
 
+// Memory a Preview of width x height needs, checked before it allocates anything: the peak memory
+// of `pxf render` grows by about this much per pixel (cornell at 256x256 and 1024x1024, 2 spp: 130
+// and 615 MiB): the accumulation (means, variances in double, albedo, replicates), the GL textures
+// of every pass, and the read-backs written to buffers.exr.
+constexpr uint64_t kPreviewBytesPerPixel = 520;
+uint64_t preview_bytes(int width, int height);
+// Throws pxf::Error, one line naming the size and both figures, when preview_bytes exceeds
+// `available_bytes` (available_memory_bytes() in the constructor).
+void check_preview_memory(int width, int height, uint64_t available_bytes);
+
 class Preview {
  public:
   Preview(const Scene& scene, const PreviewSettings& settings, int width, int height);
