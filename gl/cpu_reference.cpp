@@ -459,6 +459,9 @@ BlendOutput cpu_blend(const Image& lv, const Image& hv, const Image& var_u, cons
         float vu = clean_var(var_u.at(x, y, 0));
         if (vf_raw < -1.5f) {
           d = {1.0f, kCaseUnfiltered};
+        } else if (pool && lu.c[0] == 0.0f && lu.c[1] == 0.0f && lu.c[2] == 0.0f &&
+                   depth->at(x, y, 0) >= kBackgroundDistanceMin) {
+          d = {1.0f, kCaseUnfiltered};  // the background rule
         } else if (vu < 0.0f) {
           d = {0.0f, kCaseUnknownVar};
         } else {

@@ -501,6 +501,48 @@ TEST(BlendVsCpu, CovarianceTermFromTheFiltersCentreWeight) {
   EXPECT_GT(changed, 0u);
 }
 
+TEST(BlendVsCpu, BackgroundPixelsWithoutHvTakeNoFilteredLight) {
+  // The left third is background (guide distance kBackgroundDepth, the camera rays escaped): where
+  // L_u is exactly 0 there, the blend keeps it (case 2, s = 1) however bright the filtered light
+  // spread into it; background pixels with HV light, and surfaces, blend as before. GPU = CPU.
+  test::osmesa_context();
+  Scenario s = make_scenario(21);
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W / 3; ++x) {
+      s.depth.at(x, y, 0) = kBackgroundDepth;
+      if ((x + y) % 4 != 0)
+        for (int c = 0; c < 3; ++c) s.hv.at(x, y, c) = 0.0f;
+      if ((x + y) % 4 != 0) s.var.at(x, y, 0) = 0.0f;
+    }
+  GpuFixture gpu(s);
+  FilterParams fp;
+  fp.kind = FilterKind::Grid;
+  fp.t = 0.01f;
+  FilterPass filter(W, H);
+  filter.run(gpu.inputs, gpu.guide, fp);
+  FilterOutput ref_f = cpu_filter(s.hv, s.var, s.lv, s.range, s.depth, fp);
+  const BlendParams bp{fp.t, range_weights(fp)};
+  BlendPass blend(W, H);
+  blend.run(gpu.inputs, &filter, gpu.guide, bp);
+  BlendOutput ref = cpu_blend(s.lv, s.hv, s.var, &ref_f, bp, &s.range, &s.depth);
+  expect_close(blend.s_image(), ref.s, 1e-4f, 1e-4f, "s");
+  expect_close(blend.case_image(), ref.blend_case, 0.0f, 0.0f, "case");
+  int background = 0, other_cases = 0;
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      const bool empty_background = x < W / 3 && (x + y) % 4 != 0;
+      if (empty_background) {
+        ++background;
+        EXPECT_EQ(ref.s.at(x, y, 0), 1.0f) << x << ", " << y;
+        EXPECT_EQ(ref.blend_case.at(x, y, 0), float(kCaseUnfiltered)) << x << ", " << y;
+      } else {
+        other_cases += ref.blend_case.at(x, y, 0) != float(kCaseUnfiltered);
+      }
+    }
+  EXPECT_GT(background, 0);
+  EXPECT_GT(other_cases, 0) << "the rest still blends";
+}
+
 TEST(BlendVsCpu, NoFilteredValueMeansUnfiltered) {
   test::osmesa_context();
   Scenario s = make_scenario(5);

@@ -92,6 +92,11 @@ constexpr float kAlbedoEpsilon = 0.05f;
 
 // Background depth (distance) of the range buffer where no surface is hit.
 constexpr float kBackgroundDepth = 1.0e4f;
+// The blend's background rule: a pixel whose guide distance is at least this (mostly background)
+// and whose L_u is exactly 0 saw no HV light: its camera rays escaped, so there was none to miss,
+// and no L_f is blended in (case 2, s = 1). Without it, the zero-variance rule lets filtered light
+// of the objects before an environment bleed into it as a halo.
+constexpr float kBackgroundDistanceMin = 0.5f * kBackgroundDepth;
 
 // Inputs larger than this are clamped, so that sums of a whole kernel stay finite in float.
 constexpr float kMaxInput = kMaxTonemapInput;

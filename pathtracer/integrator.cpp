@@ -33,8 +33,14 @@ bool emission_visible(const Material& material, const SurfacePoint& sp) {
 // The path so far is E S* (emission here is E S* L), or E S* D with the D just before (E S* D L).
 bool emission_is_lv(const PathState& s) { return s.nonspecular == 0 || (s.nonspecular == 1 && !s.prev_delta); }
 
-void add_contribution(PathSample& out, glm::vec3 value, bool lv, bool all_hv) {
-  if (lv && !all_hv)
+// Where emission reached along the path goes. all_hv moves to HV what light sampling made noisy;
+// light the camera sees directly or through perfectly specular chains (E S* L: nothing sampled but
+// the pixel position) stays in LV, so that an environment seen as the backdrop is not filtered into,
+// or blurred with, the objects before it.
+bool emission_goes_to_lv(const PathState& s, bool all_hv) { return emission_is_lv(s) && (!all_hv || s.nonspecular == 0); }
+
+void add_contribution(PathSample& out, glm::vec3 value, bool lv) {
+  if (lv)
     out.lv += value;
   else
     out.hv += value;
@@ -72,7 +78,7 @@ struct PathTracer::ShadowQueue {
   void resolve(const EmbreeScene& geometry, bool all_hv) {
     geometry.occluded(rays, static_cast<size_t>(count), occluded);
     for (int i = 0; i < count; ++i)
-      if (!occluded[i]) add_contribution(*pending[i].out, pending[i].contribution, pending[i].lv, all_hv);
+      if (!occluded[i]) add_contribution(*pending[i].out, pending[i].contribution, pending[i].lv && !all_hv);
     count = 0;
   }
 };
@@ -146,8 +152,7 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
   if (!hit.valid()) {  // the environment is the light vertex
     if (lights_.has_environment()) {
       float w = s.prev_delta ? 1.0f : power_heuristic(s.prev_pdf, lights_.pdf_environment(path.ray.direction));
-      add_contribution(out, s.throughput * lights_.environment_radiance(path.ray.direction) * w, emission_is_lv(s),
-                       params.all_hv);
+      add_contribution(out, s.throughput * lights_.environment_radiance(path.ray.direction) * w, emission_goes_to_lv(s, params.all_hv));
     }
     return false;
   }
@@ -160,8 +165,7 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
     if (!s.prev_delta)
       w = power_heuristic(s.prev_pdf,
                           lights_.pdf_triangle(hit.mesh, hit.prim, s.prev_position, sp.position, sp.geometric_normal));
-    add_contribution(out, s.throughput * eval_emission(scene, material, sp.uv0, sp.uv1) * w, emission_is_lv(s),
-                     params.all_hv);
+    add_contribution(out, s.throughput * eval_emission(scene, material, sp.uv0, sp.uv1) * w, emission_goes_to_lv(s, params.all_hv));
   }
   const bool last_vertex = vertex == params.max_vertices;  // no room for another vertex
   if (last_vertex && s.albedo_set) return false;

@@ -11,7 +11,8 @@
 namespace pxf {
 
 // One path's contributions. LV = E S* L and E S* D L (both MIS strategies at that D vertex);
-// HV = everything else. With all_hv, lv stays 0.
+// HV = everything else. With all_hv, LV holds E S* L only (what the camera sees directly or through
+// perfectly specular chains), everything else goes to HV.
 struct PathSample {
   glm::vec3 lv{0.0f};
   glm::vec3 hv{0.0f};

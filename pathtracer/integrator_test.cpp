@@ -272,7 +272,9 @@ TEST(Integrator, LvPlusHvEqualsUnsplitEstimator) {
   PixelStats a = sample_pixels(tracer, scene.camera, size, spp, split, &lv_split);
   PixelStats b = sample_pixels(tracer, scene.camera, size, spp, unsplit, &lv_unsplit);
   EXPECT_GT(lv_split, 0.0);
-  EXPECT_EQ(lv_unsplit, 0.0);
+  // all_hv keeps only E S* L in LV: the light seen directly and in the mirror sphere.
+  EXPECT_GT(lv_unsplit, 0.0);
+  EXPECT_LT(lv_unsplit, lv_split);
   int outliers = 0;
   double total_a = 0, total_b = 0;
   for (int i = 0; i < size * size; ++i) {
@@ -290,6 +292,37 @@ TEST(Integrator, LvPlusHvEqualsUnsplitEstimator) {
   // P(|Z| > 3.5) = 4.7e-4 for a normal Z; heavy-tailed pixels (caustics) get some slack.
   EXPECT_LE(outliers, size * size / 100) << outliers << " pixels with |Z| > 3.5";
   EXPECT_NEAR(total_a / total_b, 1.0, 0.02);
+}
+
+TEST(Integrator, AllHvKeepsWhatTheCameraSeesDirectlyInLv) {
+  // A diffuse plane under a uniform sky, the camera looking at the horizon: with all_hv, pixels
+  // whose camera ray escapes hold exactly the sky's radiance in LV and nothing in HV; pixels on the
+  // plane hold everything in HV (their direct light is sampled, hence noisy). Without all_hv the
+  // plane's direct light is LV.
+  Scene scene;
+  scene.materials = {make_diffuse(glm::vec3(0.6f))};
+  scene.meshes.push_back(make_quad(glm::vec3(-50, 0, 50), glm::vec3(100, 0, 0), glm::vec3(0, 0, -100), 0));
+  scene.environment = uniform_environment(1.0f);
+  scene.camera = look_at_camera(glm::vec3(0, 2, 0), glm::vec3(0, 2, -10), glm::vec3(0, 1, 0), 0.8f);
+  PathTracer tracer(scene);
+  constexpr int kSize = 16;
+  for (bool all_hv : {true, false}) {
+    TraceParams params = furnace_params();
+    params.all_hv = all_hv;
+    PathSample samples[kSize * kSize];
+    tracer.trace_pixels(scene.camera, kSize, kSize, PixelRect{0, 0, kSize, kSize}, 0, params, samples);
+    int sky = 0, plane = 0;
+    for (const PathSample& s : samples) {
+      if (s.hv == glm::vec3(0.0f) && s.lv == glm::vec3(1.0f)) {
+        ++sky;
+        continue;
+      }
+      ++plane;
+      if (all_hv) EXPECT_EQ(s.lv, glm::vec3(0.0f)) << "plane light in LV with all_hv";
+    }
+    EXPECT_GT(plane, kSize * kSize / 4) << all_hv;
+    if (all_hv) EXPECT_GT(sky, kSize * kSize / 4) << "escaping camera rays: LV = sky radiance, HV = 0";
+  }
 }
 
 TEST(Integrator, DeterministicAcrossThreadCounts) {

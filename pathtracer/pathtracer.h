@@ -17,7 +17,7 @@ namespace pxf {
 struct TraceParams {
   int max_vertices = 6;     // path length in vertices, camera and light vertex included
   int rr_start_vertex = 3;  // Russian roulette from this vertex on
-  bool all_hv = false;      // every contribution goes to HV (environment-lit scenes)
+  bool all_hv = false;      // every contribution but E S* L goes to HV (environment-lit scenes)
   uint64_t seed = 1;
   int threads = 0;          // 0 = all cores
   SamplerType sampler = SamplerType::Sobol;  // see pathtracer/sampler.h for the dimension table

@@ -33,6 +33,9 @@ void main() {
     if (fv.a < -1.5) {
       s = 1.0;
       blend_case = 2;  // skipped by the filter: case 2
+    } else if (has_guide != 0 && lu == vec3(0.0) && texelFetch(guide_tex, p, 0).a >= kBackgroundDistanceMin) {
+      s = 1.0;
+      blend_case = 2;  // the background rule (gl/preview_params.h): no HV light to miss
     } else if (vu < 0.0) {
       s = 0.0;
       blend_case = 4;  // n < 2

@@ -4,6 +4,7 @@ const float kMaxInput = 1.0e30;
 const float kVarUnknown = -1.0;
 const float kVarSkipped = -2.0;
 const float kInf = uintBitsToFloat(0x7f800000u);
+const float kBackgroundDistanceMin = 5.0e3;  // kBackgroundDistanceMin in gl/preview_params.h
 
 float luminance(vec3 c) { return dot(c, vec3(0.2126, 0.7152, 0.0722)); }
 
