@@ -73,10 +73,21 @@ bool same_pixels(const std::vector<Layer>& a, const std::vector<Layer>& b) {
 
 // Every file under an output name is complete: it reads back whole.
 void expect_outputs_complete(const std::string& dir) {
-  if (fs::exists(dir + "/final.exr")) EXPECT_NO_THROW(read_exr(dir + "/final.exr")) << dir;
-  if (fs::exists(dir + "/buffers.exr")) EXPECT_NO_THROW(read_exr_layers(dir + "/buffers.exr")) << dir;
-  if (fs::exists(dir + "/final.png")) EXPECT_NO_THROW(read_ldr_or_hdr(dir + "/final.png")) << dir;
-  if (fs::exists(dir + "/stats.json")) EXPECT_NO_THROW((void)nlohmann::json::parse(slurp(dir + "/stats.json"))) << dir;
+  if (fs::exists(dir + "/final.exr")) {
+    EXPECT_NO_THROW(read_exr(dir + "/final.exr")) << dir;
+  }
+  if (fs::exists(dir + "/buffers.exr")) {
+    EXPECT_NO_THROW(read_exr_layers(dir + "/buffers.exr")) << dir;
+  }
+  if (fs::exists(dir + "/final.png")) {
+    EXPECT_NO_THROW(read_ldr_or_hdr(dir + "/final.png")) << dir;
+  }
+  if (fs::exists(dir + "/stats.json")) {
+    EXPECT_NO_THROW({
+      const nlohmann::json stats = nlohmann::json::parse(slurp(dir + "/stats.json"));
+      EXPECT_TRUE(stats.is_object()) << dir;
+    }) << dir;
+  }
 }
 
 using test_support::expect_merge_close;

@@ -66,7 +66,9 @@ TEST(Cli, UsageErrorsExitWithCode2AndOneLine) {
                            "render --time nan", "render --time 1e99", "render --time soon", "render --schedule x"}) {
     const Result r = run(args);
     EXPECT_EQ(r.code, 2) << args;
-    if (std::string(args).find(' ') != std::string::npos) EXPECT_EQ(lines(r.err), 1u) << args << ": " << r.err;
+    if (std::string(args).find(' ') != std::string::npos) {
+      EXPECT_EQ(lines(r.err), 1u) << args << ": " << r.err;
+    }
   }
 }
 
