@@ -34,6 +34,7 @@ int run_explore(const Args& args) {
     throw UsageError("--inspect wants X,Y, got '" + inspect + "'");
   if (print_scene_list_if_asked(o.scene)) return 0;
   o.all_hv_given = cli.given("--all-hv");
+  o.filter_given = cli.given("--filter");
   return run_explorer(o);
 }
 

@@ -13,6 +13,7 @@ struct ExploreOptions {
   SceneOptions scene;
   PreviewOptions preview;
   bool all_hv_given = false;  // --all-hv on the command line wins over a loaded scene's default
+  bool filter_given = false;  // --filter likewise over kAllHvFilter
   std::string out = "out";    // capture folder
   std::string view = "final"; // initial buffer view (buffer_view_names())
   std::string screenshot;     // PNG of the whole window (UI included), saved before quitting

@@ -91,6 +91,10 @@ Scene load_scene_for(SceneOptions& options, PreviewOptions& preview, const Comma
   }
   if (scene.automatic_camera) scene.camera = frame_scene(scene, static_cast<float>(options.width) / options.height);
   if (!cli.given("--all-hv") && scene.defaults.all_hv) preview.all_hv = true;
+  if (preview.all_hv && !cli.given("--filter")) {
+    preview.filter = kAllHvFilter;
+    std::fprintf(stderr, "pxf: all-HV (environment-lit) scene: filter %s (--filter to choose another)\n", kAllHvFilter);
+  }
   finish_preview_options(preview);
   return scene;
 }

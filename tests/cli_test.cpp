@@ -162,6 +162,20 @@ TEST(Cli, SceneWithoutLightsIsLitByDefaultAndNoneWarnsOfBlack) {
   EXPECT_NE(wrong.err.find("not a scene"), std::string::npos) << wrong.err;
 }
 
+TEST(Cli, AllHvScenesDefaultToAtrousUnlessFilterIsGiven) {
+  const std::string out = temp_dir("allhv");
+  const Result r = run("render --scene envmap --size 24x16 --spp 2 --quiet --out " + out);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("filter atrous"), std::string::npos) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(slurp(out + "/stats.json"))["settings"]["filter"], "atrous");
+  const Result chosen = run("render --scene envmap --size 24x16 --spp 2 --quiet --filter grid --out " + out);
+  ASSERT_EQ(chosen.code, 0) << chosen.err;
+  EXPECT_EQ(nlohmann::json::parse(slurp(out + "/stats.json"))["settings"]["filter"], "grid");
+  const Result plain = run("render --scene cornell --size 24x16 --spp 2 --quiet --out " + out);
+  ASSERT_EQ(plain.code, 0) << plain.err;
+  EXPECT_EQ(nlohmann::json::parse(slurp(out + "/stats.json"))["settings"]["filter"], "grid");
+}
+
 TEST(Cli, RenderWritesEveryOutput) {
   const std::string out = temp_dir("render");
   const Result r = run("render --size 32x24 --spp 4 --schedule pow2 --quiet --out " + out);
