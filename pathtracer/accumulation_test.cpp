@@ -2,7 +2,10 @@
 // renderer's buffers, reset and image getters.
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <chrono>
 #include <limits>
+#include <thread>
 
 #include <cmath>
 
@@ -57,6 +60,47 @@ TEST(Accumulation, VarianceOfMeanNeedsTwoSamples) {
   // Y = 1 and 3: s^2 = 2, Var[mean] = s^2 / n = 1.
   EXPECT_NEAR(acc.variance_of_mean(0), 1.0f, 1e-6f);
   EXPECT_EQ(acc.variance_of_mean(1), -1.0f);
+}
+
+TEST(Accumulation, CancelledFrameResetsTheSamplesAndTheNextFrameCounts) {
+  // The explorer cancels the frame in flight when the camera moves (cancel_frame from the UI
+  // thread). A cancelled frame is incomplete: add_frame returns false and the samples are reset.
+  // Deterministic here: the cancel arrives before the frame starts, so no tile is traced.
+  Scene scene = make_cornell_box(false);
+  TraceParams params;
+  params.threads = 2;
+  ProgressiveRenderer renderer(scene, params, 16, 12);
+  ASSERT_TRUE(renderer.add_frame());
+  ASSERT_TRUE(renderer.add_frame());
+  renderer.cancel_frame();
+  EXPECT_FALSE(renderer.add_frame());
+  EXPECT_EQ(renderer.frames(), 0);
+  for (uint32_t n : renderer.accumulation().samples) EXPECT_EQ(n, 0u);
+  for (const glm::vec3& v : renderer.accumulation().hv_mean) EXPECT_EQ(v, glm::vec3(0.0f));
+  // The cancel is spent: the next frame counts, as does one after a reset that follows a stale cancel.
+  EXPECT_TRUE(renderer.add_frame());
+  EXPECT_EQ(renderer.frames(), 1);
+  renderer.cancel_frame();
+  renderer.reset();
+  EXPECT_TRUE(renderer.add_frame());
+  EXPECT_EQ(renderer.frames(), 1);
+  // Cancelling from another thread while frames run: each add_frame either completes or is
+  // cancelled and leaves no samples behind.
+  std::atomic<bool> stop{false};
+  std::thread canceller([&] {
+    while (!stop.load()) {
+      renderer.cancel_frame();
+      std::this_thread::sleep_for(std::chrono::microseconds(200));
+    }
+  });
+  for (int i = 0; i < 20; ++i) {
+    if (!renderer.add_frame()) {
+      EXPECT_EQ(renderer.frames(), 0);
+      for (uint32_t n : renderer.accumulation().samples) ASSERT_EQ(n, 0u);
+    }
+  }
+  stop = true;
+  canceller.join();
 }
 
 TEST(Accumulation, RendererBuffersResetAndImages) {
