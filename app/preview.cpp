@@ -321,9 +321,11 @@ void Preview::run_next_pass() {
   total_ += added;
 }
 
+// The last frame always filters: its run (predicted by the newest one) is kept in reserve, so that
+// the range frames never push a job's passes past kPassShare once that run comes.
 bool Preview::range_due() const {
   return settings_.filter_enabled && !schedule_.hv_empty && range_.frames() != 0 && !range_.converged() &&
-         schedule_.pass_ms + range_.last_ms() <= kPassShare * schedule_.tracing_ms;
+         schedule_.pass_ms + range_.last_ms() + schedule_.last_run_ms <= kPassShare * schedule_.tracing_ms;
 }
 
 bool Preview::filter_due_now() const {
