@@ -27,7 +27,7 @@ struct ProgressiveRenderer::Impl {
   std::atomic<bool> cancel{false};
   Accumulation acc;
   TraceStats stats;
-  int frames = 0;
+  std::atomic<int> frames{0};  // read by the explorer's UI thread while a worker traces
   uint32_t first_frame = 0;
 
   Impl(const Scene& s, const TraceParams& p, int w, int h) : scene(s), camera(s.camera), params(p), width(w), height(h) {
