@@ -25,7 +25,8 @@ void FilterPass::run(const PreviewInputs& inputs, const Texture2D& guide, const 
   inputs.hv().bind(0);
   inputs.lv().bind(1);
   guide.bind(2);
-  centre_weight_valid_ = p.kind == FilterKind::Bilateral || p.kind == FilterKind::BilateralDepth;
+  centre_weight_valid_ =
+      p.kind == FilterKind::Bilateral || p.kind == FilterKind::BilateralDepth || p.kind == FilterKind::Grid;
   if (p.kind == FilterKind::Atrous)
     run_atrous(inputs, p);
   else if (p.kind == FilterKind::Subsampled)

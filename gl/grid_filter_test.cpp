@@ -84,6 +84,7 @@ TEST(Grid, WhiteNoiseVarianceMatchesExactSum) {
         propagated[j][i] = v.at(xs[i], xs[j], 0) / kNoiseVar;
       }
   }
+  const Image centre = filter.centre_weight_image();
   for (int j = 0; j < 4; ++j)
     for (int i = 0; i < 4; ++i) {
       const double exact = exact_variance_factor(xs[i], xs[j], N, cell_s);
@@ -94,6 +95,12 @@ TEST(Grid, WhiteNoiseVarianceMatchesExactSum) {
                   xs[i], xs[j], exact, measured, propagated[j][i], uncorrected);
       EXPECT_NEAR(propagated[j][i] / exact, 1.0, 1e-3) << xs[i] << ", " << xs[j];
       EXPECT_NEAR(measured / exact, 1.0, 0.1) << xs[i] << ", " << xs[j];
+      // The centre weight (the blend's covariance term): the pixel's own effective weight over the
+      // sum, from the definition; on a flat guide the range axis contributes the same factor to both.
+      double own = axis_weight(xs[i], xs[i], cell_s) * axis_weight(xs[j], xs[j], cell_s), sx = 0, sy = 0;
+      for (int k = 0; k < N; ++k) sx += axis_weight(xs[i], k, cell_s), sy += axis_weight(xs[j], k, cell_s);
+      ASSERT_NE(filter.centre_weight(), nullptr);
+      EXPECT_NEAR(centre.at(xs[i], xs[j], 0) / (own / (sx * sy)), 1.0, 1e-4) << xs[i] << ", " << xs[j];
       if (i == 2 && j == 2) {
         EXPECT_GT(exact / uncorrected, 2.5) << "the correction matters at the cell boundary";
       }

@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdlib>
 #include <vector>
 #include "gl/grid_layout.h"
 
@@ -101,7 +102,12 @@ void blur(Grid& g, int axis) {
   g.cells = std::move(out);
 }
 
+// The blur tap g(d) along one axis, 0 beyond the taps.
+float blur_tap(int d) { return std::abs(d) <= kGridBlurRadius ? kGridBlurTaps[d + kGridBlurRadius] : 0.0f; }
+
 // Trilinear slice at the pixel's own grid coordinates (see the comment at the top of the file).
+// The centre weight: the pixel's own effective weight W_i = sum_j a_j g(j - c(i)) over the corners j
+// (c(i) its nearest cell: the cell its splat went to) over sum_i W_i, the interpolated count.
 void slice(const Grid& g, int x, int y, float luminance_y, FilterOutput& out) {
   const float inv_cell_s = 1.0f / g.layout.cell_s;
   const float u = float(x) * inv_cell_s, v = float(y) * inv_cell_s, z = grid_z(g, luminance_y);
@@ -109,14 +115,18 @@ void slice(const Grid& g, int x, int y, float luminance_y, FilterOutput& out) {
                      std::min(static_cast<int>(std::floor(z)), kGridRangeCells - 2)};
   const float frac[3] = {std::clamp(u - c0[0], 0.0f, 1.0f), std::clamp(v - c0[1], 0.0f, 1.0f),
                          std::clamp(z - c0[2], 0.0f, 1.0f)};
+  const int own[3] = {nearest_cell(u), nearest_cell(v), std::clamp(nearest_cell(z), 0, kGridRangeCells - 1)};
   Cell sum{};
+  float own_weight = 0.0f;
   for (int dz = 0; dz < 2; ++dz)
     for (int dy = 0; dy < 2; ++dy)
       for (int dx = 0; dx < 2; ++dx) {
         const float w = (dx ? frac[0] : 1.0f - frac[0]) * (dy ? frac[1] : 1.0f - frac[1]) * (dz ? frac[2] : 1.0f - frac[2]);
         const Cell& c = g.cells[g.index(c0[0] + dx, c0[1] + dy, c0[2] + dz)];
         add_weighted(sum, c, w);
+        own_weight += w * blur_tap(c0[0] + dx - own[0]) * blur_tap(c0[1] + dy - own[1]) * blur_tap(c0[2] + dz - own[2]);
       }
+  out.centre_weight.at(x, y, 0) = own_weight / sum[3];
   // sum[3] > 0: the pixel's own nearest cell is a corner with weight >= 1/2 per axis.
   for (int ch = 0; ch < 3; ++ch) out.filtered.at(x, y, ch) = sum[ch] / sum[3];
   const float correction = grid_interpolation_correction(frac[0]) * grid_interpolation_correction(frac[1]);
@@ -130,7 +140,8 @@ FilterOutput cpu_grid_filter(const Image& hv, const Image& var_u, const Image& l
                              const Image& depth, const FilterParams& p) {
   Grid g = splat(hv, var_u, range_color, p);
   for (int axis = 0; axis < 2; ++axis) blur(g, axis);  // z: in the splat
-  FilterOutput out{Image::rgb(hv.width, hv.height), Image::gray(hv.width, hv.height)};
+  FilterOutput out{Image::rgb(hv.width, hv.height), Image::gray(hv.width, hv.height),
+                   Image::gray(hv.width, hv.height, "Y", 1.0f)};  // centre weight 1 where skipped
   for (int y = 0; y < hv.height; ++y)
     for (int x = 0; x < hv.width; ++x) {
       if (p.skip_case2 && skip_as_case2(hv, var_u, lv, range_color, depth, p, x, y, out)) continue;

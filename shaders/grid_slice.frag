@@ -22,11 +22,15 @@ uniform int skip_case2;
 uniform float t;
 
 layout(location = 0) out vec4 out_filtered;  // rgb L_f, a Var[L_f] (kVarUnknown, kVarSkipped)
+layout(location = 1) out float out_centre_weight;  // the pixel's own share of L_f (1 where skipped)
+
+float blur_tap(int d) { return abs(d) <= kGridBlurRadius ? kGridBlurTaps[d + kGridBlurRadius] : 0.0; }
 
 void main() {
   ivec2 p = ivec2(gl_FragCoord.xy);
   if (skip_case2 != 0 && skip_as_case2(hv_tex, lv_tex, guide_tex, p, k_c, k_d, t)) {
     out_filtered = vec4(clean(texelFetch(hv_tex, p, 0).rgb), kVarSkipped);
+    out_centre_weight = 1.0;
     return;
   }
   atomicAdd(filtered_pixels, 1u);
@@ -34,7 +38,9 @@ void main() {
   float z = grid_z(guide_luminance(texelFetch(guide_tex, p, 0)), min_cell_z);
   ivec3 c0 = ivec3(ivec2(floor(uv)), min(int(floor(z)), kGridRangeCells - 2));
   vec3 frac = clamp(vec3(uv, z) - vec3(c0), 0.0, 1.0);
+  ivec3 own = ivec3(nearest_cell(uv.x), nearest_cell(uv.y), clamp(nearest_cell(z), 0, kGridRangeCells - 1));
   vec4 a = vec4(0.0), b = vec4(0.0);
+  float own_weight = 0.0;
   for (int dz = 0; dz < 2; ++dz)
     for (int dy = 0; dy < 2; ++dy)
       for (int dx = 0; dx < 2; ++dx) {
@@ -42,10 +48,12 @@ void main() {
                   (dz == 1 ? frac.z : 1.0 - frac.z);
         int cell = ((c0.z + dz) * grid_xy.y + c0.y + dy) * grid_xy.x + c0.x + dx;
         a += w * cells[2 * cell];
+        own_weight += w * blur_tap(c0.x + dx - own.x) * blur_tap(c0.y + dy - own.y) * blur_tap(c0.z + dz - own.z);
         b += vec4(w * w, w * w, w, w) * cells[2 * cell + 1];
       }
   // a.w > 0: the pixel's own nearest cell is a corner with interpolation weight >= 1/2 per axis.
   float correction = grid_interpolation_correction(frac.x) * grid_interpolation_correction(frac.y);
   float var_f = b.z > 0.0 ? correction * (b.x + b.y * (b.w / b.z)) / (a.w * a.w) : kVarUnknown;
   out_filtered = vec4(a.rgb / a.w, var_f);
+  out_centre_weight = own_weight / a.w;
 }
