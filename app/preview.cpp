@@ -47,6 +47,17 @@ StageTimes& StageTimes::operator+=(const StageTimes& o) {
   return *this;
 }
 
+StageTimes StageTimes::operator-(const StageTimes& o) const {
+  StageTimes d = *this;
+  d.path_tracing -= o.path_tracing;
+  d.upload -= o.upload;
+  d.range -= o.range;
+  d.filter -= o.filter;
+  d.blend -= o.blend;
+  d.tonemap -= o.tonemap;
+  return d;
+}
+
 double share_outside_tracing(const StageTimes& t, double wall_ms) {
   return wall_ms > 0 ? std::max(0.0, wall_ms - t.path_tracing) / wall_ms : 0.0;
 }
@@ -314,11 +325,7 @@ void Preview::run_next_pass() {
       blend_and_tonemap();
       break;
   }
-  StageTimes added = last_;
-  added.path_tracing = 0;
-  added.upload -= before.upload, added.range -= before.range, added.filter -= before.filter;
-  added.blend -= before.blend, added.tonemap -= before.tonemap;
-  total_ += added;
+  total_ += last_ - before;  // what this step added (its path tracing is 0)
 }
 
 // The last frame always filters: its run (predicted by the newest one) is kept in reserve, so that

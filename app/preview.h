@@ -51,6 +51,7 @@ struct StageTimes {
   double path_tracing = 0, upload = 0, range = 0, filter = 0, blend = 0, tonemap = 0;
   double total() const { return path_tracing + upload + range + filter + blend + tonemap; }
   StageTimes& operator+=(const StageTimes& o);
+  StageTimes operator-(const StageTimes& o) const;
 };
 
 // Share of a job's wall time spent outside path tracing.
