@@ -23,7 +23,7 @@ enum class PassStep {
 // already spent used_ms on UI work, on waiting for the tracer and on earlier steps: it must fit in
 // budget_ms. `fresh`: nothing but the frame's UI work ran yet (no wait, no step); then the step
 // always runs, so that the queue drains. A step that does not fit even alone is so deferred to a
-// display frame of its own (the explorer shows the longest GL block; the default filter at
+// display frame of its own (the explorer shows the longest display frame; the default filter at
 // 512x512 fits, the exact bilateral filter does not).
 bool step_fits_display_frame(double used_ms, bool fresh, double next_ms, double budget_ms = kUiBudgetMs);
 
