@@ -39,7 +39,7 @@ void add_preview_options(CommandLine& cli, PreviewOptions& o) {
              "the last frame");
   cli.choice("--demodulate", &o.demodulate, {"on", "off"},
              "albedo demodulation: filter HV divided by the first non-specular albedo, so textures stay\n"
-             "sharp (default off: README \"Albedo demodulation\")");
+             "sharp (default off: docs/measurements.md, \"Albedo demodulation\")");
   cli.option("--seed", &o.seed, "random seed", 0, 2147483647);
   cli.choice("--sampler", &o.sampler, {"sobol", "independent"},
              "random numbers of the path tracer: Owen-scrambled Sobol (default) or independent PCG32");

@@ -33,7 +33,8 @@ struct PreviewSettings {
   FilterParams filter;         // kind and sigmas; filter.t is kept equal to threshold
   // Albedo demodulation: filter HV divided by the first non-specular albedo and multiply L_f back
   // (gl/demodulation.h), so the filter does not blur textures. Off by default: at equal time it did
-  // not beat filtering radiance with the default grid filter (README "Albedo demodulation").
+  // not beat filtering radiance with the default grid filter (docs/measurements.md, "Albedo
+  // demodulation").
   bool demodulate = false;
   FilterSchedule schedule = FilterSchedule::Budget;
   TonemapParams tonemap;

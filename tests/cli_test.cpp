@@ -171,7 +171,8 @@ TEST(Cli, AllHvRendersDefaultToAtrousUnlessFilterIsGiven) {
   const Result chosen = run("render --scene envmap --all-hv --size 24x16 --spp 2 --quiet --filter grid --out " + out);
   ASSERT_EQ(chosen.code, 0) << chosen.err;
   EXPECT_EQ(nlohmann::json::parse(slurp(out + "/stats.json"))["settings"]["filter"], "grid");
-  // envmap itself renders with the LV/HV split and the default filter (README "Environment-lit scenes").
+  // envmap itself renders with the LV/HV split and the default filter (docs/measurements.md,
+  // "Environment-lit scenes").
   const Result plain = run("render --scene envmap --size 24x16 --spp 2 --quiet --out " + out);
   ASSERT_EQ(plain.code, 0) << plain.err;
   EXPECT_EQ(plain.err.find("all-HV"), std::string::npos) << plain.err;

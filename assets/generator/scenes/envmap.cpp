@@ -2,7 +2,8 @@
 // softboxes and a strip light over a dark backdrop): a torus knot with spiral ridges and a
 // fish-scale glaze (base color, roughness and normal textures), and a perfect mirror sphere, on a
 // ground disc. Renders with the usual LV/HV split: all-HV (`--all-hv`) filters the direct light on
-// the knot's texture too and measured worse at equal time (README "Environment-lit scenes").
+// the knot's texture too and measured worse at equal time (docs/measurements.md, "Environment-lit
+// scenes").
 #include <glm/gtc/constants.hpp>
 
 #include "../exr_writer.h"
