@@ -10,7 +10,7 @@
 #include <array>
 #include "gl/filter_pass.h"
 #include "gl/inputs.h"
-#include "gl/preview_params.h"
+#include "gl/pass_params.h"
 #include "gl/resources.h"
 
 namespace pxf {

@@ -20,7 +20,7 @@
 //   blend.run(inputs, &demod.output(), &guide, blend_params, filter.centre_weight());  // w unchanged
 #pragma once
 #include "gl/inputs.h"
-#include "gl/preview_params.h"
+#include "gl/pass_params.h"
 #include "gl/resources.h"
 
 namespace pxf {

@@ -1,10 +1,11 @@
 #version 450 core
-// Explorer view of the blend case per pixel (BlendCase in gl/preview_params.h). Keep the colors in
-// step with kCaseColors in app/explorer_views.cpp (the legend).
+// Explorer view of the blend case per pixel (kCase* in pass_formulas.h). Keep the colors in step
+// with kCaseStyles in app/explorer_views.cpp (the legend).
+#include "pass_formulas.h"
 layout(binding = 0) uniform sampler2D case_tex;  // r: BlendCase code
 layout(location = 0) out vec4 out_display;
 
-const vec3 kColors[5] = vec3[5](
+const vec3 kColors[kBlendCaseCount] = vec3[kBlendCaseCount](
     vec3(0.35, 0.35, 0.35),   // 0: no L_f yet (s = 1)
     vec3(0.90, 0.20, 0.15),   // 1: D < 0, filtered only (s = 0)
     vec3(0.20, 0.75, 0.25),   // 2: u <= t, unfiltered (s = 1)
@@ -13,5 +14,5 @@ const vec3 kColors[5] = vec3[5](
 
 void main() {
   int code = int(texelFetch(case_tex, ivec2(gl_FragCoord.xy), 0).r + 0.5);
-  out_display = vec4(code >= 0 && code < 5 ? kColors[code] : vec3(1.0, 1.0, 0.0), 1.0);
+  out_display = vec4(code >= 0 && code < kBlendCaseCount ? kColors[code] : vec3(1.0, 1.0, 0.0), 1.0);
 }

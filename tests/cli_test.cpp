@@ -20,7 +20,7 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
-#include "gl/preview_params.h"
+#include "gl/pass_params.h"
 #include "image/image.h"
 #include "tests/test_support.h"
 #include "pathtracer/pathtracer.h"
