@@ -127,7 +127,7 @@ class Preview {
   bool filter_stopped() const { return schedule_.all_pixels_case2; }
   // Filter runs left out because HV's energy share was below kMinHvShare.
   int filter_runs_skipped_low_hv() const { return low_hv_skips_; }
-  // Pixels per BlendCase (gl/pass_params.h) of the last displayed frame.
+  // Pixels per blend case (kCase* in shaders/pass_formulas.h) of the last displayed frame.
   const std::array<uint32_t, kBlendCaseCount>& case_counts() const { return case_counts_; }
 
   // GPU results for the explorer's views.

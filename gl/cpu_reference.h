@@ -75,7 +75,7 @@ FilterOutput cpu_remodulate(const FilterOutput& filtered, const Image& albedo);
 struct BlendOutput {
   Image final_rgb;   // "R,G,B"
   Image s;           // "Y"
-  Image blend_case;  // "Y": BlendCase codes
+  Image blend_case;  // "Y": case codes (kCase*)
 };
 // `filtered` empty = the filter never ran. range_color and depth both null: no variance pooling.
 BlendOutput cpu_blend(const Image& lv, const Image& hv, const Image& var_u, const FilterOutput* filtered,

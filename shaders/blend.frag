@@ -35,7 +35,7 @@ void main() {
       blend_case = kCaseUnfiltered;  // skipped by the filter
     } else if (has_guide != 0 && lu == vec3(0.0) && texelFetch(guide_tex, p, 0).a >= kBackgroundDistanceMin) {
       s = 1.0;
-      blend_case = kCaseUnfiltered;  // the background rule (gl/preview_params.h): no HV light to miss
+      blend_case = kCaseUnfiltered;  // the background rule (kBackgroundDistanceMin): no HV light to miss
     } else if (vu < 0.0) {
       s = 0.0;
       blend_case = kCaseUnknownVar;  // n < 2

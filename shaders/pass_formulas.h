@@ -24,6 +24,15 @@ PXF_CONST int kCaseUnfiltered = 2;    // u <= t (or the filter skipped the pixel
 PXF_CONST int kCaseMixed = 3;         // s = (f + sqrt(D)) / (u + f)
 PXF_CONST int kCaseUnknownVar = 4;    // n < 2, variance unknown: s = 0 (filtered value only)
 PXF_CONST int kBlendCaseCount = 5;
+// The color of each case in the explorer's case view and its legend; yellow for any other code.
+PXF_INLINE vec3 case_color(int code) {
+  if (code == kCaseNoFiltered) return vec3(0.35f, 0.35f, 0.35f);
+  if (code == kCaseFilteredOnly) return vec3(0.90f, 0.20f, 0.15f);
+  if (code == kCaseUnfiltered) return vec3(0.20f, 0.75f, 0.25f);
+  if (code == kCaseMixed) return vec3(0.20f, 0.45f, 0.95f);
+  if (code == kCaseUnknownVar) return vec3(0.85f, 0.30f, 0.85f);
+  return vec3(1.0f, 1.0f, 0.0f);
+}
 
 // Background depth (distance) of the range buffer where no surface is hit.
 PXF_CONST float kBackgroundDepth = 1.0e4f;
