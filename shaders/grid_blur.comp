@@ -1,6 +1,6 @@
 #version 450 core
 // Bilateral grid, step 3: blur along one axis (x or y, one dispatch each; z is blurred in the splat) with the
-// binomial taps g = 1/4 [1 2 1] (grid_common.glsl); taps outside the grid are left out. The value sums (a, and the
+// binomial taps g = 1/4 [1 2 1] (pass_formulas.h); taps outside the grid are left out. The value sums (a, and the
 // linear sums b.zw) take g, the squared-weight sums (b.xy) take g^2: the variance of a linear
 // combination of independent cells. Mirrors blur() in gl/grid_reference.cpp.
 #include "pass_formulas.h"
