@@ -32,6 +32,11 @@ FilterKind parse_filter_kind(const std::string& name) {
 // below the Gaussian's sigma_s^2 (sigma_s = 8: 4 passes, variance 85 = (9.2 px)^2, footprint
 // radius 30 px against the exact kernel's 24), as long as the footprint radius 2 (2^k - 1) of the
 // next count fits kMaxFilterRadius (at most 5 passes).
+float effective_threshold(float t, uint64_t samples) {
+  const double n = static_cast<double>(std::max<uint64_t>(samples, 4));
+  return static_cast<float>(t * ((n - 3.0) / (n - 1.0)));
+}
+
 int atrous_iterations(float sigma_s) {
   const double target = double(sigma_s) * sigma_s;
   int passes = 1;

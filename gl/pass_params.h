@@ -3,6 +3,7 @@
 // use too are in shaders/pass_formulas.h.
 #pragma once
 #include <algorithm>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -100,6 +101,14 @@ int atrous_iterations(float sigma_s);
 // Factor on the Var[L_f] that à-trous pass `pass` (from 0) propagates as if its input pixels were
 // independent, so that it is exact where the range weights are all 1 (see pass_params.cpp).
 float atrous_variance_correction(int pass);
+
+// The threshold the blend and the filter's case-2 skip are given after n samples per pixel:
+// t (n - 3) / (n - 1), t itself as n grows (docs/method.md, "The threshold after few samples").
+// Why: the blend solves for s with the *estimated* Var[L_u], and where u dominates, s^2 is about
+// t / u_hat. With a sample variance of k = n - 1 degrees of freedom, E[1 / S^2] = k / (k - 2) / sigma^2
+// (Gaussian samples), so the perceived variance the blend leaves is on average t (n - 1) / (n - 3):
+// 15 % over t at 16 spp. E[1 / S^2] is infinite for n <= 3; there the n = 4 factor 1/3 is used.
+float effective_threshold(float t, uint64_t samples);
 
 struct BlendParams {
   float t = 0.01f;  // perceived-variance threshold; sqrt(t) = allowed relative std. deviation
