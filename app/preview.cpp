@@ -101,7 +101,7 @@ Preview::Preview(const Scene& scene, const PreviewSettings& settings, int width,
       filter_(width, height),
       blend_(width, height),
       tonemap_(width, height),
-      variance_(static_cast<size_t>(width) * height, kVarUnknown) {
+      hv_packed_(static_cast<size_t>(width) * height * 4) {
   settings_.filter.t = settings_.threshold;
   range_.set_settings(settings_.range);
   range_.set_scene(scene);
@@ -164,8 +164,9 @@ void Preview::upload() {
   if (uploaded_) return;
   const auto start = BenchClock::now();
   const Accumulation& acc = renderer_->accumulation();
-  variance_ = acc.variance_of_mean_image();
-  inputs_.upload(&acc.lv_mean[0].x, &acc.hv_mean[0].x, variance_.data(), acc.samples.data());
+  static_assert(kVarUnknown == -1.0f, "Accumulation marks an unknown variance (n < 2) with -1");
+  acc.hv_and_variance_of_mean(hv_packed_.data());
+  inputs_.upload_packed(&acc.lv_mean[0].x, hv_packed_.data());
   last_.upload += elapsed_ms(start);
   uploaded_ = true;
 }
@@ -374,10 +375,12 @@ std::vector<Layer> Preview::buffers() {
   upload();
   std::vector<Layer> layers;
   layers.push_back({"final", blend_.final_image()});
-  layers.push_back({"lv", inputs_.lv_image()});
-  layers.push_back({"hv", inputs_.hv_image()});
-  layers.push_back({"hv_filtered", have_filtered_ ? filtered_image() : inputs_.hv_image()});
-  layers.push_back({"var_u", inputs_.var_image()});
+  // The inputs as the renderer holds them: the textures hold the same floats.
+  Image hv = renderer_->hv_image();
+  layers.push_back({"lv", renderer_->lv_image()});
+  layers.push_back({"hv", hv});
+  layers.push_back({"hv_filtered", have_filtered_ ? filtered_image() : std::move(hv)});
+  layers.push_back({"var_u", renderer_->variance_image()});
   layers.push_back({"var_f", have_filtered_ ? filtered_variance_image() : Image::gray(width_, height_)});
   layers.push_back({"blend", blend_.s_image()});
   layers.push_back({"case", blend_.case_image()});

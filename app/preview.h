@@ -78,7 +78,9 @@ void check_preview_memory(int width, int height, uint64_t available_bytes);
 
 class Preview {
  public:
+  // `scene` is referenced, not copied (ProgressiveRenderer): it must outlive the Preview.
   Preview(const Scene& scene, const PreviewSettings& settings, int width, int height);
+  Preview(Scene&& scene, const PreviewSettings& settings, int width, int height) = delete;
   ~Preview();
 
   // Traces one path per pixel, then runs the passes that are due. `display`: also blend and tone
@@ -172,7 +174,7 @@ class Preview {
   bool filtered_demodulated_ = false;    // the newest L_f went through demod_
   BlendPass blend_;
   TonemapPass tonemap_;
-  std::vector<float> variance_;  // staging for Var[L_u]
+  std::vector<float> hv_packed_;  // the HV texture's data (rgb L_u, a Var[L_u]), filled by the renderer
   ScheduleState schedule_;
   bool have_filtered_ = false;
   bool uploaded_ = false;  // inputs hold the current samples

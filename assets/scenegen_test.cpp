@@ -14,7 +14,7 @@
 #include "scenes.h"
 
 namespace fs = std::filesystem;
-using pxf::scenegen::sceneNames;
+using pxf::scenegen::scene_names;
 
 namespace {
 
@@ -22,11 +22,11 @@ const fs::path kAssets = fs::path(PXF_SOURCE_DIR) / "assets";
 
 struct Expectation {
   std::string name;
-  size_t minTriangles, maxTriangles;
-  bool emissiveMaterial;  // has area lights
+  size_t min_triangles, max_triangles;
+  bool emissive_material;  // has area lights
   bool sun;               // has a KHR_lights_punctual directional light
   bool environment;       // ships environment.exr
-  bool allHv;             // scene extras ask for --all-hv
+  bool all_hv;             // scene extras ask for --all-hv
 };
 
 const std::vector<Expectation>& expectations() {
@@ -52,42 +52,42 @@ tinygltf::Model load(const std::string& name) {
 }
 
 // Every extension name that appears as a key of an "extensions" object below `value`.
-void collectExtensions(const tinygltf::Value& value, std::set<std::string>& out) {
+void collect_extensions(const tinygltf::Value& value, std::set<std::string>& out) {
   if (value.IsArray()) {
-    for (size_t i = 0; i < value.ArrayLen(); ++i) collectExtensions(value.Get(int(i)), out);
+    for (size_t i = 0; i < value.ArrayLen(); ++i) collect_extensions(value.Get(int(i)), out);
   } else if (value.IsObject()) {
     for (const std::string& key : value.Keys()) {
       const tinygltf::Value& child = value.Get(key);
       if (key == "extensions" && child.IsObject()) {
         for (const std::string& ext : child.Keys()) out.insert(ext);
       }
-      collectExtensions(child, out);
+      collect_extensions(child, out);
     }
   }
 }
 
-void collectExtensions(const tinygltf::ExtensionMap& map, std::set<std::string>& out) {
+void collect_extensions(const tinygltf::ExtensionMap& map, std::set<std::string>& out) {
   for (const auto& [name, value] : map) {
     out.insert(name);
-    collectExtensions(value, out);
+    collect_extensions(value, out);
   }
 }
 
-std::set<std::string> extensionsInUse(const tinygltf::Model& model) {
+std::set<std::string> extensions_in_use(const tinygltf::Model& model) {
   std::set<std::string> used;
   for (const tinygltf::Material& m : model.materials) {
-    collectExtensions(m.extensions, used);
-    collectExtensions(m.pbrMetallicRoughness.baseColorTexture.extensions, used);
-    collectExtensions(m.pbrMetallicRoughness.metallicRoughnessTexture.extensions, used);
-    collectExtensions(m.normalTexture.extensions, used);
-    collectExtensions(m.emissiveTexture.extensions, used);
+    collect_extensions(m.extensions, used);
+    collect_extensions(m.pbrMetallicRoughness.baseColorTexture.extensions, used);
+    collect_extensions(m.pbrMetallicRoughness.metallicRoughnessTexture.extensions, used);
+    collect_extensions(m.normalTexture.extensions, used);
+    collect_extensions(m.emissiveTexture.extensions, used);
   }
-  for (const tinygltf::Node& node : model.nodes) collectExtensions(node.extensions, used);
+  for (const tinygltf::Node& node : model.nodes) collect_extensions(node.extensions, used);
   if (!model.lights.empty()) used.insert("KHR_lights_punctual");
   return used;
 }
 
-size_t triangleCount(const tinygltf::Model& model) {
+size_t triangle_count(const tinygltf::Model& model) {
   size_t triangles = 0;
   for (const tinygltf::Node& node : model.nodes) {
     if (node.mesh < 0) continue;
@@ -98,7 +98,7 @@ size_t triangleCount(const tinygltf::Model& model) {
   return triangles;
 }
 
-std::string readFile(const fs::path& path) {
+std::string read_file(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
   return std::string(std::istreambuf_iterator<char>(in), {});
 }
@@ -111,26 +111,26 @@ TEST_P(SceneTest, LoadsWithCameraEmittersAndSaneSize) {
   ASSERT_EQ(model.scenes.size(), 1u);
   ASSERT_EQ(model.cameras.size(), 1u);
   EXPECT_EQ(model.cameras[0].type, "perspective");
-  bool cameraNode = false;
-  for (const auto& node : model.nodes) cameraNode |= node.camera == 0;
-  EXPECT_TRUE(cameraNode);
+  bool camera_node = false;
+  for (const auto& node : model.nodes) camera_node |= node.camera == 0;
+  EXPECT_TRUE(camera_node);
 
   bool emissive = false;
   for (const auto& m : model.materials) {
     for (double c : m.emissiveFactor) emissive |= c > 0.0;
   }
-  EXPECT_EQ(emissive, e.emissiveMaterial);
+  EXPECT_EQ(emissive, e.emissive_material);
   bool sun = false;
   for (const auto& light : model.lights) sun |= light.type == "directional";
   EXPECT_EQ(sun, e.sun);
   EXPECT_EQ(fs::exists(kAssets / e.name / "environment.exr"), e.environment);
 
   const tinygltf::Value& pxf = model.scenes[0].extras.Get("pxf");
-  EXPECT_EQ(pxf.Get("all_hv").IsBool() && pxf.Get("all_hv").Get<bool>(), e.allHv);
+  EXPECT_EQ(pxf.Get("all_hv").IsBool() && pxf.Get("all_hv").Get<bool>(), e.all_hv);
 
-  const size_t triangles = triangleCount(model);
-  EXPECT_GE(triangles, e.minTriangles);
-  EXPECT_LE(triangles, e.maxTriangles);
+  const size_t triangles = triangle_count(model);
+  EXPECT_GE(triangles, e.min_triangles);
+  EXPECT_LE(triangles, e.max_triangles);
   for (const auto& image : model.images) {
     EXPECT_GE(image.width, 256) << image.uri;
     EXPECT_LE(image.width, 1024) << image.uri;
@@ -139,7 +139,7 @@ TEST_P(SceneTest, LoadsWithCameraEmittersAndSaneSize) {
 
 // Reads accessor `index` (tightly packed floats or unsigned indices) as doubles.
 template <typename T>
-std::vector<T> readAccessor(const tinygltf::Model& model, int index) {
+std::vector<T> read_accessor(const tinygltf::Model& model, int index) {
   const tinygltf::Accessor& accessor = model.accessors[size_t(index)];
   const tinygltf::BufferView& view = model.bufferViews[size_t(accessor.bufferView)];
   const unsigned char* data = model.buffers[size_t(view.buffer)].data.data() + view.byteOffset + accessor.byteOffset;
@@ -163,9 +163,9 @@ TEST_P(SceneTest, WindingAgreesWithNormals) {
   for (const tinygltf::Mesh& mesh : model.meshes) {
     for (const tinygltf::Primitive& primitive : mesh.primitives) {
       ASSERT_TRUE(primitive.attributes.count("NORMAL") && primitive.attributes.count("TEXCOORD_0")) << mesh.name;
-      const auto p = readAccessor<double>(model, primitive.attributes.at("POSITION"));
-      const auto n = readAccessor<double>(model, primitive.attributes.at("NORMAL"));
-      const auto indices = readAccessor<uint32_t>(model, primitive.indices);
+      const auto p = read_accessor<double>(model, primitive.attributes.at("POSITION"));
+      const auto n = read_accessor<double>(model, primitive.attributes.at("NORMAL"));
+      const auto indices = read_accessor<uint32_t>(model, primitive.indices);
       size_t flipped = 0;
       for (size_t t = 0; t + 2 < indices.size(); t += 3) {
         const size_t a = 3 * indices[t], b = 3 * indices[t + 1], c = 3 * indices[t + 2];
@@ -188,21 +188,20 @@ TEST_P(SceneTest, DeclaresExactlyTheExtensionsItUses) {
   const tinygltf::Model model = load(GetParam().name);
   const std::set<std::string> declared(model.extensionsUsed.begin(), model.extensionsUsed.end());
   EXPECT_EQ(declared.size(), model.extensionsUsed.size()) << "duplicates in extensionsUsed";
-  EXPECT_EQ(declared, extensionsInUse(model));
+  EXPECT_EQ(declared, extensions_in_use(model));
   EXPECT_TRUE(model.extensionsRequired.empty());
 }
 
 TEST_P(SceneTest, CommittedFilesMatchAFreshRun) {
   const std::string name = GetParam().name;
   const fs::path fresh = fs::temp_directory_path() / ("pxf_scenegen_test_" + std::to_string(::getpid()));
-  std::string error;
-  ASSERT_TRUE(pxf::scenegen::writeScene(name, fresh.string(), &error)) << error;
-  std::set<std::string> committedFiles, freshFiles;
-  for (const auto& entry : fs::directory_iterator(kAssets / name)) committedFiles.insert(entry.path().filename());
-  for (const auto& entry : fs::directory_iterator(fresh / name)) freshFiles.insert(entry.path().filename());
-  EXPECT_EQ(committedFiles, freshFiles);
-  for (const std::string& file : freshFiles) {
-    EXPECT_TRUE(readFile(kAssets / name / file) == readFile(fresh / name / file))
+  pxf::scenegen::write_scene(name, fresh.string());
+  std::set<std::string> committed_files, fresh_files;
+  for (const auto& entry : fs::directory_iterator(kAssets / name)) committed_files.insert(entry.path().filename());
+  for (const auto& entry : fs::directory_iterator(fresh / name)) fresh_files.insert(entry.path().filename());
+  EXPECT_EQ(committed_files, fresh_files);
+  for (const std::string& file : fresh_files) {
+    EXPECT_TRUE(read_file(kAssets / name / file) == read_file(fresh / name / file))
         << name << "/" << file << " differs from a fresh run: regenerate the assets (see assets/README.md)";
   }
   fs::remove_all(fresh);
@@ -211,7 +210,7 @@ TEST_P(SceneTest, CommittedFilesMatchAFreshRun) {
 TEST(Scenegen, EverySceneHasExpectations) {
   std::vector<std::string> expected;
   for (const auto& e : expectations()) expected.push_back(e.name);
-  EXPECT_EQ(expected, sceneNames());
+  EXPECT_EQ(expected, scene_names());
 }
 
 INSTANTIATE_TEST_SUITE_P(BuiltIn, SceneTest, ::testing::ValuesIn(expectations()),

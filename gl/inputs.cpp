@@ -1,28 +1,28 @@
 #include "gl/inputs.h"
 
-#include "gl/pass_params.h"
-
 namespace pxf {
 
 PreviewInputs::PreviewInputs(int width, int height)
     : width_(width), height_(height), lv_(width, height, TextureFormat::RGBA32F),
       hv_(width, height, TextureFormat::RGBA32F), albedo_(width, height, TextureFormat::RGBA32F) {}
 
-void PreviewInputs::upload(const float* lv_rgb, const float* hv_rgb, const float* var_of_mean,
-                           const uint32_t* samples) {
+void PreviewInputs::upload_packed(const float* lv_rgb, const float* hv_rgba) {
   timer_.begin();
+  lv_.upload(lv_rgb, 3);
+  hv_.upload(hv_rgba, 4);
+  timer_.end();
+}
+
+void PreviewInputs::upload(const float* lv_rgb, const float* hv_rgb, const float* var_of_mean) {
   const size_t n = static_cast<size_t>(width_) * height_;
   packed_.resize(n * 4);
   for (size_t i = 0; i < n; ++i) {
     packed_[4 * i + 0] = hv_rgb[3 * i + 0];
     packed_[4 * i + 1] = hv_rgb[3 * i + 1];
     packed_[4 * i + 2] = hv_rgb[3 * i + 2];
-    bool unknown = samples && samples[i] < 2;
-    packed_[4 * i + 3] = unknown ? kVarUnknown : var_of_mean[i];
+    packed_[4 * i + 3] = var_of_mean[i];
   }
-  lv_.upload(lv_rgb, 3);
-  hv_.upload(packed_.data(), 4);
-  timer_.end();
+  upload_packed(lv_rgb, packed_.data());
 }
 
 void PreviewInputs::upload(const Image& lv, const Image& hv, const Image& var) {

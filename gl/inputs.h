@@ -3,7 +3,8 @@
 // Usage (each frame, after ProgressiveRenderer::add_frame):
 //   PreviewInputs in(w, h);
 //   const Accumulation& a = renderer.accumulation();
-//   in.upload(&a.lv_mean[0].x, &a.hv_mean[0].x, renderer.variance_of_mean().data());
+//   a.hv_and_variance_of_mean(hv_rgba.data());   // the packed HV texture, filled by the renderer
+//   in.upload_packed(&a.lv_mean[0].x, hv_rgba.data());
 //   ... filter.run(in, range.guide(), ...); blend.run(in, &filter, ...);
 #pragma once
 #include <cstdint>
@@ -18,11 +19,12 @@ class PreviewInputs {
   int width() const { return width_; }
   int height() const { return height_; }
 
-  // lv_rgb, hv_rgb: 3 floats per pixel, top row first. var_of_mean: Var[L_u] per pixel, negative
-  // where unknown (n < 2). samples (optional): per-pixel n; where n < 2 the variance is marked
-  // unknown whatever var_of_mean says (for callers holding a variance image with 0 there).
-  void upload(const float* lv_rgb, const float* hv_rgb, const float* var_of_mean,
-              const uint32_t* samples = nullptr);
+  // lv_rgb: 3 floats per pixel, top row first. hv_rgba: 4 floats per pixel, rgb L_u, a Var[L_u]
+  // (kVarUnknown where n < 2), the HV texture's layout: uploaded as it is, without a copy.
+  void upload_packed(const float* lv_rgb, const float* hv_rgba);
+  // The same from separate buffers: hv_rgb 3 floats per pixel, var_of_mean one (kVarUnknown where
+  // n < 2), interleaved into a staging buffer first.
+  void upload(const float* lv_rgb, const float* hv_rgb, const float* var_of_mean);
   // The same from images: lv, hv "R,G,B"; var one channel.
   void upload(const Image& lv, const Image& hv, const Image& var);
   // The per-pixel mean albedo of the first non-specular vertex (Accumulation::albedo_mean, 3 floats
@@ -43,7 +45,7 @@ class PreviewInputs {
  private:
   int width_, height_;
   Texture2D lv_, hv_, albedo_;
-  std::vector<float> packed_;  // staging: hv rgb + variance interleaved
+  std::vector<float> packed_;  // staging of upload(): hv rgb + variance interleaved
   StageTimer timer_;
 };
 

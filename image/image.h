@@ -54,8 +54,10 @@ void sync_folder(const std::string& folder);
 // pixels, from a header that is corrupt far more often than it is real.
 constexpr size_t kMaxImageSamples = size_t{1} << 31;
 
-void write_exr(const std::string& path, const Image& image);  // half=false: full 32-bit float
-void write_exr(const std::string& path, const std::vector<Layer>& layers);
+// ZIP-compressed. Samples are stored as 32-bit floats, or with `half_float` as 16-bit half floats (about
+// 3 decimal digits; magnitudes beyond 65504 become infinite, so a caller clamps first where that matters).
+void write_exr(const std::string& path, const Image& image, bool half_float = false);
+void write_exr(const std::string& path, const std::vector<Layer>& layers, bool half_float = false);
 std::vector<Layer> read_exr_layers(const std::string& path);
 // The same from a file image in memory (the file reader reads the bytes and calls this); `name`
 // prefixes error messages.

@@ -1,10 +1,11 @@
-// EXR (OpenEXR, multi-layer, 32-bit float) and PNG/JPEG/HDR (stb) input and output.
+// EXR (OpenEXR, multi-layer, 32-bit or half float) and PNG/JPEG/HDR (stb) input and output.
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfFrameBuffer.h>
 #include <OpenEXR/ImfHeader.h>
 #include <OpenEXR/ImfInputFile.h>
 #include <OpenEXR/ImfIO.h>
 #include <OpenEXR/ImfOutputFile.h>
+#include <Imath/half.h>
 #include <stb_image.h>
 #include <stb_image_write.h>
 
@@ -275,9 +276,11 @@ void check_image_data(const void* bytes, size_t size, const std::string& name) {
     check_radiance_data(data, size, name);
 }
 
-void write_exr(const std::string& path, const Image& image) { write_exr(path, std::vector<Layer>{{"", image}}); }
+void write_exr(const std::string& path, const Image& image, bool half_float) {
+  write_exr(path, std::vector<Layer>{{"", image}}, half_float);
+}
 
-void write_exr(const std::string& path, const std::vector<Layer>& layers) {
+void write_exr(const std::string& path, const std::vector<Layer>& layers, bool half_float) {
   check_layers(path, layers);
   const int width = layers.front().image.width, height = layers.front().image.height;
   write_file_atomically(path, [&](const std::string& tmp) {
@@ -285,14 +288,22 @@ void write_exr(const std::string& path, const std::vector<Layer>& layers) {
       Imf::Header header(width, height);
       header.compression() = Imf::ZIP_COMPRESSION;
       Imf::FrameBuffer frame;
+      // OpenEXR writes a channel from a slice of its own type: half floats are converted here first.
+      std::vector<std::vector<half>> halves;
       for (const Layer& layer : layers) {
         const Image& img = layer.image;
-        const size_t x_stride = sizeof(float) * img.channels.size();
+        const Imf::PixelType type = half_float ? Imf::HALF : Imf::FLOAT;
+        const size_t x_stride = (half_float ? sizeof(half) : sizeof(float)) * img.channels.size();
+        char* pixels = reinterpret_cast<char*>(const_cast<float*>(img.pixels.data()));
+        if (half_float) {
+          halves.emplace_back(img.pixels.begin(), img.pixels.end());
+          pixels = reinterpret_cast<char*>(halves.back().data());
+        }
         for (int c = 0; c < img.num_channels(); ++c) {
           const std::string name = exr_channel_name(layer.name, img.channels[c]);
-          header.channels().insert(name, Imf::Channel(Imf::FLOAT));
-          char* base = reinterpret_cast<char*>(const_cast<float*>(img.pixels.data() + c));
-          frame.insert(name, Imf::Slice(Imf::FLOAT, base, x_stride, x_stride * width));
+          header.channels().insert(name, Imf::Channel(type));
+          const size_t offset = (half_float ? sizeof(half) : sizeof(float)) * static_cast<size_t>(c);
+          frame.insert(name, Imf::Slice(type, pixels + offset, x_stride, x_stride * width));
         }
       }
       MemoryOStream stream;

@@ -65,6 +65,36 @@ TEST(ImageExr, MultiLayerRoundTripKeepsNamesAndOrder) {
   EXPECT_THROW(read_exr(path, "missing"), Error);
 }
 
+// Half floats: 10 mantissa bits, round to nearest even, largest finite 65504; read back as floats.
+TEST(ImageExr, HalfFloatOptionRoundsToTheNearestHalfAndHalvesTheSamples) {
+  const std::string path = temp_path("half.exr");
+  const std::vector<float> values = {1.0f, 0.1f, 1.0f / 3.0f, -2.5f, 65504.0f, 70000.0f, 1e-8f, 2049.0f};
+  const std::vector<float> halves = {1.0f, 0.0999755859375f, 0.333251953125f, -2.5f, 65504.0f, INFINITY, 0.0f, 2048.0f};
+  Image img = Image::gray(4, 2);
+  img.pixels = values;
+  write_exr(path, img, /*half=*/true);
+  Image back = read_exr(path);
+  EXPECT_EQ(back.channels, img.channels);
+  EXPECT_EQ(back.pixels, halves);
+
+  // Pixel data takes 2 bytes a sample instead of 4 (an incompressible pattern, so ZIP keeps that ratio).
+  Image noise = Image::rgb(64, 64);
+  uint32_t state = 12345;
+  for (float& v : noise.pixels) v = static_cast<float>((state = state * 1664525u + 1013904223u) >> 8) / 16777216.0f;
+  const std::string full_path = temp_path("noise_full.exr"), half_path = temp_path("noise_half.exr");
+  write_exr(full_path, noise);
+  write_exr(half_path, noise, true);
+  const double ratio = static_cast<double>(fs::file_size(half_path)) / static_cast<double>(fs::file_size(full_path));
+  EXPECT_GT(ratio, 0.4);
+  EXPECT_LT(ratio, 0.6);
+  const Image noise_back = read_exr(half_path);
+  for (size_t i = 0; i < noise.pixels.size(); ++i) ASSERT_NEAR(noise_back.pixels[i], noise.pixels[i], 0.5f / 1024.0f) << i;
+
+  // Layers too.
+  write_exr(path, std::vector<Layer>{{"sky", img}}, true);
+  EXPECT_EQ(read_exr(path, "sky").pixels, halves);
+}
+
 TEST(ImageExr, NonFiniteValuesSurviveRoundTripAndAreCounted) {
   const std::string path = temp_path("nan.exr");
   Image img = Image::rgb(2, 2, 1.0f);

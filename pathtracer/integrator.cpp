@@ -366,14 +366,27 @@ float Accumulation::variance_of_mean(size_t pixel) const {
   });
 }
 
-std::vector<float> Accumulation::variance_of_mean_image() const {
+void Accumulation::variance_of_mean_image(float* out, size_t stride) const {
   const size_t n = samples.size();
   std::vector<std::pair<float, float>> estimates(n);
   for (size_t q = 0; q < n; ++q) estimates[q] = {replicate_variance_of_mean(q), per_sample_variance_of_mean(q)};
-  std::vector<float> out(n);
   for (size_t p = 0; p < n; ++p)
-    out[p] = pooled_gain_variance_of_mean(*this, p, [&estimates](size_t q) { return estimates[q]; });
+    out[p * stride] = pooled_gain_variance_of_mean(*this, p, [&estimates](size_t q) { return estimates[q]; });
+}
+
+std::vector<float> Accumulation::variance_of_mean_image() const {
+  std::vector<float> out(samples.size());
+  variance_of_mean_image(out.data(), 1);
   return out;
+}
+
+void Accumulation::hv_and_variance_of_mean(float* rgba) const {
+  for (size_t p = 0; p < hv_mean.size(); ++p) {
+    rgba[4 * p + 0] = hv_mean[p].x;
+    rgba[4 * p + 1] = hv_mean[p].y;
+    rgba[4 * p + 2] = hv_mean[p].z;
+  }
+  variance_of_mean_image(rgba + 3, 4);
 }
 
 }  // namespace pxf

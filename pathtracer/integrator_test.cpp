@@ -469,7 +469,8 @@ TEST(Integrator, SpecularChainsReachTheFirstDiffuseSurface) {
   const int size = 64;
   ProgressiveRenderer renderer(scene, params, size, size);
   EXPECT_TRUE(renderer.scene_has_perfect_specular());
-  ProgressiveRenderer plain(make_cornell_box(false), params, size, size);
+  const Scene plain_scene = make_cornell_box(false);  // the renderer references its scene
+  ProgressiveRenderer plain(plain_scene, params, size, size);
   EXPECT_FALSE(plain.scene_has_perfect_specular());
 
   // Find pixels whose camera ray hits the mirror / glass sphere and one that hits the back wall.

@@ -105,6 +105,10 @@ struct Accumulation {
   // the gain, which varies slowly across the image, keeps the n - 1 of s^2 / n.
   float variance_of_mean(size_t pixel) const;
   std::vector<float> variance_of_mean_image() const;  // variance_of_mean of every pixel, in O(pixels)
+  void variance_of_mean_image(float* out, size_t stride) const;  // the same into out[pixel * stride]
+  // 4 floats per pixel: rgb hv_mean, a variance_of_mean (-1 where n < 2). The preview uploads this
+  // buffer as its HV texture as it is.
+  void hv_and_variance_of_mean(float* rgba) const;
   float per_sample_variance_of_mean(size_t pixel) const;  // s^2 / n, -1 when n < 2
   // K'/(K'-1) sum_r (n_r / n)^2 (m_r - m)^2 over the K' replicates with samples; -1 when K' < 2.
   float replicate_variance_of_mean(size_t pixel) const;
@@ -122,7 +126,10 @@ class PathTracer;  // Embree scene, light and environment samplers (pathtracer i
 // The progressive state: one path per pixel per add_frame().
 class ProgressiveRenderer {
  public:
+  // The renderer keeps a reference to `scene`, not a copy: the scene must outlive the renderer and
+  // stay unchanged while it exists. A temporary scene does not compile.
   ProgressiveRenderer(const Scene& scene, const TraceParams& params, int width, int height);
+  ProgressiveRenderer(Scene&& scene, const TraceParams& params, int width, int height) = delete;
   ~ProgressiveRenderer();
   ProgressiveRenderer(const ProgressiveRenderer&) = delete;
   ProgressiveRenderer& operator=(const ProgressiveRenderer&) = delete;

@@ -18,7 +18,7 @@ constexpr int kTileSize = 16;
 }  // namespace
 
 struct ProgressiveRenderer::Impl {
-  Scene scene;  // owned: the Embree scene and the light sampler point into it
+  const Scene& scene;  // the caller's, not copied: the Embree scene and the light sampler point into it
   Camera camera;
   TraceParams params;
   int width, height;

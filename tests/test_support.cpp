@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
 
 #include "pathtracer/pathtracer.h"
 
@@ -21,7 +22,11 @@ GlContext& headless_context() {
 std::unique_ptr<Preview> render_preview(const std::string& scene_name, int width, int height, int spp,
                                         const PreviewSettings& settings) {
   headless_context();
-  const Scene scene = load_scene(scene_name);
+  // The Preview references its scene: each scene is loaded once and kept for the test binary's life.
+  static std::map<std::string, std::unique_ptr<const Scene>> scenes;
+  std::unique_ptr<const Scene>& cached = scenes[scene_name];
+  if (!cached) cached = std::make_unique<const Scene>(load_scene(scene_name));
+  const Scene& scene = *cached;
   PreviewSettings s = settings;
   s.trace.all_hv = s.trace.all_hv || scene.defaults.all_hv;
   auto preview = std::make_unique<Preview>(scene, s, width, height);

@@ -12,7 +12,8 @@ namespace pxf::test_support {
 // One OSMesa context for the whole test binary (created on first use, made current).
 GlContext& headless_context();
 
-// Renders `spp` frames of a built-in scene (or file) with `settings` and finishes the capture.
+// Renders `spp` frames of a built-in scene (or file) with `settings` and finishes the capture. The
+// scene is loaded once per test binary and stays loaded (the Preview references it).
 std::unique_ptr<Preview> render_preview(const std::string& scene, int width, int height, int spp,
                                         const PreviewSettings& settings);
 

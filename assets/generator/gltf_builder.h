@@ -16,65 +16,65 @@
 namespace pxf::scenegen {
 
 // A material in the renderer's vocabulary (glTF metallic-roughness + the supported extensions).
-// Texture fields are texture indices from SceneBuilder::addTexture, -1 for none.
+// Texture fields are texture indices from SceneBuilder::add_texture, -1 for none.
 struct MaterialDesc {
   std::string name;
-  glm::vec4 baseColor{1.0f};
-  int baseColorTexture = -1;
+  glm::vec4 base_color{1.0f};
+  int base_color_texture = -1;
   float metallic = 0.0f;
   float roughness = 1.0f;
-  int metallicRoughnessTexture = -1;  // G roughness, B metallic
-  int normalTexture = -1;
-  float normalScale = 1.0f;
+  int metallic_roughness_texture = -1;  // G roughness, B metallic
+  int normal_texture = -1;
+  float normal_scale = 1.0f;
   glm::vec3 emissive{0.0f};           // emissiveFactor, each component in [0, 1]
-  float emissiveStrength = 1.0f;      // KHR_materials_emissive_strength when != 1
+  float emissive_strength = 1.0f;      // KHR_materials_emissive_strength when != 1
   float transmission = 0.0f;          // KHR_materials_transmission when > 0
   float ior = 1.5f;                   // KHR_materials_ior when transmission > 0 or != 1.5
-  bool useSpecular = false;           // KHR_materials_specular
+  bool use_specular = false;           // KHR_materials_specular
   float specular = 1.0f;
-  int specularTexture = -1;           // A channel
-  glm::vec3 specularColor{1.0f};
-  glm::vec2 uvScale{1.0f};            // KHR_texture_transform on every texture when != 1
+  int specular_texture = -1;           // A channel
+  glm::vec3 specular_color{1.0f};
+  glm::vec2 uv_scale{1.0f};            // KHR_texture_transform on every texture when != 1
   bool doubleSided = false;
-  bool alphaMask = false;
-  float alphaCutoff = 0.5f;
+  bool alpha_mask = false;
+  float alpha_cutoff = 0.5f;
 };
 
 // A dielectric (metallic 0) material of the given color and roughness.
-MaterialDesc plainMaterial(const std::string& name, const glm::vec3& color, float roughness = 1.0f);
+MaterialDesc plain_material(const std::string& name, const glm::vec3& color, float roughness = 1.0f);
 
 class SceneBuilder {
  public:
   explicit SceneBuilder(std::string name);
 
-  // Adds a PNG texture (written as <fileStem>.png) with a repeating, mipmapped sampler.
-  int addTexture(ByteImage image, const std::string& fileStem);
-  int addMaterial(const MaterialDesc& desc);
+  // Adds a PNG texture (written as <file_stem>.png) with a repeating, mipmapped sampler.
+  int add_texture(ByteImage image, const std::string& file_stem);
+  int add_material(const MaterialDesc& desc);
   // One mesh with one primitive; returns the mesh index.
-  int addMesh(const std::string& name, const MeshData& data, int material);
+  int add_mesh(const std::string& name, const MeshData& data, int material);
   // A root node instancing `mesh` (rotation as a quaternion).
-  int addNode(const std::string& name, int mesh, const glm::vec3& translation = glm::vec3(0.0f),
+  int add_node(const std::string& name, int mesh, const glm::vec3& translation = glm::vec3(0.0f),
               const glm::quat& rotation = glm::quat(1, 0, 0, 0), const glm::vec3& scale = glm::vec3(1.0f));
-  // Convenience: addMesh + addNode at the origin.
-  int addObject(const std::string& name, const MeshData& data, int material);
+  // Convenience: add_mesh + add_node at the origin.
+  int add_object(const std::string& name, const MeshData& data, int material);
 
-  void setCamera(const glm::vec3& eye, const glm::vec3& target, float yfov, float aspectRatio);
+  void set_camera(const glm::vec3& eye, const glm::vec3& target, float yfov, float aspect_ratio);
   // A KHR_lights_punctual directional light; `direction` is where the light travels.
-  void addSun(const std::string& name, const glm::vec3& direction, const glm::vec3& color, float intensity);
+  void add_sun(const std::string& name, const glm::vec3& direction, const glm::vec3& color, float intensity);
   // Scene-level render defaults for pxf (scenes[0].extras.pxf).
-  void setRenderDefaults(bool allHv, int width, int height);
+  void set_render_defaults(bool all_hv, int width, int height);
 
-  // Writes <dir>/<name>.gltf, .bin and the textures; false with a message on failure.
-  bool write(const std::string& dir, std::string* error) const;
+  // Writes <dir>/<name>.gltf, .bin and the textures; throws pxf::Error naming the file on failure.
+  void write(const std::string& dir) const;
 
   const tinygltf::Model& model() const { return model_; }
-  size_t triangleCount() const { return triangles_; }
+  size_t triangle_count() const { return triangles_; }
 
  private:
-  int addAccessor(const void* bytes, size_t byteCount, size_t count, int componentType, int type,
+  int add_accessor(const void* bytes, size_t byte_count, size_t count, int componentType, int type,
                   int target);
-  tinygltf::TextureInfo textureInfo(int texture, const MaterialDesc& desc);
-  void useExtension(const std::string& extension);
+  tinygltf::TextureInfo texture_info(int texture, const MaterialDesc& desc);
+  void use_extension(const std::string& extension);
 
   std::string name_;
   tinygltf::Model model_;

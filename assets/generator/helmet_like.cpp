@@ -18,7 +18,7 @@
 
 namespace {
 
-using pxf::scenegen::tileableFbm;
+using pxf::scenegen::tileable_fbm;
 
 void append(std::vector<unsigned char>& buffer, const void* data, size_t size) {
   const auto* bytes = static_cast<const unsigned char*>(data);
@@ -39,7 +39,7 @@ std::vector<unsigned char> noise_image(int size, uint32_t seed, float base, floa
     for (int x = 0; x < size; ++x)
       for (int c = 0; c < 3; ++c) {
         float u = (x + 0.5f) / size, v = (y + 0.5f) / size;
-        float n = tileableFbm(u, v, 8, 6, 0.6f, seed + 17 * c);
+        float n = tileable_fbm(u, v, 8, 6, 0.6f, seed + 17 * c);
         float value = std::fmin(std::fmax(base + amplitude * (n - 0.5f), 0.0f), 1.0f);
         rgb[(static_cast<size_t>(y) * size + x) * 3 + c] = static_cast<unsigned char>(value * 255.0f + 0.5f);
       }

@@ -24,21 +24,20 @@ struct Texel {
 };
 
 template <typename Painter>
-TextureSet paint(int size, bool withAlpha, bool withSpecular, Painter painter) {
+TextureSet paint(int size, bool with_alpha, bool with_specular, Painter painter) {
   TextureSet set;
-  set.albedo = FloatImage(size, size, withAlpha ? 4 : 3);
-  set.height = FloatImage(size, size, 1);
-  set.roughness = FloatImage(size, size, 1);
-  if (withSpecular) set.specular = FloatImage(size, size, 1);
+  set.albedo = with_alpha ? Image::rgba(size, size) : Image::rgb(size, size);
+  set.height = Image::gray(size, size);
+  set.roughness = Image::gray(size, size);
+  if (with_specular) set.specular = Image::gray(size, size);
   for (int y = 0; y < size; ++y) {
     for (int x = 0; x < size; ++x) {
       Texel t = painter((x + 0.5f) / size, (y + 0.5f) / size);
-      float* a = set.albedo.at(x, y);
-      a[0] = t.albedo.r, a[1] = t.albedo.g, a[2] = t.albedo.b;
-      if (withAlpha) a[3] = t.alpha;
-      set.height.at(x, y)[0] = t.height;
-      set.roughness.at(x, y)[0] = std::clamp(t.roughness, 0.02f, 1.0f);
-      if (withSpecular) set.specular.at(x, y)[0] = std::clamp(t.specular, 0.0f, 1.0f);
+      set.albedo.at(x, y, 0) = t.albedo.r, set.albedo.at(x, y, 1) = t.albedo.g, set.albedo.at(x, y, 2) = t.albedo.b;
+      if (with_alpha) set.albedo.at(x, y, 3) = t.alpha;
+      set.height.at(x, y, 0) = t.height;
+      set.roughness.at(x, y, 0) = std::clamp(t.roughness, 0.02f, 1.0f);
+      if (with_specular) set.specular.at(x, y, 0) = std::clamp(t.specular, 0.0f, 1.0f);
     }
   }
   return set;
@@ -53,33 +52,33 @@ glm::vec3 vary(const glm::vec3& base, float amount, uint32_t cx, uint32_t cy, ui
 
 }  // namespace
 
-TextureSet paintTiles(int size, const TileStyle& s) {
+TextureSet paint_tiles(int size, const TileStyle& s) {
   return paint(size, false, false, [&](float x, float y) {
-    const float gx = x * s.tilesPerSide, gy = y * s.tilesPerSide;
+    const float gx = x * s.tiles_per_side, gy = y * s.tiles_per_side;
     const int ix = int(gx), iy = int(gy);
     const float fx = fract(gx), fy = fract(gy);
     const float edge = std::min(std::min(fx, 1.0f - fx), std::min(fy, 1.0f - fy));
-    const float tileMask = smoothstep(s.groutWidth, s.groutWidth * 2.0f, edge);
-    const float grain = tileableFbm(x, y, 8, 5, 0.55f, s.seed);
-    const float fine = tileableFbm(x, y, 64, 3, 0.5f, s.seed + 3);
+    const float tile_mask = smoothstep(s.grout_width, s.grout_width * 2.0f, edge);
+    const float grain = tileable_fbm(x, y, 8, 5, 0.55f, s.seed);
+    const float fine = tileable_fbm(x, y, 64, 3, 0.5f, s.seed + 3);
 
-    glm::vec3 tile = (!s.checker || ((ix + iy) & 1) == 0) ? s.colorA : s.colorB;
+    glm::vec3 tile = (!s.checker || ((ix + iy) & 1) == 0) ? s.color_a : s.color_b;
     tile = vary(tile, 0.12f, ix, iy, s.seed);
     // Marble veins: thin dark bands along a noise-warped diagonal.
-    const float warp = tileableFbm(x, y, 4, 5, 0.6f, s.seed + 11);
+    const float warp = tileable_fbm(x, y, 4, 5, 0.6f, s.seed + 11);
     const float vein = std::pow(1.0f - std::abs(std::sin((x + y) * glm::pi<float>() * 3.0f + warp * 9.0f)), 12.0f);
     tile *= 1.0f - s.veins * 0.6f * vein;
     tile *= 0.9f + 0.2f * grain;
 
     Texel t;
-    t.albedo = glm::mix(s.groutColor * (0.8f + 0.4f * fine), tile, tileMask);
-    t.height = tileMask * (1.0f + 0.02f * grain) + 0.15f * fine * (1.0f - tileMask);
-    t.roughness = glm::mix(0.9f, s.tileRoughness + 0.15f * (grain - 0.5f) + 0.3f * s.veins * vein, tileMask);
+    t.albedo = glm::mix(s.grout_color * (0.8f + 0.4f * fine), tile, tile_mask);
+    t.height = tile_mask * (1.0f + 0.02f * grain) + 0.15f * fine * (1.0f - tile_mask);
+    t.roughness = glm::mix(0.9f, s.tile_roughness + 0.15f * (grain - 0.5f) + 0.3f * s.veins * vein, tile_mask);
     return t;
   });
 }
 
-TextureSet paintBricks(int size, const BrickStyle& s) {
+TextureSet paint_bricks(int size, const BrickStyle& s) {
   const int rows = s.rows, columns = s.columns;
   const uint32_t seed = s.seed;
   return paint(size, false, true, [&](float x, float y) {
@@ -89,25 +88,25 @@ TextureSet paintBricks(int size, const BrickStyle& s) {
     const float fx = fract(gx), fy = fract(y * rows);
     // Distance to the nearest joint in texture units.
     const float edge = std::min(std::min(fx, 1.0f - fx) / columns, std::min(fy, 1.0f - fy) / rows);
-    const float brickMask = smoothstep(s.jointWidth, 2.0f * s.jointWidth, edge);
-    const float speckle = tileableFbm(x, y, 32, 4, 0.6f, seed + 1);
-    const float pits = std::pow(tileableFbm(x, y, 96, 2, 0.5f, seed + 2), 4.0f);
-    const float blotch = tileableFbm(x, y, 6, 4, 0.5f, seed + 5);
+    const float brick_mask = smoothstep(s.joint_width, 2.0f * s.joint_width, edge);
+    const float speckle = tileable_fbm(x, y, 32, 4, 0.6f, seed + 1);
+    const float pits = std::pow(tileable_fbm(x, y, 96, 2, 0.5f, seed + 2), 4.0f);
+    const float blotch = tileable_fbm(x, y, 6, 4, 0.5f, seed + 5);
 
     const size_t pick = size_t(hash01(column, row, seed) * float(s.palette.size())) % s.palette.size();
     const float texture = s.pitting > 0.0f ? (0.75f + 0.5f * speckle) * (0.85f + 0.3f * blotch) : 0.96f + 0.08f * blotch;
     const glm::vec3 brick = s.palette[pick] * texture;
     const glm::vec3 mortar = s.mortar * (0.8f + 0.4f * speckle);
     Texel t;
-    t.albedo = glm::mix(mortar, brick, brickMask);
-    t.height = brickMask * (1.0f - s.pitting * pits) + 0.15f * blotch;
-    t.roughness = glm::mix(0.95f, s.brickRoughness + 0.2f * (speckle - 0.5f), brickMask);
-    t.specular = glm::mix(0.15f, 0.35f + 0.4f * blotch, brickMask);
+    t.albedo = glm::mix(mortar, brick, brick_mask);
+    t.height = brick_mask * (1.0f - s.pitting * pits) + 0.15f * blotch;
+    t.roughness = glm::mix(0.95f, s.brick_roughness + 0.2f * (speckle - 0.5f), brick_mask);
+    t.specular = glm::mix(0.15f, 0.35f + 0.4f * blotch, brick_mask);
     return t;
   });
 }
 
-TextureSet paintStone(int size, glm::vec3 tint, uint32_t seed) {
+TextureSet paint_stone(int size, glm::vec3 tint, uint32_t seed) {
   // Ashlar courses: two rows of two blocks per tile, offset by half a block.
   return paint(size, false, true, [&](float x, float y) {
     const int row = int(y * 2.0f);
@@ -115,73 +114,73 @@ TextureSet paintStone(int size, glm::vec3 tint, uint32_t seed) {
     const int column = int(gx) % 2;
     const float fx = fract(gx), fy = fract(y * 2.0f);
     const float edge = std::min(std::min(fx, 1.0f - fx), std::min(fy, 1.0f - fy)) * 0.5f;
-    const float blockMask = smoothstep(0.002f, 0.006f, edge);
-    const float grain = tileableFbm(x, y, 16, 6, 0.55f, seed);
+    const float block_mask = smoothstep(0.002f, 0.006f, edge);
+    const float grain = tileable_fbm(x, y, 16, 6, 0.55f, seed);
     const float strata = 0.5f + 0.5f * std::sin(y * glm::pi<float>() * 2.0f * 24.0f + grain * 10.0f);
-    const float relief = tileableFbm(x, y, 8, 4, 0.5f, seed + 4);
-    const float pits = std::pow(tileableFbm(x, y, 64, 2, 0.5f, seed + 9), 6.0f);
+    const float relief = tileable_fbm(x, y, 8, 4, 0.5f, seed + 4);
+    const float pits = std::pow(tileable_fbm(x, y, 64, 2, 0.5f, seed + 9), 6.0f);
 
     Texel t;
     const glm::vec3 stone = vary(tint, 0.1f, column, row, seed) * (0.8f + 0.25f * grain + 0.1f * strata);
-    t.albedo = glm::mix(tint * 0.55f, stone, blockMask);
-    t.height = blockMask * (1.0f + 0.5f * relief - 1.5f * pits);
-    t.roughness = 0.55f + 0.35f * relief + 0.1f * (1.0f - blockMask);
-    t.specular = 0.3f + 0.4f * relief * blockMask;
+    t.albedo = glm::mix(tint * 0.55f, stone, block_mask);
+    t.height = block_mask * (1.0f + 0.5f * relief - 1.5f * pits);
+    t.roughness = 0.55f + 0.35f * relief + 0.1f * (1.0f - block_mask);
+    t.specular = 0.3f + 0.4f * relief * block_mask;
     return t;
   });
 }
 
-TextureSet paintWood(int size, int planks, glm::vec3 light, glm::vec3 dark, uint32_t seed) {
+TextureSet paint_wood(int size, int planks, glm::vec3 light, glm::vec3 dark, uint32_t seed) {
   // Planks run along x; growth rings are noise-warped bands along each plank.
   return paint(size, false, false, [&](float x, float y) {
     const int plank = int(y * planks);
     const float fy = fract(y * planks);
     const float shift = hash01(plank, 0, seed);  // each plank shows another part of the log
     const float seam = smoothstep(0.0f, 0.03f, std::min(fy, 1.0f - fy));
-    const float warp = tileableFbm(fract(x + shift), y, 2, 5, 0.5f, seed + plank);
+    const float warp = tileable_fbm(fract(x + shift), y, 2, 5, 0.5f, seed + plank);
     const float rings = fract(fy * 6.0f + warp * 5.0f + 13.0f * shift);
-    const float ringMask = smoothstep(0.0f, 0.25f, rings) * smoothstep(1.0f, 0.6f, rings);
-    const float streaks = tileableFbm(x, y * 8.0f - std::floor(y * 8.0f), 64, 3, 0.5f, seed + 4);
+    const float ring_mask = smoothstep(0.0f, 0.25f, rings) * smoothstep(1.0f, 0.6f, rings);
+    const float streaks = tileable_fbm(x, y * 8.0f - std::floor(y * 8.0f), 64, 3, 0.5f, seed + 4);
 
     Texel t;
-    glm::vec3 wood = glm::mix(dark, light, ringMask * (0.7f + 0.3f * streaks));
+    glm::vec3 wood = glm::mix(dark, light, ring_mask * (0.7f + 0.3f * streaks));
     wood = vary(wood, 0.08f, plank, 0, seed + 2);
     t.albedo = wood * (0.4f + 0.6f * seam);
-    t.height = seam + 0.05f * ringMask;
-    t.roughness = 0.35f + 0.2f * (1.0f - ringMask) + 0.3f * (1.0f - seam);
+    t.height = seam + 0.05f * ring_mask;
+    t.roughness = 0.35f + 0.2f * (1.0f - ring_mask) + 0.3f * (1.0f - seam);
     return t;
   });
 }
 
-TextureSet paintGrille(int size, int bars) {
+TextureSet paint_grille(int size, int bars) {
   return paint(size, true, false, [&](float x, float y) {
     // Vertical bars, top and bottom rails, and three rings between each pair of bars.
     // Distances are in texture units (the texture spans 1 m x 1 m).
     const float bx = fract(x * bars);
-    const float barDistance = std::abs(bx - 0.5f) / bars;
-    const float railDistance = std::min(std::abs(y - 0.06f), std::abs(y - 0.94f));
+    const float bar_distance = std::abs(bx - 0.5f) / bars;
+    const float rail_distance = std::min(std::abs(y - 0.06f), std::abs(y - 0.94f));
     const float cx = (bx < 0.5f ? bx : bx - 1.0f) / bars;  // offset from the gap's center line
-    float ringDistance = 1.0f;
-    for (float ringY : {0.28f, 0.5f, 0.72f})  // rings just touching the bars on either side
-      ringDistance = std::min(ringDistance, std::abs(std::hypot(cx, y - ringY) - 0.46f / bars));
-    const float d = std::min({barDistance, railDistance, ringDistance});
-    const float barHalfWidth = 0.008f;
+    float ring_distance = 1.0f;
+    for (float ring_y : {0.28f, 0.5f, 0.72f})  // rings just touching the bars on either side
+      ring_distance = std::min(ring_distance, std::abs(std::hypot(cx, y - ring_y) - 0.46f / bars));
+    const float d = std::min({bar_distance, rail_distance, ring_distance});
+    const float bar_half_width = 0.008f;
     Texel t;
-    t.alpha = d < barHalfWidth ? 1.0f : 0.0f;
+    t.alpha = d < bar_half_width ? 1.0f : 0.0f;
     t.albedo = glm::vec3(0.06f, 0.055f, 0.05f);
-    t.height = std::max(0.0f, 1.0f - d / barHalfWidth);
+    t.height = std::max(0.0f, 1.0f - d / bar_half_width);
     t.roughness = 0.45f;
     return t;
   });
 }
 
-TextureSet paintScales(int size, int rows, uint32_t seed) {
+TextureSet paint_scales(int size, int rows, uint32_t seed) {
   const glm::vec3 teal(0.02f, 0.22f, 0.26f), gold(0.62f, 0.42f, 0.12f), rim(0.03f, 0.03f, 0.035f);
   return paint(size, false, false, [&](float x, float y) {
     // Scales sit on a staggered grid; where domes overlap the one from the lower row wins.
     const float gx = x * rows, gy = y * rows;
-    float best = -1.0f, bestDome = 0.0f;
-    int bestI = 0, bestJ = 0;
+    float best = -1.0f, best_dome = 0.0f;
+    int best_i = 0, best_j = 0;
     for (int j = int(gy) - 1; j <= int(gy) + 1; ++j) {
       for (int i = int(gx) - 1; i <= int(gx) + 1; ++i) {
         const glm::vec2 center(float(i) + 0.5f + ((j & 1) ? 0.5f : 0.0f), float(j));
@@ -189,39 +188,39 @@ TextureSet paintScales(int size, int rows, uint32_t seed) {
         if (r >= 1.0f) continue;
         const float dome = std::sqrt(1.0f - r * r);
         const float order = float(j) + 0.5f * dome;  // lower rows overlap upper ones
-        if (order > best) best = order, bestDome = dome, bestI = i, bestJ = j;
+        if (order > best) best = order, best_dome = dome, best_i = i, best_j = j;
       }
     }
-    const uint32_t ci = uint32_t((bestI % rows + rows) % rows), cj = uint32_t((bestJ % rows + rows) % rows);
+    const uint32_t ci = uint32_t((best_i % rows + rows) % rows), cj = uint32_t((best_j % rows + rows) % rows);
     const float pick = hash01(ci, cj, seed);
-    const float glaze = tileableFbm(x, y, 16, 3, 0.5f, seed + 1);
+    const float glaze = tileable_fbm(x, y, 16, 3, 0.5f, seed + 1);
     Texel t;
     const glm::vec3 color = pick < 0.8f ? vary(teal, 0.25f, ci, cj, seed + 2) : vary(gold, 0.15f, ci, cj, seed + 2);
-    t.albedo = glm::mix(rim, color * (0.85f + 0.3f * glaze), smoothstep(0.0f, 0.35f, bestDome));
-    t.height = bestDome + 0.03f * glaze;
-    t.roughness = glm::mix(0.6f, 0.08f + 0.15f * glaze, smoothstep(0.05f, 0.5f, bestDome));
+    t.albedo = glm::mix(rim, color * (0.85f + 0.3f * glaze), smoothstep(0.0f, 0.35f, best_dome));
+    t.height = best_dome + 0.03f * glaze;
+    t.roughness = glm::mix(0.6f, 0.08f + 0.15f * glaze, smoothstep(0.05f, 0.5f, best_dome));
     return t;
   });
 }
 
-MaterialDesc addTextureSet(SceneBuilder& scene, const TextureSet& set, const std::string& stem,
-                           float normalStrength, glm::vec2 uvScale, float metallic) {
+MaterialDesc add_texture_set(SceneBuilder& scene, const TextureSet& set, const std::string& stem,
+                           float normal_strength, glm::vec2 uv_scale, float metallic) {
   MaterialDesc desc;
   desc.name = stem;
-  desc.uvScale = uvScale;
+  desc.uv_scale = uv_scale;
   desc.metallic = 1.0f;  // the texture's B channel carries the metallic value
   desc.roughness = 1.0f;
-  desc.baseColorTexture = scene.addTexture(encodeSrgb(set.albedo), stem + "_basecolor");
-  desc.normalTexture = scene.addTexture(encodeNormalMap(normalMapFromHeight(set.height, normalStrength)),
+  desc.base_color_texture = scene.add_texture(encode_srgb(set.albedo), stem + "_basecolor");
+  desc.normal_texture = scene.add_texture(encode_normal_map(normal_map_from_height(set.height, normal_strength)),
                                         stem + "_normal");
-  const bool hasSpecular = !set.specular.data.empty();
-  desc.metallicRoughnessTexture = scene.addTexture(
-      packMetallicRoughness(set.roughness, metallic, hasSpecular ? &set.specular : nullptr), stem + "_mr");
-  if (hasSpecular) {
-    desc.useSpecular = true;
-    desc.specularTexture = desc.metallicRoughnessTexture;
+  const bool has_specular = !set.specular.empty();
+  desc.metallic_roughness_texture = scene.add_texture(
+      pack_metallic_roughness(set.roughness, metallic, has_specular ? &set.specular : nullptr), stem + "_mr");
+  if (has_specular) {
+    desc.use_specular = true;
+    desc.specular_texture = desc.metallic_roughness_texture;
   }
-  if (set.albedo.channels == 4) desc.alphaMask = true;
+  if (set.albedo.num_channels() == 4) desc.alpha_mask = true;
   return desc;
 }
 

@@ -18,11 +18,12 @@ int main(int argc, char** argv) {
   }
   const std::string root = argv[1];
   std::vector<std::string> names(argv + 2, argv + argc);
-  if (names.empty()) names = pxf::scenegen::sceneNames();
+  if (names.empty()) names = pxf::scenegen::scene_names();
   for (const std::string& name : names) {
-    std::string error;
-    if (!pxf::scenegen::writeScene(name, root, &error)) {
-      std::fprintf(stderr, "pxf_scenegen: %s\n", error.c_str());
+    try {
+      pxf::scenegen::write_scene(name, root);
+    } catch (const pxf::Error& e) {
+      std::fprintf(stderr, "pxf_scenegen: %s\n", e.what());
       return 1;
     }
     std::printf("wrote %s/%s\n", root.c_str(), name.c_str());

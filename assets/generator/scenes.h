@@ -4,16 +4,23 @@
 #include <string>
 #include <vector>
 
+#include "texture.h"
+
 namespace pxf::scenegen {
 
-bool writeCornell(const std::string& dir, std::string* error);
-bool writeAtrium(const std::string& dir, std::string* error);
-bool writeKitchen(const std::string& dir, std::string* error);
-bool writeEnvmap(const std::string& dir, std::string* error);
+// Each throws pxf::Error naming the file it could not write.
+void write_cornell(const std::string& dir);
+void write_atrium(const std::string& dir);
+void write_kitchen(const std::string& dir);
+void write_envmap(const std::string& dir);
 
 // Scene names in generation order.
-const std::vector<std::string>& sceneNames();
-// Writes scene `name` into <assetsRoot>/<name>/.
-bool writeScene(const std::string& name, const std::string& assetsRoot, std::string* error);
+const std::vector<std::string>& scene_names();
+// Writes scene `name` into <assets_root>/<name>/; pxf::Error for an unknown name or a failed write.
+void write_scene(const std::string& name, const std::string& assets_root);
+
+// <dir>/environment.exr, a scene's sky: RGB half floats, clamped to [0, 60000] (half floats
+// overflow to infinity above 65504; no sky needs more).
+void write_environment(const std::string& dir, Image rgb);
 
 }  // namespace pxf::scenegen

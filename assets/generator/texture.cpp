@@ -6,21 +6,21 @@
 namespace pxf::scenegen {
 namespace {
 
-uint8_t toByte(float v) { return uint8_t(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f)); }
+uint8_t to_byte(float v) { return uint8_t(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f)); }
 
-float linearToSrgb(float c) {
+float linear_to_srgb(float c) {
   c = std::clamp(c, 0.0f, 1.0f);
   return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
 }
 
 float smootherstep(float t) { return t * t * t * (t * (t * 6.0f - 15.0f) + 10.0f); }
 
-int positiveMod(int a, int m) { return ((a % m) + m) % m; }
+int positive_mod(int a, int m) { return ((a % m) + m) % m; }
 
 }  // namespace
 
-const float* FloatImage::wrapped(int x, int y) const {
-  return at(positiveMod(x, width), positiveMod(y, height));
+float wrapped(const Image& image, int x, int y) {
+  return image.at(positive_mod(x, image.width), positive_mod(y, image.height), 0);
 }
 
 float hash01(uint32_t x, uint32_t y, uint32_t seed) {
@@ -35,9 +35,9 @@ float hash01(uint32_t x, uint32_t y, uint32_t seed) {
   return float(h >> 8) * (1.0f / 16777216.0f);
 }
 
-float tileableNoise(float u, float v, int period, uint32_t seed) {
+float tileable_noise(float u, float v, int period, uint32_t seed) {
   const float fu = std::floor(u), fv = std::floor(v);
-  const int x0 = positiveMod(int(fu), period), y0 = positiveMod(int(fv), period);
+  const int x0 = positive_mod(int(fu), period), y0 = positive_mod(int(fv), period);
   const int x1 = (x0 + 1) % period, y1 = (y0 + 1) % period;
   const float tx = smootherstep(u - fu), ty = smootherstep(v - fv);
   const float a = hash01(x0, y0, seed), b = hash01(x1, y0, seed);
@@ -45,11 +45,11 @@ float tileableNoise(float u, float v, int period, uint32_t seed) {
   return glm::mix(glm::mix(a, b, tx), glm::mix(c, d, tx), ty);
 }
 
-float tileableFbm(float x, float y, int basePeriod, int octaves, float gain, uint32_t seed) {
+float tileable_fbm(float x, float y, int base_period, int octaves, float gain, uint32_t seed) {
   float sum = 0.0f, amplitude = 1.0f, norm = 0.0f;
-  int period = basePeriod;
+  int period = base_period;
   for (int o = 0; o < octaves; ++o) {
-    sum += amplitude * tileableNoise(x * period, y * period, period, seed + uint32_t(o) * 101u);
+    sum += amplitude * tileable_noise(x * period, y * period, period, seed + uint32_t(o) * 101u);
     norm += amplitude;
     amplitude *= gain;
     period *= 2;
@@ -57,56 +57,55 @@ float tileableFbm(float x, float y, int basePeriod, int octaves, float gain, uin
   return sum / norm;
 }
 
-FloatImage makeField(int size, const std::function<float(float, float)>& f) {
-  FloatImage image(size, size, 1);
+Image make_field(int size, const std::function<float(float, float)>& f) {
+  Image image = Image::gray(size, size);
   for (int y = 0; y < size; ++y) {
-    for (int x = 0; x < size; ++x) image.at(x, y)[0] = f((x + 0.5f) / size, (y + 0.5f) / size);
+    for (int x = 0; x < size; ++x) image.at(x, y, 0) = f((x + 0.5f) / size, (y + 0.5f) / size);
   }
   return image;
 }
 
-FloatImage normalMapFromHeight(const FloatImage& height, float strength) {
-  FloatImage normals(height.width, height.height, 3);
+Image normal_map_from_height(const Image& height, float strength) {
+  Image normals = Image::rgb(height.width, height.height);
   // Central differences span two texels; slopes are per texture width.
   const float scale = strength * float(height.width) * 0.5f;
   for (int y = 0; y < height.height; ++y) {
     for (int x = 0; x < height.width; ++x) {
-      const float dx = height.wrapped(x + 1, y)[0] - height.wrapped(x - 1, y)[0];
+      const float dx = wrapped(height, x + 1, y) - wrapped(height, x - 1, y);
       // Image rows go down; +Y of the normal map points up the image.
-      const float dUp = height.wrapped(x, y - 1)[0] - height.wrapped(x, y + 1)[0];
-      glm::vec3 n = glm::normalize(glm::vec3(-dx * scale, -dUp * scale, 1.0f));
-      float* out = normals.at(x, y);
-      out[0] = n.x, out[1] = n.y, out[2] = n.z;
+      const float d_up = wrapped(height, x, y - 1) - wrapped(height, x, y + 1);
+      glm::vec3 n = glm::normalize(glm::vec3(-dx * scale, -d_up * scale, 1.0f));
+      normals.at(x, y, 0) = n.x, normals.at(x, y, 1) = n.y, normals.at(x, y, 2) = n.z;
     }
   }
   return normals;
 }
 
-ByteImage encodeSrgb(const FloatImage& linear) {
-  ByteImage out{linear.width, linear.height, linear.channels, {}};
-  out.data.resize(linear.data.size());
-  for (size_t i = 0; i < linear.data.size(); ++i) {
-    const bool isAlpha = linear.channels == 4 && i % 4 == 3;
-    out.data[i] = toByte(isAlpha ? linear.data[i] : linearToSrgb(linear.data[i]));
+ByteImage encode_srgb(const Image& linear) {
+  ByteImage out{linear.width, linear.height, linear.num_channels(), {}};
+  out.data.resize(linear.pixels.size());
+  for (size_t i = 0; i < linear.pixels.size(); ++i) {
+    const bool is_alpha = linear.num_channels() == 4 && i % 4 == 3;
+    out.data[i] = to_byte(is_alpha ? linear.pixels[i] : linear_to_srgb(linear.pixels[i]));
   }
   return out;
 }
 
-ByteImage encodeLinear(const FloatImage& data) {
-  ByteImage out{data.width, data.height, data.channels, {}};
-  out.data.resize(data.data.size());
-  for (size_t i = 0; i < data.data.size(); ++i) out.data[i] = toByte(data.data[i]);
+ByteImage encode_linear(const Image& data) {
+  ByteImage out{data.width, data.height, data.num_channels(), {}};
+  out.data.resize(data.pixels.size());
+  for (size_t i = 0; i < data.pixels.size(); ++i) out.data[i] = to_byte(data.pixels[i]);
   return out;
 }
 
-ByteImage encodeNormalMap(const FloatImage& normals) {
+ByteImage encode_normal_map(const Image& normals) {
   ByteImage out{normals.width, normals.height, 3, {}};
-  out.data.resize(normals.data.size());
-  for (size_t i = 0; i < normals.data.size(); ++i) out.data[i] = toByte(normals.data[i] * 0.5f + 0.5f);
+  out.data.resize(normals.pixels.size());
+  for (size_t i = 0; i < normals.pixels.size(); ++i) out.data[i] = to_byte(normals.pixels[i] * 0.5f + 0.5f);
   return out;
 }
 
-ByteImage packMetallicRoughness(const FloatImage& roughness, float metallic, const FloatImage* specular) {
+ByteImage pack_metallic_roughness(const Image& roughness, float metallic, const Image* specular) {
   const int channels = specular ? 4 : 3;
   ByteImage out{roughness.width, roughness.height, channels, {}};
   out.data.resize(size_t(roughness.width) * roughness.height * channels);
@@ -114,9 +113,9 @@ ByteImage packMetallicRoughness(const FloatImage& roughness, float metallic, con
     for (int x = 0; x < roughness.width; ++x) {
       uint8_t* texel = &out.data[(size_t(y) * roughness.width + x) * channels];
       texel[0] = 255;
-      texel[1] = toByte(roughness.at(x, y)[0]);
-      texel[2] = toByte(metallic);
-      if (specular) texel[3] = toByte(specular->at(x, y)[0]);
+      texel[1] = to_byte(roughness.at(x, y, 0));
+      texel[2] = to_byte(metallic);
+      if (specular) texel[3] = to_byte(specular->at(x, y, 0));
     }
   }
   return out;

@@ -6,7 +6,6 @@
 // scenes").
 #include <glm/gtc/constants.hpp>
 
-#include "../exr_writer.h"
 #include "../gltf_builder.h"
 #include "../procedural.h"
 #include "../scenes.h"
@@ -15,7 +14,7 @@ namespace pxf::scenegen {
 namespace {
 
 // A (2, 3) torus knot of overall radius about 0.75 m in the XY plane, centered at `center`.
-glm::vec3 torusKnot(float t, const glm::vec3& center) {
+glm::vec3 torus_knot(float t, const glm::vec3& center) {
   constexpr float p = 2.0f, q = 3.0f, radius = 0.5f;
   const float u = t * p * glm::two_pi<float>();
   const float cs = std::cos(q / p * u);
@@ -23,23 +22,23 @@ glm::vec3 torusKnot(float t, const glm::vec3& center) {
                                      std::sin(q / p * u) * 0.5f);
 }
 
-MeshData makeRidgedKnot(const glm::vec3& center) {
+MeshData make_ridged_knot(const glm::vec3& center) {
   // Twisted-rope ridges: three helical ridges winding 48 times along the knot.
   auto ridges = [](float t, float phi) {
     const float s = std::sin(3.0f * phi + 48.0f * glm::two_pi<float>() * t);
     return 0.012f * s * s * s;
   };
-  return makeSweptTube([&](float t) { return torusKnot(t, center); }, 0.15f, 384, 40, {24.0f, 3.0f}, ridges);
+  return make_swept_tube([&](float t) { return torus_knot(t, center); }, 0.15f, 384, 40, {24.0f, 3.0f}, ridges);
 }
 
 struct Softbox {
   glm::vec3 direction;   // center of the box as seen from the origin
-  glm::vec2 halfSize;    // half extents, tangent of the angle
+  glm::vec2 half_size;    // half extents, tangent of the angle
   glm::vec3 radiance;
 };
 
 // A photo studio: dark gradient backdrop, dim floor, and bright rectangular light sources.
-glm::vec3 studioRadiance(const glm::vec3& d) {
+glm::vec3 studio_radiance(const glm::vec3& d) {
   static const Softbox boxes[] = {
       {glm::normalize(glm::vec3(-1.0f, 0.8f, 1.0f)), {0.45f, 0.32f}, {60.0f, 55.0f, 48.0f}},   // key, front left
       {glm::normalize(glm::vec3(1.2f, 0.4f, 0.8f)), {0.3f, 0.4f}, {9.0f, 10.0f, 12.0f}},       // fill, right
@@ -56,24 +55,23 @@ glm::vec3 studioRadiance(const glm::vec3& d) {
     const glm::vec3 up = glm::cross(right, box.direction);
     const glm::vec2 local(std::abs(glm::dot(d, right)) / facing, std::abs(glm::dot(d, up)) / facing);
     // Soft-edged rectangle with a slightly brighter center, like a diffusion panel.
-    const glm::vec2 edge = glm::clamp((box.halfSize - local) / (0.04f * box.halfSize + 0.005f), 0.0f, 1.0f);
-    const float falloff = 1.0f - 0.3f * glm::length(local / box.halfSize) * 0.5f;
+    const glm::vec2 edge = glm::clamp((box.half_size - local) / (0.04f * box.half_size + 0.005f), 0.0f, 1.0f);
+    const float falloff = 1.0f - 0.3f * glm::length(local / box.half_size) * 0.5f;
     radiance += box.radiance * edge.x * edge.y * falloff;
   }
   return radiance;
 }
 
-FloatImage paintStudio(int width, int height) {
-  FloatImage studio(width, height, 3);
+Image paint_studio(int width, int height) {
+  Image studio = Image::rgb(width, height);
   for (int j = 0; j < height; ++j) {
     const float theta = (j + 0.5f) / height * glm::pi<float>();
     for (int i = 0; i < width; ++i) {
       // Inverse of u = 0.5 + atan2(d.x, -d.z) / (2 pi), v = acos(d.y) / pi.
       const float phi = ((i + 0.5f) / width - 0.5f) * glm::two_pi<float>();
       const glm::vec3 d(std::sin(theta) * std::sin(phi), std::cos(theta), -std::sin(theta) * std::cos(phi));
-      const glm::vec3 radiance = studioRadiance(d);
-      float* texel = studio.at(i, j);
-      texel[0] = radiance.r, texel[1] = radiance.g, texel[2] = radiance.b;
+      const glm::vec3 radiance = studio_radiance(d);
+      studio.at(i, j, 0) = radiance.r, studio.at(i, j, 1) = radiance.g, studio.at(i, j, 2) = radiance.b;
     }
   }
   return studio;
@@ -81,22 +79,22 @@ FloatImage paintStudio(int width, int height) {
 
 }  // namespace
 
-bool writeEnvmap(const std::string& dir, std::string* error) {
+void write_envmap(const std::string& dir) {
   SceneBuilder scene("envmap");
-  const int scales = scene.addMaterial(addTextureSet(scene, paintScales(512, 8, 71), "scales", 0.015f));
-  MaterialDesc mirror = plainMaterial("mirror", glm::vec3(0.95f), 0.0f);
+  const int scales = scene.add_material(add_texture_set(scene, paint_scales(512, 8, 71), "scales", 0.015f));
+  MaterialDesc mirror = plain_material("mirror", glm::vec3(0.95f), 0.0f);
   mirror.metallic = 1.0f;
-  const int mirrorMaterial = scene.addMaterial(mirror);
-  const int ground = scene.addMaterial(plainMaterial("studio_floor", {0.3f, 0.3f, 0.3f}, 0.85f));
+  const int mirror_material = scene.add_material(mirror);
+  const int ground = scene.add_material(plain_material("studio_floor", {0.3f, 0.3f, 0.3f}, 0.85f));
 
-  scene.addObject("ground", makeDisc({0, 0, 0}, 4.0f, 128), ground);
-  scene.addObject("scaled_knot", makeRidgedKnot({-0.55f, 0.93f, 0.0f}), scales);
-  scene.addObject("mirror_sphere", makeSphere({0.95f, 0.5f, 0.35f}, 0.5f, 96, 48), mirrorMaterial);
+  scene.add_object("ground", make_disc({0, 0, 0}, 4.0f, 128), ground);
+  scene.add_object("scaled_knot", make_ridged_knot({-0.55f, 0.93f, 0.0f}), scales);
+  scene.add_object("mirror_sphere", make_sphere({0.95f, 0.5f, 0.35f}, 0.5f, 96, 48), mirror_material);
 
-  scene.setCamera({0.2f, 1.35f, 3.9f}, {0.15f, 0.7f, 0.0f}, 0.7f, 16.0f / 9.0f);
-  scene.setRenderDefaults(false, 960, 540);
-  if (!scene.write(dir, error)) return false;
-  return writeExrRgb(dir + "/environment.exr", paintStudio(2048, 1024), error);
+  scene.set_camera({0.2f, 1.35f, 3.9f}, {0.15f, 0.7f, 0.0f}, 0.7f, 16.0f / 9.0f);
+  scene.set_render_defaults(false, 960, 540);
+  scene.write(dir);
+  write_environment(dir, paint_studio(2048, 1024));
 }
 
 }  // namespace pxf::scenegen
