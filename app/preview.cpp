@@ -375,12 +375,13 @@ std::vector<Layer> Preview::buffers() {
   upload();
   std::vector<Layer> layers;
   layers.push_back({"final", blend_.final_image()});
-  // The inputs as the renderer holds them: the textures hold the same floats.
-  Image hv = renderer_->hv_image();
+  // The inputs as the renderer holds them (the textures hold the same floats), not read back.
   layers.push_back({"lv", renderer_->lv_image()});
-  layers.push_back({"hv", hv});
-  layers.push_back({"hv_filtered", have_filtered_ ? filtered_image() : std::move(hv)});
-  layers.push_back({"var_u", renderer_->variance_image()});
+  layers.push_back({"hv", renderer_->hv_image()});
+  layers.push_back({"hv_filtered", have_filtered_ ? filtered_image() : renderer_->hv_image()});
+  Image var_u = Image::gray(width_, height_);  // Var[L_u] as uploaded, 0 where unknown
+  for (size_t i = 0; i < var_u.pixels.size(); ++i) var_u.pixels[i] = std::max(0.0f, hv_packed_[4 * i + 3]);
+  layers.push_back({"var_u", std::move(var_u)});
   layers.push_back({"var_f", have_filtered_ ? filtered_variance_image() : Image::gray(width_, height_)});
   layers.push_back({"blend", blend_.s_image()});
   layers.push_back({"case", blend_.case_image()});

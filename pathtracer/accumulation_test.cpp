@@ -62,6 +62,34 @@ TEST(Accumulation, VarianceOfMeanNeedsTwoSamples) {
   EXPECT_EQ(acc.variance_of_mean(1), -1.0f);
 }
 
+// The packed HV buffer the preview uploads: rgb hv_mean and a variance_of_mean, bit for bit the
+// per-pixel query (-1 where n < 2), with and without replicates (whose gain pools the 3x3 neighbourhood).
+TEST(Accumulation, PackedHvAndVarianceMatchThePerPixelValues) {
+  for (int replicates : {1, 4}) {
+    Accumulation acc;
+    resize_accumulation(acc, 5, 3, replicates);
+    Rng rng(7, 0, 0);
+    for (size_t p = 0; p < acc.samples.size(); ++p) {
+      const int n = static_cast<int>(p % 4);  // 0, 1, 2, 3 samples: unknown, unknown, known, known
+      for (int i = 0; i < n; ++i)
+        accumulate_sample(acc, p, glm::vec3(rng.next_float()), glm::vec3(rng.next_float(), 0.5f, rng.next_float()), i);
+    }
+    std::vector<float> packed(acc.samples.size() * 4, 123.0f);
+    acc.hv_and_variance_of_mean(packed.data());
+    const std::vector<float> image = acc.variance_of_mean_image();
+    for (size_t p = 0; p < acc.samples.size(); ++p) {
+      for (int c = 0; c < 3; ++c) EXPECT_EQ(packed[4 * p + c], acc.hv_mean[p][c]) << replicates << " " << p;
+      EXPECT_EQ(packed[4 * p + 3], acc.variance_of_mean(p)) << replicates << " " << p;
+      EXPECT_EQ(packed[4 * p + 3], image[p]) << replicates << " " << p;
+      if (acc.samples[p] < 2) {
+        EXPECT_EQ(packed[4 * p + 3], -1.0f) << p;
+      } else {
+        EXPECT_GE(packed[4 * p + 3], 0.0f) << p;
+      }
+    }
+  }
+}
+
 TEST(Accumulation, CancelledFrameResetsTheSamplesAndTheNextFrameCounts) {
   // The explorer cancels the frame in flight when the camera moves (cancel_frame from the UI
   // thread). A cancelled frame is incomplete: add_frame returns false and the samples are reset.

@@ -29,7 +29,7 @@ tinygltf::Value number(float v) { return tinygltf::Value(tidy(v)); }
 
 // PNGs are written by stb (deterministic zlib stream); the model only records the file name.
 bool write_png_file(const std::string* base_path, const std::string* file_name, const tinygltf::Image* image,
-                   bool /*embed*/, std::string* out_uri, void* /*user*/) {
+                    bool /*embed*/, std::string* out_uri, void* /*user*/) {
   const std::string path = (std::filesystem::path(*base_path) / *file_name).string();
   *out_uri = *file_name;
   return stbi_write_png(path.c_str(), image->width, image->height, image->component,
@@ -151,8 +151,8 @@ int SceneBuilder::add_material(const MaterialDesc& d) {
   return int(model_.materials.size()) - 1;
 }
 
-int SceneBuilder::add_accessor(const void* bytes, size_t byte_count, size_t count, int componentType,
-                              int type, int target) {
+int SceneBuilder::add_accessor(const void* bytes, size_t byte_count, size_t count, int component_type,
+                               int type, int target) {
   auto& buffer = model_.buffers[0].data;
   while (buffer.size() % 4 != 0) buffer.push_back(0);  // every accessor starts 4-byte aligned
   tinygltf::BufferView view;
@@ -165,7 +165,7 @@ int SceneBuilder::add_accessor(const void* bytes, size_t byte_count, size_t coun
   model_.bufferViews.push_back(view);
   tinygltf::Accessor accessor;
   accessor.bufferView = int(model_.bufferViews.size()) - 1;
-  accessor.componentType = componentType;
+  accessor.componentType = component_type;
   accessor.type = type;
   accessor.count = count;
   model_.accessors.push_back(accessor);
@@ -178,7 +178,7 @@ int SceneBuilder::add_mesh(const std::string& name, const MeshData& data, int ma
   primitive.material = material;
   const size_t n = data.positions.size();
   int position = add_accessor(data.positions.data(), n * sizeof(glm::vec3), n, TINYGLTF_COMPONENT_TYPE_FLOAT,
-                             TINYGLTF_TYPE_VEC3, TINYGLTF_TARGET_ARRAY_BUFFER);
+                              TINYGLTF_TYPE_VEC3, TINYGLTF_TARGET_ARRAY_BUFFER);
   glm::vec3 lo(INFINITY), hi(-INFINITY);
   for (const glm::vec3& p : data.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
   // min/max must bound the stored floats exactly, so they are not rounded.
@@ -186,20 +186,20 @@ int SceneBuilder::add_mesh(const std::string& name, const MeshData& data, int ma
   model_.accessors[position].maxValues = {hi.x, hi.y, hi.z};
   primitive.attributes["POSITION"] = position;
   primitive.attributes["NORMAL"] = add_accessor(data.normals.data(), n * sizeof(glm::vec3), n,
-                                               TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3,
-                                               TINYGLTF_TARGET_ARRAY_BUFFER);
+                                                TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3,
+                                                TINYGLTF_TARGET_ARRAY_BUFFER);
   primitive.attributes["TEXCOORD_0"] = add_accessor(data.uvs.data(), n * sizeof(glm::vec2), n,
-                                                   TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC2,
-                                                   TINYGLTF_TARGET_ARRAY_BUFFER);
+                                                    TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC2,
+                                                    TINYGLTF_TARGET_ARRAY_BUFFER);
   if (n <= 65535) {
     std::vector<uint16_t> short_indices(data.indices.begin(), data.indices.end());
     primitive.indices = add_accessor(short_indices.data(), short_indices.size() * 2, short_indices.size(),
-                                    TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, TINYGLTF_TYPE_SCALAR,
-                                    TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+                                     TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, TINYGLTF_TYPE_SCALAR,
+                                     TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
   } else {
     primitive.indices = add_accessor(data.indices.data(), data.indices.size() * 4, data.indices.size(),
-                                    TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR,
-                                    TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+                                     TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR,
+                                     TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
   }
   tinygltf::Mesh mesh;
   mesh.name = name;
@@ -210,7 +210,7 @@ int SceneBuilder::add_mesh(const std::string& name, const MeshData& data, int ma
 }
 
 int SceneBuilder::add_node(const std::string& name, int mesh, const glm::vec3& t, const glm::quat& r,
-                          const glm::vec3& s) {
+                           const glm::vec3& s) {
   tinygltf::Node node;
   node.name = name;
   node.mesh = mesh;
@@ -249,7 +249,7 @@ void SceneBuilder::set_camera(const glm::vec3& eye, const glm::vec3& target, flo
 }
 
 void SceneBuilder::add_sun(const std::string& name, const glm::vec3& direction, const glm::vec3& color,
-                          float intensity) {
+                           float intensity) {
   tinygltf::Light light;
   light.name = name;
   light.type = "directional";

@@ -54,7 +54,7 @@ class SceneBuilder {
   int add_mesh(const std::string& name, const MeshData& data, int material);
   // A root node instancing `mesh` (rotation as a quaternion).
   int add_node(const std::string& name, int mesh, const glm::vec3& translation = glm::vec3(0.0f),
-              const glm::quat& rotation = glm::quat(1, 0, 0, 0), const glm::vec3& scale = glm::vec3(1.0f));
+               const glm::quat& rotation = glm::quat(1, 0, 0, 0), const glm::vec3& scale = glm::vec3(1.0f));
   // Convenience: add_mesh + add_node at the origin.
   int add_object(const std::string& name, const MeshData& data, int material);
 
@@ -71,8 +71,8 @@ class SceneBuilder {
   size_t triangle_count() const { return triangles_; }
 
  private:
-  int add_accessor(const void* bytes, size_t byte_count, size_t count, int componentType, int type,
-                  int target);
+  int add_accessor(const void* bytes, size_t byte_count, size_t count, int component_type, int type,
+                   int target);
   tinygltf::TextureInfo texture_info(int texture, const MaterialDesc& desc);
   void use_extension(const std::string& extension);
 

@@ -67,7 +67,7 @@ void MeshData::append(const MeshData& other, const glm::mat4& transform) {
 }
 
 MeshData make_quad(const glm::vec3& corner, const glm::vec3& edge_u, const glm::vec3& edge_v,
-                  glm::vec2 uv_scale) {
+                   glm::vec2 uv_scale) {
   MeshData mesh;
   const glm::vec3 n = glm::normalize(glm::cross(edge_u, edge_v));
   push_vertex(mesh, corner, n, {0.0f, uv_scale.y});
@@ -100,13 +100,13 @@ MeshData make_sphere(const glm::vec3& center, float radius, int segments, int ri
 }
 
 MeshData make_cylinder(const glm::vec3& base, float radius, float height, int segments, bool cap_top,
-                      bool cap_bottom) {
+                       bool cap_bottom) {
   const float circumference = kTwoPi * radius;
   MeshData mesh = make_grid(segments, 1, [&](MeshData& m, float u, float v) {
     const float phi = u * kTwoPi;
     glm::vec3 n(std::cos(phi), 0.0f, -std::sin(phi));
     push_vertex(m, base + radius * n + glm::vec3(0, (1.0f - v) * height, 0), n,
-               {u * circumference, v * height});
+                {u * circumference, v * height});
   });
   if (cap_top) mesh.append(make_disc(base + glm::vec3(0, height, 0), radius, segments));
   if (cap_bottom) {
@@ -137,14 +137,14 @@ MeshData make_lathe(const std::vector<glm::vec2>& profile, int segments, float u
     const float r = profile[j].x;
     glm::vec3 normal = glm::dot(n, n) > 0.0f ? n : glm::vec3(0, tangent.y >= 0 ? -1 : 1, 0);
     push_vertex(m, radial * r + glm::vec3(0, profile[j].y, 0), normal,
-               {u * kTwoPi * 0.1f * uv_per_meter, (arc_length[rows] - arc_length[j]) * uv_per_meter});
+                {u * kTwoPi * 0.1f * uv_per_meter, (arc_length[rows] - arc_length[j]) * uv_per_meter});
   });
   return mesh;
 }
 
 MeshData make_swept_tube(const std::function<glm::vec3(float)>& center, float radius, int length_segments,
-                       int radial_segments, glm::vec2 uv_repeat,
-                       const std::function<float(float, float)>& radial_offset) {
+                         int radial_segments, glm::vec2 uv_repeat,
+                         const std::function<float(float, float)>& radial_offset) {
   const int cols = length_segments, rows = radial_segments;
   // Positions on the periodic grid (cols x rows), each with its undisplaced outward direction.
   std::vector<glm::vec3> grid(size_t(cols) * rows), outward(grid.size());
@@ -229,7 +229,7 @@ MeshData make_arch_wall(float half_span, float top_y, float depth, int segments,
   });
   wall.append(intrados);
   wall.append(make_quad({-half_span, top_y, 0.5f * depth}, {2.0f * half_span, 0, 0}, {0, 0, -depth},
-                       s * glm::vec2(2.0f * half_span, depth)));
+                        s * glm::vec2(2.0f * half_span, depth)));
   return wall;
 }
 

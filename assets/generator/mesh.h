@@ -22,7 +22,7 @@ struct MeshData {
 // UVs run 0..uv_scale.x along edge_u and 0..uv_scale.y along edge_v (v = 0 at the corner + edge_v side
 // so that textures appear upright when edge_v points up).
 MeshData make_quad(const glm::vec3& corner, const glm::vec3& edge_u, const glm::vec3& edge_v,
-                  glm::vec2 uv_scale = glm::vec2(1.0f));
+                   glm::vec2 uv_scale = glm::vec2(1.0f));
 
 // An axis-aligned box with outward faces; UVs in meters times uv_per_meter (world-scaled textures).
 MeshData make_box(const glm::vec3& min_corner, const glm::vec3& max_corner, float uv_per_meter = 1.0f);
@@ -32,7 +32,7 @@ MeshData make_sphere(const glm::vec3& center, float radius, int segments, int ri
 
 // A capped cylinder along +Y from y0 to y1 (smooth side normals, flat caps).
 MeshData make_cylinder(const glm::vec3& base_center, float radius, float height, int segments,
-                      bool cap_top = true, bool cap_bottom = true);
+                       bool cap_top = true, bool cap_bottom = true);
 
 // A surface of revolution around +Y through the profile points (radius, y), bottom to top.
 // Normals come from the profile's tangents, so lathed bowls and bottles look smooth; a point
@@ -43,8 +43,8 @@ MeshData make_lathe(const std::vector<glm::vec2>& profile, int segments, float u
 // `radial_offset(t, phi)` displaces the surface along its normal (0 for a plain tube);
 // normals are recomputed from the displaced grid so that bumps shade correctly.
 MeshData make_swept_tube(const std::function<glm::vec3(float)>& center, float radius, int length_segments,
-                       int radial_segments, glm::vec2 uv_repeat,
-                       const std::function<float(float, float)>& radial_offset = nullptr);
+                         int radial_segments, glm::vec2 uv_repeat,
+                         const std::function<float(float, float)>& radial_offset = nullptr);
 
 // A flat disc in the XZ plane facing +Y.
 MeshData make_disc(const glm::vec3& center, float radius, int segments, float uv_per_meter = 1.0f);

@@ -204,7 +204,7 @@ TextureSet paint_scales(int size, int rows, uint32_t seed) {
 }
 
 MaterialDesc add_texture_set(SceneBuilder& scene, const TextureSet& set, const std::string& stem,
-                           float normal_strength, glm::vec2 uv_scale, float metallic) {
+                             float normal_strength, glm::vec2 uv_scale, float metallic) {
   MaterialDesc desc;
   desc.name = stem;
   desc.uv_scale = uv_scale;
@@ -212,7 +212,7 @@ MaterialDesc add_texture_set(SceneBuilder& scene, const TextureSet& set, const s
   desc.roughness = 1.0f;
   desc.base_color_texture = scene.add_texture(encode_srgb(set.albedo), stem + "_basecolor");
   desc.normal_texture = scene.add_texture(encode_normal_map(normal_map_from_height(set.height, normal_strength)),
-                                        stem + "_normal");
+                                          stem + "_normal");
   const bool has_specular = !set.specular.empty();
   desc.metallic_roughness_texture = scene.add_texture(
       pack_metallic_roughness(set.roughness, metallic, has_specular ? &set.specular : nullptr), stem + "_mr");

@@ -54,6 +54,6 @@ TextureSet paint_grille(int size, int bars);
 // Adds the set's PNGs (<stem>_basecolor, _normal, _mr) and returns a material using them;
 // the specular map, if any, goes into the A channel of the _mr texture.
 MaterialDesc add_texture_set(SceneBuilder& scene, const TextureSet& set, const std::string& stem,
-                           float normal_strength, glm::vec2 uv_scale = glm::vec2(1.0f), float metallic = 0.0f);
+                             float normal_strength, glm::vec2 uv_scale = glm::vec2(1.0f), float metallic = 0.0f);
 
 }  // namespace pxf::scenegen

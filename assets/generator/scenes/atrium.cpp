@@ -129,7 +129,7 @@ void write_atrium(const std::string& dir) {
   const int grille_material = scene.add_material(grille);
 
   scene.add_object("floor", make_quad({-kHalfLength, 0, kBackWallZ}, {2 * kHalfLength, 0, 0},
-                                    {0, 0, -2 * kBackWallZ}, {2 * kHalfLength, 2 * kBackWallZ}),
+                                      {0, 0, -2 * kBackWallZ}, {2 * kHalfLength, 2 * kBackWallZ}),
                   floor);
   scene.add_object("walls", make_walls(), brick);
   scene.add_object("slabs", make_slabs(), stone);

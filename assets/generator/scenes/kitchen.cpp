@@ -48,7 +48,7 @@ Materials add_materials(SceneBuilder& scene) {
   floor_tiles.seed = 5;
   m.floor = scene.add_material(add_texture_set(scene, paint_tiles(512, floor_tiles), "floor_tiles", 0.02f, glm::vec2(1.0f / 1.2f)));
   m.wood = scene.add_material(add_texture_set(scene, paint_wood(512, 4, {0.62f, 0.42f, 0.24f}, {0.36f, 0.2f, 0.1f}, 41),
-                                           "oak", 0.004f));
+                                              "oak", 0.004f));
   m.counter = scene.add_material(add_texture_set(scene, paint_stone(512, {0.16f, 0.155f, 0.17f}, 51), "granite", 0.004f));
   BrickStyle subway;  // glazed white 15 cm x 7.5 cm tiles, 0.6 m per texture
   subway.rows = 8;
@@ -94,7 +94,7 @@ void add_room(SceneBuilder& scene, const Materials& m) {
   // Backsplash between counter and wall cabinets, 1 cm proud of the back wall.
   const float splash_height = kWallCabinetBottom - kCounterTop;
   scene.add_object("backsplash", make_quad({-kRoomX, kCounterTop, -kRoomZ + 0.01f}, w * x, splash_height * y, {w, splash_height}),
-                  m.backsplash);
+                   m.backsplash);
   // The soffit: a frame hanging 0.3 m from the ceiling along all four walls.
   MeshData soffit;
   const float b = kSoffitBottom, s = kSoffitWidth;
@@ -113,7 +113,7 @@ void add_room(SceneBuilder& scene, const Materials& m) {
 // Doors of width `doorWidth` tiling [x0, x1], 2 cm proud of the carcass front at z = front, with
 // 3 mm gaps; each door gets a steel bar handle placed at `handle_y`.
 void add_doors(MeshData& doors, MeshData& handles, float x0, float x1, float y0, float y1, float front,
-              int count, float handle_y) {
+               int count, float handle_y) {
   const float width = (x1 - x0) / float(count);
   for (int i = 0; i < count; ++i) {
     const float a = x0 + width * float(i) + 0.003f, b = a + width - 0.006f;
@@ -137,7 +137,7 @@ void add_cabinets(SceneBuilder& scene, const Materials& m) {
     carcass.append(make_box({x0, kWallCabinetBottom, back}, {x1, kWallCabinetTop, front}));
     carcass.append(make_box({x0, kWallCabinetBottom - 0.04f, front - 0.02f}, {x1, kWallCabinetBottom, front}));
     add_doors(doors, handles, x0, x1, kWallCabinetBottom - 0.04f, kWallCabinetTop, front, door_count,
-             kWallCabinetBottom + 0.06f);
+              kWallCabinetBottom + 0.06f);
   }
   // Island in the middle of the room.
   carcass.append(make_box({-0.9f, 0.0f, 0.1f}, {0.9f, kCounterTop - 0.04f, 0.8f}));
