@@ -45,8 +45,9 @@ struct FilterOutput {
   // kernel, 1 where skipped), for the blend's covariance term; empty for the other variants.
   Image centre_weight;
 };
+// t: the blend threshold, for the case-2 skip.
 FilterOutput cpu_filter(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
-                        const Image& depth, const FilterParams& params);
+                        const Image& depth, const FilterParams& params, float t);
 
 // The shaders' clean(): non-finite -> 0, magnitude clamped to kMaxInput; clean_var(): negative or
 // non-finite variance -> kVarUnknown. For the variants' references in other files.
@@ -56,11 +57,11 @@ float clean_var(float v);
 // variance) with the unfiltered background; a zero variance is not trusted. Writes the skip
 // (L_f = L_u, Var = kVarSkipped) into `out` and returns true where the pixel is skipped.
 bool skip_as_case2(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
-                   const Image& depth, const FilterParams& p, int x, int y, FilterOutput& out);
+                   const Image& depth, const FilterParams& p, float t, int x, int y, FilterOutput& out);
 
 // The filter's case-2 skip decision alone (what skip_as_case2 tests).
 bool case2_skip_decision(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
-                         const Image& depth, const FilterParams& p, int x, int y);
+                         const Image& depth, const FilterParams& p, float t, int x, int y);
 
 // Albedo demodulation (gl/demodulation.h). The factor: grey Y(albedo) where that is at least
 // kAlbedoEpsilon, else (1, 1, 1) (that pixel is not demodulated).
@@ -72,7 +73,7 @@ struct DemodulatedInputs {
 };
 // The filter's inputs under demodulation; albedo "R,G,B" (the mean first non-specular albedo).
 DemodulatedInputs cpu_demodulate(const Image& hv, const Image& var_u, const Image& lv, const Image& albedo,
-                                 const Image& range_color, const Image& depth, const FilterParams& params);
+                                 const Image& range_color, const Image& depth, const FilterParams& params, float t);
 // L_f = a L_f', Var[L_f] = Y(a)^2 Var[L_f'] (sentinels kept).
 FilterOutput cpu_remodulate(const FilterOutput& filtered, const Image& albedo);
 
@@ -82,7 +83,7 @@ struct BlendOutput {
   Image blend_case;  // "Y": BlendCase codes
 };
 // `filtered` empty = the filter never ran. range_color and depth both null: no variance pooling.
-BlendOutput cpu_blend(const Image& lv, const Image& hv, const Image& var_u, const FilterOutput* filtered,
+BlendOutput cpu_blend(const Image& lv, const Image& hv, const Image& var_u, const FilterOutput* filtered, float t,
                       const BlendParams& params, const Image* range_color, const Image* depth);
 
 double cpu_log_average(const Image& rgb, float delta);
