@@ -9,7 +9,7 @@
 
 #include "app/render_output.h"
 #include "gl/preview_params.h"
-#include "pathtracer/bench.h"
+#include "core/timing.h"
 
 namespace pxf {
 namespace {

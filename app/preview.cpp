@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 
-#include "pathtracer/bench.h"
+#include "core/timing.h"
 
 namespace pxf {
 

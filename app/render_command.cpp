@@ -10,9 +10,8 @@
 #include "app/options.h"
 #include "app/preview.h"
 #include "app/render_output.h"
-#include "pathtracer/bench.h"
+#include "core/timing.h"
 #include "gl/context.h"
-#include "pathtracer/bench.h"
 
 namespace pxf {
 

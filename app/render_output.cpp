@@ -1,5 +1,5 @@
 #include "app/render_output.h"
-#include "pathtracer/bench.h"
+#include "core/timing.h"
 
 #include <pthread.h>
 #include <signal.h>

@@ -6,7 +6,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "pathtracer/bench.h"
+#include "core/timing.h"
 
 namespace pxf {
 namespace {

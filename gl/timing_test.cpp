@@ -16,7 +16,7 @@
 #include "gl/range_pass.h"
 #include "gl/test_util.h"
 #include "gl/tonemap_pass.h"
-#include "pathtracer/bench.h"
+#include "core/timing.h"
 
 namespace pxf {
 namespace {
