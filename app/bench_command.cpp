@@ -494,6 +494,7 @@ int run_bench(const Args& args) {
                   "--variants instead tabulates every filter variant on one --variant-spp HV buffer: ms per\n"
                   "application, path-tracing frames, HV-only NRMSE against the reference's HV (layer hv of\n"
                   "--reference, e.g. buffers.exr of `pxf render --filter none`; default: rendered and cached).");
+  scene_options.stage_timing = GlTiming::Finish;  // exact per-stage figures
   add_scene_options(cli, scene_options, /*headless=*/true);
   add_preview_options(cli, preview_settings);
   cli.flag("--pathtracer", &pathtracer, "path tracer throughput only");
@@ -528,6 +529,7 @@ int run_bench(const Args& args) {
   cli.option("--out", &out, "DIR", "folder for CSV, plots and the cached reference (default bench-out)");
   if (!cli.parse(args)) return 0;
   if (print_scene_list_if_asked(scene_options)) return 0;
+  set_gl_timing(scene_options.stage_timing);
   const std::vector<int> budgets = parse_counts("--budgets", budgets_text);
   const std::vector<int> extra_taps = parse_counts("--subsampled-taps", extra_taps_text);
   if (stage_table) {

@@ -735,6 +735,7 @@ int run_explorer(ExploreOptions& options) {
   // The window size depends on the image size: known from --size, else a common default.
   const int width = options.scene.width > 0 ? options.scene.width : 512;
   const int height = options.scene.height > 0 ? options.scene.height : 512;
+  set_gl_timing(options.scene.stage_timing);
   auto context = create_gl_context(parse_gl_backend(options.scene.gl), window_options(options, width, height));
   if (!context->native_window())
     throw Error(std::string("explore needs a window; the '") + context->backend_name() +

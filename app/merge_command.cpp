@@ -55,6 +55,7 @@ int run_merge(const Args& args) {
   const std::string diff = merged.settings.difference(here);
   if (!diff.empty()) throw Error("the states were not rendered from this scene: " + diff);
 
+  set_gl_timing(scene_options.stage_timing);
   auto context = create_gl_context(parse_gl_backend(scene_options.gl));
   Preview preview(scene, preview_settings, scene_options.width, scene_options.height);
   preview.load_accumulation(merged.acc, merged.frames.front().begin, static_cast<int>(merged.frame_count()));

@@ -24,6 +24,10 @@ void add_scene_options(CommandLine& cli, SceneOptions& o, bool headless) {
     cli.choice("--gl", &o.gl, {"auto", "osmesa", "egl"}, "headless GL back end (auto: OSMesa, else EGL)");
   else
     cli.choice("--gl", &o.gl, {"auto", "window", "osmesa", "egl"}, "GL back end (auto: a window when a display exists)");
+  cli.choice("--stage-timing", &o.stage_timing, gl_timing_names(),
+             std::string("how the GL stages' ms are measured: finish = glFinish around each (exact, stalls),\n"
+                         "submit = without (on llvmpipe nearly the same figures); default ") +
+                 gl_timing_names()[static_cast<int>(o.stage_timing)]);
 }
 
 void add_preview_options(CommandLine& cli, PreviewSettings& s) {

@@ -4,6 +4,7 @@
 
 #include "app/cli.h"
 #include "app/preview.h"
+#include "gl/resources.h"
 #include "pathtracer/pathtracer.h"
 #include "pathtracer/scene.h"
 
@@ -16,6 +17,9 @@ struct SceneOptions {
   std::string default_light = "sky";  // default_light_names(): lights a scene that has no light
   int width = 0, height = 0;      // 0 = the scene's default, else 512x512
   std::string gl = "auto";
+  // How GL stages are timed (gl/resources.h): submit, no stall per stage, for rendering; pxf bench
+  // sets finish before binding the options. Applied by set_gl_timing when the command starts.
+  GlTiming stage_timing = GlTiming::Submit;
   int max_texture_size = LoadLimits::kDefaultMaxTextureSize;
   int max_triangles = static_cast<int>(LoadLimits::kDefaultMaxTriangles);
 };

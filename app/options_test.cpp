@@ -50,3 +50,20 @@ TEST(PreviewOptions, FilterNameTableIndexesFilterKind) {
     EXPECT_EQ(s.trace.sampler, static_cast<SamplerType>(i));
   }
 }
+
+TEST(SceneOptions, StageTimingIsBoundThroughItsNameTable) {
+  for (bool headless : {true, false}) {
+    SceneOptions o;
+    EXPECT_EQ(o.stage_timing, GlTiming::Submit);  // rendering: no stall per stage
+    CommandLine cli{"render", "[options]", "test"};
+    add_scene_options(cli, o, headless);
+    ASSERT_TRUE(cli.parse({"--stage-timing", "finish"}));
+    EXPECT_EQ(o.stage_timing, GlTiming::Finish);
+    CommandLine bad{"render", "[options]", "test"};
+    add_scene_options(bad, o, headless);
+    EXPECT_THROW(bad.parse({"--stage-timing", "query"}), UsageError);
+  }
+  ASSERT_EQ(gl_timing_names().size(), 2u);
+  EXPECT_EQ(gl_timing_names()[static_cast<int>(GlTiming::Finish)], "finish");
+  EXPECT_EQ(gl_timing_names()[static_cast<int>(GlTiming::Submit)], "submit");
+}

@@ -108,6 +108,7 @@ int run_render(const Args& args) {
   Scene scene = load_scene_for(scene_options, preview_settings, cli);
   const double load_ms = elapsed_ms(start);
   if (!reference.empty()) check_reference(reference, scene_options.width, scene_options.height);  // before tracing
+  set_gl_timing(scene_options.stage_timing);
   auto context = create_gl_context(parse_gl_backend(scene_options.gl));
   Preview preview(scene, preview_settings, scene_options.width, scene_options.height);
   const FrameRange frames = render_frame_range(checkpoint_options, spp);

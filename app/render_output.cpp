@@ -63,6 +63,7 @@ nlohmann::json stats_json(Preview& preview, const RenderReport& r) {
                    {"all_hv", s.trace.all_hv},
                    {"key", s.tonemap.key},
                    {"gl", r.gl_backend},
+                   {"stage_timing", gl_timing_names()[static_cast<int>(gl_timing())]},
                    {"gl_renderer", r.gl_renderer}};
   j["stage_ms_total"] = times_json(total);
   j["stage_ms_per_frame"] = {{"path_tracing", preview.samples() ? total.path_tracing / preview.samples() : 0.0}};
