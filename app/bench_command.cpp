@@ -1,5 +1,5 @@
-// pxf bench: run time against error (README "Measured", docs/timebudget.md). Not a test: it
-// prints figures and writes CSV and SVG plots into --out.
+// pxf bench: run time against error (README "Current figures", docs/measurements.md). Not a
+// test: it prints figures and writes CSV and SVG plots into --out.
 //   pxf bench                 per-stage times, filtering overhead, equal-time NRMSE, spp to match
 //   pxf bench --pathtracer    paths/s, rays/s, ms/frame and the raw Embree ray rate
 //   pxf bench --pathtracer --sampler-error | --variance-ratio   the samplers (app/sampler_bench.h)

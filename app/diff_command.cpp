@@ -1,6 +1,9 @@
 // pxf diff: image metrics between two images (docs/metrics.md), the same code the tests use:
 // HDR metrics, then display-space NRMSE and LDR-FLIP, each also with the emitters masked out.
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <optional>
 
 #include "app/cli.h"
@@ -47,6 +50,20 @@ ImageMetrics compare_against(const Image& test, const Image& reference, const st
   }
 }
 
+// DIR/test.png, DIR/reference.png (both tone-mapped like the display metrics) and DIR/error.png,
+// |test - reference| of the display values times 4: where the display error sits.
+void write_display_images(const std::string& dir, const Image& test, const Image& reference, float key) {
+  const DisplayImages display = tonemap_like_reference(test, reference, key);
+  Image error = display.test;
+  for (size_t i = 0; i < error.pixels.size(); ++i)
+    error.pixels[i] = std::min(1.0f, 4.0f * std::abs(display.test.pixels[i] - display.reference.pixels[i]));
+  std::filesystem::create_directories(dir);
+  write_png(dir + "/test.png", display.test);
+  write_png(dir + "/reference.png", display.reference);
+  write_png(dir + "/error.png", error);
+  std::printf("wrote %s/test.png, reference.png, error.png (4 x |display difference|)\n", dir.c_str());
+}
+
 void print_display(const char* label, const DisplayMetrics& m) {
   std::printf("%s: HDR NRMSE %.4f %%  display NRMSE %.4f %%  FLIP %.6f\n", label, m.hdr.nrmse_percent,
               m.display_nrmse_percent, m.flip_mean);
@@ -54,7 +71,7 @@ void print_display(const char* label, const DisplayMetrics& m) {
 }  // namespace
 
 int run_diff(const Args& args) {
-  std::string test_path, reference_path, layer, reference_layer, mask_path;
+  std::string test_path, reference_path, layer, reference_layer, mask_path, images_dir;
   double max_nrmse = -1, max_flip = -1;
   DisplayMetricOptions display;
   CommandLine cli("diff", "TEST.exr REFERENCE.exr [options]",
@@ -73,6 +90,8 @@ int run_diff(const Args& args) {
   cli.option("--ppd", &display.pixels_per_degree, "FLIP's pixels per degree of visual angle", 1.0, 1000.0);
   cli.option("--max-nrmse", &max_nrmse, "exit with code 1 when the HDR NRMSE (%) is above this", 0.0, 1e9);
   cli.option("--max-flip", &max_flip, "exit with code 1 when the mean FLIP (all pixels) is above this", 0.0, 1.0);
+  cli.option("--images", &images_dir, "DIR",
+             "write DIR/test.png, reference.png (display values) and error.png (4 x |difference|)");
   if (!cli.parse(args)) return 0;
   if (!cli.given("--reference-layer")) reference_layer = layer;
 
@@ -95,6 +114,7 @@ int run_diff(const Args& args) {
     const DisplayMetrics all = compare_display(test, reference, nullptr, display);
     print_display("all pixels", all);
     flip = all.flip_mean;
+    if (!images_dir.empty()) write_display_images(images_dir, test, reference, display.key);
     if (mask) {
       const DisplayMetrics masked = compare_display(test, reference, &*mask, display);
       char label[64];

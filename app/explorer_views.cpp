@@ -29,12 +29,17 @@ const ViewInfo kViews[kBufferViewCount] = {
     {BufferView::Unfiltered, "unfiltered", "   unfiltered L_lv + L_u"},
 };
 
+// The legend's colors are the case view's (shared::case_color, shaders/view_case.frag).
+CaseStyle case_style(const char* label, int code) {
+  const glm::vec3 c = shared::case_color(code);
+  return {label, c.r, c.g, c.b};
+}
 const std::array<CaseStyle, kBlendCaseCount> kCaseStyles = {{
-    {"0  no L_f yet (s = 1)", 0.35f, 0.35f, 0.35f},
-    {"1  filtered only (s = 0)", 0.90f, 0.20f, 0.15f},
-    {"2  unfiltered (s = 1)", 0.20f, 0.75f, 0.25f},
-    {"3  mixed (0 < s < 1)", 0.20f, 0.45f, 0.95f},
-    {"4  n < 2 (s = 0)", 0.85f, 0.30f, 0.85f},
+    case_style("0  no L_f yet (s = 1)", kCaseNoFiltered),
+    case_style("1  filtered only (s = 0)", kCaseFilteredOnly),
+    case_style("2  unfiltered (s = 1)", kCaseUnfiltered),
+    case_style("3  mixed (0 < s < 1)", kCaseMixed),
+    case_style("4  n < 2 (s = 0)", kCaseUnknownVar),
 }};
 
 constexpr int kLegendWidth = 256;

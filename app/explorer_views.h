@@ -37,7 +37,7 @@ struct ScalarScale {
 };
 bool is_scalar_view(BufferView view);  // VarU, VarF, Blend, Depth
 
-// Colors of the case view, also for its legend: index = BlendCase code.
+// Colors of the case view, also for its legend: index = case code (kCase*).
 struct CaseStyle {
   const char* label;
   float r, g, b;

@@ -8,7 +8,7 @@
 #include <sstream>
 
 #include "app/render_output.h"
-#include "gl/preview_params.h"
+#include "gl/pass_params.h"
 #include "core/timing.h"
 
 namespace pxf {

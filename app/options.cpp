@@ -42,7 +42,7 @@ void add_preview_options(CommandLine& cli, PreviewSettings& s) {
              "the last frame");
   cli.choice("--demodulate", &s.demodulate, {"off", "on"},
              "albedo demodulation: filter HV divided by the first non-specular albedo, so textures stay\n"
-             "sharp (default off: README \"Albedo demodulation\")");
+             "sharp (default off: docs/measurements.md, \"Albedo demodulation\")");
   cli.option("--seed", &s.trace.seed, "random seed", 0, 2147483647);
   cli.choice("--sampler", &s.trace.sampler, sampler_type_names(),
              "random numbers of the path tracer: Owen-scrambled Sobol (default) or independent PCG32");

@@ -31,7 +31,7 @@ LoadLimits load_limits(const SceneOptions& options);
 // (384x216, 32 PT frames, median of 3, display NRMSE filtered / unfiltered): grid 1.48x, a-trous
 // 0.97x. There HV holds the direct light too, so textured detail is filtered, and the grid's range
 // axis (luminance only) averages texture stripes that differ in luminance by less than sigma_c;
-// a-trous weighs the RGB range color. Elsewhere the grid is ahead (README, Measured).
+// a-trous weighs the RGB range color. Elsewhere the grid is ahead (README, "Current figures").
 constexpr FilterKind kAllHvFilter = FilterKind::Atrous;
 
 void add_scene_options(CommandLine& cli, SceneOptions& options, bool headless);

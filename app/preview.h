@@ -18,7 +18,7 @@
 #include "gl/demodulation.h"
 #include "gl/filter_pass.h"
 #include "gl/inputs.h"
-#include "gl/preview_params.h"
+#include "gl/pass_params.h"
 #include "gl/range_pass.h"
 #include "gl/tonemap_pass.h"
 #include "image/image.h"
@@ -36,7 +36,8 @@ struct PreviewSettings {
   FilterParams filter;  // variant (FilterKind::None = plain path tracing) and sigmas
   // Albedo demodulation: filter HV divided by the first non-specular albedo and multiply L_f back
   // (gl/demodulation.h), so the filter does not blur textures. Off by default: at equal time it did
-  // not beat filtering radiance with the default grid filter (README "Albedo demodulation").
+  // not beat filtering radiance with the default grid filter (docs/measurements.md, "Albedo
+  // demodulation").
   bool demodulate = false;
   FilterSchedule schedule = FilterSchedule::Budget;
   TonemapParams tonemap;
@@ -128,7 +129,7 @@ class Preview {
   bool filter_stopped() const { return schedule_.all_pixels_case2; }
   // Filter runs left out because HV's energy share was below kMinHvShare.
   int filter_runs_skipped_low_hv() const { return low_hv_skips_; }
-  // Pixels per BlendCase (gl/preview_params.h) of the last displayed frame.
+  // Pixels per blend case (kCase* in shaders/pass_formulas.h) of the last displayed frame.
   const std::array<uint32_t, kBlendCaseCount>& case_counts() const { return case_counts_; }
 
   // GPU results for the explorer's views.

@@ -34,7 +34,7 @@ const std::vector<Expectation>& expectations() {
       {"cornell", 1000, 20000, true, false, false, false},
       {"atrium", 5000, 300000, false, true, true, false},
       {"kitchen", 2000, 300000, true, false, false, false},
-      {"envmap", 10000, 300000, false, false, true, true},
+      {"envmap", 10000, 300000, false, false, true, false},
   };
   return table;
 }

@@ -34,13 +34,13 @@ void BlendPass::run(const PreviewInputs& inputs, const Texture2D* filtered, cons
   program_.set("t", t);
   const std::array<uint32_t, kBlendCaseCount> zeros{};
   counts_.upload(zeros.data(), sizeof zeros);
-  counts_.bind_storage(0);
-  inputs.hv().bind(0);
-  inputs.lv().bind(1);
+  counts_.bind_storage(shared::kBufferCounts);
+  inputs.hv().bind(shared::kUnitHv);
+  inputs.lv().bind(shared::kUnitLv);
   // Unused units still get a texture, so every sampler is valid.
-  if (filtered) filtered->bind(2); else inputs.hv().bind(2);
-  if (guide) guide->bind(3); else inputs.hv().bind(3);
-  if (centre_weight) centre_weight->bind(4); else inputs.hv().bind(4);
+  (filtered ? *filtered : inputs.hv()).bind(shared::kUnitFiltered);
+  (guide ? *guide : inputs.hv()).bind(shared::kUnitGuide);
+  (centre_weight ? *centre_weight : inputs.hv()).bind(shared::kUnitCentreWeight);
   program_.use();
   quad_.draw(fbo_, width_, height_);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);

@@ -10,7 +10,7 @@
 #include <array>
 #include "gl/filter_pass.h"
 #include "gl/inputs.h"
-#include "gl/preview_params.h"
+#include "gl/pass_params.h"
 #include "gl/resources.h"
 
 namespace pxf {
@@ -31,8 +31,8 @@ class BlendPass {
            const BlendParams& params, const Texture2D* centre_weight = nullptr);
 
   const Texture2D& output() const { return output_; }       // rgb L, a s
-  const Texture2D& case_texture() const { return case_; }   // r: BlendCase code
-  // Pixels per BlendCase of the last run (a 20-byte read-back).
+  const Texture2D& case_texture() const { return case_; }   // r: case code (kCase* in shaders/pass_formulas.h)
+  // Pixels per case of the last run (a 20-byte read-back).
   std::array<uint32_t, kBlendCaseCount> case_counts() const;
   double last_ms() const { return timer_.last_ms(); }
 

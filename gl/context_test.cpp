@@ -5,6 +5,7 @@
 #include "gl/context.h"
 #include "gl/gl.h"
 #include "gl/resources.h"
+#include "gl/shader_library.h"
 #include "gl/test_util.h"
 
 namespace pxf {
@@ -132,15 +133,29 @@ TEST(Shader, CompileErrorInIncludeNamesIncludedFile) {
   }
 }
 
+// Every fragment and compute shader in shaders/ (most include the shared shaders/pass_formulas.h),
+// each fragment shader with its vertex shader: the one of the same name, else the full-screen one.
 TEST(Shader, EveryEmbeddedPassCompiles) {
   test::osmesa_context();
-  EXPECT_NO_THROW(Program::from_embedded("fullscreen.vert", "bilateral.frag"));
-  EXPECT_NO_THROW(Program::from_embedded("fullscreen.vert", "blend.frag"));
-  EXPECT_NO_THROW(Program::from_embedded("fullscreen.vert", "tonemap.frag"));
-  EXPECT_NO_THROW(Program::from_embedded("range.vert", "range.frag"));
-  EXPECT_NO_THROW(Program::from_embedded("specular_points.vert", "specular_points.frag"));
-  EXPECT_NO_THROW(Program::from_embedded("fullscreen.vert", "range_accumulate.frag"));
-  EXPECT_NO_THROW(Program::from_embedded_compute("reduce.comp"));
+  auto ends_with = [](const std::string& s, const std::string& end) {
+    return s.size() >= end.size() && s.compare(s.size() - end.size(), end.size(), end) == 0;
+  };
+  int programs = 0;
+  for (const EmbeddedShader* s = kEmbeddedShaders; s->name; ++s) {
+    const std::string name = s->name;
+    SCOPED_TRACE(name);
+    if (ends_with(name, ".frag")) {
+      std::string vert = name.substr(0, name.size() - 5) + ".vert";
+      bool own_vert = false;
+      for (const EmbeddedShader* v = kEmbeddedShaders; v->name; ++v) own_vert = own_vert || vert == v->name;
+      EXPECT_NO_THROW(Program::from_embedded(own_vert ? vert : "fullscreen.vert", name));
+      ++programs;
+    } else if (ends_with(name, ".comp")) {
+      EXPECT_NO_THROW(Program::from_embedded_compute(name));
+      ++programs;
+    }
+  }
+  EXPECT_GE(programs, 20);
   EXPECT_THROW(embedded_shader("nope.frag"), Error);
 }
 

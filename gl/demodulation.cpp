@@ -24,10 +24,10 @@ void Demodulation::demodulate(const PreviewInputs& inputs, const Texture2D& guid
   demod_program_.set("k_d", range.k_d);
   demod_program_.set("t", t);
   demod_program_.set("skip_case2", p.skip_case2 ? 1 : 0);
-  inputs.hv().bind(0);
-  inputs.lv().bind(1);
-  guide.bind(2);
-  inputs.albedo().bind(3);
+  inputs.hv().bind(shared::kUnitHv);
+  inputs.lv().bind(shared::kUnitLv);
+  guide.bind(shared::kUnitGuide);
+  inputs.albedo().bind(shared::kUnitAlbedo);
   demod_program_.use();
   quad_.draw(demod_fbo_, width_, height_);
   demod_timer_.end();
@@ -39,8 +39,8 @@ void Demodulation::remodulate(const Texture2D& filtered, const PreviewInputs& in
       inputs.height() != height_)
     throw Error("remodulation: input size differs from the pass size");
   remod_timer_.begin();
-  filtered.bind(0);
-  inputs.albedo().bind(1);
+  filtered.bind(shared::kUnitFiltered);
+  inputs.albedo().bind(shared::kUnitAlbedo);
   remod_program_.use();
   quad_.draw(remod_fbo_, width_, height_);
   remod_timer_.end();

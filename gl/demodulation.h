@@ -3,7 +3,7 @@
 // output is multiplied back by each pixel's own albedo before the blend, so textures stay sharp.
 //   demodulate: L_u' = L_u / a, Var[L_u'] = Var[L_u] / Y(a)^2
 //   remodulate: L_f  = a L_f', Var[L_f]  = Y(a)^2 Var[L_f']   (a grey: Y(a) = a)
-// a = demodulation_factor(mean albedo) (shaders/common.glsl): grey, the albedo's luminance where
+// a = demodulation_factor(mean albedo) (shaders/pass_formulas.h): grey, the albedo's luminance where
 // that is at least kAlbedoEpsilon (0.05), else 1 (that pixel is not demodulated). Grey because a
 // per-channel division amplifies, in the channels a saturated texture nearly lacks, light that the
 // albedo does not shape (specular highlights): on envmap that gave pink speckles and a red halo and
@@ -20,7 +20,7 @@
 //   blend.run(inputs, &demod.output(), &guide, t, blend_params, filter.centre_weight());  // w unchanged
 #pragma once
 #include "gl/inputs.h"
-#include "gl/preview_params.h"
+#include "gl/pass_params.h"
 #include "gl/resources.h"
 
 namespace pxf {

@@ -22,10 +22,10 @@ void FilterPass::run(const PreviewInputs& inputs, const Texture2D& guide, const 
   timer_.begin();
   const uint32_t zero = 0;
   counter_.upload(&zero, sizeof zero);
-  counter_.bind_storage(0);
-  inputs.hv().bind(0);
-  inputs.lv().bind(1);
-  guide.bind(2);
+  counter_.bind_storage(shared::kBufferCounts);
+  inputs.hv().bind(shared::kUnitHv);
+  inputs.lv().bind(shared::kUnitLv);
+  guide.bind(shared::kUnitGuide);
   centre_weight_valid_ =
       p.kind == FilterKind::Bilateral || p.kind == FilterKind::BilateralDepth || p.kind == FilterKind::Grid;
   if (p.kind == FilterKind::Atrous)
@@ -62,13 +62,13 @@ void FilterPass::run_bilateral(const PreviewInputs& inputs, const FilterParams& 
   if (p.kind == FilterKind::Separable) {
     program_.set("extent", glm::ivec2(1, 0));
     program_.set("final_pass", 0);
-    inputs.hv().bind(3);
+    inputs.hv().bind(shared::kUnitSignal);
     quad_.draw(scratch_target(0), width_, height_);
     program_.set("extent", glm::ivec2(0, 1));
-    scratch_[0].bind(3);
+    scratch_[0].bind(shared::kUnitSignal);
   } else {
     program_.set("extent", glm::ivec2(1, 1));
-    inputs.hv().bind(3);
+    inputs.hv().bind(shared::kUnitSignal);
   }
   program_.set("final_pass", 1);
   quad_.draw(fbo_, width_, height_);
@@ -82,14 +82,14 @@ void FilterPass::run_atrous(const PreviewInputs& inputs, const FilterParams& p, 
   set_range_and_skip(atrous_program_, p, t);
   atrous_program_.use();
   const int passes = atrous_iterations(p.sigma_s);
-  inputs.hv().bind(3);
+  inputs.hv().bind(shared::kUnitSignal);
   for (int i = 0; i < passes; ++i) {
     const bool last = i + 1 == passes;
     atrous_program_.set("step_px", 1 << i);
     atrous_program_.set("variance_correction", atrous_variance_correction(i));
     atrous_program_.set("final_pass", last ? 1 : 0);
     quad_.draw(last ? fbo_ : scratch_target(i % 2), width_, height_);
-    if (!last) scratch_[i % 2].bind(3);
+    if (!last) scratch_[i % 2].bind(shared::kUnitSignal);
   }
 }
 
@@ -104,7 +104,7 @@ void FilterPass::run_subsampled(const FilterParams& p, float t) {
     subsampled_taps_.upload(table.taps.data(), bytes);
     subsampled_key_ = {p.sigma_s, taps};
   }
-  subsampled_taps_.bind_storage(1);
+  subsampled_taps_.bind_storage(shared::kBufferTaps);
   set_range_and_skip(subsampled_program_, p, t);
   subsampled_program_.set("taps_per_rotation", table.per_rotation);
   subsampled_program_.set("rotations", kSubsampledRotations);

@@ -13,7 +13,7 @@
 #include <memory>
 #include "gl/grid_filter.h"
 #include "gl/inputs.h"
-#include "gl/preview_params.h"
+#include "gl/pass_params.h"
 #include "gl/resources.h"
 
 namespace pxf {

@@ -24,7 +24,7 @@ void GridFilter::run(const FilterParams& p, float t, const Framebuffer& target) 
   const uint32_t initial_bounds[2] = {0x7f7fffffu, 0u};  // FLT_MAX, +0
   step_timer_.begin();
   bounds_buffer_.upload(initial_bounds, sizeof initial_bounds);
-  bounds_buffer_.bind_storage(4);
+  bounds_buffer_.bind_storage(shared::kBufferGridBounds);
 
   bounds_.use();
   const int strips = (width_ + 63) / 64 * height_;  // 64-pixel row strips (grid_bounds.comp)
@@ -38,7 +38,7 @@ void GridFilter::run(const FilterParams& p, float t, const Framebuffer& target) 
   splat_.set("inv_cell_s", inv_cell_s);
   splat_.set("min_cell_z", grid_min_cell_z(p.sigma_c));
   splat_.use();
-  grid_[0].bind_storage(1);
+  grid_[0].bind_storage(shared::kBufferGrid);
   glDispatchCompute((layout_.nx + 7) / 8, (layout_.ny + 7) / 8, 1);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
 
@@ -50,8 +50,8 @@ void GridFilter::run(const FilterParams& p, float t, const Framebuffer& target) 
   const GLuint groups = static_cast<GLuint>((layout_.cells() + 63) / 64);
   for (int axis = 0; axis < 2; ++axis) {  // z was blurred in the splat
     blur_.set("axis", axis);
-    grid_[axis % 2].bind_storage(1);
-    grid_[1 - axis % 2].bind_storage(2);
+    grid_[axis % 2].bind_storage(shared::kBufferGrid);
+    grid_[1 - axis % 2].bind_storage(shared::kBufferGridTarget);
     glDispatchCompute(groups, 1, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
   }
@@ -67,7 +67,7 @@ void GridFilter::run(const FilterParams& p, float t, const Framebuffer& target) 
   slice_.set("skip_case2", p.skip_case2 ? 1 : 0);
   slice_.set("t", t);
   slice_.use();
-  grid_[0].bind_storage(1);
+  grid_[0].bind_storage(shared::kBufferGrid);
   quad_.draw(target, width_, height_);
   step_ms_[3] = step_timer_.end();
 }

@@ -14,7 +14,7 @@
 #pragma once
 #include <algorithm>
 #include <cmath>
-#include "gl/preview_params.h"
+#include "gl/pass_params.h"
 
 namespace pxf {
 
@@ -24,10 +24,14 @@ namespace pxf {
 // deviation of 1.08 sigma at 1.25 (the 5-tap blur on cells of one sigma gave 1.12 sigma, with 2.9x
 // the blur work: 1.8x the cells, 5 taps instead of 3).
 constexpr float kGridCellPerSigma = 1.25f;
-// Range cells along z. The range color's luminance spans [0, 1] (albedo x shading), i.e. 40 cells
-// at the default sigma_c = 0.02; a wider span stretches the cells (cell_z grows) instead of
-// growing the grid, which widens the range kernel proportionally.
-constexpr int kGridRangeCells = 40;
+// Range cells along z: kGridRangeCells (shaders/pass_formulas.h, which the shaders share). The range
+// color's luminance spans [0, 1] (albedo x shading), i.e. 40 cells at the default sigma_c = 0.02; a
+// wider span stretches the cells (cell_z grows) instead of growing the grid, which widens the range
+// kernel proportionally. The blur's taps and the slice's variance correction are there too.
+using shared::grid_interpolation_correction;
+using shared::kGridBlurRadius;
+using shared::kGridBlurTaps;
+using shared::kGridRangeCells;
 // Spatial cells are at least this wide: below it the grid would have more cells than the image has
 // pixels, and the exact kernel is cheap anyway.
 constexpr float kGridMinCellPx = 4.0f;
@@ -54,24 +58,7 @@ inline float grid_min_cell_z(float sigma_c) { return std::max(sigma_c * kGridCel
 // Range cell size from the guide's luminance span [y_min, y_max]: grid_min_cell_z, stretched so that
 // the span fits the kGridRangeCells cells (z in [0, nz - 1]).
 inline float grid_cell_z(float y_min, float y_max, float sigma_c) {
-  return std::max(grid_min_cell_z(sigma_c), (y_max - y_min) / float(kGridRangeCells - 1));
-}
-
-// The grid blur, along each axis in turn: the binomial taps 1/4 [1 2 1] (a variance of 1/2 cell^2;
-// Chen et al. blur with a Gaussian of one cell, which needs 5 taps). Taps outside the grid are left
-// out.
-constexpr int kGridBlurRadius = 1;
-constexpr float kGridBlurTaps[2 * kGridBlurRadius + 1] = {0.25f, 0.5f, 0.25f};
-
-// Var[L_f] correction for the interpolation along one spatial axis at fraction a (see
-// grid_reference.cpp): the two interpolated cells are correlated (the blur spreads each pixel into
-// both), which the squared interpolation weights ignore. With G0 = sum g^2 and G1 = sum g(k) g(k+1)
-// of the blur taps (6/16 and 4/16 for 1/4 [1 2 1]), the exact variance over uniformly occupied cells
-// is (a0^2 + a1^2) G0 + 2 a0 a1 G1 against (a0^2 + a1^2) G0 propagated.
-inline float grid_interpolation_correction(float a) {
-  constexpr float g0 = 6.0f / 16.0f, g1 = 4.0f / 16.0f;
-  const float b = 1.0f - a;
-  return 1.0f + 2.0f * a * b * g1 / (g0 * (a * a + b * b));
+  return shared::grid_cell_z(y_min, y_max, grid_min_cell_z(sigma_c));
 }
 
 }  // namespace pxf

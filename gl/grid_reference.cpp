@@ -7,7 +7,7 @@
 //   sum_j a_j^2 sum_c g(j - c)^2 sum_{i in c} Var_i,
 // which drops the cross terms 2 a_j a_k g(j - c) g(k - c) of the exact sum: two corners of the slice
 // share pixels through the blur. Along each spatial axis that omission is corrected by the factor
-// grid_interpolation_correction(a) (gl/grid_layout.h), exact for uniformly occupied cells of
+// grid_interpolation_correction(a) (shaders/pass_formulas.h), exact for uniformly occupied cells of
 // uniform variance (a flat guide: Grid.WhiteNoiseVariance in gl/passes_test.cpp checks it). Not
 // corrected: the same cross term along z, where a pixel's luminance lies between two range cells
 // (up to 0.53x low at a_z = 1/2 when only one range cell is occupied), and non-uniform occupancy.
@@ -18,7 +18,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdlib>
 #include <vector>
 #include "gl/grid_layout.h"
 
@@ -34,15 +33,12 @@ struct Grid {
   size_t index(int i, int j, int k) const { return (size_t(k) * layout.ny + j) * layout.nx + i; }
 };
 
+using shared::nearest_cell;
+
 float guide_luminance(const Image& range_color, int x, int y) {
-  return std::max(luminance(clean(range_color.at(x, y, 0)), clean(range_color.at(x, y, 1)),
-                            clean(range_color.at(x, y, 2))),
-                  0.0f);
+  return shared::guide_luminance(glm::vec4(range_color.at(x, y, 0), range_color.at(x, y, 1), range_color.at(x, y, 2), 0.0f));
 }
-int nearest_cell(float u) { return static_cast<int>(std::floor(u + 0.5f)); }
-float grid_z(const Grid& g, float y) {
-  return std::clamp((y - g.y_min) / g.cell_z, 0.0f, float(kGridRangeCells - 1));
-}
+float grid_z(const Grid& g, float y) { return shared::grid_z(y, g.y_min, g.cell_z); }
 
 // c += w x (value sums), w^2 x (squared-weight sums b.xy).
 void add_weighted(Cell& c, const Cell& src, float w) {
@@ -102,9 +98,6 @@ void blur(Grid& g, int axis) {
   g.cells = std::move(out);
 }
 
-// The blur tap g(d) along one axis, 0 beyond the taps.
-float blur_tap(int d) { return std::abs(d) <= kGridBlurRadius ? kGridBlurTaps[d + kGridBlurRadius] : 0.0f; }
-
 // Trilinear slice at the pixel's own grid coordinates (see the comment at the top of the file).
 // The centre weight: the pixel's own effective weight W_i = sum_j a_j g(j - c(i)) over the corners j
 // (c(i) its nearest cell: the cell its splat went to) over sum_i W_i, the interpolated count.
@@ -124,7 +117,8 @@ void slice(const Grid& g, int x, int y, float luminance_y, FilterOutput& out) {
         const float w = (dx ? frac[0] : 1.0f - frac[0]) * (dy ? frac[1] : 1.0f - frac[1]) * (dz ? frac[2] : 1.0f - frac[2]);
         const Cell& c = g.cells[g.index(c0[0] + dx, c0[1] + dy, c0[2] + dz)];
         add_weighted(sum, c, w);
-        own_weight += w * blur_tap(c0[0] + dx - own[0]) * blur_tap(c0[1] + dy - own[1]) * blur_tap(c0[2] + dz - own[2]);
+        own_weight += w * shared::grid_blur_tap(c0[0] + dx - own[0]) * shared::grid_blur_tap(c0[1] + dy - own[1]) *
+                      shared::grid_blur_tap(c0[2] + dz - own[2]);
       }
   out.centre_weight.at(x, y, 0) = own_weight / sum[3];
   // sum[3] > 0: the pixel's own nearest cell is a corner with weight >= 1/2 per axis.

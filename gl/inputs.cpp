@@ -1,6 +1,6 @@
 #include "gl/inputs.h"
 
-#include "gl/preview_params.h"
+#include "gl/pass_params.h"
 
 namespace pxf {
 

@@ -2,7 +2,7 @@
 
 #include <cstring>
 #include "gl/gl.h"
-#include "gl/preview_params.h"
+#include "gl/pass_params.h"
 #include "pathtracer/camera.h"
 
 namespace pxf {
@@ -22,14 +22,6 @@ GLint gl_wrap(Wrap w) {
     case Wrap::Repeat: break;
   }
   return GL_REPEAT;
-}
-
-// The path tracer's material_is_perfect_specular (bsdf.cpp), on the factors only.
-bool perfect_specular(const Material& m) {
-  if (m.metallic_roughness_texture.valid() || m.roughness >= 1e-3f) return false;
-  bool mirror = m.metallic >= 1.0f - 1e-3f;
-  bool glass = !m.transmission_texture.valid() && m.transmission >= 1.0f - 1e-3f && m.metallic <= 1e-3f;
-  return mirror || glass;
 }
 
 bool same_camera(const Camera& a, const Camera& b) {
@@ -120,7 +112,7 @@ void RangePass::set_scene(const Scene& scene) {
     g.vao.element_buffer(g.indices);
     g.index_count = static_cast<int>(m.triangles.size() * 3);
     g.material = (m.material >= 0 && m.material < static_cast<int>(materials_.size())) ? m.material : -1;
-    if (g.material >= 0 && perfect_specular(materials_[g.material])) has_specular_material_ = true;
+    if (g.material >= 0 && material_is_perfect_specular(materials_[g.material])) has_specular_material_ = true;
     meshes_.push_back(std::move(g));
   }
   check_gl_error("range pass scene upload");
@@ -194,7 +186,7 @@ void RangePass::draw_scene(glm::vec2 jitter) {
     raster_.set("alpha_mask", m.alpha_mode == AlphaMode::Mask ? 1 : 0);
     raster_.set("alpha_cutoff", m.alpha_cutoff);
     raster_.set("double_sided", m.double_sided ? 1 : 0);
-    raster_.set("specular", perfect_specular(m) ? 1.0f : 0.0f);
+    raster_.set("specular", material_is_perfect_specular(m) ? 1.0f : 0.0f);
     g.vao.bind();
     glDrawElements(GL_TRIANGLES, g.index_count, GL_UNSIGNED_INT, nullptr);
   }

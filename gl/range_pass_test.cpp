@@ -4,7 +4,7 @@
 
 #include <cmath>
 #include <cstdio>
-#include "gl/preview_params.h"
+#include "gl/pass_params.h"
 #include "gl/range_pass.h"
 #include "gl/test_util.h"
 #include "pathtracer/camera.h"

@@ -5,7 +5,7 @@
 //   tonemap.run(blend.output(), {});          // key 0.18, no white point
 //   tonemap.output() (RGBA32F display values in [0,1]), tonemap.display_image(), last_ms()
 #pragma once
-#include "gl/preview_params.h"
+#include "gl/pass_params.h"
 #include "gl/reduction.h"
 #include "gl/resources.h"
 

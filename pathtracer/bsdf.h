@@ -34,11 +34,6 @@ glm::vec3 eval_emission(const Scene& scene, const Material& material, glm::vec2 
 // Base color alpha x texture alpha x vertex alpha (for MASK cutouts).
 float eval_opacity(const Scene& scene, const Material& material, glm::vec2 uv0, glm::vec2 uv1, float vertex_alpha);
 
-// Material-level classification (factors only, a texture on metallic/roughness/transmission
-// disqualifies): a perfect mirror or a smooth dielectric, i.e. every interaction is a delta.
-bool material_is_perfect_specular(const Material& material);
-bool material_is_perfect_mirror(const Material& material);
-
 // Beer-Lambert transmittance of `distance` scene units inside the material's volume.
 inline glm::vec3 volume_transmittance(const Material& material, float distance) {
   return glm::exp(-material.attenuation * distance);

@@ -11,6 +11,7 @@
 #include "pathtracer/default_light.h"
 #include "pathtracer/sampler.h"
 #include "pathtracer/scene.h"
+#include "shaders/range_formulas.h"
 
 namespace pxf {
 
@@ -68,22 +69,10 @@ Scene load_scene_from_memory(const std::vector<unsigned char>& bytes, const std:
 struct BuiltinScene { std::string name, description, path; };
 std::vector<BuiltinScene> builtin_scenes();
 
-// The range-buffer color of a surface: albedo times a noise-free shading term that separates
-// differently oriented surfaces (docs/method.md section 1.2). The raster shader implements the same formula.
-inline glm::vec3 range_shading(glm::vec3 albedo, glm::vec3 normal, glm::vec3 to_viewer) {
-  float c = glm::dot(normal, to_viewer);
-  return albedo * (0.2f + 0.8f * (c > 0.0f ? c : 0.0f));
-}
-
-// The range-buffer color where a ray escapes to the environment: its radiance compressed to
-// [0, 1) per channel by L / (1 + L), so that bright and dark parts of the environment (a softbox,
-// the backdrop) differ in range color and the filter does not mix them. The raster pass
-// (shaders/range_background.frag) computes the same for camera rays that miss the scene.
-inline glm::vec3 range_environment_color(glm::vec3 radiance) {
-  if (!std::isfinite(radiance.x) || !std::isfinite(radiance.y) || !std::isfinite(radiance.z)) return glm::vec3(0.0f);
-  glm::vec3 l = glm::max(radiance, glm::vec3(0.0f));
-  return l / (1.0f + l);
-}
+// The range-buffer colors of a surface and of the environment (docs/method.md section 1.2), which
+// the raster pass's shaders compute from the same source (shaders/range_formulas.h).
+using shared::range_environment_color;
+using shared::range_shading;
 
 // Result of following a perfectly specular chain from the camera (docs/method.md section 1.2).
 struct SpecularChainHit {

@@ -85,6 +85,13 @@ struct Material {
   bool has_volume() const { return attenuation.x > 0 || attenuation.y > 0 || attenuation.z > 0; }
 };
 
+// Material-level classification (factors only, a texture on metallic/roughness/transmission
+// disqualifies): a perfect mirror or a smooth dielectric, i.e. every interaction is a delta. The
+// path tracer follows such surfaces as specular chains, and the range pass marks them for it
+// (implemented in pathtracer/bsdf.cpp).
+bool material_is_perfect_specular(const Material& material);
+bool material_is_perfect_mirror(const Material& material);
+
 // One glTF primitive instance in world space. Optional attributes are empty when absent.
 struct Mesh {
   std::string name;

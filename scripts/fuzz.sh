@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# libFuzzer campaigns on the harnesses of fuzz/ (README "Fuzzing"), built with clang under
+# libFuzzer campaigns on the harnesses of fuzz/ (docs/fuzzing.md), built with clang under
 # AddressSanitizer + UndefinedBehaviorSanitizer in build-fuzz/ (-DPXF_FUZZ=ON). The normal gcc build
 # is not touched.
 #   scripts/fuzz.sh [SECONDS_PER_HARNESS] [HARNESS...]   fuzz each harness (default 600 s, all of them)

@@ -6,12 +6,12 @@
 // correction c_k for the correlation between the previous pass's pixels (atrous_variance_correction).
 // Taps outside the image are left out.
 // Mirrors atrous_pass() in gl/cpu_reference.cpp.
-#include "common.glsl"
+#include "pass_formulas.h"
 
-layout(binding = 0) uniform sampler2D hv_tex;     // rgb L_u, a Var[L_u] (kVarUnknown: n < 2; 0: all samples equal)
-layout(binding = 1) uniform sampler2D lv_tex;     // rgb L_lv (only for skipping)
-layout(binding = 2) uniform sampler2D guide_tex;  // rgb range color, a distance
-layout(binding = 3) uniform sampler2D signal_tex; // what is filtered: hv_tex, or the previous pass
+layout(binding = kUnitHv) uniform sampler2D hv_tex;     // rgb L_u, a Var[L_u] (kVarUnknown: n < 2; 0: all samples equal)
+layout(binding = kUnitLv) uniform sampler2D lv_tex;     // rgb L_lv (only for skipping)
+layout(binding = kUnitGuide) uniform sampler2D guide_tex;  // rgb range color, a distance
+layout(binding = kUnitSignal) uniform sampler2D signal_tex; // what is filtered: hv_tex, or the previous pass
 uniform int step_px;
 uniform int final_pass;  // skipping and counting happen in the final pass only: later passes read every pixel
 uniform float k_c;  // 1 / (2 sigma_c^2)
@@ -20,10 +20,8 @@ uniform int skip_case2;
 uniform float t;
 uniform float variance_correction;  // atrous_variance_correction(pass)
 
-layout(std430, binding = 0) buffer Counter { uint filtered_pixels; };
+layout(std430, binding = kBufferCounts) buffer Counter { uint filtered_pixels; };
 layout(location = 0) out vec4 out_filtered;  // rgb L_f, a Var[L_f] (kVarUnknown, kVarSkipped)
-
-const float kB3[5] = float[5](1.0 / 16.0, 4.0 / 16.0, 6.0 / 16.0, 4.0 / 16.0, 1.0 / 16.0);
 
 void main() {
   ivec2 p = ivec2(gl_FragCoord.xy);

@@ -3,12 +3,12 @@
 // of the result: L_f = sum w L_u / sum w, Var[L_f] = sum w^2 Var[L_u] / (sum w)^2.
 // extent (1,1): the full square kernel; (1,0) then (0,1): the separable variant's two 1D passes
 // (the second filters the first's output, whose rows are independent, so its variance is exact).
-#include "common.glsl"
+#include "pass_formulas.h"
 
-layout(binding = 0) uniform sampler2D hv_tex;     // rgb L_u, a Var[L_u] (kVarUnknown: n < 2; 0: all samples equal)
-layout(binding = 1) uniform sampler2D lv_tex;     // rgb L_lv (only for skipping)
-layout(binding = 2) uniform sampler2D guide_tex;  // rgb range color, a distance
-layout(binding = 3) uniform sampler2D signal_tex; // what is filtered: hv_tex, or the first 1D pass
+layout(binding = kUnitHv) uniform sampler2D hv_tex;     // rgb L_u, a Var[L_u] (kVarUnknown: n < 2; 0: all samples equal)
+layout(binding = kUnitLv) uniform sampler2D lv_tex;     // rgb L_lv (only for skipping)
+layout(binding = kUnitGuide) uniform sampler2D guide_tex;  // rgb range color, a distance
+layout(binding = kUnitSignal) uniform sampler2D signal_tex; // what is filtered: hv_tex, or the first 1D pass
 uniform ivec2 extent;
 uniform int final_pass;  // skipping and counting happen in the final pass only
 uniform int radius;
@@ -18,7 +18,7 @@ uniform float k_d;   // 1 / (2 sigma_d^2), 0 for the color-only variant
 uniform int skip_case2;
 uniform float t;
 
-layout(std430, binding = 0) buffer Counter { uint filtered_pixels; };
+layout(std430, binding = kBufferCounts) buffer Counter { uint filtered_pixels; };
 layout(location = 0) out vec4 out_filtered;  // rgb L_f, a Var[L_f] (kVarUnknown, kVarSkipped)
 layout(location = 1) out float out_centre_weight;  // 1 / sum w: the pixel's own share of L_f
 

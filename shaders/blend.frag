@@ -1,12 +1,12 @@
 #version 450 core
 // Blend of filtered and unfiltered HV light (docs/method.md section 3): s per pixel, L = L_lv + s L_u + (1-s) L_f.
-#include "common.glsl"
+#include "pass_formulas.h"
 
-layout(binding = 0) uniform sampler2D hv_tex;        // rgb L_u, a Var[L_u]
-layout(binding = 1) uniform sampler2D lv_tex;        // rgb L_lv
-layout(binding = 2) uniform sampler2D filtered_tex;  // rgb L_f, a Var[L_f] (or a sentinel)
-layout(binding = 3) uniform sampler2D guide_tex;     // rgb range color, a distance (pooling)
-layout(binding = 4) uniform sampler2D centre_weight_tex;  // r: the filter's centre weight w
+layout(binding = kUnitHv) uniform sampler2D hv_tex;        // rgb L_u, a Var[L_u]
+layout(binding = kUnitLv) uniform sampler2D lv_tex;        // rgb L_lv
+layout(binding = kUnitFiltered) uniform sampler2D filtered_tex;  // rgb L_f, a Var[L_f] (or a sentinel)
+layout(binding = kUnitGuide) uniform sampler2D guide_tex;   // rgb range color, a distance (pooling)
+layout(binding = kUnitCentreWeight) uniform sampler2D centre_weight_tex;  // r: the filter's centre weight w
 uniform int has_filtered;
 uniform int has_centre_weight;  // 0: Cov[L_u, L_f] not known, left out (w = 0)
 uniform int has_guide;  // 0: u from the pixel's own variance only
@@ -14,7 +14,7 @@ uniform float k_c;      // range weights of the variance pooling (the filter's)
 uniform float k_d;
 uniform float t;
 
-layout(std430, binding = 0) buffer CaseCounts { uint case_counts[5]; };
+layout(std430, binding = kBufferCounts) buffer CaseCounts { uint case_counts[kBlendCaseCount]; };
 layout(location = 0) out vec4 out_final;  // rgb L, a s
 layout(location = 1) out float out_case;
 
@@ -25,20 +25,20 @@ void main() {
   vec3 lv = clean(texelFetch(lv_tex, p, 0).rgb);
   vec3 lf = lu;
   float s = 1.0;
-  int blend_case = 0;
+  int blend_case = kCaseNoFiltered;
   if (has_filtered != 0) {
     vec4 fv = texelFetch(filtered_tex, p, 0);
     lf = clean(fv.rgb);
     float vu = clean_var(hv.a);
-    if (fv.a < -1.5) {
+    if (fv.a < kVarSkippedBelow) {
       s = 1.0;
-      blend_case = 2;  // skipped by the filter: case 2
+      blend_case = kCaseUnfiltered;  // skipped by the filter
     } else if (has_guide != 0 && lu == vec3(0.0) && texelFetch(guide_tex, p, 0).a >= kBackgroundDistanceMin) {
       s = 1.0;
-      blend_case = 2;  // the background rule (gl/preview_params.h): no HV light to miss
+      blend_case = kCaseUnfiltered;  // the background rule (kBackgroundDistanceMin): no HV light to miss
     } else if (vu < 0.0) {
       s = 0.0;
-      blend_case = 4;  // n < 2
+      blend_case = kCaseUnknownVar;  // n < 2
     } else {
       float vf = max(clean_var(fv.a), 0.0);
       float lb = max(luminance(lf) + luminance(lv), 0.0);

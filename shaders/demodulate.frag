@@ -4,12 +4,12 @@
 // its case-2 skip; that input here carries the skip decision taken on the original buffers, so that
 // every variant skips exactly the pixels it skips without demodulation: +kMaxInput makes u vanish
 // (skip), -kMaxInput makes L_b = 0 and u infinite (filter).
-#include "common.glsl"
+#include "pass_formulas.h"
 
-layout(binding = 0) uniform sampler2D hv_tex;      // rgb L_u, a Var[L_u]
-layout(binding = 1) uniform sampler2D lv_tex;      // rgb L_lv
-layout(binding = 2) uniform sampler2D guide_tex;   // rgb range color, a distance
-layout(binding = 3) uniform sampler2D albedo_tex;  // rgb mean albedo
+layout(binding = kUnitHv) uniform sampler2D hv_tex;    // rgb L_u, a Var[L_u]
+layout(binding = kUnitLv) uniform sampler2D lv_tex;    // rgb L_lv
+layout(binding = kUnitGuide) uniform sampler2D guide_tex;  // rgb range color, a distance
+layout(binding = kUnitAlbedo) uniform sampler2D albedo_tex;  // rgb mean albedo
 uniform float k_c;
 uniform float k_d;
 uniform float t;
@@ -24,7 +24,7 @@ void main() {
   vec3 a = demodulation_factor(texelFetch(albedo_tex, p, 0).rgb);
   float k = luminance(a);
   float v = clean_var(hv.a);
-  out_hv = vec4(clean(hv.rgb) / a, v >= 0.0 ? (v / k) / k : v);
+  out_hv = vec4(clean(hv.rgb) / a, demodulated_var(v, k));
   bool skip = skip_case2 != 0 && skip_as_case2(hv_tex, lv_tex, guide_tex, p, k_c, k_d, t);
   out_lv = vec4(vec3(skip ? kMaxInput : -kMaxInput), 1.0);
 }

@@ -1,14 +1,14 @@
 #version 450 core
 // Bilateral grid, step 3: blur along one axis (x or y, one dispatch each; z is blurred in the splat) with the
-// binomial taps g = 1/4 [1 2 1] (grid_common.glsl); taps outside the grid are left out. The value sums (a, and the
+// binomial taps g = 1/4 [1 2 1] (pass_formulas.h); taps outside the grid are left out. The value sums (a, and the
 // linear sums b.zw) take g, the squared-weight sums (b.xy) take g^2: the variance of a linear
 // combination of independent cells. Mirrors blur() in gl/grid_reference.cpp.
-#include "common.glsl"
+#include "pass_formulas.h"
 #include "grid_common.glsl"
 layout(local_size_x = 64) in;
 
-layout(std430, binding = 1) readonly buffer Source { vec4 src[]; };
-layout(std430, binding = 2) writeonly buffer Target { vec4 dst[]; };
+layout(std430, binding = kBufferGrid) readonly buffer Source { vec4 src[]; };
+layout(std430, binding = kBufferGridTarget) writeonly buffer Target { vec4 dst[]; };
 uniform ivec2 grid_xy;  // nx, ny (nz = kGridRangeCells)
 uniform int grid_z_cells;
 uniform int axis;       // 0: x, 1: y, 2: z

@@ -2,11 +2,11 @@
 // Bilateral grid, step 1: the min and max of the guide's luminance over the image (the z range of
 // the grid). Each invocation scans a strip of 64 pixels of one row, then two atomics (a
 // shared-memory tree with barriers costs several times more on llvmpipe).
-#include "common.glsl"
+#include "pass_formulas.h"
 #include "grid_common.glsl"
 layout(local_size_x = 64) in;
 
-layout(binding = 2) uniform sampler2D guide_tex;
+layout(binding = kUnitGuide) uniform sampler2D guide_tex;
 const int kStrip = 64;
 
 void main() {

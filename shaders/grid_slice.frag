@@ -5,14 +5,14 @@
 // Var) / (sum w)^2, c = grid_interpolation_correction (gl/grid_layout.h) for the correlation of
 // the interpolated cells along the spatial axes. Case-2 pixels are skipped as in the other variants.
 // Mirrors slice() in gl/grid_reference.cpp.
-#include "common.glsl"
+#include "pass_formulas.h"
 #include "grid_common.glsl"
 
-layout(binding = 0) uniform sampler2D hv_tex;     // rgb L_u, a Var[L_u]
-layout(binding = 1) uniform sampler2D lv_tex;     // rgb L_lv (only for skipping)
-layout(binding = 2) uniform sampler2D guide_tex;  // rgb range color, a distance
-layout(std430, binding = 1) readonly buffer Grid { vec4 cells[]; };
-layout(std430, binding = 0) buffer Counter { uint filtered_pixels; };
+layout(binding = kUnitHv) uniform sampler2D hv_tex;     // rgb L_u, a Var[L_u]
+layout(binding = kUnitLv) uniform sampler2D lv_tex;     // rgb L_lv (only for skipping)
+layout(binding = kUnitGuide) uniform sampler2D guide_tex;  // rgb range color, a distance
+layout(std430, binding = kBufferGrid) readonly buffer Grid { vec4 cells[]; };
+layout(std430, binding = kBufferCounts) buffer Counter { uint filtered_pixels; };
 uniform ivec2 grid_xy;
 uniform float inv_cell_s;
 uniform float min_cell_z;  // grid_min_cell_z(sigma_c)
@@ -23,8 +23,6 @@ uniform float t;
 
 layout(location = 0) out vec4 out_filtered;  // rgb L_f, a Var[L_f] (kVarUnknown, kVarSkipped)
 layout(location = 1) out float out_centre_weight;  // the pixel's own share of L_f (1 where skipped)
-
-float blur_tap(int d) { return abs(d) <= kGridBlurRadius ? kGridBlurTaps[d + kGridBlurRadius] : 0.0; }
 
 void main() {
   ivec2 p = ivec2(gl_FragCoord.xy);
@@ -48,7 +46,7 @@ void main() {
                   (dz == 1 ? frac.z : 1.0 - frac.z);
         int cell = ((c0.z + dz) * grid_xy.y + c0.y + dy) * grid_xy.x + c0.x + dx;
         a += w * cells[2 * cell];
-        own_weight += w * blur_tap(c0.x + dx - own.x) * blur_tap(c0.y + dy - own.y) * blur_tap(c0.z + dz - own.z);
+        own_weight += w * grid_blur_tap(c0.x + dx - own.x) * grid_blur_tap(c0.y + dy - own.y) * grid_blur_tap(c0.z + dz - own.z);
         b += vec4(w * w, w * w, w, w) * cells[2 * cell + 1];
       }
   // a.w > 0: the pixel's own nearest cell is a corner with interpolation weight >= 1/2 per axis.

@@ -11,13 +11,13 @@
 // filter with w = 1, which the blur and the slice then weight like the exact kernel sums.
 // No atomics: every cell is written by exactly one invocation (empty cells with zeros).
 // Mirrors splat() in gl/grid_reference.cpp.
-#include "common.glsl"
+#include "pass_formulas.h"
 #include "grid_common.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(binding = 0) uniform sampler2D hv_tex;     // rgb L_u, a Var[L_u]
-layout(binding = 2) uniform sampler2D guide_tex;  // rgb range color, a distance
-layout(std430, binding = 1) writeonly buffer Grid { vec4 cells[]; };
+layout(binding = kUnitHv) uniform sampler2D hv_tex;     // rgb L_u, a Var[L_u]
+layout(binding = kUnitGuide) uniform sampler2D guide_tex;  // rgb range color, a distance
+layout(std430, binding = kBufferGrid) writeonly buffer Grid { vec4 cells[]; };
 uniform ivec2 grid_xy;      // nx, ny
 uniform float cell_s;       // pixels per spatial cell
 uniform float inv_cell_s;   // 1 / cell_s (computed once on the CPU: same rounding as the reference)

@@ -1,7 +1,8 @@
 #version 450 core
-// Range color = range_shading(albedo, interpolated normal, to_viewer) (pathtracer.h), albedo =
+// Range color = range_shading(albedo, interpolated normal, to_viewer) (range_formulas.h), albedo =
 // base color factor x base color texture x vertex color (linear); the camera ray's length; the
 // perfectly-specular flag. Alpha-mask cutouts are discarded; nothing is culled.
+#include "range_formulas.h"
 in vec3 world_position;
 in vec3 world_normal;
 in vec2 uv0;
@@ -34,7 +35,6 @@ void main() {
   vec3 n = normalize(world_normal);
   // As the path tracer: only double-sided materials flip the normal toward the viewer.
   if (double_sided != 0 && dot(n, v) < 0.0) n = -n;
-  float c = dot(n, v);
-  out_color = vec4(albedo.rgb * (0.2 + 0.8 * max(c, 0.0)), specular);
+  out_color = vec4(range_shading(albedo.rgb, n, v), specular);
   out_distance = distance;
 }

@@ -1,8 +1,9 @@
 #version 450 core
 // Range buffer where the camera ray escapes to the environment: its radiance, compressed to
-// [0, 1) per channel by L / (1 + L) (range_environment_color in pathtracer.h), so that a bright
+// [0, 1) per channel by L / (1 + L) (range_environment_color in range_formulas.h), so that a bright
 // softbox and a dark backdrop get different range colors and the filter does not mix them. The
 // distance stays the background's. Drawn before the geometry, which overwrites it where it is hit.
+#include "range_formulas.h"
 layout(binding = 0) uniform sampler2D environment_tex;  // equirect linear RGB radiance
 uniform mat4 inverse_view_projection;                   // of the jittered raster camera
 uniform vec2 size;
@@ -27,8 +28,6 @@ void main() {
   vec4 far = inverse_view_projection * vec4(ndc, 1.0, 1.0);
   vec3 direction = normalize(far.xyz / far.w - near.xyz / near.w);
   vec3 radiance = texture(environment_tex, equirect_uv(direction)).rgb * strength;
-  if (any(isnan(radiance)) || any(isinf(radiance))) radiance = vec3(0.0);
-  radiance = max(radiance, vec3(0.0));
-  out_color = vec4(radiance / (1.0 + radiance), 0.0);
+  out_color = vec4(range_environment_color(radiance), 0.0);
   out_distance = background_distance;
 }

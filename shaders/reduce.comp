@@ -2,7 +2,7 @@
 // Two-stage sum reduction on the GPU. Stage 0: each 16x16 work group sums one tile of the source
 // texture into partial[group]; stage 1: one group sums the partials into result[0] (and writes the
 // pixel count to result[1]). mode 0 sums the red channel, mode 1 log(delta + Y(rgb)), mode 2 alpha.
-#include "common.glsl"
+#include "pass_formulas.h"
 layout(local_size_x = 16, local_size_y = 16) in;
 
 layout(binding = 0) uniform sampler2D src;

@@ -6,11 +6,11 @@
 // x the color x depth range weights: L_f = sum w L_u / sum w, Var[L_f] = sum w^2 Var / (sum w)^2,
 // exact for the weights used. The tap table comes from subsampled_tap_table() in
 // gl/cpu_reference.cpp, which cpu_subsampled() there uses too. Taps outside the image are left out.
-#include "common.glsl"
+#include "pass_formulas.h"
 
-layout(binding = 0) uniform sampler2D hv_tex;     // rgb L_u, a Var[L_u] (kVarUnknown: n < 2; 0: all samples equal)
-layout(binding = 1) uniform sampler2D lv_tex;     // rgb L_lv (only for skipping)
-layout(binding = 2) uniform sampler2D guide_tex;  // rgb range color, a distance
+layout(binding = kUnitHv) uniform sampler2D hv_tex;     // rgb L_u, a Var[L_u] (kVarUnknown: n < 2; 0: all samples equal)
+layout(binding = kUnitLv) uniform sampler2D lv_tex;     // rgb L_lv (only for skipping)
+layout(binding = kUnitGuide) uniform sampler2D guide_tex;  // rgb range color, a distance
 uniform int taps_per_rotation;
 uniform int rotations;
 uniform float k_c;  // 1 / (2 sigma_c^2)
@@ -18,21 +18,10 @@ uniform float k_d;  // 1 / (2 sigma_d^2)
 uniform int skip_case2;
 uniform float t;
 
-layout(std430, binding = 0) buffer Counter { uint filtered_pixels; };
+layout(std430, binding = kBufferCounts) buffer Counter { uint filtered_pixels; };
 // Rotation r's taps at [r * taps_per_rotation, ...): xy the offset, z the count (0 = padding).
-layout(std430, binding = 1) readonly buffer Taps { ivec4 taps[]; };
+layout(std430, binding = kBufferTaps) readonly buffer Taps { ivec4 taps[]; };
 layout(location = 0) out vec4 out_filtered;  // rgb L_f, a Var[L_f] (kVarUnknown, kVarSkipped)
-
-// subsampled_rotation() in gl/cpu_reference.cpp.
-int rotation_of(ivec2 p) {
-  uint h = uint(p.x) * 0x8da6b343u ^ uint(p.y) * 0xd8163841u;
-  h ^= h >> 16;
-  h *= 0x7feb352du;
-  h ^= h >> 15;
-  h *= 0x846ca68bu;
-  h ^= h >> 16;
-  return int(h % uint(rotations));
-}
 
 void main() {
   ivec2 p = ivec2(gl_FragCoord.xy);
@@ -45,7 +34,7 @@ void main() {
   vec4 g_p = texelFetch(guide_tex, p, 0);
   float sw = 0.0, sw2v = 0.0, sw2u = 0.0, swk = 0.0, swv = 0.0;
   vec3 swl = vec3(0.0);
-  int first = rotation_of(p) * taps_per_rotation;
+  int first = subsampled_rotation(p, rotations) * taps_per_rotation;
   for (int i = 0; i < taps_per_rotation; ++i) {
     ivec4 tap = taps[first + i];
     if (tap.z == 0) break;

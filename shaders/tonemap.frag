@@ -1,7 +1,7 @@
 #version 450 core
 // Reinhard's global photographic operator (key a, log-average luminance, optional white point),
 // then the sRGB transfer curve. Output: display values in [0,1].
-#include "common.glsl"
+#include "pass_formulas.h"
 
 layout(binding = 0) uniform sampler2D hdr_tex;  // rgb linear radiance
 layout(std430, binding = 2) buffer Result { float result[]; };  // reduce.comp: sum log(delta+Y), count

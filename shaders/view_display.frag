@@ -1,7 +1,7 @@
 #version 450 core
 // Explorer view of an RGB texture: display values copied as they are (tone-mapped buffers), or
 // linear values through the sRGB curve only (the range color: an albedo, not a radiance).
-#include "common.glsl"
+#include "pass_formulas.h"
 
 layout(binding = 0) uniform sampler2D source_tex;
 uniform int encode_srgb;  // 1: linear in, sRGB out

@@ -4,7 +4,7 @@
 // (a ramp texture through the same shader, so legend and image always agree).
 // Sentinels get fixed colors: kVarUnknown (n < 2, or no L_f yet) dark gray, kVarSkipped (the
 // filter skipped a case-2 pixel) light gray, values >= background (depth: no surface) black.
-#include "common.glsl"
+#include "pass_formulas.h"
 #include "view_colormap.glsl"
 
 layout(binding = 0) uniform sampler2D source_tex;

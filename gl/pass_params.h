@@ -1,13 +1,33 @@
 // Parameters and codes of the preview passes (docs/method.md sections 2-4), shared by the GL passes, the CPU
-// reference and the app. No GL here.
+// reference and the app (implemented in gl/pass_params.cpp). No GL here. The constants and formulas the shaders
+// use too are in shaders/pass_formulas.h.
 #pragma once
 #include <algorithm>
+#include <cstdint>
 #include <string>
 #include <vector>
 
 #include "image/tonemap.h"
+#include "shaders/pass_formulas.h"
 
 namespace pxf {
+
+// The shared constants (shaders/pass_formulas.h) under their C++ names.
+using shared::kAlbedoEpsilon;
+using shared::kBackgroundDepth;
+using shared::kBackgroundDistanceMin;
+using shared::kBlendCaseCount;
+using shared::kCaseFilteredOnly;
+using shared::kCaseMixed;
+using shared::kCaseNoFiltered;
+using shared::kCaseUnfiltered;
+using shared::kCaseUnknownVar;
+using shared::kMaxInput;
+using shared::kVarSkipped;
+using shared::kVarSkippedBelow;
+using shared::kVarUnknown;
+// Inputs are clamped to the tone map's largest input, so that every pass's output tone-maps.
+static_assert(kMaxInput == kMaxTonemapInput);
 
 // Cross bilateral filter variants: "bilateral-depth" (the full weight: spatial x color x depth) and
 // "bilateral" (spatial x color, no depth term) are the exact square kernel; "separable" is the
@@ -16,7 +36,7 @@ namespace pxf {
 // is the edge-avoiding à-trous wavelet (Dammertz et al. 2010): atrous_iterations(sigma_s) passes of
 // a 5x5 B3-spline kernel with hole spacing 2^i, each tap weighted by the same color x depth range
 // weights (25 taps per pass; its Var[L_f] treats each pass's inputs as independent, see
-// gl/cpu_reference.cpp); "subsampled" is the bilateral-depth kernel evaluated at subsampled_taps()
+// gl/pass_params.cpp); "subsampled" is the bilateral-depth kernel evaluated at subsampled_taps()
 // only: Poisson-disk offsets drawn from the spatial Gaussian (the tap density carries the spatial
 // weight), rotated per pixel (Banterle et al. 2012), each weighted by the color x depth range
 // weights; its Var[L_f] is exact for the weights it uses. "grid" is the bilateral grid (Chen et al.
@@ -60,8 +80,8 @@ struct SubsampledTapTable {
   std::vector<SubsampledTap> taps;
 };
 SubsampledTapTable subsampled_tap_table(float sigma_s, int taps);
-// The pattern rotation of pixel (x, y): an integer hash, identical in shaders/subsampled.frag.
-int subsampled_rotation(int x, int y);
+// The pattern rotation of pixel (x, y): shared::subsampled_rotation (the shader's).
+inline int subsampled_rotation(int x, int y) { return shared::subsampled_rotation(glm::ivec2(x, y), kSubsampledRotations); }
 
 // 1 / (2 sigma^2), sigma clamped away from 0.
 constexpr float inv_two_sigma2(float sigma) {
@@ -77,48 +97,27 @@ constexpr RangeWeights range_weights(const FilterParams& p) {
   return {inv_two_sigma2(p.sigma_c), p.kind != FilterKind::Bilateral ? inv_two_sigma2(p.sigma_d) : 0.0f};
 }
 
-// Passes of the à-trous variant for sigma_s (rule in gl/cpu_reference.cpp), at least 1, and few
+// Passes of the à-trous variant for sigma_s (rule in gl/pass_params.cpp), at least 1, and few
 // enough that its footprint radius 2 (2^k - 1) stays within kMaxFilterRadius.
 int atrous_iterations(float sigma_s);
 // Factor on the Var[L_f] that à-trous pass `pass` (from 0) propagates as if its input pixels were
-// independent, so that it is exact where the range weights are all 1 (see cpu_reference.cpp).
+// independent, so that it is exact where the range weights are all 1 (see pass_params.cpp).
 float atrous_variance_correction(int pass);
 
-// Sentinels of the variance channels (alpha of the HV and filtered textures).
-constexpr float kVarUnknown = -1.0f;  // n < 2 (Var[L_u]); no known neighbour variance (Var[L_f])
-constexpr float kVarSkipped = -2.0f;  // Var[L_f] of a pixel the filter skipped (case 2)
-
-// Albedo demodulation (gl/demodulation.h): a pixel whose mean albedo's luminance is below this is
-// not demodulated (factor 1), so that dividing never amplifies by more than 1 / kAlbedoEpsilon.
-constexpr float kAlbedoEpsilon = 0.05f;
-
-// Background depth (distance) of the range buffer where no surface is hit.
-constexpr float kBackgroundDepth = 1.0e4f;
-// The blend's background rule: a pixel whose guide distance is at least this (mostly background)
-// and whose L_u is exactly 0 saw no HV light: its camera rays escaped, so there was none to miss,
-// and no L_f is blended in (case 2, s = 1). Without it, the zero-variance rule lets filtered light
-// of the objects before an environment bleed into it as a halo.
-constexpr float kBackgroundDistanceMin = 0.5f * kBackgroundDepth;
-
-// Inputs larger than this are clamped, so that sums of a whole kernel stay finite in float.
-constexpr float kMaxInput = kMaxTonemapInput;
+// The threshold the blend and the filter's case-2 skip are given after n samples per pixel:
+// t (n - 3) / (n - 1), t itself as n grows (docs/method.md, "The threshold after few samples").
+// Why: the blend solves for s with the *estimated* Var[L_u], and where u dominates, s^2 is about
+// t / u_hat. With a sample variance of k = n - 1 degrees of freedom, E[1 / S^2] = k / (k - 2) / sigma^2
+// (Gaussian samples), so the perceived variance the blend leaves is on average t (n - 1) / (n - 3):
+// 15 % over t at 16 spp. E[1 / S^2] is infinite for n <= 3; there the n = 4 factor 1/3 is used.
+float effective_threshold(float t, uint64_t samples);
 
 // The blend's parameters besides its threshold t (the perceived-variance threshold, sqrt(t) = the
 // allowed relative standard deviation), which every run is given next to them.
 struct BlendParams {
-  // Weights of the 3x3 variance pooling (see pooled_var_u in cpu_reference.h): the filter's.
+  // Weights of the 3x3 variance pooling (pooled_var_u in shaders/pass_formulas.h): the filter's.
   RangeWeights range = range_weights(FilterParams{});
 };
-
-// Blend case per pixel (the "case" buffer), tested in the order of docs/method.md section 3.2.
-enum BlendCase : int {
-  kCaseNoFiltered = 0,   // no L_f exists yet (the filter never ran): s = 1
-  kCaseFilteredOnly = 1, // D < 0: s = 0
-  kCaseUnfiltered = 2,   // u <= t (or the filter skipped the pixel): s = 1
-  kCaseMixed = 3,        // s = (f + sqrt(D)) / (u + f)
-  kCaseUnknownVar = 4,   // n < 2, variance unknown: s = 0 (filtered value only)
-};
-constexpr int kBlendCaseCount = 5;
 
 // TonemapParams: image/tonemap.h (the tone map formula lives there).
 

@@ -1,0 +1,289 @@
+// The formulas and constants of the preview passes (docs/method.md sections 2-4) that the shaders
+// and the CPU reference (gl/cpu_reference.cpp, gl/grid_reference.cpp) both compute: one source,
+// valid GLSL and C++ (shaders/cpu_gpu.h). The gl_tests compare the two compilations of it.
+#include "cpu_gpu.h"
+
+PXF_SHARED_BEGIN
+
+// ---- Constants ----
+
+// Inputs larger than this are clamped, so that sums of a whole kernel stay finite in float.
+PXF_CONST float kMaxInput = 1.0e30f;
+PXF_CONST float kInf = PXF_INFINITY;
+
+// Sentinels of the variance channels (alpha of the HV and filtered textures).
+PXF_CONST float kVarUnknown = -1.0f;  // n < 2 (Var[L_u]); no known neighbour variance (Var[L_f])
+PXF_CONST float kVarSkipped = -2.0f;  // Var[L_f] of a pixel the filter skipped (case 2)
+// A Var[L_f] below this is kVarSkipped (halfway between the two sentinels).
+PXF_CONST float kVarSkippedBelow = -1.5f;
+
+// Blend case per pixel (the "case" buffer), tested in the order of docs/method.md section 3.2.
+PXF_CONST int kCaseNoFiltered = 0;    // no L_f exists yet (the filter never ran): s = 1
+PXF_CONST int kCaseFilteredOnly = 1;  // D < 0: s = 0
+PXF_CONST int kCaseUnfiltered = 2;    // u <= t (or the filter skipped the pixel): s = 1
+PXF_CONST int kCaseMixed = 3;         // s = (f + sqrt(D)) / (u + f)
+PXF_CONST int kCaseUnknownVar = 4;    // n < 2, variance unknown: s = 0 (filtered value only)
+PXF_CONST int kBlendCaseCount = 5;
+// The color of each case in the explorer's case view and its legend; yellow for any other code.
+PXF_INLINE vec3 case_color(int code) {
+  if (code == kCaseNoFiltered) return vec3(0.35f, 0.35f, 0.35f);
+  if (code == kCaseFilteredOnly) return vec3(0.90f, 0.20f, 0.15f);
+  if (code == kCaseUnfiltered) return vec3(0.20f, 0.75f, 0.25f);
+  if (code == kCaseMixed) return vec3(0.20f, 0.45f, 0.95f);
+  if (code == kCaseUnknownVar) return vec3(0.85f, 0.30f, 0.85f);
+  return vec3(1.0f, 1.0f, 0.0f);
+}
+
+// Background depth (distance) of the range buffer where no surface is hit.
+PXF_CONST float kBackgroundDepth = 1.0e4f;
+// The blend's background rule: a pixel whose guide distance is at least this (mostly background)
+// and whose L_u is exactly 0 saw no HV light: its camera rays escaped, so there was none to miss,
+// and no L_f is blended in (case 2, s = 1). Without it, the zero-variance rule lets filtered light
+// of the objects before an environment bleed into it as a halo.
+PXF_CONST float kBackgroundDistanceMin = 0.5f * kBackgroundDepth;
+
+// Albedo demodulation (gl/demodulation.h): a pixel whose mean albedo's luminance is below this is
+// not demodulated (factor 1), so that dividing never amplifies by more than 1 / kAlbedoEpsilon.
+PXF_CONST float kAlbedoEpsilon = 0.05f;
+
+// Texture units of the pass shaders (filters, demodulation, blend), one per role: the GL passes
+// bind their textures to these names.
+PXF_CONST int kUnitHv = 0;            // rgb L_u, a Var[L_u]
+PXF_CONST int kUnitLv = 1;            // rgb L_lv
+PXF_CONST int kUnitGuide = 2;         // rgb range color, a distance
+PXF_CONST int kUnitSignal = 3;        // what a filter pass filters: L_u, or the previous pass's output
+PXF_CONST int kUnitFiltered = 4;      // rgb L_f, a Var[L_f] or a sentinel
+PXF_CONST int kUnitCentreWeight = 5;  // r: the filter's centre weight
+PXF_CONST int kUnitAlbedo = 6;        // rgb mean first non-specular albedo
+
+// Shader storage buffer bindings of the pass shaders.
+PXF_CONST int kBufferCounts = 0;      // the filters' filtered-pixel counter, the blend's case counts
+PXF_CONST int kBufferGrid = 1;        // the bilateral grid's cells (read by the blur and the slice)
+PXF_CONST int kBufferGridTarget = 2;  // the grid blur's output
+PXF_CONST int kBufferTaps = 3;        // the subsampled variant's tap table
+PXF_CONST int kBufferGridBounds = 4;  // the guide's luminance bounds (grid_bounds.comp)
+
+// ---- Input sanitizing ----
+
+// Rec. 709 luminance of linear RGB.
+PXF_INLINE float luminance(vec3 c) { return dot(c, vec3(0.2126f, 0.7152f, 0.0722f)); }
+
+// Non-finite -> 0, magnitude clamped (so kernel sums stay finite in float).
+PXF_INLINE float clean(float v) { return (isnan(v) || isinf(v)) ? 0.0f : clamp(v, -kMaxInput, kMaxInput); }
+PXF_INLINE vec3 clean(vec3 c) { return vec3(clean(c.r), clean(c.g), clean(c.b)); }
+// Variance channel: negative or non-finite = unknown.
+PXF_INLINE float clean_var(float v) { return (isnan(v) || isinf(v) || v < 0.0f) ? kVarUnknown : min(v, kMaxInput); }
+
+// ---- Range weights ----
+
+// The exponent of the cross bilateral filter's range weight between guide texels (rgb range
+// color, a distance): |R(p) - R(q)|^2 k_c + (d(p) - d(q))^2 k_d.
+PXF_INLINE wide_float range_exponent(vec4 g_p, vec4 g_q, float k_c, float k_d) {
+  wide_vec3 dr = wide_vec3(clean(vec3(g_p)) - clean(vec3(g_q)));
+  wide_float dd = wide_float(clean(g_p.a)) - wide_float(clean(g_q.a));
+  return dot(dr, dr) * k_c + dd * dd * k_d;
+}
+PXF_INLINE wide_float range_weight(vec4 g_p, vec4 g_q, float k_c, float k_d) {
+  return exp(-range_exponent(g_p, g_q, k_c, k_d));
+}
+
+// ---- Perceived variance ----
+
+// var / lb^2 without overflow in the intermediate; 0 when var <= 0, +inf when lb <= 0.
+PXF_INLINE float relative_variance(float var, float lb) {
+  if (!(var > 0.0f)) return 0.0f;
+  if (!(lb > 0.0f)) return kInf;
+  return (var / lb) / lb;
+}
+
+// Perceived variance u of a pixel whose n >= 2 HV samples were all equal (sample variance exactly
+// 0, in practice all zero): that is no evidence of low variance, only that rare paths were missed.
+// A mean of L_f is as consistent with such samples as their own mean, so the variance of the mean
+// is taken as Y(L_f)^2: u = (Y(L_f) / L_b)^2. Zero where L_f is black (nothing to blend in).
+PXF_INLINE float zero_variance_u(float y_f, float lb) {
+  if (!(y_f > 0.0f)) return 0.0f;
+  if (!(lb > 0.0f)) return kInf;
+  float r = y_f / lb;
+  return r * r;
+}
+
+// Var[L_u] for the decisions of the blend and the filter's skipping (docs/method.md section 3.3). A
+// variance estimated from few samples is itself noisy, and far more often too low than too high:
+// path contributions are heavy-tailed, and a pixel that missed the rare bright paths looks quiet
+// (dark speckles kept by case 2). So the decision uses the larger of the pixel's own variance and
+// the range-weighted mean of the known variances in its 3x3 neighbourhood (the filter's weights).
+// Both fall as 1/n, so the bias still vanishes. Returns kVarUnknown where n < 2, and 0 where all
+// the pixel's samples were equal and no neighbour variance is known.
+PXF_SAMPLER_FN float pooled_var_u(sampler2D hv, sampler2D guide, ivec2 p, float k_c, float k_d) {
+  float own = clean_var(texelFetch(hv, p, 0).a);
+  if (own < 0.0f) return kVarUnknown;
+  ivec2 size = textureSize(hv, 0);
+  vec4 g_p = texelFetch(guide, p, 0);
+  wide_float sw = 0.0f, swv = 0.0f;
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx) {
+      ivec2 q = p + ivec2(dx, dy);
+      if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) continue;
+      float v = clean_var(texelFetch(hv, q, 0).a);
+      if (!(v > 0.0f)) continue;  // unknown, or all samples equal: no evidence
+      wide_float w = range_weight(g_p, texelFetch(guide, q, 0), k_c, k_d);
+      sw += w;
+      swv += w * v;
+    }
+  return sw > 0.0f ? max(own, float(swv / sw)) : own;
+}
+
+// The filter's case-2 skip (FilterParams::skip_case2, final pass only): the blend's u (pooled
+// variance) with the unfiltered background L_b = Y(L_u) + Y(L_lv); a zero variance (all samples
+// equal, no neighbour known) is not trusted. The pooled variance is at least the pixel's own, so a
+// pixel whose own variance already exceeds t is not skipped without looking at its neighbours: the
+// same answer for a fraction of the cost (at low spp nearly every pixel leaves here, and the 3x3
+// pooling cost more than a grid slice).
+PXF_SAMPLER_FN bool skip_as_case2(sampler2D hv, sampler2D lv, sampler2D guide, ivec2 p, float k_c, float k_d,
+                                  float t) {
+  vec4 hv_p = texelFetch(hv, p, 0);
+  float lb = max(luminance(clean(vec3(hv_p))) + luminance(clean(vec3(texelFetch(lv, p, 0)))), 0.0f);
+  float own = clean_var(hv_p.a);
+  if (own > 0.0f && relative_variance(own, lb) > max(t, 0.0f)) return false;
+  float v = pooled_var_u(hv, guide, p, k_c, k_d);
+  return v > 0.0f && relative_variance(v, lb) <= max(t, 0.0f);
+}
+
+// ---- Blend factor ----
+
+// The blend case logic (docs/method.md section 3.2) on relative variances u, f (>= 0, may be
+// +inf) and threshold t: case 2 (u <= t) first, case 1 (D < 0), else case 3. NaN u or f count as
+// +inf, NaN or negative t as 0. D < 0 <=> t < H = u f / (u + f) = lo / (1 + lo / hi), and
+// s = f / (u + f) + sqrt((t - H) / (u + f)): no product of two large or two small numbers, so
+// nothing overflows or underflows into a wrong case. Returns s; the case goes to blend_case.
+PXF_INLINE float blend_factor(float u, float f, float t, PXF_OUT(int) blend_case) {
+  if (!(t >= 0.0f)) t = 0.0f;
+  if (isnan(u)) u = kInf;
+  if (isnan(f)) f = kInf;
+  u = max(u, 0.0f);
+  f = max(f, 0.0f);
+  if (u <= t) {
+    blend_case = kCaseUnfiltered;
+    return 1.0f;
+  }
+  float hi = max(u, f), lo = min(u, f);  // hi > t >= 0
+  float r = isinf(hi) ? (isinf(lo) ? 1.0f : 0.0f) : lo / hi;
+  float harmonic = isinf(lo) ? kInf : lo / (1.0f + r);
+  if (t < harmonic) {
+    blend_case = kCaseFilteredOnly;
+    return 0.0f;
+  }
+  // The first term is the minimizer of g (g = H <= t there), so an underflowing second term stays
+  // under t.
+  float uh = isinf(hi) ? (isinf(u) ? 1.0f : 0.0f) : u / hi;
+  float fh = isinf(hi) ? (isinf(f) ? 1.0f : 0.0f) : f / hi;
+  float q = isinf(hi) ? 0.0f : ((t - harmonic) / hi) / (1.0f + r);
+  blend_case = kCaseMixed;
+  return clamp(fh / (uh + fh) + sqrt(q), 0.0f, 1.0f);  // uh + fh >= 1
+}
+
+// Below this curvature a of g(s) (in units of max(u, f)) g is taken as flat: g(s) = f = u > t.
+#ifdef __cplusplus
+PXF_CONST wide_float kBlendFlatCurvature = 1e-12;
+#else
+const float kBlendFlatCurvature = 1e-6;
+#endif
+
+// blend_factor with the covariance of L_u and L_f: the filter averages each pixel's own samples
+// with normalized centre weight w (0..1), so Cov[L_u, L_f] = w Var[L_u] and the blend's relative
+// variance is g(s) = s^2 u + (1-s)^2 f + 2 s (1-s) w u. Case 2 as above; case 1 where t is below
+// the minimum of g on [0, 1]: (u f - c^2) / (u + f - 2c) with c = w u (clamped to sqrt(u f),
+// Cauchy-Schwarz), or f where that minimum lies at s < 0 (c > f); case 3 the larger root of
+// g(s) = t. w <= 0 (or NaN), or u or f infinite: blend_factor. Scaled by hi = max(u, f) > t.
+PXF_INLINE float blend_factor_covariance(float u, float f, float t, float w, PXF_OUT(int) blend_case) {
+  float plain = blend_factor(u, f, t, blend_case);
+  if (!(w > 0.0f) || blend_case == kCaseUnfiltered || isinf(u) || isinf(f) || isnan(u) || isnan(f)) return plain;
+  if (!(t >= 0.0f)) t = 0.0f;
+  u = max(u, 0.0f);
+  f = max(f, 0.0f);
+  wide_float hi = wide_float(max(u, f));
+  wide_float uh = wide_float(u) / hi, fh = wide_float(f) / hi, th = wide_float(t) / hi;
+  wide_float c = min(wide_float(min(w, 1.0f)) * uh, sqrt(uh * fh));
+  wide_float a = uh + fh - 2.0f * c;  // >= (sqrt(uh) - sqrt(fh))^2 >= 0
+  blend_case = kCaseFilteredOnly;
+  if (!(a > kBlendFlatCurvature)) return 0.0f;
+  // g's minimum lies at s* = (f - c) / a, below 0 where c > f: then the lowest g on [0, 1] is g(0) = f.
+  wide_float s_min = (fh - c) / a, g_min = max((uh * fh - c * c) / a, wide_float(0.0f));
+  if (th < (s_min >= 0.0f ? g_min : fh)) return 0.0f;
+  blend_case = kCaseMixed;
+  return float(clamp(s_min + sqrt((th - g_min) / a), wide_float(0.0f), wide_float(1.0f)));
+}
+
+// ---- Albedo demodulation ----
+
+// The factor HV is divided by before the filter and L_f multiplied by after it (gl/demodulation.h):
+// grey, the luminance Y(a) of the pixel's mean albedo where it is at least kAlbedoEpsilon, else 1
+// (a nearly black albedo is not demodulated). Grey, not per channel: a channel near 0 (a saturated
+// texture) would amplify that channel of light the albedo does not shape (specular highlights,
+// neighbours' light) many times over.
+PXF_INLINE vec3 demodulation_factor(vec3 albedo) {
+  float k = luminance(clean(albedo));
+  return k >= kAlbedoEpsilon ? vec3(k) : vec3(1.0f);
+}
+// Var[L_u] / k^2 and Var[L_f'] k^2 with k = Y(a); the sentinels (negative) are kept.
+PXF_INLINE float demodulated_var(float v, float k) { return v >= 0.0f ? (v / k) / k : v; }
+PXF_INLINE float remodulated_var(float v, float k) { return v >= 0.0f ? (v * k) * k : v; }
+
+// ---- Filter variants ----
+
+// The B3-spline taps of the à-trous kernel; its 5x5 kernel h is their outer product (sum 1).
+PXF_CONST float kB3[5] = PXF_FLOAT_ARRAY5(1.0f / 16.0f, 4.0f / 16.0f, 6.0f / 16.0f, 4.0f / 16.0f, 1.0f / 16.0f);
+
+// The subsampled variant's pattern rotation of pixel p: an integer hash (the "lowbias32"
+// finalizer) of the pixel, modulo the number of rotations.
+PXF_INLINE int subsampled_rotation(ivec2 p, int rotations) {
+  uint h = uint(p.x) * 0x8da6b343u ^ uint(p.y) * 0xd8163841u;
+  h ^= h >> 16;
+  h *= 0x7feb352du;
+  h ^= h >> 15;
+  h *= 0x846ca68bu;
+  h ^= h >> 16;
+  return int(h % uint(rotations));
+}
+
+// ---- Bilateral grid (cell layout: gl/grid_layout.h) ----
+
+// Range cells along z (see gl/grid_layout.h).
+PXF_CONST int kGridRangeCells = 40;
+// The grid blur, along each axis in turn: the binomial taps 1/4 [1 2 1] (a variance of 1/2 cell^2;
+// Chen et al. blur with a Gaussian of one cell, which needs 5 taps). Taps outside the grid are left
+// out.
+PXF_CONST int kGridBlurRadius = 1;
+PXF_CONST float kGridBlurTaps[3] = PXF_FLOAT_ARRAY3(0.25f, 0.5f, 0.25f);
+
+// The blur tap g(d) along one axis, 0 beyond the taps.
+PXF_INLINE float grid_blur_tap(int d) { return abs(d) <= kGridBlurRadius ? kGridBlurTaps[d + kGridBlurRadius] : 0.0f; }
+
+// The range coordinate: luminance of the cleaned range color (a guide texel), negative values read as 0.
+PXF_INLINE float guide_luminance(vec4 g) { return max(luminance(clean(vec3(g))), 0.0f); }
+
+// Range cell size from the guide's luminance span [y_min, y_max]: min_cell_z (gl/grid_layout.h:
+// grid_min_cell_z), stretched so that the span fits the kGridRangeCells cells (z in [0, nz - 1]).
+PXF_INLINE float grid_cell_z(float y_min, float y_max, float min_cell_z) {
+  return max(min_cell_z, (y_max - y_min) / float(kGridRangeCells - 1));
+}
+// z of a luminance: (Y - Y_min) / cell_z, clamped to the grid.
+PXF_INLINE float grid_z(float y, float y_min, float cell_z) {
+  return clamp((y - y_min) / cell_z, 0.0f, float(kGridRangeCells - 1));
+}
+
+// Var[L_f] correction for the interpolation along one spatial axis at fraction a (see
+// gl/grid_reference.cpp): the two interpolated cells are correlated (the blur spreads each pixel
+// into both), which the squared interpolation weights ignore. With G0 = sum g^2 and G1 =
+// sum g(k) g(k+1) of the blur taps (6/16 and 4/16 for 1/4 [1 2 1]), the exact variance over
+// uniformly occupied cells is (a0^2 + a1^2) G0 + 2 a0 a1 G1 against (a0^2 + a1^2) G0 propagated.
+PXF_INLINE float grid_interpolation_correction(float a) {
+  PXF_CONST float g0 = 6.0f / 16.0f, g1 = 4.0f / 16.0f;
+  float b = 1.0f - a;
+  return 1.0f + 2.0f * a * b * g1 / (g0 * (a * a + b * b));
+}
+
+// Nearest cell of a grid coordinate (cell centers at integers).
+PXF_INLINE int nearest_cell(float u) { return int(floor(u + 0.5f)); }
+
+PXF_SHARED_END
