@@ -276,7 +276,7 @@ StageRow measure_stages(const BenchSetup& b, const std::string& scene_name, int 
   return row;
 }
 
-int run_stage_table(SceneOptions scene_options, PreviewOptions preview_options, const CommandLine& cli, int frames,
+int run_stage_table(SceneOptions scene_options, PreviewSettings preview_settings, const CommandLine& cli, int frames,
                     const std::string& out) {
   std::printf("per-stage ms over %d frames (scheduled filter runs), every built-in scene:\n", frames);
   std::printf("   %-10s %9s %8s %9s %8s %8s %5s %9s\n", "scene", "size", "PT ms", "filter", "range", "display",
@@ -289,14 +289,13 @@ int run_stage_table(SceneOptions scene_options, PreviewOptions preview_options, 
     SceneOptions so = scene_options;
     so.scene = builtin.name;
     if (!cli.given("--size")) so.width = so.height = 0;  // each scene's own default size
-    PreviewOptions po = preview_options;
     BenchSetup b;
-    b.scene = load_scene_for(so, po, cli);
+    b.filtered = preview_settings;
+    b.scene = load_scene_for(so, b.filtered, cli);
     b.width = so.width;
     b.height = so.height;
-    b.filtered = po.settings;
     b.plain = b.filtered;
-    b.plain.filter_enabled = false;
+    b.plain.filter.kind = FilterKind::None;
     const StageRow r = measure_stages(b, builtin.name, frames);
     std::printf("   %-10s %4dx%-4d %8.1f %9.1f %8.1f %8.1f %5d %+8.1f %%\n", r.scene.c_str(), r.width, r.height,
                 r.pt_ms, r.filter_ms, r.range_ms, r.display_ms, r.filter_runs, 100.0 * r.overhead());
@@ -362,7 +361,6 @@ int run_variant_bench(const BenchSetup& b, const Image& reference_hv, int spp, i
     params.back().kind = FilterKind::Subsampled;
     params.back().subsampled_taps = taps;
   }
-  for (FilterParams& p : params) p.t = b.filtered.threshold;
   FilterPass filter(b.width, b.height);
   std::vector<std::vector<double>> ms(names.size());
   std::vector<double> pt_ms;
@@ -374,7 +372,7 @@ int run_variant_bench(const BenchSetup& b, const Image& reference_hv, int spp, i
     timing_tracer.add_frame();
     pt_ms.push_back(elapsed_ms(start));
     for (size_t k = 0; k < names.size(); ++k) {
-      filter.run(preview.inputs(), preview.range().guide(), params[k]);
+      filter.run(preview.inputs(), preview.range().guide(), params[k], b.filtered.threshold);
       if (round >= 0) ms[k].push_back(filter.last_ms());
       if (round >= 0 && params[k].kind == FilterKind::Grid)
         for (size_t i = 0; i < grid_step_ms.size(); ++i) grid_step_ms[i].push_back(filter.grid()->last_step_ms()[i]);
@@ -472,7 +470,7 @@ int run_demodulation_ab(const BenchSetup& b, const Image& reference, double pt_m
 
 int run_bench(const Args& args) {
   SceneOptions scene_options;
-  PreviewOptions preview_options;
+  PreviewSettings preview_settings;
   bool pathtracer = false, variants = false, stage_table = false, sampler_error = false, variance_ratio = false;
   bool demodulation_ab = false;
   bool threshold_fidelity = false;
@@ -496,8 +494,9 @@ int run_bench(const Args& args) {
                   "--variants instead tabulates every filter variant on one --variant-spp HV buffer: ms per\n"
                   "application, path-tracing frames, HV-only NRMSE against the reference's HV (layer hv of\n"
                   "--reference, e.g. buffers.exr of `pxf render --filter none`; default: rendered and cached).");
+  scene_options.stage_timing = GlTiming::Finish;  // exact per-stage figures
   add_scene_options(cli, scene_options, /*headless=*/true);
-  add_preview_options(cli, preview_options);
+  add_preview_options(cli, preview_settings);
   cli.flag("--pathtracer", &pathtracer, "path tracer throughput only");
   cli.flag("--variants", &variants, "the filter variant table (time vs HV-only NRMSE)");
   cli.option("--variant-spp", &variant_spp, "spp of the --variants HV buffer (default 4)", 1, 1 << 16);
@@ -530,25 +529,25 @@ int run_bench(const Args& args) {
   cli.option("--out", &out, "DIR", "folder for CSV, plots and the cached reference (default bench-out)");
   if (!cli.parse(args)) return 0;
   if (print_scene_list_if_asked(scene_options)) return 0;
+  set_gl_timing(scene_options.stage_timing);
   const std::vector<int> budgets = parse_counts("--budgets", budgets_text);
   const std::vector<int> extra_taps = parse_counts("--subsampled-taps", extra_taps_text);
   if (stage_table) {
     std::filesystem::create_directories(out);
-    finish_preview_options(preview_options);
-    if (!preview_options.settings.filter_enabled) throw UsageError("--filter none: nothing to compare against");
+    if (!preview_settings.filtering()) throw UsageError("--filter none: nothing to compare against");
     auto context = create_gl_context(parse_gl_backend(scene_options.gl));
-    return run_stage_table(scene_options, preview_options, cli, frames, out);
+    return run_stage_table(scene_options, preview_settings, cli, frames, out);
   }
 
   BenchSetup b;
-  b.scene = load_scene_for(scene_options, preview_options, cli);
+  b.filtered = preview_settings;
+  b.scene = load_scene_for(scene_options, b.filtered, cli);
   b.width = scene_options.width;
   b.height = scene_options.height;
   b.out = out;
-  b.filtered = preview_options.settings;
-  if (!b.filtered.filter_enabled) throw UsageError("--filter none: nothing to compare against");
+  if (!b.filtered.filtering()) throw UsageError("--filter none: nothing to compare against");
   b.plain = b.filtered;
-  b.plain.filter_enabled = false;
+  b.plain.filter.kind = FilterKind::None;
   std::filesystem::create_directories(out);
   if (pathtracer && (sampler_error || variance_ratio)) {
     SamplerBenchSetup sb{b.scene, std::filesystem::path(scene_options.scene).stem().string(), b.plain.trace, b.width,
@@ -572,7 +571,7 @@ int run_bench(const Args& args) {
   auto context = create_gl_context(parse_gl_backend(scene_options.gl));
   std::printf("bench: %s %dx%d, t=%g, filter %s, sigma_s=%g sigma_c=%g sigma_d=%g, GL %s (%s)\n",
               scene_options.scene.c_str(), b.width, b.height, b.filtered.threshold,
-              filter_option_name(b.filtered).c_str(), b.filtered.filter.sigma_s, b.filtered.filter.sigma_c,
+              filter_kind_name(b.filtered.filter.kind), b.filtered.filter.sigma_s, b.filtered.filter.sigma_c,
               b.filtered.filter.sigma_d, context->backend_name(), context->gl_renderer().c_str());
   if (variants)
     return run_variant_bench(b, obtain_reference(b, reference_path, reference_spp, scene_options.scene, "hv"),

@@ -81,15 +81,26 @@ void CommandLine::option(const std::string& name, double* target, const std::str
   options_.push_back({name, "X", help, false, number_setter(name, target, min, max, false)});
 }
 
+void CommandLine::option(const std::string& name, uint64_t* target, const std::string& help, uint64_t min,
+                         uint64_t max) {
+  options_.push_back({name, "N", help + " [" + std::to_string(min) + ".." + std::to_string(max) + "]", false,
+                      number_setter(name, target, static_cast<double>(min), static_cast<double>(max), true)});
+}
+
 void CommandLine::choice(const std::string& name, std::string* target, const std::vector<std::string>& choices,
                          const std::string& help) {
-  options_.push_back({name, join(choices, "|"), help, false, [=](const std::string& v) {
-                        for (const auto& c : choices)
-                          if (c == v) {
-                            *target = v;
+  choice_index(name, [target, choices](size_t i) { *target = choices[i]; }, choices, help);
+}
+
+void CommandLine::choice_index(const std::string& name, std::function<void(size_t)> set,
+                               const std::vector<std::string>& names, const std::string& help) {
+  options_.push_back({name, join(names, "|"), help, false, [=](const std::string& v) {
+                        for (size_t i = 0; i < names.size(); ++i)
+                          if (names[i] == v) {
+                            set(i);
                             return;
                           }
-                        throw UsageError(name + ": '" + v + "' is not one of " + join(choices, ", "));
+                        throw UsageError(name + ": '" + v + "' is not one of " + join(names, ", "));
                       }});
 }
 

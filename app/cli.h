@@ -2,6 +2,7 @@
 // parameter structs; unknown flags, missing values and out-of-range numbers are a UsageError
 // (one line, exit code 2).
 #pragma once
+#include <cstdint>
 #include <functional>
 #include <stdexcept>
 #include <string>
@@ -22,9 +23,17 @@ class CommandLine {
   void option(const std::string& name, int* target, const std::string& help, int min, int max);
   void option(const std::string& name, float* target, const std::string& help, float min, float max);
   void option(const std::string& name, double* target, const std::string& help, double min, double max);
-  // A value from a fixed name table (e.g. filter variants, GL back ends).
+  void option(const std::string& name, uint64_t* target, const std::string& help, uint64_t min, uint64_t max);
+  // A value from a fixed name table (e.g. GL back ends).
   void choice(const std::string& name, std::string* target, const std::vector<std::string>& choices,
               const std::string& help);
+  // An enum (or bool) bound to its name table: names[i] names static_cast<E>(i). The same table
+  // names the value everywhere else (the explorer's combo boxes, stats.json), so the command line
+  // sets the enum itself and no name travels as a string.
+  template <typename E>
+  void choice(const std::string& name, E* target, const std::vector<std::string>& names, const std::string& help) {
+    choice_index(name, [target](size_t i) { *target = static_cast<E>(i); }, names, help);
+  }
   // "WxH" sizes.
   void size_option(const std::string& name, int* width, int* height, const std::string& help);
   void positional(const std::string& name, std::string* target, const std::string& help);
@@ -39,6 +48,8 @@ class CommandLine {
   bool given(const std::string& name) const;
 
  private:
+  void choice_index(const std::string& name, std::function<void(size_t)> set, const std::vector<std::string>& names,
+                    const std::string& help);
   struct Option {
     std::string name, metavar, help;
     bool is_flag = false;

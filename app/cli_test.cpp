@@ -118,3 +118,33 @@ TEST(CommandLine, FloatLimitsCompareInTheirTypeAndPrintReadably) {
   }
   EXPECT_THROW(cli.parse({"--sigma-s", "1e99"}), UsageError);  // beyond float: out of range, not inf
 }
+
+TEST(CommandLine, ChoiceBindsAnEnumThroughItsNameTable) {
+  enum class Color { Red, Green, Blue };
+  Color color = Color::Red;
+  bool on = false;
+  CommandLine cli{"render", "[options]", "test"};
+  cli.choice("--color", &color, {"red", "green", "blue"}, "color");
+  cli.choice("--switch", &on, {"off", "on"}, "a bool named by its table");
+  ASSERT_TRUE(cli.parse({"--color", "blue", "--switch=on"}));
+  EXPECT_EQ(color, Color::Blue);
+  EXPECT_TRUE(on);
+  EXPECT_NE(cli.help().find("--color red|green|blue"), std::string::npos);
+  CommandLine bad{"render", "[options]", "test"};
+  bad.choice("--color", &color, {"red", "green", "blue"}, "color");
+  EXPECT_THROW(bad.parse({"--color", "Blue"}), UsageError);  // names are exact
+  EXPECT_EQ(color, Color::Blue);                              // unchanged by the refused value
+}
+
+TEST(CommandLine, Uint64OptionKeepsItsRange) {
+  uint64_t seed = 1;
+  CommandLine cli{"render", "[options]", "test"};
+  cli.option("--seed", &seed, "seed", 0, 2147483647);
+  ASSERT_TRUE(cli.parse({"--seed", "2147483647"}));
+  EXPECT_EQ(seed, 2147483647u);
+  for (const char* bad : {"-1", "2147483648", "1.5"}) {
+    CommandLine c{"render", "[options]", "test"};
+    c.option("--seed", &seed, "seed", 0, 2147483647);
+    EXPECT_THROW(c.parse({"--seed", bad}), UsageError) << bad;
+  }
+}

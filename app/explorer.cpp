@@ -112,7 +112,7 @@ class Explorer {
  public:
   Explorer(ExploreOptions& options, GlContext& context)
       : options_(options), context_(context), window_(static_cast<GLFWwindow*>(context.native_window())) {
-    settings_ = options_.preview.settings;
+    settings_ = options_.preview;
     view_ = parse_buffer_view(options_.view);
     if (!options_.split.empty()) {
       split_ = true;
@@ -173,8 +173,7 @@ class Explorer {
                                                       load_limits(options_.scene)));
       print_scene_messages(*scene);
       if (!options_.all_hv_given) settings_.trace.all_hv = scene->defaults.all_hv;
-      if (!options_.filter_given)
-        set_filter_option(settings_, settings_.trace.all_hv ? kAllHvFilter : options_.preview.filter.c_str());
+      if (!options_.filter_given) settings_.filter.kind = settings_.trace.all_hv ? kAllHvFilter : options_.preview.filter.kind;
       if (first) size_image(*scene);
       if (scene->automatic_camera) scene->camera = frame_scene(*scene, static_cast<float>(width_) / height_);
       auto preview = std::make_unique<Preview>(*scene, settings_, width_, height_);
@@ -444,11 +443,9 @@ class Explorer {
     changed |= ImGui::SliderFloat("sigma s (px)", &s.filter.sigma_s, 0.5f, kMaxFilterRadius / 3.0f, "%.2f");
     changed |= ImGui::SliderFloat("sigma c", &s.filter.sigma_c, 1e-4f, 10.0f, "%.3g", ImGuiSliderFlags_Logarithmic);
     changed |= ImGui::SliderFloat("sigma d", &s.filter.sigma_d, 1e-3f, 1e3f, "%.3g", ImGuiSliderFlags_Logarithmic);
-    changed |= name_combo("filter", filter_option_names(), filter_option_name(s),
-                          [&](const std::string& n) { set_filter_option(s, n); });
+    changed |= enum_combo("filter", filter_option_names(), &s.filter.kind);
     changed |= ImGui::Checkbox("albedo demodulation", &s.demodulate);
-    changed |= name_combo("schedule", filter_schedule_names(), filter_schedule_names()[static_cast<int>(s.schedule)],
-                          [&](const std::string& n) { s.schedule = parse_filter_schedule(n); });
+    changed |= enum_combo("schedule", filter_schedule_names(), &s.schedule);
     changed |= ImGui::SliderInt("path length", &s.trace.max_vertices, 2, 32);
     changed |= ImGui::Checkbox("all HV", &s.trace.all_hv);
     changed |= ImGui::SliderFloat("exposure key", &s.tonemap.key, 0.01f, 2.0f, "%.3f", ImGuiSliderFlags_Logarithmic);
@@ -460,13 +457,15 @@ class Explorer {
     settings_changed_ |= changed;
   }
 
-  template <typename Apply>
-  static bool name_combo(const char* label, const std::vector<std::string>& names, const std::string& current, Apply apply) {
+  // A combo box over an enum's name table (names[i] names static_cast<E>(i), as on the command line).
+  template <typename E>
+  static bool enum_combo(const char* label, const std::vector<std::string>& names, E* value) {
     bool changed = false;
-    if (ImGui::BeginCombo(label, current.c_str())) {
-      for (const std::string& n : names)
-        if (ImGui::Selectable(n.c_str(), n == current) && n != current) {
-          apply(n);
+    const size_t current = static_cast<size_t>(*value);
+    if (ImGui::BeginCombo(label, current < names.size() ? names[current].c_str() : "?")) {
+      for (size_t i = 0; i < names.size(); ++i)
+        if (ImGui::Selectable(names[i].c_str(), i == current) && i != current) {
+          *value = static_cast<E>(i);
           changed = true;
         }
       ImGui::EndCombo();
@@ -537,7 +536,7 @@ class Explorer {
     const bool moving = fast_while_moving_ && (dragging_camera_ || flying_);
     if (settings_changed_ || moving != applied_moving_) {
       PreviewSettings effective = settings_;
-      if (moving) effective.filter_enabled = false;
+      if (moving) effective.filter.kind = FilterKind::None;
       preview_->set_settings(effective);
       settings_changed_ = false;
       applied_moving_ = moving;
@@ -661,18 +660,12 @@ class Explorer {
   // --- capture ----------------------------------------------------------------------------------
   void capture() {
     try {
-      options_.preview.settings = settings_;
-      options_.preview.filter = filter_option_name(settings_);
-      options_.preview.schedule = filter_schedule_names()[static_cast<int>(settings_.schedule)];
-      options_.preview.all_hv = settings_.trace.all_hv;
-      options_.preview.demodulate = settings_.demodulate ? "on" : "off";
       options_.scene.width = width_, options_.scene.height = height_;
       stop_tracing(/*cancel=*/false);  // the frame in flight and its passes first
       while (preview_->passes_pending()) preview_->run_next_pass();
       preview_->finish();  // like an interrupted `pxf render`: the last-frame filter run, blend, tone map
       RenderReport report;
       report.scene = &options_.scene;
-      report.preview = &options_.preview;
       report.gl_backend = context_.backend_name();
       report.gl_renderer = context_.gl_renderer();
       report.wall_ms = ms_between(started_, Clock::now());
@@ -742,7 +735,7 @@ int run_explorer(ExploreOptions& options) {
   // The window size depends on the image size: known from --size, else a common default.
   const int width = options.scene.width > 0 ? options.scene.width : 512;
   const int height = options.scene.height > 0 ? options.scene.height : 512;
-  finish_preview_options(options.preview);
+  set_gl_timing(options.scene.stage_timing);
   auto context = create_gl_context(parse_gl_backend(options.scene.gl), window_options(options, width, height));
   if (!context->native_window())
     throw Error(std::string("explore needs a window; the '") + context->backend_name() +

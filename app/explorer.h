@@ -11,7 +11,7 @@ namespace pxf {
 
 struct ExploreOptions {
   SceneOptions scene;
-  PreviewOptions preview;
+  PreviewSettings preview;  // as the command line set them
   bool all_hv_given = false;  // --all-hv on the command line wins over a loaded scene's default
   bool filter_given = false;  // --filter likewise over kAllHvFilter
   std::string out = "out";    // capture folder

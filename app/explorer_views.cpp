@@ -152,7 +152,7 @@ const Texture2D& ViewRenderer::render(BufferView view, Preview& preview, int slo
       tonemap_like_final(filtered ? *filtered : preview.inputs().hv(), preview, slot);
       break;
     case BufferView::Unfiltered:
-      unfiltered_.run(preview.inputs(), nullptr, nullptr, BlendParams{preview.settings().threshold});
+      unfiltered_.run(preview.inputs(), nullptr, nullptr, preview.settings().threshold, BlendParams{});
       tonemap_like_final(unfiltered_.output(), preview, slot);
       break;
     case BufferView::RangeColor:

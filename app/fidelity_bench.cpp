@@ -9,7 +9,7 @@
 
 #include "app/render_output.h"
 #include "gl/pass_params.h"
-#include "pathtracer/bench.h"
+#include "core/timing.h"
 
 namespace pxf {
 namespace {
@@ -121,7 +121,7 @@ void run_threshold_fidelity_bench(const FidelityBenchSetup& b, const std::vector
   csv << "scene,filter,spp,t,case,pixels,fraction_at_most_t,median_ratio,median_ratio_sd\n";
   std::printf("%s %dx%d, filter %s, %d seeds: empirical perceived variance Var[Y(L - L_lv)] / L_b^2 of the final "
               "image against t, by the pixel's most frequent blend case\n",
-              b.scene_name.c_str(), b.width, b.height, filter_option_name(b.settings).c_str(), seeds);
+              b.scene_name.c_str(), b.width, b.height, filter_kind_name(b.settings.filter.kind), seeds);
   std::printf("%6s %7s %6s %8s %12s %22s\n", "spp", "t", "case", "pixels", "<= t", "median empirical / t");
   for (size_t k = 0; k < spps.size(); ++k)
     for (size_t ti = 0; ti < thresholds.size(); ++ti) {
@@ -137,7 +137,7 @@ void run_threshold_fidelity_bench(const FidelityBenchSetup& b, const std::vector
         const double fraction = r.pixels ? static_cast<double>(r.at_most_t) / r.pixels : 0;
         std::printf("%6d %7g %6d %8zu %11.1f%% %13.3f +- %.3f\n", spps[k], thresholds[ti], want, r.pixels,
                     100 * fraction, r.median_ratio, r.median_ratio_sd);
-        csv << b.scene_name << "," << filter_option_name(b.settings) << "," << spps[k] << "," << thresholds[ti] << ","
+        csv << b.scene_name << "," << filter_kind_name(b.settings.filter.kind) << "," << spps[k] << "," << thresholds[ti] << ","
             << want << "," << r.pixels << "," << fraction << "," << r.median_ratio << "," << r.median_ratio_sd << "\n";
       }
     }

@@ -16,22 +16,20 @@ namespace {
 
 // The sample settings of the states decide size and path-tracing parameters: the command line's
 // must not contradict them (the merged image is the render the shards were made of).
-void take_settings_from_state(const SampleSettings& s, SceneOptions& scene, PreviewOptions& preview) {
+void take_settings_from_state(const SampleSettings& s, SceneOptions& scene, PreviewSettings& preview) {
   scene.width = static_cast<int>(s.width);
   scene.height = static_cast<int>(s.height);
-  preview.settings.trace.seed = s.seed;
-  preview.settings.trace.max_vertices = s.max_vertices;
-  preview.settings.trace.rr_start_vertex = s.rr_start_vertex;
-  preview.settings.trace.all_hv = s.all_hv != 0;
-  preview.seed = static_cast<int>(s.seed);
-  preview.all_hv = s.all_hv != 0;
+  preview.trace.seed = s.seed;
+  preview.trace.max_vertices = s.max_vertices;
+  preview.trace.rr_start_vertex = s.rr_start_vertex;
+  preview.trace.all_hv = s.all_hv != 0;
 }
 
 }  // namespace
 
 int run_merge(const Args& args) {
   SceneOptions scene_options;
-  PreviewOptions preview_options;
+  PreviewSettings preview_settings;
   std::vector<std::string> state_paths;
   std::string out = "out";
   CommandLine cli("merge", "STATE... --scene SCENE [options]",
@@ -41,7 +39,7 @@ int run_merge(const Args& args) {
                   "the merged DIR/state.pxfs. Size, seed and path-tracing settings come from the states.");
   cli.positional_list("STATE...", &state_paths, "state files of the shards");
   add_scene_options(cli, scene_options, /*headless=*/true);
-  add_preview_options(cli, preview_options);
+  add_preview_options(cli, preview_settings);
   cli.option("--out", &out, "DIR", "output folder (default out)");
   if (!cli.parse(args)) return 0;
 
@@ -51,20 +49,20 @@ int run_merge(const Args& args) {
   const AccumulationState merged = merge_states(states);
   const double merge_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 
-  Scene scene = load_scene_for(scene_options, preview_options, cli);
-  take_settings_from_state(merged.settings, scene_options, preview_options);
-  const SampleSettings here = render_sample_settings(scene_options, preview_options.settings);
+  Scene scene = load_scene_for(scene_options, preview_settings, cli);
+  take_settings_from_state(merged.settings, scene_options, preview_settings);
+  const SampleSettings here = render_sample_settings(scene_options, preview_settings);
   const std::string diff = merged.settings.difference(here);
   if (!diff.empty()) throw Error("the states were not rendered from this scene: " + diff);
 
+  set_gl_timing(scene_options.stage_timing);
   auto context = create_gl_context(parse_gl_backend(scene_options.gl));
-  Preview preview(scene, preview_options.settings, scene_options.width, scene_options.height);
+  Preview preview(scene, preview_settings, scene_options.width, scene_options.height);
   preview.load_accumulation(merged.acc, merged.frames.front().begin, static_cast<int>(merged.frame_count()));
   preview.finish();
 
   RenderReport report;
   report.scene = &scene_options;
-  report.preview = &preview_options;
   report.gl_backend = context->backend_name();
   report.gl_renderer = context->gl_renderer();
   report.wall_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

@@ -24,31 +24,34 @@ void add_scene_options(CommandLine& cli, SceneOptions& o, bool headless) {
     cli.choice("--gl", &o.gl, {"auto", "osmesa", "egl"}, "headless GL back end (auto: OSMesa, else EGL)");
   else
     cli.choice("--gl", &o.gl, {"auto", "window", "osmesa", "egl"}, "GL back end (auto: a window when a display exists)");
+  cli.choice("--stage-timing", &o.stage_timing, gl_timing_names(),
+             std::string("how the GL stages' ms are measured: finish = glFinish around each (exact, stalls),\n"
+                         "submit = without (on llvmpipe nearly the same figures); default ") +
+                 gl_timing_names()[static_cast<int>(o.stage_timing)]);
 }
 
-void add_preview_options(CommandLine& cli, PreviewOptions& o) {
-  PreviewSettings& s = o.settings;
+void add_preview_options(CommandLine& cli, PreviewSettings& s) {
   cli.option("--threshold", &s.threshold, "blend threshold t on perceived variance (default 0.001)", 0.0f, 1e6f);
   cli.option("--sigma-s", &s.filter.sigma_s, "spatial sigma in pixels (default 8)", 0.1f, kMaxFilterRadius / 3.0f);
   cli.option("--sigma-c", &s.filter.sigma_c, "range color sigma, linear RGB (default 0.02)", 1e-6f, 1e6f);
   cli.option("--sigma-d", &s.filter.sigma_d, "range depth sigma, scene units (default 2)", 1e-6f, 1e6f);
-  cli.choice("--filter", &o.filter, filter_option_names(), "filter variant (default grid: the bilateral grid on the range luminance)");
-  cli.choice("--schedule", &o.schedule, filter_schedule_names(),
+  cli.choice("--filter", &s.filter.kind, filter_option_names(), "filter variant (default grid: the bilateral grid on the range luminance)");
+  cli.choice("--schedule", &s.schedule, filter_schedule_names(),
              "when the filter runs: budget = at power-of-two sample counts while filter + range stay within\n"
              "10 % of the tracing time (default); pow2 = at every power of two; every = each frame; all also\n"
              "the last frame");
-  cli.choice("--demodulate", &o.demodulate, {"on", "off"},
+  cli.choice("--demodulate", &s.demodulate, {"off", "on"},
              "albedo demodulation: filter HV divided by the first non-specular albedo, so textures stay\n"
              "sharp (default off: docs/measurements.md, \"Albedo demodulation\")");
-  cli.option("--seed", &o.seed, "random seed", 0, 2147483647);
-  cli.choice("--sampler", &o.sampler, {"sobol", "independent"},
+  cli.option("--seed", &s.trace.seed, "random seed", 0, 2147483647);
+  cli.choice("--sampler", &s.trace.sampler, sampler_type_names(),
              "random numbers of the path tracer: Owen-scrambled Sobol (default) or independent PCG32");
   cli.option("--replicates", &s.trace.replicates,
              "independently scrambled Sobol replicates for the variance estimate (default 1 = none)", 1, 64);
   cli.option("--threads", &s.trace.threads, "path-tracing threads (0 = all cores)", 0, 1024);
   cli.option("--max-vertices", &s.trace.max_vertices, "maximum path length in vertices, camera and light included", 2, 1024);
   cli.option("--rr-start", &s.trace.rr_start_vertex, "Russian roulette from this vertex on", 2, 1024);
-  cli.flag("--all-hv", &o.all_hv, "put every contribution into the HV buffer but what the camera sees directly or through\nmirrors and glass (environment-lit scenes)");
+  cli.flag("--all-hv", &s.trace.all_hv, "put every contribution into the HV buffer but what the camera sees directly or through\nmirrors and glass (environment-lit scenes)");
   cli.option("--key", &s.tonemap.key, "Reinhard key a (default 0.18)", 1e-4f, 100.0f);
   cli.option("--white", &s.tonemap.white, "Reinhard white point (0 = none)", 0.0f, 1e9f);
 }
@@ -64,16 +67,6 @@ void print_scene_messages(const Scene& scene) {
   for (const std::string& w : scene.warnings) std::fprintf(stderr, "pxf: warning: %s\n", w.c_str());
 }
 
-void finish_preview_options(PreviewOptions& o) {
-  set_filter_option(o.settings, o.filter);
-  o.settings.schedule = parse_filter_schedule(o.schedule);
-  o.settings.trace.seed = static_cast<uint64_t>(o.seed);
-  o.settings.trace.all_hv = o.all_hv;
-  o.settings.trace.sampler = o.sampler == "independent" ? SamplerType::Independent : SamplerType::Sobol;
-  o.settings.filter.t = o.settings.threshold;
-  o.settings.demodulate = o.demodulate == "on";
-}
-
 LoadLimits load_limits(const SceneOptions& options) {
   LoadLimits limits;
   limits.max_texture_size = options.max_texture_size;
@@ -81,7 +74,7 @@ LoadLimits load_limits(const SceneOptions& options) {
   return limits;
 }
 
-Scene load_scene_for(SceneOptions& options, PreviewOptions& preview, const CommandLine& cli) {
+Scene load_scene_for(SceneOptions& options, PreviewSettings& settings, const CommandLine& cli) {
   Scene scene = load_scene(options.scene, options.env, options.env_strength, parse_default_light(options.default_light),
                            load_limits(options));
   print_scene_messages(scene);
@@ -90,12 +83,12 @@ Scene load_scene_for(SceneOptions& options, PreviewOptions& preview, const Comma
     options.height = scene.defaults.height > 0 ? scene.defaults.height : 512;
   }
   if (scene.automatic_camera) scene.camera = frame_scene(scene, static_cast<float>(options.width) / options.height);
-  if (!cli.given("--all-hv") && scene.defaults.all_hv) preview.all_hv = true;
-  if (preview.all_hv && !cli.given("--filter")) {
-    preview.filter = kAllHvFilter;
-    std::fprintf(stderr, "pxf: all-HV (environment-lit) scene: filter %s (--filter to choose another)\n", kAllHvFilter);
+  if (!cli.given("--all-hv") && scene.defaults.all_hv) settings.trace.all_hv = true;
+  if (settings.trace.all_hv && !cli.given("--filter")) {
+    settings.filter.kind = kAllHvFilter;
+    std::fprintf(stderr, "pxf: all-HV (environment-lit) scene: filter %s (--filter to choose another)\n",
+                 filter_kind_name(kAllHvFilter));
   }
-  finish_preview_options(preview);
   return scene;
 }
 

@@ -4,6 +4,7 @@
 
 #include "app/cli.h"
 #include "app/preview.h"
+#include "gl/resources.h"
 #include "pathtracer/pathtracer.h"
 #include "pathtracer/scene.h"
 
@@ -16,6 +17,9 @@ struct SceneOptions {
   std::string default_light = "sky";  // default_light_names(): lights a scene that has no light
   int width = 0, height = 0;      // 0 = the scene's default, else 512x512
   std::string gl = "auto";
+  // How GL stages are timed (gl/resources.h): submit, no stall per stage, for rendering; pxf bench
+  // sets finish before binding the options. Applied by set_gl_timing when the command starts.
+  GlTiming stage_timing = GlTiming::Submit;
   int max_texture_size = LoadLimits::kDefaultMaxTextureSize;
   int max_triangles = static_cast<int>(LoadLimits::kDefaultMaxTriangles);
 };
@@ -23,33 +27,23 @@ struct SceneOptions {
 // The loader's limits from the scene options (memory: what the system reports).
 LoadLimits load_limits(const SceneOptions& options);
 
-struct PreviewOptions {
-  PreviewSettings settings;
-  std::string filter = "grid";
-  std::string schedule = "budget";
-  int seed = 1;
-  bool all_hv = false;
-  std::string sampler = "sobol";
-  std::string demodulate = "off";  // "on" | "off": PreviewSettings::demodulate
-};
-
 // The filter of an all-HV (environment-lit) scene unless --filter is given. Measured on envmap
 // (384x216, 32 PT frames, median of 3, display NRMSE filtered / unfiltered): grid 1.48x, a-trous
 // 0.97x. There HV holds the direct light too, so textured detail is filtered, and the grid's range
 // axis (luminance only) averages texture stripes that differ in luminance by less than sigma_c;
 // a-trous weighs the RGB range color. Elsewhere the grid is ahead (README, "Current figures").
-constexpr const char* kAllHvFilter = "atrous";
+constexpr FilterKind kAllHvFilter = FilterKind::Atrous;
 
 void add_scene_options(CommandLine& cli, SceneOptions& options, bool headless);
-void add_preview_options(CommandLine& cli, PreviewOptions& options);
+// Binds the command line to the one PreviewSettings (enums through their name tables).
+void add_preview_options(CommandLine& cli, PreviewSettings& settings);
 
 // Prints the built-in scenes when options.scene == "list" (returns true: nothing else to do).
 bool print_scene_list_if_asked(const SceneOptions& options);
-// Loads the scene, applies its render defaults (size, all_hv unless given on the command line).
-Scene load_scene_for(SceneOptions& options, PreviewOptions& preview, const CommandLine& cli);
+// Loads the scene, applies its render defaults (size, all_hv unless given on the command line, and
+// then kAllHvFilter unless --filter is given).
+Scene load_scene_for(SceneOptions& options, PreviewSettings& settings, const CommandLine& cli);
 // Prints the scene's notes and warnings to stderr, one "pxf: ..." line each.
 void print_scene_messages(const Scene& scene);
-// Resolves the names of PreviewOptions into its settings.
-void finish_preview_options(PreviewOptions& options);
 
 }  // namespace pxf

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 
-#include "pathtracer/bench.h"
+#include "core/timing.h"
 
 namespace pxf {
 
@@ -15,26 +15,20 @@ bool same_trace_params(const TraceParams& a, const TraceParams& b) {
 }
 
 bool same_filter_params(const PreviewSettings& a, const PreviewSettings& b) {
-  return a.filter_enabled == b.filter_enabled && a.filter.kind == b.filter.kind && a.filter.sigma_s == b.filter.sigma_s &&
+  return a.filter.kind == b.filter.kind && a.filter.sigma_s == b.filter.sigma_s &&
          a.filter.sigma_c == b.filter.sigma_c && a.filter.sigma_d == b.filter.sigma_d &&
          a.filter.skip_case2 == b.filter.skip_case2 && a.filter.subsampled_taps == b.filter.subsampled_taps &&
          a.threshold == b.threshold && a.demodulate == b.demodulate;
 }
 }  // namespace
 
-std::vector<std::string> filter_option_names() {
-  std::vector<std::string> names = filter_kind_names();
-  names.push_back("none");
+const std::vector<std::string>& filter_option_names() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> n = filter_kind_names();
+    n.push_back(filter_kind_name(FilterKind::None));
+    return n;
+  }();
   return names;
-}
-
-void set_filter_option(PreviewSettings& settings, const std::string& name) {
-  settings.filter_enabled = name != "none";
-  if (settings.filter_enabled) settings.filter.kind = parse_filter_kind(name);
-}
-
-std::string filter_option_name(const PreviewSettings& settings) {
-  return settings.filter_enabled ? filter_kind_name(settings.filter.kind) : "none";
 }
 
 StageTimes& StageTimes::operator+=(const StageTimes& o) {
@@ -102,7 +96,6 @@ Preview::Preview(const Scene& scene, const PreviewSettings& settings, int width,
       blend_(width, height),
       tonemap_(width, height),
       hv_packed_(static_cast<size_t>(width) * height * 4) {
-  settings_.filter.t = settings_.threshold;
   range_.set_settings(settings_.range);
   range_.set_scene(scene);
   range_.set_camera(renderer_->camera());
@@ -144,7 +137,6 @@ void Preview::set_settings(const PreviewSettings& settings) {
   const bool retrace = !same_trace_params(settings.trace, settings_.trace);
   const bool refilter = !same_filter_params(settings, settings_);
   settings_ = settings;
-  settings_.filter.t = settings_.threshold;
   range_.set_settings(settings_.range);
   if (retrace) {
     renderer_->set_params(settings_.trace);
@@ -155,7 +147,7 @@ void Preview::set_settings(const PreviewSettings& settings) {
     // The samples stay valid: filter them again with the new parameters (or drop L_f).
     schedule_.all_pixels_case2 = false;
     have_filtered_ = false;
-    if (settings_.filter_enabled && samples() > 0 && !schedule_.hv_empty) run_filter();
+    if (settings_.filtering() && samples() > 0 && !schedule_.hv_empty) run_filter();
   }
   if (samples() > 0) redisplay();
 }
@@ -206,12 +198,12 @@ void Preview::run_filter() {
     const auto start = BenchClock::now();
     if (!demod_) demod_ = std::make_unique<Demodulation>(width_, height_);
     inputs_.upload_albedo(&renderer_->accumulation().albedo_mean[0].x);
-    demod_->demodulate(inputs_, range_.guide(), settings_.filter);
-    filter_.run(demod_->filter_inputs(), range_.guide(), settings_.filter);
+    demod_->demodulate(inputs_, range_.guide(), settings_.filter, settings_.threshold);
+    filter_.run(demod_->filter_inputs(), range_.guide(), settings_.filter, settings_.threshold);
     demod_->remodulate(filter_.output(), inputs_);
     filter_ms = elapsed_ms(start);
   } else {
-    filter_.run(inputs_, range_.guide(), settings_.filter);
+    filter_.run(inputs_, range_.guide(), settings_.filter, settings_.threshold);
     filter_ms = filter_.last_ms();
   }
   last_.filter += filter_ms;
@@ -256,8 +248,8 @@ void Preview::blend_and_tonemap() {
   upload();
   // The filter's centre weight is that of the demodulated run too: with a grey factor a,
   // Cov[L_u, a L_f'] = a w Var[L_u] / a = w Var[L_u], the blend's covariance term is unchanged.
-  blend_.run(inputs_, have_filtered_ ? &filtered_output() : nullptr, &range_.guide(),
-             BlendParams{settings_.threshold, range_weights(settings_.filter)},
+  blend_.run(inputs_, have_filtered_ ? &filtered_output() : nullptr, &range_.guide(), settings_.threshold,
+             BlendParams{range_weights(settings_.filter)},
              have_filtered_ ? filter_.centre_weight() : nullptr);
   last_.blend += blend_.last_ms();
   tonemap_.run(blend_.output(), settings_.tonemap);
@@ -332,19 +324,19 @@ void Preview::run_next_pass() {
 // The last frame always filters: its run (predicted by the newest one) is kept in reserve, so that
 // the range frames never push a job's passes past kPassShare once that run comes.
 bool Preview::range_due() const {
-  return settings_.filter_enabled && !schedule_.hv_empty && range_.frames() != 0 && !range_.converged() &&
+  return settings_.filtering() && !schedule_.hv_empty && range_.frames() != 0 && !range_.converged() &&
          schedule_.pass_ms + range_.last_ms() + schedule_.last_run_ms <= kPassShare * schedule_.tracing_ms;
 }
 
 bool Preview::filter_due_now() const {
-  if (!settings_.filter_enabled) return false;
+  if (!settings_.filtering()) return false;
   if (pending_last_frame_)
     return filtered_samples_ != samples() && filter_due(settings_.schedule, samples(), true, schedule_);
   return filter_due(settings_.schedule, samples(), false, schedule_);
 }
 
 void Preview::finish_passes() {
-  if (settings_.filter_enabled && filtered_samples_ != samples() &&
+  if (settings_.filtering() && filtered_samples_ != samples() &&
       filter_due(settings_.schedule, samples(), true, schedule_) && filter_worthwhile())
     run_filter();
   blend_and_tonemap();
@@ -353,7 +345,7 @@ void Preview::finish_passes() {
 TimeBudget Preview::predict_next_frame(double budget_ms, double elapsed_ms) const {
   MeasuredJob job;
   job.schedule = settings_.schedule;
-  job.filtering = settings_.filter_enabled;
+  job.filtering = settings_.filtering();
   job.samples = samples();
   job.state = schedule_;
   job.recent_frame_ms = recent_frame_ms_;

@@ -26,11 +26,14 @@
 
 namespace pxf {
 
+// Every setting of a preview, held once: the command line (app/options.cpp) binds these fields
+// directly, the explorer edits them, stats.json and the bench read them.
 struct PreviewSettings {
   TraceParams trace;
-  float threshold = 0.001f;  // t: allowed perceived (relative) variance
-  bool filter_enabled = true;  // false = plain path tracing (--filter none)
-  FilterParams filter;         // kind and sigmas; filter.t is kept equal to threshold
+  // t: allowed perceived (relative) variance. The one threshold: the filter's case-2 skip and the
+  // blend are both given this value on every run.
+  float threshold = 0.001f;
+  FilterParams filter;  // variant (FilterKind::None = plain path tracing) and sigmas
   // Albedo demodulation: filter HV divided by the first non-specular albedo and multiply L_f back
   // (gl/demodulation.h), so the filter does not blur textures. Off by default: at equal time it did
   // not beat filtering radiance with the default grid filter (docs/measurements.md, "Albedo
@@ -39,13 +42,12 @@ struct PreviewSettings {
   FilterSchedule schedule = FilterSchedule::Budget;
   TonemapParams tonemap;
   RangeSettings range;
+  bool filtering() const { return filter.kind != FilterKind::None; }
 };
 
-// Filter variant names of the command line and the UI: the GL variants plus "none".
-std::vector<std::string> filter_option_names();
-// Applies a filter option name ("none" disables filtering).
-void set_filter_option(PreviewSettings& settings, const std::string& name);
-std::string filter_option_name(const PreviewSettings& settings);
+// The name table of FilterKind for the command line and the UI (index = value): the GL variants
+// (filter_kind_names()) and "none" (FilterKind::None).
+const std::vector<std::string>& filter_option_names();
 
 // Milliseconds per stage (reported in stats.json and by pxf bench).
 struct StageTimes {

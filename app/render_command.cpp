@@ -10,9 +10,8 @@
 #include "app/options.h"
 #include "app/preview.h"
 #include "app/render_output.h"
-#include "pathtracer/bench.h"
+#include "core/timing.h"
 #include "gl/context.h"
-#include "pathtracer/bench.h"
 
 namespace pxf {
 
@@ -75,7 +74,7 @@ class ProgressBar {
 
 int run_render(const Args& args) {
   SceneOptions scene_options;
-  PreviewOptions preview_options;
+  PreviewSettings preview_settings;
   int spp = 64;
   double time_s = 0;
   std::string out = "out", reference;
@@ -91,7 +90,7 @@ int run_render(const Args& args) {
   cli.option("--time", &time_s,
              "wall-clock budget in seconds of the whole job (load, trace, passes, finish); with --spp: first wins",
              0.001, 1e7);
-  add_preview_options(cli, preview_options);
+  add_preview_options(cli, preview_settings);
   cli.option("--reference", &reference, "REF.exr", "report NRMSE of the final and the unfiltered image against it");
   cli.option("--out", &out, "DIR", "output folder (default out)");
   cli.flag("--quiet", &quiet, "no progress bar");
@@ -106,13 +105,14 @@ int run_render(const Args& args) {
   }
 
   const auto start = BenchClock::now();
-  Scene scene = load_scene_for(scene_options, preview_options, cli);
+  Scene scene = load_scene_for(scene_options, preview_settings, cli);
   const double load_ms = elapsed_ms(start);
   if (!reference.empty()) check_reference(reference, scene_options.width, scene_options.height);  // before tracing
+  set_gl_timing(scene_options.stage_timing);
   auto context = create_gl_context(parse_gl_backend(scene_options.gl));
-  Preview preview(scene, preview_options.settings, scene_options.width, scene_options.height);
+  Preview preview(scene, preview_settings, scene_options.width, scene_options.height);
   const FrameRange frames = render_frame_range(checkpoint_options, spp);
-  Checkpointer checkpointer(checkpoint_options, out, render_sample_settings(scene_options, preview_options.settings),
+  Checkpointer checkpointer(checkpoint_options, out, render_sample_settings(scene_options, preview_settings),
                             frames);
   checkpointer.start(preview);
 
@@ -136,7 +136,6 @@ int run_render(const Args& args) {
 
   RenderReport report;
   report.scene = &scene_options;
-  report.preview = &preview_options;
   report.interrupted = g_interrupted;
   report.gl_backend = context->backend_name();
   report.gl_renderer = context->gl_renderer();

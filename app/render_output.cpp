@@ -1,5 +1,5 @@
 #include "app/render_output.h"
-#include "pathtracer/bench.h"
+#include "core/timing.h"
 
 #include <pthread.h>
 #include <signal.h>
@@ -50,9 +50,9 @@ nlohmann::json stats_json(Preview& preview, const RenderReport& r) {
                    {"height", preview.height()},
                    {"spp", preview.samples()},
                    {"threshold", s.threshold},
-                   {"filter", filter_option_name(s)},
+                   {"filter", filter_kind_name(s.filter.kind)},
                    {"demodulate", s.demodulate},
-                   {"schedule", r.preview->schedule},
+                   {"schedule", filter_schedule_names()[static_cast<int>(s.schedule)]},
                    {"sigma_s", s.filter.sigma_s},
                    {"sigma_c", s.filter.sigma_c},
                    {"sigma_d", s.filter.sigma_d},
@@ -63,6 +63,7 @@ nlohmann::json stats_json(Preview& preview, const RenderReport& r) {
                    {"all_hv", s.trace.all_hv},
                    {"key", s.tonemap.key},
                    {"gl", r.gl_backend},
+                   {"stage_timing", gl_timing_names()[static_cast<int>(gl_timing())]},
                    {"gl_renderer", r.gl_renderer}};
   j["stage_ms_total"] = times_json(total);
   j["stage_ms_per_frame"] = {{"path_tracing", preview.samples() ? total.path_tracing / preview.samples() : 0.0}};

@@ -13,7 +13,6 @@ namespace pxf {
 
 struct RenderReport {
   const SceneOptions* scene = nullptr;
-  const PreviewOptions* preview = nullptr;
   double wall_ms = 0;
   double budget_ms = 0;  // --time (0 = none)
   double used_ms = 0;    // from the start until the finish (files not included)

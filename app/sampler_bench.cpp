@@ -6,12 +6,12 @@
 #include <fstream>
 #include <sstream>
 
-#include "pathtracer/bench.h"
+#include "core/timing.h"
 
 namespace pxf {
 namespace {
 
-const char* sampler_name(SamplerType type) { return type == SamplerType::Sobol ? "sobol" : "independent"; }
+const char* sampler_name(SamplerType type) { return sampler_type_names()[static_cast<int>(type)].c_str(); }
 constexpr SamplerType kSamplers[2] = {SamplerType::Independent, SamplerType::Sobol};
 
 void write_csv(const std::string& path, const std::string& text) {

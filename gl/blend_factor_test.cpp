@@ -170,7 +170,7 @@ TEST(BlendFactorShader, MatchesCpuOnGridAndBoundaries) {
   ftex.upload(filtered);
   BlendPass blend(w, h);
   for (float t : thresholds()) {
-    blend.run(inputs, &ftex, nullptr, {t});
+    blend.run(inputs, &ftex, nullptr, t, {});
     Image s = blend.s_image(), cases = blend.case_image(), final_rgb = blend.final_image();
     EXPECT_EQ(count_nonfinite(final_rgb), 0u);
     for (int y = 0; y < w; ++y)
@@ -240,10 +240,11 @@ TEST(PooledVariance, DarkSpeckleIsFilteredNotKept) {
   for (int c = 0; c < 3; ++c) hv.at(1, 1, c) = 0.01f;  // few small samples: mean and variance tiny
   p.var.at(1, 1, 0) = 1e-7f;
   // Pooled u = (8e-2 + 1e-7) / 9 / L_b^2 with L_b = Y(L_f) = 1: above t = 0.005.
-  const BlendParams params{0.005f, range_weights(FilterParams{})};
-  BlendOutput own_only = cpu_blend(lv, hv, p.var, &filtered, params, nullptr, nullptr);
+  const float t = 0.005f;
+  const BlendParams params{range_weights(FilterParams{})};
+  BlendOutput own_only = cpu_blend(lv, hv, p.var, &filtered, t, params, nullptr, nullptr);
   EXPECT_EQ(own_only.blend_case.at(1, 1, 0), float(kCaseUnfiltered));  // u = 1e-7: kept dark
-  BlendOutput pooled = cpu_blend(lv, hv, p.var, &filtered, params, &p.range, &p.depth);
+  BlendOutput pooled = cpu_blend(lv, hv, p.var, &filtered, t, params, &p.range, &p.depth);
   EXPECT_NE(pooled.blend_case.at(1, 1, 0), float(kCaseUnfiltered));
   // Case 3: s = (f + sqrt(D)) / (u + f) ~ 0.75, so L ~ 0.75 * 0.01 + 0.25 * 1 instead of 0.01.
   EXPECT_NEAR(pooled.final_rgb.at(1, 1, 1), 0.26f, 0.02f);

@@ -13,13 +13,13 @@ BlendPass::BlendPass(int width, int height)
   fbo_.check("blend pass");
 }
 
-void BlendPass::run(const PreviewInputs& inputs, const FilterPass* filtered, const Texture2D& guide,
+void BlendPass::run(const PreviewInputs& inputs, const FilterPass* filtered, const Texture2D& guide, float t,
                     const BlendParams& params) {
   const bool has = filtered && filtered->has_output();
-  run(inputs, has ? &filtered->output() : nullptr, &guide, params, has ? filtered->centre_weight() : nullptr);
+  run(inputs, has ? &filtered->output() : nullptr, &guide, t, params, has ? filtered->centre_weight() : nullptr);
 }
 
-void BlendPass::run(const PreviewInputs& inputs, const Texture2D* filtered, const Texture2D* guide,
+void BlendPass::run(const PreviewInputs& inputs, const Texture2D* filtered, const Texture2D* guide, float t,
                     const BlendParams& params, const Texture2D* centre_weight) {
   auto other_size = [&](const Texture2D* tex) { return tex && (tex->width() != width_ || tex->height() != height_); };
   if (inputs.width() != width_ || inputs.height() != height_ || other_size(filtered) || other_size(guide) ||
@@ -31,7 +31,7 @@ void BlendPass::run(const PreviewInputs& inputs, const Texture2D* filtered, cons
   program_.set("has_centre_weight", filtered && centre_weight ? 1 : 0);
   program_.set("k_c", params.range.k_c);
   program_.set("k_d", params.range.k_d);
-  program_.set("t", params.t);
+  program_.set("t", t);
   const std::array<uint32_t, kBlendCaseCount> zeros{};
   counts_.upload(zeros.data(), sizeof zeros);
   counts_.bind_storage(shared::kBufferCounts);

@@ -2,7 +2,7 @@
 // composite L = L_lv + s L_u + (1 - s) L_f. Runs every displayed frame with the newest L_f.
 // Usage:
 //   BlendPass blend(w, h);
-//   blend.run(inputs, &filter, range.guide(), {t, range_weights(filter_params)});
+//   blend.run(inputs, &filter, range.guide(), t, {range_weights(filter_params)});
 //   tonemap.run(blend.output(), tonemap_params);
 //   auto counts = blend.case_counts();  // e.g. counts[kCaseUnfiltered] == w*h: stop filtering
 //   blend.final_image(), blend.s_image(), blend.case_image(), blend.last_ms()
@@ -19,14 +19,16 @@ class BlendPass {
  public:
   BlendPass(int width, int height);
   // filtered == nullptr (or without output): no L_f yet, s = 1 everywhere (kCaseNoFiltered).
-  // guide: the range buffer (rgb color, a distance), for the 3x3 variance pooling of u.
-  void run(const PreviewInputs& inputs, const FilterPass* filtered, const Texture2D& guide, const BlendParams& params);
+  // guide: the range buffer (rgb color, a distance), for the 3x3 variance pooling of u. t: the
+  // perceived-variance threshold (the filter's skip used the same).
+  void run(const PreviewInputs& inputs, const FilterPass* filtered, const Texture2D& guide, float t,
+           const BlendParams& params);
   // Same with a raw L_f texture (rgb L_f, a Var[L_f]); guide == nullptr: u from each pixel's own
   // variance (no pooling). Used by tests and custom filters.
   // centre_weight (r: the filter's normalized centre weight, FilterPass::centre_weight()) adds the
   // covariance of L_u and L_f to the blend's variance; nullptr leaves it out.
-  void run(const PreviewInputs& inputs, const Texture2D* filtered, const Texture2D* guide, const BlendParams& params,
-           const Texture2D* centre_weight = nullptr);
+  void run(const PreviewInputs& inputs, const Texture2D* filtered, const Texture2D* guide, float t,
+           const BlendParams& params, const Texture2D* centre_weight = nullptr);
 
   const Texture2D& output() const { return output_; }       // rgb L, a s
   const Texture2D& case_texture() const { return case_; }   // r: case code (kCase* in shaders/pass_formulas.h)

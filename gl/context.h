@@ -10,7 +10,7 @@
 #pragma once
 #include <memory>
 #include <string>
-#include "image/image.h"
+#include "core/error.h"
 
 namespace pxf {
 

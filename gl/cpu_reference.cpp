@@ -73,15 +73,15 @@ struct KernelSums {
 }  // namespace
 
 bool case2_skip_decision(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
-                         const Image& depth, const FilterParams& p, int x, int y) {
+                         const Image& depth, const FilterParams& p, float t, int x, int y) {
   const RangeWeights range = range_weights(p);
   return shared::skip_as_case2(TexelView{&hv, &var_u}, TexelView{&lv, nullptr}, TexelView{&range_color, &depth},
-                               glm::ivec2(x, y), range.k_c, range.k_d, p.t);
+                               glm::ivec2(x, y), range.k_c, range.k_d, t);
 }
 
 bool skip_as_case2(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
-                   const Image& depth, const FilterParams& p, int x, int y, FilterOutput& out) {
-  if (!case2_skip_decision(hv, var_u, lv, range_color, depth, p, x, y)) return false;
+                   const Image& depth, const FilterParams& p, float t, int x, int y, FilterOutput& out) {
+  if (!case2_skip_decision(hv, var_u, lv, range_color, depth, p, t, x, y)) return false;
   const Px lu = rgb_at(hv, x, y);
   for (int c = 0; c < 3; ++c) out.filtered.at(x, y, c) = lu.c[c];
   out.variance.at(x, y, 0) = kVarSkipped;
@@ -112,7 +112,7 @@ namespace {
 // the radius; skipping (final pass only) looks at the unfiltered hv / var_u.
 FilterOutput filter_once(const Image& signal, const Image& signal_var, const Image& hv, const Image& var_u,
                          const Image& lv, const Image& range_color, const Image& depth, const FilterParams& p,
-                         int ex, int ey, bool final_pass) {
+                         float t, int ex, int ey, bool final_pass) {
   const int w = hv.width, h = hv.height;
   FilterOutput out{Image::rgb(w, h), Image::gray(w, h), Image::gray(w, h, "Y", 1.0f)};
   const int radius = std::min(kMaxFilterRadius, static_cast<int>(std::ceil(3.0f * std::max(p.sigma_s, 0.0f))));
@@ -120,7 +120,7 @@ FilterOutput filter_once(const Image& signal, const Image& signal_var, const Ima
   const RangeWeights range = range_weights(p);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
-      if (final_pass && p.skip_case2 && skip_as_case2(hv, var_u, lv, range_color, depth, p, x, y, out)) continue;
+      if (final_pass && p.skip_case2 && skip_as_case2(hv, var_u, lv, range_color, depth, p, t, x, y, out)) continue;
       KernelSums sums;
       for (int qy = std::max(0, y - radius * ey); qy <= std::min(h - 1, y + radius * ey); ++qy)
         for (int qx = std::max(0, x - radius * ex); qx <= std::min(w - 1, x + radius * ex); ++qx) {
@@ -140,13 +140,13 @@ FilterOutput filter_once(const Image& signal, const Image& signal_var, const Ima
 // sums are normalized). Skipping (final pass only) looks at the unfiltered hv / var_u.
 FilterOutput atrous_pass(const Image& signal, const Image& signal_var, const Image& hv, const Image& var_u,
                          const Image& lv, const Image& range_color, const Image& depth, const FilterParams& p,
-                         int step, float variance_factor, bool final_pass) {
+                         float t, int step, float variance_factor, bool final_pass) {
   const int w = hv.width, h = hv.height;
   FilterOutput out{Image::rgb(w, h), Image::gray(w, h)};
   const RangeWeights range = range_weights(p);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
-      if (final_pass && p.skip_case2 && skip_as_case2(hv, var_u, lv, range_color, depth, p, x, y, out)) continue;
+      if (final_pass && p.skip_case2 && skip_as_case2(hv, var_u, lv, range_color, depth, p, t, x, y, out)) continue;
       KernelSums sums;
       for (int j = 0; j < 5; ++j)
         for (int i = 0; i < 5; ++i) {
@@ -165,11 +165,11 @@ FilterOutput atrous_pass(const Image& signal, const Image& signal_var, const Ima
 // and then multiplied by atrous_variance_correction(pass), which makes it exact where all range
 // weights are 1 (Atrous.WhiteNoiseVarianceShrinksBySumOfSquaredWeights in gl/passes_test.cpp).
 FilterOutput cpu_atrous(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
-                        const Image& depth, const FilterParams& p) {
+                        const Image& depth, const FilterParams& p, float t) {
   const int passes = atrous_iterations(p.sigma_s);
   FilterOutput level{hv, var_u};
   for (int i = 0; i < passes; ++i)
-    level = atrous_pass(level.filtered, level.variance, hv, var_u, lv, range_color, depth, p, 1 << i,
+    level = atrous_pass(level.filtered, level.variance, hv, var_u, lv, range_color, depth, p, t, 1 << i,
                         atrous_variance_correction(i), i + 1 == passes);
   return level;
 }
@@ -180,14 +180,14 @@ FilterOutput cpu_atrous(const Image& hv, const Image& var_u, const Image& lv, co
 // its count x the range weights (the spatial weight is in the tap density), taps outside the image
 // left out. Mirrors shaders/subsampled.frag.
 FilterOutput cpu_subsampled(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
-                            const Image& depth, const FilterParams& p) {
+                            const Image& depth, const FilterParams& p, float t) {
   const int w = hv.width, h = hv.height;
   FilterOutput out{Image::rgb(w, h), Image::gray(w, h)};
   const RangeWeights range = range_weights(p);
   const SubsampledTapTable table = subsampled_tap_table(p.sigma_s, p.subsampled_taps > 0 ? p.subsampled_taps : kSubsampledTaps);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
-      if (p.skip_case2 && skip_as_case2(hv, var_u, lv, range_color, depth, p, x, y, out)) continue;
+      if (p.skip_case2 && skip_as_case2(hv, var_u, lv, range_color, depth, p, t, x, y, out)) continue;
       KernelSums sums;
       const SubsampledTap* taps = &table.taps[static_cast<size_t>(subsampled_rotation(x, y)) * table.per_rotation];
       for (int i = 0; i < table.per_rotation && taps[i].count > 0; ++i) {
@@ -204,18 +204,19 @@ FilterOutput cpu_subsampled(const Image& hv, const Image& var_u, const Image& lv
 }  // namespace
 
 FilterOutput cpu_filter(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
-                        const Image& depth, const FilterParams& p) {
-  if (p.kind == FilterKind::Atrous) return cpu_atrous(hv, var_u, lv, range_color, depth, p);
-  if (p.kind == FilterKind::Subsampled) return cpu_subsampled(hv, var_u, lv, range_color, depth, p);
-  if (p.kind == FilterKind::Grid) return cpu_grid_filter(hv, var_u, lv, range_color, depth, p);
-  if (p.kind != FilterKind::Separable) return filter_once(hv, var_u, hv, var_u, lv, range_color, depth, p, 1, 1, true);
-  FilterOutput rows = filter_once(hv, var_u, hv, var_u, lv, range_color, depth, p, 1, 0, false);
-  FilterOutput out = filter_once(rows.filtered, rows.variance, hv, var_u, lv, range_color, depth, p, 0, 1, true);
+                        const Image& depth, const FilterParams& p, float t) {
+  if (p.kind == FilterKind::None) throw Error("cpu_filter: filter kind none");
+  if (p.kind == FilterKind::Atrous) return cpu_atrous(hv, var_u, lv, range_color, depth, p, t);
+  if (p.kind == FilterKind::Subsampled) return cpu_subsampled(hv, var_u, lv, range_color, depth, p, t);
+  if (p.kind == FilterKind::Grid) return cpu_grid_filter(hv, var_u, lv, range_color, depth, p, t);
+  if (p.kind != FilterKind::Separable) return filter_once(hv, var_u, hv, var_u, lv, range_color, depth, p, t, 1, 1, true);
+  FilterOutput rows = filter_once(hv, var_u, hv, var_u, lv, range_color, depth, p, t, 1, 0, false);
+  FilterOutput out = filter_once(rows.filtered, rows.variance, hv, var_u, lv, range_color, depth, p, t, 0, 1, true);
   out.centre_weight = Image();  // the second pass's centre weight alone would understate it: none
   return out;
 }
 
-BlendOutput cpu_blend(const Image& lv, const Image& hv, const Image& var_u, const FilterOutput* filtered,
+BlendOutput cpu_blend(const Image& lv, const Image& hv, const Image& var_u, const FilterOutput* filtered, float t,
                       const BlendParams& params, const Image* range_color, const Image* depth) {
   const bool pool = range_color && depth;
   const int w = hv.width, h = hv.height;
@@ -242,7 +243,7 @@ BlendOutput cpu_blend(const Image& lv, const Image& hv, const Image& var_u, cons
           if (pool) vu = pooled_var_u(var_u, *range_color, *depth, x, y, params.range);
           float u = vu > 0.0f ? relative_variance(vu, lb) : zero_variance_u(lum(lf.c), lb);
           const float w_centre = filtered->centre_weight.pixels.empty() ? 0.0f : filtered->centre_weight.at(x, y, 0);
-          d = blend_decision(u, relative_variance(vf, lb), params.t, w_centre);
+          d = blend_decision(u, relative_variance(vf, lb), t, w_centre);
         }
       }
       for (int c = 0; c < 3; ++c)
@@ -259,7 +260,7 @@ std::array<float, 3> demodulation_factor(float r, float g, float b) {
 }
 
 DemodulatedInputs cpu_demodulate(const Image& hv, const Image& var_u, const Image& lv, const Image& albedo,
-                                 const Image& range_color, const Image& depth, const FilterParams& p) {
+                                 const Image& range_color, const Image& depth, const FilterParams& p, float t) {
   const int w = hv.width, h = hv.height;
   DemodulatedInputs out{Image::rgb(w, h), Image::gray(w, h), Image::rgb(w, h)};
   for (int y = 0; y < h; ++y)
@@ -270,7 +271,7 @@ DemodulatedInputs cpu_demodulate(const Image& hv, const Image& var_u, const Imag
       for (int c = 0; c < 3; ++c) out.hv.at(x, y, c) = lu.c[c] / a[c];
       const float v = clean_var(var_u.at(x, y, 0));
       out.var_u.at(x, y, 0) = shared::demodulated_var(v, k);
-      const bool skip = p.skip_case2 && case2_skip_decision(hv, var_u, lv, range_color, depth, p, x, y);
+      const bool skip = p.skip_case2 && case2_skip_decision(hv, var_u, lv, range_color, depth, p, t, x, y);
       for (int c = 0; c < 3; ++c) out.lv.at(x, y, c) = skip ? kMaxInput : -kMaxInput;
     }
   return out;

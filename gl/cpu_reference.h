@@ -45,18 +45,19 @@ struct FilterOutput {
   // kernel, 1 where skipped), for the blend's covariance term; empty for the other variants.
   Image centre_weight;
 };
+// t: the blend threshold, for the case-2 skip.
 FilterOutput cpu_filter(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
-                        const Image& depth, const FilterParams& params);
+                        const Image& depth, const FilterParams& params, float t);
 
 // The filter's case-2 skip (FilterParams::skip_case2, final pass only): the blend's u (pooled
 // variance) with the unfiltered background; a zero variance is not trusted. Writes the skip
 // (L_f = L_u, Var = kVarSkipped) into `out` and returns true where the pixel is skipped.
 bool skip_as_case2(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
-                   const Image& depth, const FilterParams& p, int x, int y, FilterOutput& out);
+                   const Image& depth, const FilterParams& p, float t, int x, int y, FilterOutput& out);
 
 // The filter's case-2 skip decision alone (what skip_as_case2 tests): shared::skip_as_case2.
 bool case2_skip_decision(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
-                         const Image& depth, const FilterParams& p, int x, int y);
+                         const Image& depth, const FilterParams& p, float t, int x, int y);
 
 // Albedo demodulation (gl/demodulation.h). The factor (shared::demodulation_factor): grey Y(albedo)
 // where that is at least kAlbedoEpsilon, else (1, 1, 1) (that pixel is not demodulated).
@@ -68,7 +69,7 @@ struct DemodulatedInputs {
 };
 // The filter's inputs under demodulation; albedo "R,G,B" (the mean first non-specular albedo).
 DemodulatedInputs cpu_demodulate(const Image& hv, const Image& var_u, const Image& lv, const Image& albedo,
-                                 const Image& range_color, const Image& depth, const FilterParams& params);
+                                 const Image& range_color, const Image& depth, const FilterParams& params, float t);
 // L_f = a L_f', Var[L_f] = Y(a)^2 Var[L_f'] (sentinels kept).
 FilterOutput cpu_remodulate(const FilterOutput& filtered, const Image& albedo);
 
@@ -78,7 +79,7 @@ struct BlendOutput {
   Image blend_case;  // "Y": case codes (kCase*)
 };
 // `filtered` empty = the filter never ran. range_color and depth both null: no variance pooling.
-BlendOutput cpu_blend(const Image& lv, const Image& hv, const Image& var_u, const FilterOutput* filtered,
+BlendOutput cpu_blend(const Image& lv, const Image& hv, const Image& var_u, const FilterOutput* filtered, float t,
                       const BlendParams& params, const Image* range_color, const Image* depth);
 
 double cpu_log_average(const Image& rgb, float delta);

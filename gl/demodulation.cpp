@@ -15,14 +15,14 @@ Demodulation::Demodulation(int width, int height)
   remod_fbo_.check("remodulation");
 }
 
-void Demodulation::demodulate(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& p) {
+void Demodulation::demodulate(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& p, float t) {
   if (inputs.width() != width_ || inputs.height() != height_ || guide.width() != width_ || guide.height() != height_)
     throw Error("demodulation: input size differs from the pass size");
   demod_timer_.begin();
   const RangeWeights range = range_weights(p);
   demod_program_.set("k_c", range.k_c);
   demod_program_.set("k_d", range.k_d);
-  demod_program_.set("t", p.t);
+  demod_program_.set("t", t);
   demod_program_.set("skip_case2", p.skip_case2 ? 1 : 0);
   inputs.hv().bind(shared::kUnitHv);
   inputs.lv().bind(shared::kUnitLv);

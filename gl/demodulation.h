@@ -14,10 +14,10 @@
 // buffers (shaders/demodulate.frag). CPU reference: cpu_demodulate / cpu_remodulate.
 // Usage:
 //   inputs.upload_albedo(&acc.albedo_mean[0].x);
-//   demod.demodulate(inputs, guide, filter_params);
-//   filter.run(demod.filter_inputs(), guide, filter_params);
+//   demod.demodulate(inputs, guide, filter_params, t);
+//   filter.run(demod.filter_inputs(), guide, filter_params, t);
 //   demod.remodulate(filter.output(), inputs);
-//   blend.run(inputs, &demod.output(), &guide, blend_params, filter.centre_weight());  // w unchanged
+//   blend.run(inputs, &demod.output(), &guide, t, blend_params, filter.centre_weight());  // w unchanged
 #pragma once
 #include "gl/inputs.h"
 #include "gl/pass_params.h"
@@ -29,8 +29,8 @@ class Demodulation {
  public:
   Demodulation(int width, int height);
   // inputs: L_u, Var[L_u], L_lv and the albedo (PreviewInputs::upload_albedo); guide: the range
-  // buffer; params: the filter's (range weights, skip_case2, t for the skip decision).
-  void demodulate(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& params);
+  // buffer; params: the filter's (range weights, skip_case2); t: the blend threshold, for the skip decision.
+  void demodulate(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& params, float t);
   const PreviewInputs& filter_inputs() const { return filter_inputs_; }  // the filter's input
   // filtered: the filter's output on filter_inputs(); albedo from `inputs`.
   void remodulate(const Texture2D& filtered, const PreviewInputs& inputs);

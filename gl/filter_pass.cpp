@@ -15,7 +15,8 @@ FilterPass::FilterPass(int width, int height)
   fbo_.check("filter pass");
 }
 
-void FilterPass::run(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& p) {
+void FilterPass::run(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& p, float t) {
+  if (p.kind == FilterKind::None) throw Error("filter pass: filter kind none (the caller skips the filter)");
   if (inputs.width() != width_ || inputs.height() != height_ || guide.width() != width_ || guide.height() != height_)
     throw Error("filter pass: input size differs from the pass size");
   timer_.begin();
@@ -28,13 +29,13 @@ void FilterPass::run(const PreviewInputs& inputs, const Texture2D& guide, const 
   centre_weight_valid_ =
       p.kind == FilterKind::Bilateral || p.kind == FilterKind::BilateralDepth || p.kind == FilterKind::Grid;
   if (p.kind == FilterKind::Atrous)
-    run_atrous(inputs, p);
+    run_atrous(inputs, p, t);
   else if (p.kind == FilterKind::Subsampled)
-    run_subsampled(p);
+    run_subsampled(p, t);
   else if (p.kind == FilterKind::Grid)
-    run_grid(p);
+    run_grid(p, t);
   else
-    run_bilateral(inputs, p);
+    run_bilateral(inputs, p, t);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
   timer_.end();
   ++runs_;
@@ -42,21 +43,21 @@ void FilterPass::run(const PreviewInputs& inputs, const Texture2D& guide, const 
 }
 
 namespace {
-// The uniforms every variant's shader shares: range weights and the case-2 skip.
-void set_range_and_skip(Program& program, const FilterParams& p) {
+// The uniforms every variant's shader shares: range weights and the case-2 skip with threshold t.
+void set_range_and_skip(Program& program, const FilterParams& p, float t) {
   const RangeWeights range = range_weights(p);
   program.set("k_c", range.k_c);
   program.set("k_d", range.k_d);
   program.set("skip_case2", p.skip_case2 ? 1 : 0);
-  program.set("t", p.t);
+  program.set("t", t);
 }
 }  // namespace
 
-void FilterPass::run_bilateral(const PreviewInputs& inputs, const FilterParams& p) {
+void FilterPass::run_bilateral(const PreviewInputs& inputs, const FilterParams& p, float t) {
   const int radius = std::min(kMaxFilterRadius, static_cast<int>(std::ceil(3.0f * std::max(p.sigma_s, 0.0f))));
   program_.set("radius", radius);
   program_.set("k_s", inv_two_sigma2(p.sigma_s));
-  set_range_and_skip(program_, p);
+  set_range_and_skip(program_, p, t);
   program_.use();
   if (p.kind == FilterKind::Separable) {
     program_.set("extent", glm::ivec2(1, 0));
@@ -76,9 +77,9 @@ void FilterPass::run_bilateral(const PreviewInputs& inputs, const FilterParams& 
 // atrous_iterations(sigma_s) passes at hole spacing 1, 2, 4, ...: each reads the previous pass's
 // output (the first reads the HV buffer), the intermediate ones ping-pong between the scratch
 // textures, the last writes output_ (and alone skips case-2 pixels and counts).
-void FilterPass::run_atrous(const PreviewInputs& inputs, const FilterParams& p) {
+void FilterPass::run_atrous(const PreviewInputs& inputs, const FilterParams& p, float t) {
   if (!atrous_program_.id()) atrous_program_ = Program::from_embedded("fullscreen.vert", "atrous.frag");
-  set_range_and_skip(atrous_program_, p);
+  set_range_and_skip(atrous_program_, p, t);
   atrous_program_.use();
   const int passes = atrous_iterations(p.sigma_s);
   inputs.hv().bind(shared::kUnitSignal);
@@ -93,7 +94,7 @@ void FilterPass::run_atrous(const PreviewInputs& inputs, const FilterParams& p) 
 }
 
 // One pass over the tap table of (sigma_s, taps), uploaded again only when those change.
-void FilterPass::run_subsampled(const FilterParams& p) {
+void FilterPass::run_subsampled(const FilterParams& p, float t) {
   if (!subsampled_program_.id()) subsampled_program_ = Program::from_embedded("fullscreen.vert", "subsampled.frag");
   const int taps = p.subsampled_taps > 0 ? p.subsampled_taps : kSubsampledTaps;
   const SubsampledTapTable table = subsampled_tap_table(p.sigma_s, taps);
@@ -104,16 +105,16 @@ void FilterPass::run_subsampled(const FilterParams& p) {
     subsampled_key_ = {p.sigma_s, taps};
   }
   subsampled_taps_.bind_storage(shared::kBufferTaps);
-  set_range_and_skip(subsampled_program_, p);
+  set_range_and_skip(subsampled_program_, p, t);
   subsampled_program_.set("taps_per_rotation", table.per_rotation);
   subsampled_program_.set("rotations", kSubsampledRotations);
   subsampled_program_.use();
   quad_.draw(fbo_, width_, height_);
 }
 
-void FilterPass::run_grid(const FilterParams& p) {
+void FilterPass::run_grid(const FilterParams& p, float t) {
   if (!grid_) grid_ = std::make_unique<GridFilter>(width_, height_);
-  grid_->run(p, fbo_);
+  grid_->run(p, t, fbo_);
 }
 
 const Framebuffer& FilterPass::scratch_target(int index) {

@@ -3,8 +3,8 @@
 // range buffer (color + distance). Runs on a schedule; the output texture persists between runs.
 // Usage:
 //   FilterPass filter(w, h);
-//   filter.run(inputs, range.guide(), params);      // params.t = the blend's t (for skipping)
-//   blend.run(inputs, &filter, blend_params);        // uses filter.output()
+//   filter.run(inputs, range.guide(), params, t);    // t: the blend's threshold (for skipping)
+//   blend.run(inputs, &filter, range.guide(), t, blend_params);  // uses filter.output()
 //   filter.filtered_image(), filter.variance_image(), filter.last_ms()
 // Pixels in case 2 (u <= t with the unfiltered background) are skipped: L_f = L_u there and
 // Var[L_f] = kVarSkipped, the blend then uses s = 1 (see FilterParams::skip_case2).
@@ -21,8 +21,9 @@ namespace pxf {
 class FilterPass {
  public:
   FilterPass(int width, int height);
-  // guide: rgb range color, a distance (RangePass::guide()).
-  void run(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& params);
+  // guide: rgb range color, a distance (RangePass::guide()); t: the blend threshold, for the case-2
+  // skip. params.kind must not be FilterKind::None (throws pxf::Error).
+  void run(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& params, float t);
 
   bool has_output() const { return runs_ > 0; }
   int runs() const { return runs_; }
@@ -43,10 +44,10 @@ class FilterPass {
   Image raw_variance_image() const;  // "Y" with the sentinels kept
 
  private:
-  void run_bilateral(const PreviewInputs& inputs, const FilterParams& params);
-  void run_atrous(const PreviewInputs& inputs, const FilterParams& params);
-  void run_subsampled(const FilterParams& params);
-  void run_grid(const FilterParams& params);
+  void run_bilateral(const PreviewInputs& inputs, const FilterParams& params, float t);
+  void run_atrous(const PreviewInputs& inputs, const FilterParams& params, float t);
+  void run_subsampled(const FilterParams& params, float t);
+  void run_grid(const FilterParams& params, float t);
   const Framebuffer& scratch_target(int index);  // allocates scratch_[index] on first use
 
   int width_, height_;

@@ -17,7 +17,7 @@ void GridFilter::resize_grid(const GridLayout& layout) {
   layout_ = layout;
 }
 
-void GridFilter::run(const FilterParams& p, const Framebuffer& target) {
+void GridFilter::run(const FilterParams& p, float t, const Framebuffer& target) {
   resize_grid(grid_layout(width_, height_, p));
   const glm::ivec2 grid_xy(layout_.nx, layout_.ny);
   const float inv_cell_s = 1.0f / layout_.cell_s;
@@ -65,7 +65,7 @@ void GridFilter::run(const FilterParams& p, const Framebuffer& target) {
   slice_.set("k_c", range.k_c);
   slice_.set("k_d", range.k_d);
   slice_.set("skip_case2", p.skip_case2 ? 1 : 0);
-  slice_.set("t", p.t);
+  slice_.set("t", t);
   slice_.use();
   grid_[0].bind_storage(shared::kBufferGrid);
   quad_.draw(target, width_, height_);

@@ -71,7 +71,7 @@ TEST(Grid, WhiteNoiseVarianceMatchesExactSum) {
     Image hv = Image::rgb(N, N);
     for (float& v : hv.pixels) v = noise(rng);
     inputs.upload(lv, hv, var);
-    filter.run(inputs, guide_tex, p);
+    filter.run(inputs, guide_tex, p, test::kTestThreshold);
     Image f = filter.filtered_image(), v = filter.raw_variance_image();
     for (int j = 0; j < 4; ++j)
       for (int i = 0; i < 4; ++i) {
@@ -131,7 +131,7 @@ TEST(Grid, LuminanceEdgesArePreserved) {
   FilterParams p;
   p.kind = FilterKind::Grid;
   p.skip_case2 = false;
-  filter.run(inputs, guide_tex, p);
+  filter.run(inputs, guide_tex, p, test::kTestThreshold);
   Image f = filter.filtered_image();
   for (int y = 0; y < H; ++y)
     for (int x = 0; x < W; ++x) ASSERT_NEAR(f.at(x, y, 0), value[region(x, y)], 1e-5f) << x << ", " << y;
@@ -176,9 +176,9 @@ TEST(Grid, NonFiniteInputsGiveFiniteOutput) {
     FilterParams p;
     p.kind = FilterKind::Grid;
     p.skip_case2 = skip;
-    p.t = 0.05f;
-    filter.run(inputs, guide_tex, p);
-    FilterOutput ref = cpu_filter(hv, var, lv, range, depth, p);
+    const float t = 0.05f;
+    filter.run(inputs, guide_tex, p, t);
+    FilterOutput ref = cpu_filter(hv, var, lv, range, depth, p, t);
     Image f = filter.filtered_image(), v = filter.raw_variance_image();
     for (size_t i = 0; i < f.pixels.size(); ++i) {
       ASSERT_TRUE(std::isfinite(f.pixels[i])) << i;

@@ -7,6 +7,6 @@
 namespace pxf {
 
 FilterOutput cpu_grid_filter(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
-                             const Image& depth, const FilterParams& params);
+                             const Image& depth, const FilterParams& params, float t);
 
 }  // namespace pxf

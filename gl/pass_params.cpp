@@ -15,7 +15,9 @@ const std::vector<std::string>& filter_kind_names() {
                                                          "subsampled", "grid"};
   return names;
 }
-const char* filter_kind_name(FilterKind kind) { return filter_kind_names()[static_cast<int>(kind)].c_str(); }
+const char* filter_kind_name(FilterKind kind) {
+  return kind == FilterKind::None ? "none" : filter_kind_names()[static_cast<int>(kind)].c_str();
+}
 FilterKind parse_filter_kind(const std::string& name) {
   const auto& names = filter_kind_names();
   std::string expected;

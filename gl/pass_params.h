@@ -41,8 +41,10 @@ static_assert(kMaxInput == kMaxTonemapInput);
 // weight), rotated per pixel (Banterle et al. 2012), each weighted by the color x depth range
 // weights; its Var[L_f] is exact for the weights it uses. "grid" is the bilateral grid (Chen et al.
 // 2007) on the range color's luminance (gl/grid_layout.h).
-enum class FilterKind { BilateralDepth, Bilateral, Separable, Atrous, Subsampled, Grid };
-// "bilateral-depth", "bilateral", "separable", "atrous", "subsampled", "grid"
+// None: no filter (plain path tracing); the preview never runs the filter pass with it.
+enum class FilterKind { BilateralDepth, Bilateral, Separable, Atrous, Subsampled, Grid, None };
+// "bilateral-depth", "bilateral", "separable", "atrous", "subsampled", "grid": the filter pass's variants
+// (FilterKind::None is named "none" by filter_kind_name and app/preview.h's filter_option_names).
 const std::vector<std::string>& filter_kind_names();
 const char* filter_kind_name(FilterKind kind);
 FilterKind parse_filter_kind(const std::string& name);  // throws pxf::Error listing the names
@@ -52,11 +54,11 @@ struct FilterParams {
   float sigma_s = 8.0f;   // pixels; kernel radius ceil(3 sigma_s), at most kMaxFilterRadius
   float sigma_c = 0.02f;  // range color, Euclidean distance in linear RGB
   float sigma_d = 2.0f;   // depth, scene units
-  // Skip pixels in case 2 (u <= t): they need no filtered value. u is computed with the
-  // *unfiltered* background L_b = Y(L_u) + Y(L_lv), so the decision needs no history; a skipped
-  // pixel gets L_f = L_u and Var[L_f] = kVarSkipped, and the blend uses s = 1 there.
+  // Skip pixels in case 2 (u <= t, t the blend threshold every filter run is given): they need no
+  // filtered value. u is computed with the *unfiltered* background L_b = Y(L_u) + Y(L_lv), so the
+  // decision needs no history; a skipped pixel gets L_f = L_u and Var[L_f] = kVarSkipped, and the
+  // blend uses s = 1 there.
   bool skip_case2 = true;
-  float t = 0.01f;  // the blend threshold (only used for skipping)
   int subsampled_taps = 0;  // taps of the subsampled variant, the centre included; 0 = kSubsampledTaps
 };
 constexpr int kMaxFilterRadius = 64;
@@ -110,8 +112,9 @@ float atrous_variance_correction(int pass);
 // 15 % over t at 16 spp. E[1 / S^2] is infinite for n <= 3; there the n = 4 factor 1/3 is used.
 float effective_threshold(float t, uint64_t samples);
 
+// The blend's parameters besides its threshold t (the perceived-variance threshold, sqrt(t) = the
+// allowed relative standard deviation), which every run is given next to them.
 struct BlendParams {
-  float t = 0.01f;  // perceived-variance threshold; sqrt(t) = allowed relative std. deviation
   // Weights of the 3x3 variance pooling (pooled_var_u in shaders/pass_formulas.h): the filter's.
   RangeWeights range = range_weights(FilterParams{});
 };

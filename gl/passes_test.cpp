@@ -94,10 +94,10 @@ TEST_P(FilterVsCpu, MatchesReference) {
   p.kind = kind;
   p.skip_case2 = skip;
   p.sigma_s = sigma_s;
-  p.t = 0.05f;
+  const float t = 0.05f;
   FilterPass filter(W, H);
-  filter.run(gpu.inputs, gpu.guide, p);
-  FilterOutput ref = cpu_filter(s.hv, s.var, s.lv, s.range, s.depth, p);
+  filter.run(gpu.inputs, gpu.guide, p, t);
+  FilterOutput ref = cpu_filter(s.hv, s.var, s.lv, s.range, s.depth, p, t);
   expect_close(filter.filtered_image(), ref.filtered, 1e-4f, 1e-7f, "L_f");
   expect_close(filter.raw_variance_image(), ref.variance, 1e-4f, 1e-12f, "Var[L_f]");
   // The centre weight for the blend's covariance term: the full-kernel variants only.
@@ -147,7 +147,7 @@ TEST(FilterKinds, ConstantHvStaysConstant) {
     FilterParams p;
     p.kind = parse_filter_kind(name);
     p.skip_case2 = false;
-    filter.run(gpu.inputs, gpu.guide, p);
+    filter.run(gpu.inputs, gpu.guide, p, test::kTestThreshold);
     Image f = filter.filtered_image();
     size_t off = 0;
     for (float v : f.pixels) off += std::abs(v - 0.7f) > 1e-5f;
@@ -188,7 +188,7 @@ void expect_edges_preserved(FilterKind kind) {
   FilterParams p;
   p.kind = kind;
   p.skip_case2 = false;
-  filter.run(gpu.inputs, gpu.guide, p);
+  filter.run(gpu.inputs, gpu.guide, p, test::kTestThreshold);
   Image f = filter.filtered_image();
   for (int y = 0; y < H; ++y)
     for (int x = 0; x < W; ++x)
@@ -210,18 +210,18 @@ TEST(Atrous, ZeroVarianceIsNoEvidence) {
   FilterPass filter(W, H);
   FilterParams p;
   p.kind = FilterKind::Atrous;
-  p.t = 0.05f;
+  const float t = 0.05f;
   for (bool skip : {false, true}) {
     p.skip_case2 = skip;
-    filter.run(gpu.inputs, gpu.guide, p);
-    FilterOutput ref = cpu_filter(s.hv, s.var, s.lv, s.range, s.depth, p);
+    filter.run(gpu.inputs, gpu.guide, p, t);
+    FilterOutput ref = cpu_filter(s.hv, s.var, s.lv, s.range, s.depth, p, t);
     expect_close(filter.filtered_image(), ref.filtered, 1e-4f, 1e-7f, "L_f");
     expect_close(filter.raw_variance_image(), ref.variance, 1e-4f, 1e-12f, "Var[L_f]");
   }
   // Only zero variances: nothing is known, nothing is skipped.
   for (float& v : s.var.pixels) v = 0.0f;
   GpuFixture zeros(s);
-  filter.run(zeros.inputs, zeros.guide, p);
+  filter.run(zeros.inputs, zeros.guide, p, t);
   EXPECT_EQ(filter.filtered_pixels(), uint32_t(W * H));
   for (float v : filter.raw_variance_image().pixels) EXPECT_EQ(v, kVarUnknown);
 }
@@ -273,7 +273,7 @@ TEST(Atrous, WhiteNoiseVarianceShrinksBySumOfSquaredWeights) {
       Image hv = Image::rgb(N, N);
       for (float& v : hv.pixels) v = noise(rng);
       inputs.upload(lv, hv, var);
-      filter.run(inputs, guide_tex, p);
+      filter.run(inputs, guide_tex, p, test::kTestThreshold);
       Image f = filter.filtered_image();
       for (int y = margin; y < N - margin; ++y)
         for (int x = margin; x < N - margin; ++x, ++count) sum_sq += (f.at(x, y, 0) - 1.0) * (f.at(x, y, 0) - 1.0);
@@ -364,7 +364,7 @@ TEST(Subsampled, WhiteNoiseVarianceIsExactForTheWeightsUsed) {
       Image hv = Image::rgb(N, N);
       for (float& v : hv.pixels) v = noise(rng);
       inputs.upload(lv, hv, var);
-      filter.run(inputs, guide_tex, p);
+      filter.run(inputs, guide_tex, p, test::kTestThreshold);
       const Image f = filter.filtered_image(), vf = filter.raw_variance_image();
       const SubsampledTapTable table = subsampled_tap_table(sigma_s, kSubsampledTaps);
       for (int y = 0; y < N; ++y)
@@ -411,7 +411,7 @@ TEST(FilterVsCpu, EdgesArePreserved) {
   FilterPass filter(W, H);
   FilterParams p;
   p.skip_case2 = false;
-  filter.run(gpu.inputs, gpu.guide, p);
+  filter.run(gpu.inputs, gpu.guide, p, test::kTestThreshold);
   Image f = filter.filtered_image();
   for (int y = 0; y < H; ++y)
     for (int x = 0; x < W; ++x) EXPECT_NEAR(f.at(x, y, 0), x < W / 2 ? 1.0f : 3.0f, 1e-5f);
@@ -432,8 +432,8 @@ TEST(BlendVsCpu, MatchesReferenceWithFilteredInput) {
   for (bool skip : {false, true}) {
     FilterParams fp;
     fp.skip_case2 = skip;
-    fp.t = 0.02f;
-    FilterOutput ref_f = cpu_filter(s.hv, s.var, s.lv, s.range, s.depth, fp);
+    const float filter_t = 0.02f;
+    FilterOutput ref_f = cpu_filter(s.hv, s.var, s.lv, s.range, s.depth, fp, filter_t);
     ref_f.centre_weight = Image();  // the blend below gets L_f as a plain texture, without a centre weight
     Image packed = Image::rgba(W, H);
     for (size_t i = 0; i < packed.pixel_count(); ++i) {
@@ -446,9 +446,9 @@ TEST(BlendVsCpu, MatchesReferenceWithFilteredInput) {
       for (bool pool : {false, true}) {
       SCOPED_TRACE(testing::Message() << "t=" << t << " pool=" << pool << " skip=" << skip);
       BlendPass blend(W, H);
-      BlendParams bp{t, range_weights(fp)};
-      blend.run(gpu.inputs, &filtered, pool ? &gpu.guide : nullptr, bp);
-      BlendOutput ref = cpu_blend(s.lv, s.hv, s.var, &ref_f, bp, pool ? &s.range : nullptr, pool ? &s.depth : nullptr);
+      const BlendParams bp{range_weights(fp)};
+      blend.run(gpu.inputs, &filtered, pool ? &gpu.guide : nullptr, t, bp);
+      BlendOutput ref = cpu_blend(s.lv, s.hv, s.var, &ref_f, t, bp, pool ? &s.range : nullptr, pool ? &s.depth : nullptr);
       expect_close(blend.final_image(), ref.final_rgb, 1e-4f, 1e-6f, "final");
       expect_close(blend.s_image(), ref.s, 1e-4f, 1e-5f, "s");
       expect_close(blend.case_image(), ref.blend_case, 0.0f, 0.0f, "case");
@@ -476,22 +476,21 @@ TEST(BlendVsCpu, CovarianceTermFromTheFiltersCentreWeight) {
   fp.sigma_s = 2.0f;
   FilterPass filter(W, H);
   BlendPass blend(W, H);
-  FilterOutput ref_f = cpu_filter(s.hv, s.var, s.lv, s.range, s.depth, fp);
+  FilterOutput ref_f = cpu_filter(s.hv, s.var, s.lv, s.range, s.depth, fp, test::kTestThreshold);
   FilterOutput ref_plain = ref_f;
   ref_plain.centre_weight = Image();
   size_t changed = 0;
   for (float t : {0.001f, 0.02f, 0.2f}) {
     SCOPED_TRACE(testing::Message() << "t=" << t);
-    fp.t = t;
-    filter.run(gpu.inputs, gpu.guide, fp);
+    filter.run(gpu.inputs, gpu.guide, fp, t);
     ASSERT_NE(filter.centre_weight(), nullptr);
-    const BlendParams bp{t, range_weights(fp)};
-    blend.run(gpu.inputs, &filter, gpu.guide, bp);
-    ref_f = cpu_filter(s.hv, s.var, s.lv, s.range, s.depth, fp);
-    BlendOutput ref = cpu_blend(s.lv, s.hv, s.var, &ref_f, bp, &s.range, &s.depth);
+    const BlendParams bp{range_weights(fp)};
+    blend.run(gpu.inputs, &filter, gpu.guide, t, bp);
+    ref_f = cpu_filter(s.hv, s.var, s.lv, s.range, s.depth, fp, t);
+    BlendOutput ref = cpu_blend(s.lv, s.hv, s.var, &ref_f, t, bp, &s.range, &s.depth);
     ref_plain = ref_f;
     ref_plain.centre_weight = Image();
-    BlendOutput plain = cpu_blend(s.lv, s.hv, s.var, &ref_plain, bp, &s.range, &s.depth);
+    BlendOutput plain = cpu_blend(s.lv, s.hv, s.var, &ref_plain, t, bp, &s.range, &s.depth);
     expect_close(blend.s_image(), ref.s, 1e-4f, 1e-4f, "s");
     expect_close(blend.case_image(), ref.blend_case, 0.0f, 0.0f, "case");
     for (size_t i = 0; i < ref.s.pixels.size(); ++i) {
@@ -518,14 +517,14 @@ TEST(BlendVsCpu, BackgroundPixelsWithoutHvTakeNoFilteredLight) {
   GpuFixture gpu(s);
   FilterParams fp;
   fp.kind = FilterKind::Grid;
-  fp.t = 0.01f;
+  const float t = 0.01f;
   FilterPass filter(W, H);
-  filter.run(gpu.inputs, gpu.guide, fp);
-  FilterOutput ref_f = cpu_filter(s.hv, s.var, s.lv, s.range, s.depth, fp);
-  const BlendParams bp{fp.t, range_weights(fp)};
+  filter.run(gpu.inputs, gpu.guide, fp, t);
+  FilterOutput ref_f = cpu_filter(s.hv, s.var, s.lv, s.range, s.depth, fp, t);
+  const BlendParams bp{range_weights(fp)};
   BlendPass blend(W, H);
-  blend.run(gpu.inputs, &filter, gpu.guide, bp);
-  BlendOutput ref = cpu_blend(s.lv, s.hv, s.var, &ref_f, bp, &s.range, &s.depth);
+  blend.run(gpu.inputs, &filter, gpu.guide, t, bp);
+  BlendOutput ref = cpu_blend(s.lv, s.hv, s.var, &ref_f, t, bp, &s.range, &s.depth);
   expect_close(blend.s_image(), ref.s, 1e-4f, 1e-4f, "s");
   expect_close(blend.case_image(), ref.blend_case, 0.0f, 0.0f, "case");
   int background = 0, other_cases = 0;
@@ -549,8 +548,8 @@ TEST(BlendVsCpu, NoFilteredValueMeansUnfiltered) {
   Scenario s = make_scenario(5);
   GpuFixture gpu(s);
   BlendPass blend(W, H);
-  blend.run(gpu.inputs, nullptr, gpu.guide, {0.01f});
-  BlendOutput ref = cpu_blend(s.lv, s.hv, s.var, nullptr, {0.01f}, &s.range, &s.depth);
+  blend.run(gpu.inputs, nullptr, gpu.guide, 0.01f, {});
+  BlendOutput ref = cpu_blend(s.lv, s.hv, s.var, nullptr, 0.01f, {}, &s.range, &s.depth);
   expect_close(blend.final_image(), ref.final_rgb, 1e-5f, 1e-7f, "final");
   EXPECT_EQ(blend.case_counts()[kCaseNoFiltered], uint32_t(W * H));
 }
@@ -560,16 +559,16 @@ TEST(FullChain, FilterBlendTonemapOnGpuMatchesCpu) {
   Scenario s = make_scenario(21);
   GpuFixture gpu(s);
   FilterParams fp;
-  fp.t = 0.01f;
+  const float t = 0.01f;
   FilterPass filter(W, H);
   BlendPass blend(W, H);
   TonemapPass tonemap(W, H);
-  filter.run(gpu.inputs, gpu.guide, fp);
-  const BlendParams bp{fp.t, range_weights(fp)};
-  blend.run(gpu.inputs, &filter, gpu.guide, bp);
+  filter.run(gpu.inputs, gpu.guide, fp, t);
+  const BlendParams bp{range_weights(fp)};
+  blend.run(gpu.inputs, &filter, gpu.guide, t, bp);
   tonemap.run(blend.output(), {});
-  FilterOutput rf = cpu_filter(s.hv, s.var, s.lv, s.range, s.depth, fp);
-  BlendOutput rb = cpu_blend(s.lv, s.hv, s.var, &rf, bp, &s.range, &s.depth);
+  FilterOutput rf = cpu_filter(s.hv, s.var, s.lv, s.range, s.depth, fp, t);
+  BlendOutput rb = cpu_blend(s.lv, s.hv, s.var, &rf, t, bp, &s.range, &s.depth);
   expect_close(blend.final_image(), rb.final_rgb, 2e-4f, 1e-6f, "final");
   expect_close(tonemap.display_image(), cpu_tonemap(rb.final_rgb, {}), 2e-4f, 2e-5f, "display");
   for (const Image& im : {filter.filtered_image(), filter.variance_image(), blend.final_image(), blend.s_image(),
@@ -640,21 +639,21 @@ TEST_P(DemodulationVsCpu, MatchesReference) {
   FilterParams p;
   p.kind = kind;
   p.skip_case2 = skip;
-  p.t = 0.05f;
+  const float t = 0.05f;
   Demodulation demod(W, H);
   FilterPass filter(W, H);
-  demod.demodulate(gpu.inputs, gpu.guide, p);
-  filter.run(demod.filter_inputs(), gpu.guide, p);
+  demod.demodulate(gpu.inputs, gpu.guide, p, t);
+  filter.run(demod.filter_inputs(), gpu.guide, p, t);
   demod.remodulate(filter.output(), gpu.inputs);
 
-  const DemodulatedInputs d = cpu_demodulate(s.hv, s.var, s.lv, albedo, s.range, s.depth, p);
+  const DemodulatedInputs d = cpu_demodulate(s.hv, s.var, s.lv, albedo, s.range, s.depth, p, t);
   expect_close(demod.filter_inputs().hv_image(), d.hv, 1e-5f, 1e-7f, "L_u / a");
   expect_close(demod.filter_inputs().var_image(), [&] {
     Image v = d.var_u;
     for (float& x : v.pixels) x = x > 0 ? x : 0.0f;
     return v;
   }(), 1e-5f, 1e-12f, "Var[L_u] / Y(a)^2");
-  const FilterOutput ref = cpu_remodulate(cpu_filter(d.hv, d.var_u, d.lv, s.range, s.depth, p), albedo);
+  const FilterOutput ref = cpu_remodulate(cpu_filter(d.hv, d.var_u, d.lv, s.range, s.depth, p, t), albedo);
   expect_close(demod.filtered_image(), ref.filtered, 1e-4f, 1e-7f, "L_f");
   Image gpu_var = demod.output().download({"R", "G", "B", "A"});
   Image gpu_raw_var = Image::gray(W, H);
@@ -663,9 +662,9 @@ TEST_P(DemodulationVsCpu, MatchesReference) {
 
   // The same pixels are skipped as without demodulation.
   FilterPass plain(W, H);
-  plain.run(gpu.inputs, gpu.guide, p);
+  plain.run(gpu.inputs, gpu.guide, p, t);
   EXPECT_EQ(filter.filtered_pixels(), plain.filtered_pixels());
-  const FilterOutput plain_ref = cpu_filter(s.hv, s.var, s.lv, s.range, s.depth, p);
+  const FilterOutput plain_ref = cpu_filter(s.hv, s.var, s.lv, s.range, s.depth, p, t);
   size_t skipped = 0;
   for (size_t i = 0; i < ref.variance.pixels.size(); ++i) {
     EXPECT_EQ(ref.variance.pixels[i] == kVarSkipped, plain_ref.variance.pixels[i] == kVarSkipped) << i;
@@ -676,12 +675,12 @@ TEST_P(DemodulationVsCpu, MatchesReference) {
   }
 
   // The blend sees the remodulated L_f and Var[L_f].
-  const BlendParams bp{p.t, range_weights(p)};
+  const BlendParams bp{range_weights(p)};
   BlendPass blend(W, H);
   // The filter's centre weight (bilateral variants) is unchanged by demodulation: Cov[L_u, L_f] =
   // w Var[L_u] with a grey factor.
-  blend.run(gpu.inputs, &demod.output(), &gpu.guide, bp, filter.centre_weight());
-  const BlendOutput rb = cpu_blend(s.lv, s.hv, s.var, &ref, bp, &s.range, &s.depth);
+  blend.run(gpu.inputs, &demod.output(), &gpu.guide, t, bp, filter.centre_weight());
+  const BlendOutput rb = cpu_blend(s.lv, s.hv, s.var, &ref, t, bp, &s.range, &s.depth);
   expect_close(blend.final_image(), rb.final_rgb, 2e-4f, 1e-6f, "final");
   expect_close(blend.case_image(), rb.blend_case, 0.0f, 0.0f, "case");
 }
@@ -701,7 +700,7 @@ TEST(Demodulation, WithoutFilteringGivesBackTheInputs) {
   GpuFixture gpu(s);
   gpu.inputs.upload_albedo(albedo);
   Demodulation demod(W, H);
-  demod.demodulate(gpu.inputs, gpu.guide, FilterParams{});
+  demod.demodulate(gpu.inputs, gpu.guide, FilterParams{}, test::kTestThreshold);
   demod.remodulate(demod.filter_inputs().hv(), gpu.inputs);
   expect_close(demod.filtered_image(), gpu.inputs.hv_image(), 1e-6f, 1e-12f, "L_u");
   const Image back = demod.output().download({"R", "G", "B", "A"});
@@ -757,12 +756,12 @@ TEST(Demodulation, TexturedConstantIrradiancePlaneKeepsItsTexture) {
     p.kind = kind;
     p.skip_case2 = false;
     FilterPass filter(W, H);
-    filter.run(gpu.inputs, gpu.guide, p);
+    filter.run(gpu.inputs, gpu.guide, p, test::kTestThreshold);
     double blurred = 0, kept = 0;
     const Image plain = filter.filtered_image();
     Demodulation demod(W, H);
-    demod.demodulate(gpu.inputs, gpu.guide, p);
-    filter.run(demod.filter_inputs(), gpu.guide, p);
+    demod.demodulate(gpu.inputs, gpu.guide, p, test::kTestThreshold);
+    filter.run(demod.filter_inputs(), gpu.guide, p, test::kTestThreshold);
     demod.remodulate(filter.output(), gpu.inputs);
     const Image textured = demod.filtered_image();
     for (size_t i = 0; i < s.hv.pixels.size(); ++i) {

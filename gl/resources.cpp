@@ -48,7 +48,7 @@ GLenum components_format(int c) {
   return f[c < 1 ? 1 : (c > 4 ? 4 : c)];
 }
 
-bool g_timing = true;
+GlTiming g_timing = GlTiming::Finish;
 double now_ms() {
   using namespace std::chrono;
   return duration<double, std::milli>(steady_clock::now().time_since_epoch()).count();
@@ -283,18 +283,20 @@ void FullscreenPass::draw(const Framebuffer& target, int width, int height) cons
 
 // ---- Timing / errors ----
 
-void set_gl_timing(bool enabled) { g_timing = enabled; }
-bool gl_timing_enabled() { return g_timing; }
+const std::vector<std::string>& gl_timing_names() {
+  static const std::vector<std::string> names = {"finish", "submit"};
+  return names;
+}
+void set_gl_timing(GlTiming timing) { g_timing = timing; }
+GlTiming gl_timing() { return g_timing; }
 
 void StageTimer::begin() {
-  if (!g_timing) return;
-  glFinish();
+  if (g_timing == GlTiming::Finish) glFinish();
   start_ = now_ms();
 }
 
 double StageTimer::end() {
-  if (!g_timing) return last_ms_ = 0;
-  glFinish();
+  if (g_timing == GlTiming::Finish) glFinish();
   return last_ms_ = now_ms() - start_;
 }
 

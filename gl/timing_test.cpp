@@ -16,7 +16,7 @@
 #include "gl/range_pass.h"
 #include "gl/test_util.h"
 #include "gl/tonemap_pass.h"
-#include "pathtracer/bench.h"
+#include "core/timing.h"
 
 namespace pxf {
 namespace {
@@ -83,8 +83,8 @@ TEST(Timing, DISABLED_Passes512) {
         FilterParams p;
         p.kind = parse_filter_kind(kinds[k]);
         p.skip_case2 = skip;
-        p.t = 0.05f;
-        filter.run(inputs, range.guide(), p);
+        const float t = 0.05f;
+        filter.run(inputs, range.guide(), p, t);
         if (round < 0) continue;
         ms[2 * k + skip].push_back(filter.last_ms());
         filtered[2 * k + skip] = filter.filtered_pixels();
@@ -96,7 +96,7 @@ TEST(Timing, DISABLED_Passes512) {
   BlendPass blend(w, h);
   TonemapPass tonemap(w, h);
   for (int i = 0; i < 3; ++i) {
-    blend.run(inputs, &filter, range.guide(), {0.01f});
+    blend.run(inputs, &filter, range.guide(), 0.01f, {});
     tonemap.run(blend.output(), {});
   }
   std::printf("blend: %.2f ms\ntone map: %.2f ms\n", blend.last_ms(), tonemap.last_ms());

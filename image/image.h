@@ -3,16 +3,12 @@
 #pragma once
 #include <cstddef>
 #include <functional>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
-namespace pxf {
+#include "core/error.h"
 
-// Every user-facing failure (bad file, bad flag, bad scene) is a pxf::Error with a one-line message.
-struct Error : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
+namespace pxf {
 
 struct Image {
   int width = 0;

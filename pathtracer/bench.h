@@ -2,21 +2,11 @@
 // frames, against the raw Embree rate for incoherent rays on the same scene, plus the share of a
 // frame spent on primary rays (what reusing the raster's first hit could save at most).
 #pragma once
-#include <chrono>
 #include <string>
-#include <vector>
+#include "core/timing.h"
 #include "pathtracer/pathtracer.h"
 
 namespace pxf {
-
-// Timing helpers shared by every benchmark and stage timer (pathtracer, pxf bench, the preview).
-using BenchClock = std::chrono::steady_clock;
-inline double elapsed_ms(BenchClock::time_point start) {
-  return std::chrono::duration<double, std::milli>(BenchClock::now() - start).count();
-}
-// Peak resident memory of this process so far (getrusage ru_maxrss), MiB.
-double peak_memory_mib();
-double median_of(std::vector<double> values);  // the upper median; 0 for none
 
 struct BenchResult {
   int width = 0, height = 0, threads = 0, max_vertices = 0;

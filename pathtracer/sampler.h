@@ -23,12 +23,19 @@
 #pragma once
 #include <array>
 #include <cstdint>
+#include <string>
+#include <vector>
 #include <glm/glm.hpp>
 #include "pathtracer/rng.h"
 
 namespace pxf {
 
 enum class SamplerType { Sobol, Independent };
+// Names of SamplerType (index = value): "sobol", "independent".
+inline const std::vector<std::string>& sampler_type_names() {
+  static const std::vector<std::string> names = {"sobol", "independent"};
+  return names;
+}
 
 // The dimensions a path vertex uses, in the order the integrator asks for them.
 enum class VertexDim { LightSelect, LightPoint, BsdfLobe, BsdfDirection, Roulette };

@@ -18,7 +18,7 @@ namespace {
 struct GoldenCase {
   std::string name, scene;
   int width, height, spp;
-  std::string filter;
+  FilterKind filter;
   float threshold;
   std::vector<std::string> layers;
   float abs_tolerance, rel_tolerance;  // a pixel fails when |got - golden| > abs + rel * |golden|
@@ -26,8 +26,8 @@ struct GoldenCase {
 };
 
 const std::vector<GoldenCase> kCases = {
-    {"cornell_128_filtered", "cornell", 128, 128, 16, "bilateral-depth", 0.001f, {"final", "blend"}, 2e-3f, 0.02f, 0.01},
-    {"cornell_128_bilateral", "cornell", 128, 128, 8, "bilateral", 0.01f, {"final", "blend"}, 2e-3f, 0.02f, 0.01},
+    {"cornell_128_filtered", "cornell", 128, 128, 16, FilterKind::BilateralDepth, 0.001f, {"final", "blend"}, 2e-3f, 0.02f, 0.01},
+    {"cornell_128_bilateral", "cornell", 128, 128, 8, FilterKind::Bilateral, 0.01f, {"final", "blend"}, 2e-3f, 0.02f, 0.01},
 };
 
 std::string golden_path(const GoldenCase& c) { return std::string(PXF_SOURCE_DIR) + "/tests/golden/" + c.name + ".exr"; }
@@ -57,7 +57,7 @@ class Golden : public ::testing::TestWithParam<GoldenCase> {};
 TEST_P(Golden, MatchesWithinTolerance) {
   const GoldenCase& c = GetParam();
   PreviewSettings settings;
-  set_filter_option(settings, c.filter);
+  settings.filter.kind = c.filter;
   settings.threshold = c.threshold;
   auto preview = test_support::render_preview(c.scene, c.width, c.height, c.spp, settings);
   const std::vector<Layer> buffers = preview->buffers();
