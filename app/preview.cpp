@@ -198,12 +198,12 @@ void Preview::run_filter() {
     const auto start = BenchClock::now();
     if (!demod_) demod_ = std::make_unique<Demodulation>(width_, height_);
     inputs_.upload_albedo(&renderer_->accumulation().albedo_mean[0].x);
-    demod_->demodulate(inputs_, range_.guide(), settings_.filter, settings_.threshold);
-    filter_.run(demod_->filter_inputs(), range_.guide(), settings_.filter, settings_.threshold);
+    demod_->demodulate(inputs_, range_.guide(), settings_.filter, threshold_now());
+    filter_.run(demod_->filter_inputs(), range_.guide(), settings_.filter, threshold_now());
     demod_->remodulate(filter_.output(), inputs_);
     filter_ms = elapsed_ms(start);
   } else {
-    filter_.run(inputs_, range_.guide(), settings_.filter, settings_.threshold);
+    filter_.run(inputs_, range_.guide(), settings_.filter, threshold_now());
     filter_ms = filter_.last_ms();
   }
   last_.filter += filter_ms;
@@ -248,7 +248,7 @@ void Preview::blend_and_tonemap() {
   upload();
   // The filter's centre weight is that of the demodulated run too: with a grey factor a,
   // Cov[L_u, a L_f'] = a w Var[L_u] / a = w Var[L_u], the blend's covariance term is unchanged.
-  blend_.run(inputs_, have_filtered_ ? &filtered_output() : nullptr, &range_.guide(), settings_.threshold,
+  blend_.run(inputs_, have_filtered_ ? &filtered_output() : nullptr, &range_.guide(), threshold_now(),
              BlendParams{range_weights(settings_.filter)},
              have_filtered_ ? filter_.centre_weight() : nullptr);
   last_.blend += blend_.last_ms();

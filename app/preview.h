@@ -120,6 +120,9 @@ class Preview {
   int width() const { return width_; }
   int height() const { return height_; }
   int samples() const { return renderer_->frames(); }
+  // The threshold the filter's skip and the blend get now: t scaled for the variance estimate's
+  // own noise at this sample count (effective_threshold, docs/method.md section 3.5).
+  float threshold_now() const { return effective_threshold(settings_.threshold, static_cast<uint64_t>(samples())); }
   const PreviewSettings& settings() const { return settings_; }
   const ProgressiveRenderer& renderer() const { return *renderer_; }
   const StageTimes& last_times() const { return last_; }
