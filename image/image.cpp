@@ -8,6 +8,8 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include "shaders/tonemap_formulas.h"
+
 namespace pxf {
 
 Image::Image(int w, int h, std::vector<std::string> channel_names, float fill)
@@ -85,11 +87,7 @@ void write_file_atomically(const std::string& path, const std::function<void(con
   sync_folder(slash == std::string::npos ? "" : path.substr(0, slash));
 }
 
-float srgb_from_linear(float v) {
-  if (!(v > 0.0f)) return 0.0f;  // also maps NaN to 0
-  if (v <= 0.0031308f) return 12.92f * v;
-  return 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
-}
+float srgb_from_linear(float v) { return shared::srgb_encode(v); }
 
 float linear_from_srgb(float v) {
   if (!(v > 0.0f)) return 0.0f;

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "shaders/tonemap_formulas.h"
+
 namespace pxf {
 
 namespace {
@@ -32,9 +34,7 @@ Image tonemap_reinhard(const Image& rgb, const TonemapParams& p) {
     for (int x = 0; x < rgb.width; ++x) {
       const Rgb c = display_input(rgb, x, y);
       const float lm = k * c.luminance();
-      // Ld / Y without dividing by Y: k (1 + Lm / white^2) / (1 + Lm).
-      const float burn = p.white > 0 ? 1.0f + lm / (p.white * p.white) : 1.0f;
-      const float scale = k * burn / (1.0f + lm);
+      const float scale = shared::reinhard_scale(k, lm, p.white);
       for (int i = 0; i < 3; ++i) out.at(x, y, i) = srgb_from_linear(std::clamp(c.c[i] * scale, 0.0f, 1.0f));
     }
   return out;
