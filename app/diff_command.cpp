@@ -57,7 +57,9 @@ void write_display_images(const std::string& dir, const Image& test, const Image
   Image error = display.test;
   for (size_t i = 0; i < error.pixels.size(); ++i)
     error.pixels[i] = std::min(1.0f, 4.0f * std::abs(display.test.pixels[i] - display.reference.pixels[i]));
-  std::filesystem::create_directories(dir);
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw Error(dir + ": cannot create the folder for --images: " + ec.message());
   write_png(dir + "/test.png", display.test);
   write_png(dir + "/reference.png", display.reference);
   write_png(dir + "/error.png", error);

@@ -375,6 +375,11 @@ TEST(Cli, DiffReportsDisplayMetricsWithAndWithoutEmitters) {
   ASSERT_EQ(run("diff " + ref + "/final.exr " + ref + "/final.exr --images " + images).code, 0);
   const Image none = read_ldr_or_hdr(images + "/error.png");
   EXPECT_EQ(*std::max_element(none.pixels.begin(), none.pixels.end()), 0.0f);
+  // A folder that cannot be made is a one-line error naming it.
+  const Result bad = run("diff " + ref + "/final.exr " + ref + "/final.exr --images " + ref + "/final.exr/sub");
+  EXPECT_EQ(bad.code, 1);
+  EXPECT_EQ(lines(bad.err), 1u) << bad.err;
+  EXPECT_NE(bad.err.find("--images"), std::string::npos) << bad.err;
 }
 
 // ---------------------------------------------------------------------------------------------
