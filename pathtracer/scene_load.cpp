@@ -29,6 +29,7 @@
 #include "pathtracer/gltf_geometry.h"
 #include "pathtracer/gltf_images.h"
 #include "pathtracer/pathtracer.h"
+#include "pathtracer/spec_gloss.h"
 #include "pathtracer/texture.h"
 
 #ifndef PXF_ASSETS_DIR
@@ -51,7 +52,7 @@ const std::set<std::string>& supported_extensions() {
   static const std::set<std::string> names = {
       "KHR_lights_punctual",      "KHR_texture_transform", "KHR_materials_emissive_strength",
       "KHR_materials_transmission", "KHR_materials_ior",   "KHR_materials_specular",
-      "KHR_materials_volume",
+      "KHR_materials_volume",     "KHR_materials_pbrSpecularGlossiness",
       "KHR_mesh_quantization"};
   return names;
 }
@@ -114,6 +115,13 @@ glm::vec3 value_vec3_or(const tinygltf::Value& value, glm::vec3 fallback) {
   if (!value.IsArray() || value.ArrayLen() < 3) return fallback;
   glm::vec3 out;
   for (int i = 0; i < 3; ++i) out[i] = finite_or(number_or(value.Get(i), fallback[i]), fallback[i]);
+  return out;
+}
+
+glm::vec4 value_vec4_or(const tinygltf::Value& value, glm::vec4 fallback) {
+  if (!value.IsArray() || value.ArrayLen() < 4) return fallback;
+  glm::vec4 out;
+  for (int i = 0; i < 4; ++i) out[i] = finite_or(number_or(value.Get(i), fallback[i]), fallback[i]);
   return out;
 }
 
@@ -202,6 +210,7 @@ class GltfLoader {
     probe_textures();    // the texture size cap, from the image headers
     check_memory();      // the estimate against the available memory
     decode_textures();
+    convert_spec_gloss();  // after decoding: textures are baked from their texels
     traverse_scene();
     read_scene_defaults();  // before the camera: the default image aspect frames the model
     finish_camera();
@@ -426,6 +435,19 @@ class GltfLoader {
       const uint64_t decode = h.bits == 8 ? 8 * texels : texels * h.channels * (h.bits / 8 + 4);
       estimate_.largest_decode_bytes = std::max(estimate_.largest_decode_bytes, decode);
     }
+    // Specular-glossiness materials get two baked 8-bit textures at the larger of their two sizes.
+    for (const SpecGlossMaterial& sg : spec_gloss_) {
+      uint64_t width = 0, height = 0;
+      for (const TextureRef* ref : {&scene_.materials[sg.material].base_color_texture,
+                                    &scene_.materials[sg.material].metallic_roughness_texture}) {
+        if (!ref->valid()) continue;
+        const gltf::ImageHeader& h = headers[pending_[ref->texture].image];
+        if (!h.ok) continue;
+        width = std::max<uint64_t>(width, h.width);
+        height = std::max<uint64_t>(height, h.height);
+      }
+      estimate_.texture_bytes += 8 * width * height;
+    }
   }
 
   std::string image_label(int index) const {
@@ -506,12 +528,16 @@ class GltfLoader {
     Material m;
     m.name = gm.name.empty() ? "material " + std::to_string(index) : gm.name;
     const auto& pbr = gm.pbrMetallicRoughness;
-    if (pbr.baseColorFactor.size() == 4)
-      for (int c = 0; c < 4; ++c) m.base_color[c] = clamp01(pbr.baseColorFactor[c], 1.0f);
-    m.base_color_texture = texture_ref(info_of(pbr.baseColorTexture), true, m.name, "base color");
-    m.metallic = clamp01(pbr.metallicFactor, 1.0f);
-    m.roughness = clamp01(pbr.roughnessFactor, 1.0f);
-    m.metallic_roughness_texture = texture_ref(info_of(pbr.metallicRoughnessTexture), false, m.name, "metallic-roughness");
+    if (const tinygltf::Value* ext = find_extension(gm.extensions, "KHR_materials_pbrSpecularGlossiness")) {
+      read_spec_gloss(*ext, m, index);  // replaces pbrMetallicRoughness (the file's fallback for other viewers)
+    } else {
+      if (pbr.baseColorFactor.size() == 4)
+        for (int c = 0; c < 4; ++c) m.base_color[c] = clamp01(pbr.baseColorFactor[c], 1.0f);
+      m.base_color_texture = texture_ref(info_of(pbr.baseColorTexture), true, m.name, "base color");
+      m.metallic = clamp01(pbr.metallicFactor, 1.0f);
+      m.roughness = clamp01(pbr.roughnessFactor, 1.0f);
+      m.metallic_roughness_texture = texture_ref(info_of(pbr.metallicRoughnessTexture), false, m.name, "metallic-roughness");
+    }
     m.normal_texture = texture_ref(info_of(gm.normalTexture), false, m.name, "normal");
     m.normal_scale = finite_or(gm.normalTexture.scale, 1.0f);
     m.emissive = glm::max(vec3_or(gm.emissiveFactor, glm::vec3(0.0f)), glm::vec3(0.0f));
@@ -543,6 +569,80 @@ class GltfLoader {
     m.alpha_cutoff = std::max(finite_or(gm.alphaCutoff, 0.5f), 0.0f);
     m.double_sided = gm.doubleSided;
     return m;
+  }
+
+  // KHR_materials_pbrSpecularGlossiness: the factors are converted here; the diffuse and
+  // specular-glossiness textures are registered in the base color and metallic-roughness slots
+  // (so decoding and renumbering handle them) and replaced by baked textures in convert_spec_gloss.
+  void read_spec_gloss(const tinygltf::Value& ext, Material& m, size_t index) {
+    SpecGlossMaterial sg;
+    sg.material = index;
+    sg.factors.diffuse = glm::clamp(value_vec4_or(ext.Get("diffuseFactor"), glm::vec4(1.0f)), glm::vec4(0.0f), glm::vec4(1.0f));
+    sg.factors.specular = glm::clamp(value_vec3_or(ext.Get("specularFactor"), glm::vec3(1.0f)), glm::vec3(0.0f), glm::vec3(1.0f));
+    sg.factors.glossiness = clamp01(number_or(ext.Get("glossinessFactor"), 1.0), 1.0f);
+    const MetalRough c = metal_rough_from_spec_gloss(sg.factors.diffuse, sg.factors.specular, sg.factors.glossiness);
+    m.base_color = c.base_color;
+    m.metallic = c.metallic;
+    m.roughness = c.roughness;
+    m.base_color_texture = texture_ref(info_of(ext.Get("diffuseTexture")), true, m.name, "diffuse");
+    m.metallic_roughness_texture =
+        texture_ref(info_of(ext.Get("specularGlossinessTexture")), true, m.name, "specular-glossiness");
+    spec_gloss_.push_back(sg);
+  }
+
+  static bool same_mapping(const TextureRef& a, const TextureRef& b) {
+    return a.texcoord == b.texcoord && a.transform == b.transform;
+  }
+
+  // Replaces each specular-glossiness material's textures by metallic-roughness ones baked per
+  // texel (at the larger of the two sizes, through their common UV mapping), then warns once. When
+  // the diffuse and specular-glossiness textures use different UV mappings they cannot be baked
+  // together: metallic and roughness come from the specular-glossiness texture and the diffuse
+  // factor, and the base color stays the diffuse color (exact only for dielectrics).
+  void convert_spec_gloss() {
+    if (spec_gloss_.empty()) return;
+    size_t baked = 0;
+    std::string approximated;
+    for (const SpecGlossMaterial& sg : spec_gloss_) {
+      Material& m = scene_.materials[sg.material];
+      const TextureRef diffuse_ref = m.base_color_texture, sg_ref = m.metallic_roughness_texture;
+      const Texture* diffuse = diffuse_ref.valid() ? &scene_.textures[diffuse_ref.texture] : nullptr;
+      const Texture* spec = sg_ref.valid() ? &scene_.textures[sg_ref.texture] : nullptr;
+      if (!diffuse && !spec) continue;  // factors only: converted in read_spec_gloss
+      ++baked;
+      if (diffuse && spec && !same_mapping(diffuse_ref, sg_ref)) {
+        BakedSpecGloss out = bake_spec_gloss(nullptr, spec, sg.factors, spec->width, spec->height, *spec);
+        scene_.textures.push_back(std::move(out.metallic_roughness));
+        m.metallic_roughness_texture.texture = static_cast<int>(scene_.textures.size()) - 1;
+        m.base_color = sg.factors.diffuse;
+        m.metallic = m.roughness = 1.0f;
+        approximated += (approximated.empty() ? "'" : ", '") + m.name + "'";
+        continue;
+      }
+      const Texture& sampler = diffuse ? *diffuse : *spec;
+      const int width = std::max(diffuse ? diffuse->width : 0, spec ? spec->width : 0);
+      const int height = std::max(diffuse ? diffuse->height : 0, spec ? spec->height : 0);
+      BakedSpecGloss out = bake_spec_gloss(diffuse, spec, sg.factors, width, height, sampler);
+      TextureRef mapping = diffuse ? diffuse_ref : sg_ref;
+      scene_.textures.push_back(std::move(out.base_color));
+      mapping.texture = static_cast<int>(scene_.textures.size()) - 1;
+      m.base_color_texture = mapping;
+      scene_.textures.push_back(std::move(out.metallic_roughness));
+      mapping.texture = static_cast<int>(scene_.textures.size()) - 1;
+      m.metallic_roughness_texture = mapping;
+      m.base_color = glm::vec4(1.0f);
+      m.metallic = m.roughness = 1.0f;
+    }
+    std::string message = "converted " + std::to_string(spec_gloss_.size()) +
+                          " KHR_materials_pbrSpecularGlossiness material(s) to metallic-roughness (metallic solved "
+                          "from specular and diffuse brightness, roughness = 1 - glossiness";
+    if (baked) message += "; textures baked per texel";
+    message += ")";
+    if (!approximated.empty())
+      message += "; approximated for " + approximated +
+                 ": diffuse and specular-glossiness textures use different UV mappings, so the base color is the "
+                 "diffuse color (exact only for dielectrics)";
+    warn(message);
   }
 
   // Beer-Lambert coefficient from attenuationColor (the color left after attenuationDistance).
@@ -997,6 +1097,12 @@ class GltfLoader {
   LoadLimits limits_;
   LoadEstimate estimate_;
   std::vector<PendingTexture> pending_;
+  // A material read from KHR_materials_pbrSpecularGlossiness, converted after decoding.
+  struct SpecGlossMaterial {
+    size_t material;
+    SpecGlossFactors factors;
+  };
+  std::vector<SpecGlossMaterial> spec_gloss_;
   std::string base_dir_;  // what relative uris are resolved against
   tinygltf::Model model_;
   gltf::ImageStore images_;

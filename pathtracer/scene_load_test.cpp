@@ -652,6 +652,124 @@ TEST(SceneLoadMaterial, KhrExtensionsEmissiveStrengthTransmissionIorSpecular) {
   EXPECT_TRUE(scene.warnings.empty()) << warnings_of(scene);
 }
 
+// KHR_materials_pbrSpecularGlossiness is converted at load, with one warning per file; a file
+// that requires it loads.
+TEST(SceneLoadMaterial, SpecularGlossinessFactorsConvertToMetallicRoughness) {
+  std::string dir = temp_dir();
+  GltfBuilder b;
+  b.doc["extensionsUsed"] = {"KHR_materials_pbrSpecularGlossiness"};
+  b.doc["extensionsRequired"] = {"KHR_materials_pbrSpecularGlossiness"};
+  auto spec_gloss = [&](const std::string& name, json ext) {
+    // The metallic-roughness block is the file's fallback for viewers without the extension.
+    return b.material({{"name", name},
+                       {"pbrMetallicRoughness", {{"baseColorFactor", {0, 1, 0, 1}}, {"metallicFactor", 0.5}}},
+                       {"extensions", {{"KHR_materials_pbrSpecularGlossiness", ext}}}});
+  };
+  int plastic = spec_gloss("plastic", {{"diffuseFactor", {0.6, 0.3, 0.1, 0.8}},
+                                       {"specularFactor", {0.04, 0.04, 0.04}},
+                                       {"glossinessFactor", 0.7}});
+  int gold = spec_gloss("gold", {{"diffuseFactor", {0, 0, 0, 1}},
+                                 {"specularFactor", {1.0, 0.78, 0.34}},
+                                 {"glossinessFactor", 0.9}});
+  int defaults = spec_gloss("defaults", json::object());
+  b.scene({b.node({{"mesh", b.mesh(b.quad_primitive(plastic))}}), b.node({{"mesh", b.mesh(b.quad_primitive(gold))}}),
+           b.node({{"mesh", b.mesh(b.quad_primitive(defaults))}})});
+  Scene scene = load_scene(b.write_gltf(dir + "/sg.gltf"));
+  ASSERT_EQ(scene.materials.size(), 4u);
+
+  const Material& p = scene.materials[0];
+  EXPECT_NEAR(p.metallic, 0.0f, 1e-4f);
+  expect_vec3_near(p.base_color, {0.6f, 0.3f, 0.1f}, 1e-4f);
+  EXPECT_NEAR(p.base_color.a, 0.8f, 1e-6f);
+  EXPECT_NEAR(p.roughness, 0.3f, 1e-6f);
+  EXPECT_FALSE(p.base_color_texture.valid() || p.metallic_roughness_texture.valid());
+
+  const Material& g = scene.materials[1];
+  EXPECT_GT(g.metallic, 0.999f);
+  expect_vec3_near(g.base_color, {1.0f, 0.78f, 0.34f}, 1e-3f);
+  EXPECT_NEAR(g.roughness, 0.1f, 1e-6f);
+
+  // Defaults: white diffuse, white specular, glossiness 1: a smooth white metal.
+  const Material& d = scene.materials[2];
+  EXPECT_GT(d.metallic, 0.999f);
+  EXPECT_EQ(d.roughness, 0.0f);
+  expect_vec3_near(d.base_color, {1, 1, 1}, 1e-3f);
+
+  size_t lines = 0;
+  for (const std::string& w : scene.warnings)
+    if (w.find("KHR_materials_pbrSpecularGlossiness") != std::string::npos) {
+      ++lines;
+      EXPECT_NE(w.find("3 "), std::string::npos) << w;  // the count of converted materials
+      EXPECT_EQ(w.find("approximated"), std::string::npos) << w;
+    }
+  EXPECT_EQ(lines, 1u) << warnings_of(scene);
+  EXPECT_FALSE(any_warning_contains(scene, "unsupported")) << warnings_of(scene);
+}
+
+TEST(SceneLoadMaterial, SpecularGlossinessTexturesAreBakedPerTexel) {
+  std::string dir = temp_dir();
+  GltfBuilder b;
+  b.doc["extensionsUsed"] = {"KHR_materials_pbrSpecularGlossiness", "KHR_texture_transform"};
+  // 2x1: texel 0 an orange dielectric (dark specular), texel 1 a metal (black diffuse, bright specular).
+  int diffuse = b.texture(b.image(encode_png(2, 1, 4, 8, {220, 120, 40, 255, 0, 0, 0, 255})), {{"sampler", 0}});
+  int spec = b.texture(b.image(encode_png(2, 1, 4, 8, {56, 56, 56, 102, 250, 210, 130, 230})), {{"sampler", 0}});
+  b.doc["samplers"] = {{{"magFilter", 9728}, {"wrapS", 33071}}};  // NEAREST, clamp to edge
+  json offset = {{"KHR_texture_transform", {{"offset", {0.25, 0}}}}};
+  int baked = b.material({{"name", "baked"},
+                          {"extensions",
+                           {{"KHR_materials_pbrSpecularGlossiness",
+                             {{"diffuseTexture", {{"index", diffuse}, {"extensions", offset}}},
+                              {"specularGlossinessTexture", {{"index", spec}, {"extensions", offset}}},
+                              {"glossinessFactor", 0.5}}}}}});
+  // Different UV mappings cannot be baked into one texture: approximated, and said so.
+  int mixed = b.material({{"name", "mixed"},
+                          {"extensions",
+                           {{"KHR_materials_pbrSpecularGlossiness",
+                             {{"diffuseTexture", {{"index", diffuse}, {"extensions", offset}}},
+                              {"specularGlossinessTexture", {{"index", spec}}}}}}}});
+  b.scene({b.node({{"mesh", b.mesh(b.quad_primitive(baked))}}), b.node({{"mesh", b.mesh(b.quad_primitive(mixed))}})});
+  Scene scene = load_scene(b.write_gltf(dir + "/sgtex.gltf"));
+  ASSERT_EQ(scene.materials.size(), 3u);
+
+  const Material& m = scene.materials[0];
+  ASSERT_TRUE(m.base_color_texture.valid() && m.metallic_roughness_texture.valid());
+  EXPECT_EQ(m.base_color, glm::vec4(1.0f));
+  EXPECT_EQ(m.metallic, 1.0f);
+  EXPECT_EQ(m.roughness, 1.0f);
+  // The baked textures keep the mapping and the sampler.
+  EXPECT_NEAR(m.base_color_texture.transform[2][0], 0.25f, 1e-6f);
+  EXPECT_NEAR(m.metallic_roughness_texture.transform[2][0], 0.25f, 1e-6f);
+  const Texture& base = scene.textures[m.base_color_texture.texture];
+  const Texture& mr = scene.textures[m.metallic_roughness_texture.texture];
+  ASSERT_EQ(base.width, 2);
+  ASSERT_EQ(mr.height, 1);
+  EXPECT_TRUE(base.nearest && mr.nearest);
+  EXPECT_EQ(base.wrap_s, Wrap::ClampToEdge);
+  // Texel 0: dielectric, base color = diffuse, roughness = 1 - 0.5 * 102/255.
+  EXPECT_EQ(mr.texel(0).b, 0.0f);
+  EXPECT_NEAR(mr.texel(0).g, 1.0f - 0.5f * 102 / 255.0f, 0.5f / 255 + 1e-6f);
+  expect_vec3_near(base.texel(0), {linear_from_srgb(220 / 255.0f), linear_from_srgb(120 / 255.0f), linear_from_srgb(40 / 255.0f)}, 0.01f);
+  // Texel 1: metal of the specular color.
+  EXPECT_GT(mr.texel(1).b, 0.99f);
+  EXPECT_NEAR(mr.texel(1).g, 1.0f - 0.5f * 230 / 255.0f, 0.5f / 255 + 1e-6f);
+  expect_vec3_near(base.texel(1), {linear_from_srgb(250 / 255.0f), linear_from_srgb(210 / 255.0f), linear_from_srgb(130 / 255.0f)}, 0.01f);
+
+  const Material& x = scene.materials[1];
+  ASSERT_TRUE(x.base_color_texture.valid() && x.metallic_roughness_texture.valid());
+  EXPECT_EQ(scene.textures[x.base_color_texture.texture].name, scene.textures[0].name);  // the diffuse texture itself
+  EXPECT_GT(scene.textures[x.metallic_roughness_texture.texture].texel(1).b, 0.9f);
+
+  std::string w;
+  for (const std::string& line : scene.warnings)
+    if (line.find("KHR_materials_pbrSpecularGlossiness") != std::string::npos) {
+      EXPECT_TRUE(w.empty()) << warnings_of(scene);  // one line per file
+      w = line;
+    }
+  EXPECT_NE(w.find("KHR_materials_pbrSpecularGlossiness"), std::string::npos) << w;
+  EXPECT_NE(w.find("baked"), std::string::npos) << w;
+  EXPECT_NE(w.find("approximated for 'mixed'"), std::string::npos) << w;
+}
+
 TEST(SceneLoadMaterial, AlphaMaskBlendAndDoubleSided) {
   std::string dir = temp_dir();
   GltfBuilder b;
