@@ -66,9 +66,9 @@ void write_display_images(const std::string& dir, const Image& test, const Image
   std::printf("wrote %s/test.png, reference.png, error.png (4 x |display difference|)\n", dir.c_str());
 }
 
-void print_display(const char* label, const DisplayMetrics& m) {
-  std::printf("%s: HDR NRMSE %.4f %%  display NRMSE %.4f %%  FLIP %.6f\n", label, m.hdr.nrmse_percent,
-              m.display_nrmse_percent, m.flip_mean);
+void print_display(const char* label, const DisplayMetrics& m, const OutlierMetrics& o) {
+  std::printf("%s: HDR NRMSE %.4f %%  display NRMSE %.4f %%  FLIP %.6f  outliers (Y > 5x reference) %zu (%.4f %%)\n",
+              label, m.hdr.nrmse_percent, m.display_nrmse_percent, m.flip_mean, o.outliers, 100.0 * o.fraction);
 }
 }  // namespace
 
@@ -81,7 +81,8 @@ int run_diff(const Args& args) {
                   "NaN/Inf count of TEST against REFERENCE over their shared color channels. For RGB images\n"
                   "also the display-space NRMSE (both tone-mapped with the reference's Reinhard key and\n"
                   "log-average luminance, compared as sRGB values) and the mean LDR-FLIP of those display\n"
-                  "images, each again with the emitters masked out when a mask is known.");
+                  "images and the count of outlier pixels (luminance above 5x the reference's, the reference floored\n"
+                  "at 1 % of its mean luminance), each again with the emitters masked out when a mask is known.");
   cli.positional("TEST.exr", &test_path, "image to judge (EXR)");
   cli.positional("REFERENCE.exr", &reference_path, "reference image (EXR)");
   cli.option("--layer", &layer, "NAME", "layer of TEST to compare (default: the unnamed layer, else the first)");
@@ -114,14 +115,14 @@ int run_diff(const Args& args) {
   if (has_rgb(test) && has_rgb(reference)) {
     const std::optional<Image> mask = emitter_mask(mask_path, reference_path);
     const DisplayMetrics all = compare_display(test, reference, nullptr, display);
-    print_display("all pixels", all);
+    print_display("all pixels", all, count_outliers(test, reference));
     flip = all.flip_mean;
     if (!images_dir.empty()) write_display_images(images_dir, test, reference, display.key);
     if (mask) {
       const DisplayMetrics masked = compare_display(test, reference, &*mask, display);
       char label[64];
       std::snprintf(label, sizeof label, "emitters masked (%zu pixels)", masked_pixels(*mask));
-      print_display(label, masked);
+      print_display(label, masked, count_outliers(test, reference, &*mask));
     }
   } else {
     std::printf("display metrics: skipped, the images have no R,G,B channels\n");

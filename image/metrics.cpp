@@ -1,4 +1,5 @@
 // docs/metrics.md: one implementation of the error metrics for tests, `pxf bench` and `pxf diff`.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -99,6 +100,37 @@ double masked_mean(const Image& values, const Image* mask) {
   return n ? sum / n : 0.0;
 }
 }  // namespace
+
+OutlierMetrics count_outliers(const Image& test, const Image& reference, const Image* mask,
+                              const OutlierOptions& options) {
+  check_same_size(test, reference, "image");
+  if (mask) {
+    check_same_size(*mask, reference, "mask and image");
+    if (mask->channels.empty()) throw Error("the mask has no channel");
+  }
+  const Image t = test.select({"R", "G", "B"}), r = reference.select({"R", "G", "B"});
+  auto y = [](const Image& im, size_t p) {
+    return static_cast<double>(luminance(im.pixels[3 * p], im.pixels[3 * p + 1], im.pixels[3 * p + 2]));
+  };
+  double sum = 0;
+  size_t judged = 0;
+  for (size_t p = 0; p < r.pixel_count(); ++p) {
+    if (masked_out(mask, p) || !std::isfinite(y(r, p))) continue;
+    sum += y(r, p);
+    ++judged;
+  }
+  OutlierMetrics m;
+  m.pixels = judged;
+  if (judged == 0) return m;
+  m.luminance_floor = options.floor_fraction * sum / static_cast<double>(judged);
+  for (size_t p = 0; p < r.pixel_count(); ++p) {
+    const double ry = y(r, p), ty = y(t, p);
+    if (masked_out(mask, p) || !std::isfinite(ry)) continue;
+    if (!std::isfinite(ty) || ty > options.factor * std::max(ry, m.luminance_floor)) ++m.outliers;
+  }
+  m.fraction = static_cast<double>(m.outliers) / static_cast<double>(judged);
+  return m;
+}
 
 DisplayImages tonemap_like_reference(const Image& test, const Image& reference, float key) {
   TonemapParams params;

@@ -28,4 +28,23 @@ struct DisplayMetrics {
 DisplayMetrics compare_display(const Image& test, const Image& reference, const Image* mask = nullptr,
                                const DisplayMetricOptions& options = {});
 
+// Fireflies: pixels whose luminance is above `factor` times the reference's luminance there. Where
+// the reference is dark the bound would catch any noise, so the reference luminance is floored at
+// floor_fraction times the reference image's mean luminance: a pixel is an outlier when
+// Y(test) > factor * max(Y(reference), floor_fraction * mean Y(reference)). A test pixel that is NaN
+// or Inf counts as an outlier; pixels whose reference is not finite, or that the mask leaves out
+// (mask > 0), are not counted at all. Needs R,G,B in both; throws pxf::Error like compare_images.
+struct OutlierOptions {
+  double factor = 5.0;
+  double floor_fraction = 0.01;
+};
+struct OutlierMetrics {
+  size_t outliers = 0;
+  size_t pixels = 0;        // pixels judged
+  double fraction = 0;      // outliers / pixels (0 when no pixel was judged)
+  double luminance_floor = 0;  // floor_fraction * the reference's mean luminance over the judged pixels
+};
+OutlierMetrics count_outliers(const Image& test, const Image& reference, const Image* mask = nullptr,
+                              const OutlierOptions& options = {});
+
 }  // namespace pxf

@@ -74,3 +74,55 @@ TEST(DisplayMetrics, MaskAppliesToEveryMetric) {
   EXPECT_NEAR(masked.flip_mean, sum / (flip.pixels.size() - 1), 1e-9);
   EXPECT_LT(masked.flip_mean, all.flip_mean);
 }
+
+// Outliers: Y(test) > 5 x max(Y(reference), 0.01 x mean Y(reference)), counted by hand on a 4x1 image.
+TEST(OutlierMetrics, CountsPixelsAboveFiveTimesTheReference) {
+  Image ref = Image::rgb(4, 1, 1.0f), test = Image::rgb(4, 1, 1.0f);
+  for (int c = 0; c < 3; ++c) {
+    test.at(0, 0, c) = 4.99f;  // below 5x: kept
+    test.at(1, 0, c) = 5.01f;  // above 5x: an outlier
+    ref.at(2, 0, c) = 0.0f;    // a black reference pixel: judged against the floor
+    test.at(2, 0, c) = 0.04f;  // floor = 0.01 x mean(1, 1, 0, 1) = 0.0075; 5 x floor = 0.0375 < 0.04
+  }
+  const OutlierMetrics m = count_outliers(test, ref);
+  EXPECT_EQ(m.pixels, 4u);
+  EXPECT_EQ(m.outliers, 2u);
+  EXPECT_DOUBLE_EQ(m.fraction, 0.5);
+  EXPECT_NEAR(m.luminance_floor, 0.0075, 1e-7);
+  for (int c = 0; c < 3; ++c) test.at(2, 0, c) = 0.035f;  // under 5 x floor: no longer an outlier
+  EXPECT_EQ(count_outliers(test, ref).outliers, 1u);
+  OutlierOptions looser;
+  looser.factor = 6.0;
+  EXPECT_EQ(count_outliers(test, ref, nullptr, looser).outliers, 0u);
+  EXPECT_EQ(count_outliers(ref, ref).outliers, 0u);
+}
+
+// Luminance, not a channel: a pure-blue pixel of 10 is no outlier against grey 1 (Y 0.72 < 5), but
+// is one against a pure-blue reference of 1 (Y 0.72 > 5 x 0.072).
+TEST(OutlierMetrics, UsesLuminance) {
+  Image grey = Image::rgb(1, 1, 1.0f), test = Image::rgb(1, 1, 0.0f);
+  test.at(0, 0, 2) = 10.0f;  // Y = 0.722 < 5 x 1
+  EXPECT_EQ(count_outliers(test, grey).outliers, 0u);
+  Image blue = Image::rgb(1, 1, 0.0f);
+  blue.at(0, 0, 2) = 1.0f;  // Y = 0.0722, 5x = 0.361
+  EXPECT_EQ(count_outliers(test, blue).outliers, 1u);
+}
+
+// A non-finite test pixel is an outlier; a non-finite reference pixel and masked pixels are not judged.
+TEST(OutlierMetrics, NonFiniteAndMask) {
+  Image ref = Image::rgb(3, 1, 1.0f), test = Image::rgb(3, 1, 1.0f);
+  test.at(0, 0, 1) = NAN;
+  ref.at(1, 0, 0) = INFINITY;
+  test.at(2, 0, 0) = 100.0f;
+  OutlierMetrics m = count_outliers(test, ref);
+  EXPECT_EQ(m.pixels, 2u);
+  EXPECT_EQ(m.outliers, 2u);
+  Image mask = Image::gray(3, 1, "emitter");
+  mask.at(2, 0, 0) = 1.0f;
+  m = count_outliers(test, ref, &mask);
+  EXPECT_EQ(m.pixels, 1u);
+  EXPECT_EQ(m.outliers, 1u);
+  EXPECT_THROW(count_outliers(test, Image::rgb(2, 1, 1.0f)), Error);
+  EXPECT_THROW(count_outliers(Image::gray(3, 1), ref), Error);
+  EXPECT_EQ(count_outliers(test, Image::rgb(3, 1, NAN)).pixels, 0u);
+}

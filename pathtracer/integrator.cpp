@@ -46,7 +46,54 @@ void add_contribution(PathSample& out, glm::vec3 value, bool lv) {
     out.hv += value;
 }
 
+// Adds an HV contribution to a sample's classification: the largest one names the sample's class.
+void record_hv(HvSampleClass& sample, glm::vec3 value, HvClass c) {
+  const float y = luminance(value);
+  if (sample.dominant == HvClass::None || y > sample.dominant_luminance) {
+    sample.dominant = c;
+    sample.dominant_luminance = y;
+  }
+}
+
 }  // namespace
+
+const char* hv_class_name(HvClass c) {
+  switch (c) {
+    case HvClass::None: return "none";
+    case HvClass::EmitterBackFace: return "emitter back face";
+    case HvClass::GlassInternal: return "glass internal reflection";
+    case HvClass::CausticGlass: return "caustic through glass (D S+ L)";
+    case HvClass::CausticMirror: return "caustic via mirror (D S+ L)";
+    case HvClass::SpecularBetweenDiffuse: return "specular between diffuse (D S+ D)";
+    case HvClass::SeenThroughSpecular: return "seen through specular (E S+ D)";
+    case HvClass::Diffuse: return "diffuse interreflection";
+    case HvClass::Count: break;
+  }
+  return "?";
+}
+
+// What the firefly attribution knows of a path so far (HvClass); only trace_pixels_classified keeps it.
+struct PathTracer::ClassState {
+  HvSampleClass* out = nullptr;
+  bool emitter_back_face = false;  // scattered off an emitter's back face
+  bool glass_internal = false;     // a delta reflection inside glass
+  bool glass_since_d = false;      // delta interactions with glass / mirrors since the last D vertex
+  bool mirror_since_d = false;
+  bool specular_between_d = false;  // a D S+ D stretch
+  bool specular_before_d = false;   // delta interactions before the first D vertex
+
+  // The class of light reaching the path now: through the BSDF sample that just arrived
+  // (`by_bsdf`: a specular chain since the last D is a caustic), or by NEE at a D vertex.
+  HvClass classify(int nonspecular, bool by_bsdf) const {
+    const bool chain = glass_since_d || mirror_since_d;
+    if (emitter_back_face) return HvClass::EmitterBackFace;
+    if (glass_internal) return HvClass::GlassInternal;
+    if (by_bsdf && nonspecular > 0 && chain) return glass_since_d ? HvClass::CausticGlass : HvClass::CausticMirror;
+    if (specular_between_d || (!by_bsdf && nonspecular > 0 && chain)) return HvClass::SpecularBetweenDiffuse;
+    if (specular_before_d) return HvClass::SeenThroughSpecular;
+    return HvClass::Diffuse;
+  }
+};
 
 // One path of a batch: its random stream, the ray it traces next, and what it has gathered.
 struct PathTracer::Path {
@@ -68,6 +115,9 @@ struct PathTracer::ShadowQueue {
   ShadowRay rays[kBatchPaths];
   Pending pending[kBatchPaths];
   bool occluded[kBatchPaths];
+  // Firefly attribution only (trace_pixels_classified): each pending contribution's sample and class.
+  HvSampleClass* class_out[kBatchPaths];
+  HvClass classes[kBatchPaths];
   int count = 0;
 
   void push(const ShadowRay& ray, const Pending& contribution) {
@@ -75,10 +125,16 @@ struct PathTracer::ShadowQueue {
     pending[count] = contribution;
     ++count;
   }
+  template <bool kClassify>
   void resolve(const EmbreeScene& geometry, bool all_hv) {
     geometry.occluded(rays, static_cast<size_t>(count), occluded);
     for (int i = 0; i < count; ++i)
-      if (!occluded[i]) add_contribution(*pending[i].out, pending[i].contribution, pending[i].lv && !all_hv);
+      if (!occluded[i]) {
+        const bool lv = pending[i].lv && !all_hv;
+        add_contribution(*pending[i].out, pending[i].contribution, lv);
+        if constexpr (kClassify)
+          if (!lv) record_hv(*class_out[i], pending[i].contribution, classes[i]);
+      }
     count = 0;
   }
 };
@@ -102,14 +158,32 @@ void PathTracer::trace_pixels(const Camera& camera, int width, int height, const
                               const TraceParams& params, PathSample* out) const {
   const int count = rect.count();
   for (int first = 0; first < count; first += kBatchPaths)
-    trace_batch(camera, width, height, rect, first, std::min(kBatchPaths, count - first), frame, params, out + first);
+    trace_batch<false>(camera, width, height, rect, first, std::min(kBatchPaths, count - first), frame, params,
+                       out + first, nullptr);
+}
+
+void PathTracer::trace_pixels_classified(const Camera& camera, int width, int height, const PixelRect& rect,
+                                         uint32_t frame, const TraceParams& params, PathSample* out,
+                                         HvSampleClass* classes) const {
+  const int count = rect.count();
+  for (int first = 0; first < count; first += kBatchPaths)
+    trace_batch<true>(camera, width, height, rect, first, std::min(kBatchPaths, count - first), frame, params,
+                      out + first, classes + first);
 }
 
 // Pixels first .. first + count - 1 (row-major in rect) of trace_pixels, in lockstep.
+template <bool kClassify>
 void PathTracer::trace_batch(const Camera& camera, int width, int height, const PixelRect& rect, int first, int count,
-                             uint32_t frame, const TraceParams& params, PathSample* out) const {
+                             uint32_t frame, const TraceParams& params, PathSample* out, HvSampleClass* classes) const {
   const CameraRays camera_rays(camera, width, height);
   Path paths[kBatchPaths];
+  ClassState class_states[kClassify ? kBatchPaths : 1];
+  if constexpr (kClassify)
+    for (int i = 0; i < count; ++i) {
+      classes[i] = HvSampleClass{};
+      class_states[i] = ClassState{};
+      class_states[i].out = &classes[i];
+    }
   for (int i = 0; i < count; ++i) {
     const int x = rect.x0 + (first + i) % rect.width(), y = rect.y0 + (first + i) / rect.width();
     const uint64_t pixel = static_cast<uint64_t>(y) * static_cast<uint64_t>(width) + static_cast<uint64_t>(x);
@@ -134,16 +208,19 @@ void PathTracer::trace_batch(const Camera& camera, int width, int height, const 
                         vertex == 2 ? RayCoherence::Coherent : RayCoherence::Incoherent, hits);
     int still_live = 0;
     for (int k = 0; k < live_count; ++k)
-      if (shade_vertex(paths[live[k]], hits[k], vertex, params, shadows)) live[still_live++] = live[k];
+      if (shade_vertex<kClassify>(paths[live[k]], hits[k], vertex, params, shadows,
+                                  kClassify ? &class_states[live[k]] : nullptr))
+        live[still_live++] = live[k];
     live_count = still_live;
-    shadows.resolve(geometry_, params.all_hv);
+    shadows.resolve<kClassify>(geometry_, params.all_hv);
   }
 }
 
 // Vertex `vertex` of a path at `hit`: the emission found there, next event estimation (queued on
 // `shadows`) and the BSDF sample that continues the path into path.ray. False: the path ends here.
-bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const TraceParams& params,
-                              ShadowQueue& shadows) const {
+template <bool kClassify>
+bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const TraceParams& params, ShadowQueue& shadows,
+                              [[maybe_unused]] ClassState* cls) const {
   const Scene& scene = geometry_.scene();
   PathState& s = path.state;
   PathSample& out = *path.out;
@@ -152,7 +229,11 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
   if (!hit.valid()) {  // the environment is the light vertex
     if (lights_.has_environment()) {
       float w = s.prev_delta ? 1.0f : power_heuristic(s.prev_pdf, lights_.pdf_environment(path.ray.direction));
-      add_contribution(out, s.throughput * lights_.environment_radiance(path.ray.direction) * w, emission_goes_to_lv(s, params.all_hv));
+      const glm::vec3 value = s.throughput * lights_.environment_radiance(path.ray.direction) * w;
+      const bool lv = emission_goes_to_lv(s, params.all_hv);
+      add_contribution(out, value, lv);
+      if constexpr (kClassify)
+        if (!lv) record_hv(*cls->out, value, cls->classify(s.nonspecular, true));
     }
     return false;
   }
@@ -165,8 +246,14 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
     if (!s.prev_delta)
       w = power_heuristic(s.prev_pdf,
                           lights_.pdf_triangle(hit.mesh, hit.prim, s.prev_position, sp.position, sp.geometric_normal));
-    add_contribution(out, s.throughput * eval_emission(scene, material, sp.uv0, sp.uv1) * w, emission_goes_to_lv(s, params.all_hv));
+    const glm::vec3 value = s.throughput * eval_emission(scene, material, sp.uv0, sp.uv1) * w;
+    const bool lv = emission_goes_to_lv(s, params.all_hv);
+    add_contribution(out, value, lv);
+    if constexpr (kClassify)
+      if (!lv) record_hv(*cls->out, value, cls->classify(s.nonspecular, true));
   }
+  if constexpr (kClassify)
+    if (material.is_emissive() && !emission_visible(material, sp)) cls->emitter_back_face = true;
   const bool last_vertex = vertex == params.max_vertices;  // no room for another vertex
   if (last_vertex && s.albedo_set) return false;
 
@@ -193,6 +280,10 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
                             : shadow_ray_between(sp.position, sp.geometric_normal, ls.point, ls.normal);
         ++out.rays;
         float w = ls.delta ? 1.0f : power_heuristic(ls.pdf, bsdf_pdf);
+        if constexpr (kClassify) {
+          shadows.class_out[shadows.count] = cls->out;
+          shadows.classes[shadows.count] = cls->classify(s.nonspecular, false);
+        }
         shadows.push(ray,
                      {&out, s.throughput * f * ls.radiance * (w / ls.pdf), s.nonspecular == 0});
       }
@@ -205,6 +296,17 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
   float u_rr = sampler.get_1d(vertex, VertexDim::Roulette);
   BsdfSample bs;
   if (!bsdf.sample(u_lobe, u_dir, &bs)) return false;
+  if constexpr (kClassify) {
+    if (bs.delta) {
+      const bool glass = bsdf_params.transmission > 0.0f && bsdf_params.metallic < 1.0f;
+      (glass ? cls->glass_since_d : cls->mirror_since_d) = true;
+      if (glass && !sp.front_face && !bs.transmitted) cls->glass_internal = true;
+      if (s.nonspecular == 0) cls->specular_before_d = true;
+    } else {
+      if (s.nonspecular > 0 && (cls->glass_since_d || cls->mirror_since_d)) cls->specular_between_d = true;
+      cls->glass_since_d = cls->mirror_since_d = false;
+    }
+  }
   s.throughput *= bs.weight;
   if (!bs.delta) ++s.nonspecular;
   s.prev_delta = bs.delta;

@@ -24,6 +24,27 @@ struct PathSample {
   bool finite() const;
 };
 
+// Firefly attribution (docs/sampling.md#fireflies): the kind of path an HV contribution came from,
+// in order of precedence (the first that fits). "S" is a delta interaction (mirror or smooth glass),
+// "D" any other scattering vertex. Only trace_pixels_classified computes it; renders never do.
+enum class HvClass : uint8_t {
+  None,                  // the sample has no HV light
+  EmitterBackFace,       // the path scattered off the back (non-emitting) face of an emitter
+  GlassInternal,         // a delta reflection inside glass (Fresnel or total internal reflection)
+  CausticGlass,          // E ... D S+ L with glass in the chain: emission found by BSDF sampling, NEE blocked
+  CausticMirror,         // E ... D S+ L through mirrors only
+  SpecularBetweenDiffuse,  // E ... D S+ D ... L: a specular chain between two diffuse vertices
+  SeenThroughSpecular,   // E S+ D ... L: the camera sees the diffuse surface through glass or a mirror
+  Diffuse,               // E D D+ L: plain diffuse interreflection
+  Count
+};
+const char* hv_class_name(HvClass c);
+// One sample's HV classification: its largest HV contribution's class and luminance.
+struct HvSampleClass {
+  HvClass dominant = HvClass::None;
+  float dominant_luminance = 0.0f;
+};
+
 // The pixels [x0, x1) x [y0, y1) of an image.
 struct PixelRect {
   int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
@@ -46,6 +67,11 @@ class PathTracer {
   PathSample trace_pixel(const Camera& camera, int width, int height, int x, int y, uint32_t frame,
                          const TraceParams& params) const;
 
+  // trace_pixels (the same samples, bit for bit) that also classifies every HV contribution; for the
+  // firefly attribution in tests, never used by renders: trace_pixels compiles without it.
+  void trace_pixels_classified(const Camera& camera, int width, int height, const PixelRect& rect, uint32_t frame,
+                               const TraceParams& params, PathSample* out, HvSampleClass* classes) const;
+
   SpecularChainHit trace_specular_chain(const Ray& camera_ray) const;
   // The ray's first surface emits toward it (the emission the path tracer adds at vertex 1).
   bool first_hit_is_emissive(const Ray& camera_ray) const;
@@ -58,9 +84,13 @@ class PathTracer {
  private:
   struct Path;
   struct ShadowQueue;
+  struct ClassState;
+  template <bool kClassify>
   void trace_batch(const Camera& camera, int width, int height, const PixelRect& rect, int first, int count,
-                   uint32_t frame, const TraceParams& params, PathSample* out) const;
-  bool shade_vertex(Path& path, const Hit& hit, int vertex, const TraceParams& params, ShadowQueue& shadows) const;
+                   uint32_t frame, const TraceParams& params, PathSample* out, HvSampleClass* classes) const;
+  template <bool kClassify>
+  bool shade_vertex(Path& path, const Hit& hit, int vertex, const TraceParams& params, ShadowQueue& shadows,
+                    ClassState* cls) const;
 
   EmbreeScene geometry_;
   LightSampler lights_;

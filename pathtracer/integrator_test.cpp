@@ -604,3 +604,125 @@ TEST(IntegratorBench, DISABLED_CornellBox512) {
 }
 }  // namespace
 }  // namespace pxf
+
+// Firefly attribution (docs/sampling.md#fireflies).
+#include <algorithm>
+#include <vector>
+namespace pxf {
+namespace {
+
+struct ClassifiedFrames {
+  std::vector<PathSample> samples;
+  std::vector<HvSampleClass> classes;
+};
+ClassifiedFrames trace_classified(const PathTracer& tracer, const Camera& camera, int size, int frames,
+                                  const TraceParams& params) {
+  ClassifiedFrames r;
+  const size_t n = static_cast<size_t>(size) * size;
+  r.samples.resize(n * frames);
+  r.classes.resize(n * frames);
+  for (int f = 0; f < frames; ++f)
+    tracer.trace_pixels_classified(camera, size, size, PixelRect{0, 0, size, size}, static_cast<uint32_t>(f), params,
+                                   &r.samples[n * f], &r.classes[n * f]);
+  return r;
+}
+
+// The classifying trace gives trace_pixels' samples bit for bit, and a class to every sample with HV
+// light: its largest contribution, never more than the sample's HV.
+TEST(FireflyAttribution, ClassifiedTraceGivesTheSameSamples) {
+  const Scene scene = make_cornell_box(true);
+  const PathTracer tracer(scene);
+  const TraceParams params = furnace_params();
+  const int size = 24, frames = 4;
+  const ClassifiedFrames c = trace_classified(tracer, scene.camera, size, frames, params);
+  std::vector<PathSample> plain(size * size);
+  size_t with_hv = 0;
+  for (int f = 0; f < frames; ++f) {
+    tracer.trace_pixels(scene.camera, size, size, PixelRect{0, 0, size, size}, static_cast<uint32_t>(f), params,
+                        plain.data());
+    for (int i = 0; i < size * size; ++i) {
+      const PathSample& a = plain[i];
+      const PathSample& b = c.samples[static_cast<size_t>(f) * size * size + i];
+      const HvSampleClass& k = c.classes[static_cast<size_t>(f) * size * size + i];
+      ASSERT_EQ(std::memcmp(&a.lv, &b.lv, sizeof a.lv), 0);
+      ASSERT_EQ(std::memcmp(&a.hv, &b.hv, sizeof a.hv), 0);
+      ASSERT_EQ(a.rays, b.rays);
+      if (luminance(b.hv) > 0.0f) {
+        ++with_hv;
+        EXPECT_NE(k.dominant, HvClass::None);
+        EXPECT_LE(k.dominant_luminance, luminance(b.hv) * (1.0f + 1e-5f));
+      } else {
+        EXPECT_EQ(k.dominant_luminance, 0.0f);
+      }
+    }
+  }
+  EXPECT_GT(with_hv, static_cast<size_t>(size * size));  // most samples carry HV light
+}
+
+std::vector<size_t> class_counts(const std::vector<HvSampleClass>& classes) {
+  std::vector<size_t> counts(static_cast<size_t>(HvClass::Count), 0);
+  for (const HvSampleClass& c : classes) ++counts[static_cast<size_t>(c.dominant)];
+  return counts;
+}
+
+// Without specular surfaces every HV sample is diffuse interreflection; with the mirror and glass
+// spheres, caustics through each and views through them appear. The box's light is single-sided,
+// 1 mm under the ceiling: a few paths scatter off its back face.
+TEST(FireflyAttribution, ClassesFollowTheScene) {
+  const TraceParams params = furnace_params();
+  {
+    const Scene scene = make_cornell_box(false);
+    const std::vector<size_t> n = class_counts(trace_classified(PathTracer(scene), scene.camera, 32, 8, params).classes);
+    for (HvClass c : {HvClass::GlassInternal, HvClass::CausticGlass, HvClass::CausticMirror,
+                      HvClass::SpecularBetweenDiffuse, HvClass::SeenThroughSpecular})
+      EXPECT_EQ(n[static_cast<size_t>(c)], 0u) << hv_class_name(c);
+    EXPECT_GT(n[static_cast<size_t>(HvClass::Diffuse)], 32u * 32u * 4u);
+  }
+  const Scene scene = make_cornell_box(true);
+  const std::vector<size_t> n = class_counts(trace_classified(PathTracer(scene), scene.camera, 32, 16, params).classes);
+  for (HvClass c : {HvClass::GlassInternal, HvClass::CausticGlass, HvClass::CausticMirror,
+                    HvClass::SpecularBetweenDiffuse, HvClass::SeenThroughSpecular, HvClass::Diffuse})
+    EXPECT_GT(n[static_cast<size_t>(c)], 0u) << hv_class_name(c);
+}
+
+// Figures for docs/sampling.md#fireflies, not a pass/fail test. Run with
+//   pathtracer_tests --gtest_also_run_disabled_tests --gtest_filter=FireflyFigures.*
+// PXF_FIREFLY_SIZE (default 512) and PXF_FIREFLY_SPP (default 64) change the render.
+TEST(FireflyFigures, DISABLED_Cornell) {
+  const Scene scene = load_scene("cornell");
+  const PathTracer tracer(scene);
+  TraceParams params;  // the render's defaults
+  const int size = std::getenv("PXF_FIREFLY_SIZE") ? std::atoi(std::getenv("PXF_FIREFLY_SIZE")) : 512;
+  const int spp = std::getenv("PXF_FIREFLY_SPP") ? std::atoi(std::getenv("PXF_FIREFLY_SPP")) : 64;
+  const ClassifiedFrames c = trace_classified(tracer, scene.camera, size, spp, params);
+  const size_t n = c.samples.size(), kinds = static_cast<size_t>(HvClass::Count);
+  std::vector<std::pair<float, HvClass>> ranked(n);
+  std::vector<double> energy(kinds, 0.0);
+  double total = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const float y = luminance(c.samples[i].hv);
+    ranked[i] = {y, c.classes[i].dominant};
+    energy[static_cast<size_t>(c.classes[i].dominant)] += y;
+    total += y;
+  }
+  std::sort(ranked.begin(), ranked.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  const size_t top1000 = n / 1000, top100 = n / 100;
+  std::vector<size_t> all(kinds, 0), in1000(kinds, 0), in100(kinds, 0);
+  for (size_t i = 0; i < n; ++i) {
+    const size_t k = static_cast<size_t>(ranked[i].second);
+    ++all[k];
+    if (i < top1000) ++in1000[k];
+    if (i < top100) ++in100[k];
+  }
+  std::printf("cornell %dx%d, %d spp, %zu samples; HV luminance: max %.3g, 0.1 %% quantile %.3g, 1 %% quantile %.3g, "
+              "mean %.3g\n", size, size, spp, n, ranked[0].first, ranked[top1000].first, ranked[top100].first,
+              total / n);
+  std::printf("| class (largest HV contribution) | all samples | share of HV | top 1 %% | top 0.1 %% |\n|---|---|---|---|---|\n");
+  for (size_t k = 0; k < kinds; ++k)
+    std::printf("| %s | %.2f %% | %.1f %% | %.1f %% | %.1f %% |\n", hv_class_name(static_cast<HvClass>(k)),
+                100.0 * all[k] / n, 100.0 * energy[k] / total, 100.0 * in100[k] / top100, 100.0 * in1000[k] / top1000);
+  EXPECT_GT(total, 0.0);
+}
+
+}  // namespace
+}  // namespace pxf

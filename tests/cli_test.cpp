@@ -354,6 +354,10 @@ TEST(Cli, DiffReportsDisplayMetricsWithAndWithoutEmitters) {
   EXPECT_GT(masked_hdr, 0.0) << r.out;
   EXPECT_NE(masked_hdr, hdr) << r.out;  // the ceiling light is in view of the default camera
   EXPECT_GT(number_after(r.out, "emitters masked", "masked ("), 0.0) << r.out;
+  // The outlier count is printed on both lines; an image against itself has none.
+  EXPECT_GE(number_after(r.out, "all pixels:", "reference) "), 0.0) << r.out;
+  EXPECT_GE(number_after(r.out, "emitters masked", "reference) "), 0.0) << r.out;
+  EXPECT_EQ(number_after(run("diff " + ref + "/final.exr " + ref + "/final.exr").out, "all pixels:", "reference) "), 0.0);
   // --mask names the file explicitly; one without an emitter layer is a clear error.
   const Result explicit_mask = run("diff " + test + "/final.exr " + ref + "/final.exr --mask " + test + "/buffers.exr");
   EXPECT_EQ(explicit_mask.code, 0) << explicit_mask.err;
