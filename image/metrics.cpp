@@ -102,7 +102,7 @@ double masked_mean(const Image& values, const Image* mask) {
 }  // namespace
 
 OutlierMetrics count_outliers(const Image& test, const Image& reference, const Image* mask,
-                              const OutlierOptions& options) {
+                              const OutlierOptions& options, std::vector<size_t>* where) {
   check_same_size(test, reference, "image");
   if (mask) {
     check_same_size(*mask, reference, "mask and image");
@@ -121,12 +121,16 @@ OutlierMetrics count_outliers(const Image& test, const Image& reference, const I
   }
   OutlierMetrics m;
   m.pixels = judged;
+  if (where) where->clear();
   if (judged == 0) return m;
   m.luminance_floor = options.floor_fraction * sum / static_cast<double>(judged);
   for (size_t p = 0; p < r.pixel_count(); ++p) {
     const double ry = y(r, p), ty = y(t, p);
     if (masked_out(mask, p) || !std::isfinite(ry)) continue;
-    if (!std::isfinite(ty) || ty > options.factor * std::max(ry, m.luminance_floor)) ++m.outliers;
+    if (!std::isfinite(ty) || ty > options.factor * std::max(ry, m.luminance_floor)) {
+      ++m.outliers;
+      if (where) where->push_back(p);
+    }
   }
   m.fraction = static_cast<double>(m.outliers) / static_cast<double>(judged);
   return m;

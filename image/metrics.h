@@ -44,7 +44,8 @@ struct OutlierMetrics {
   double fraction = 0;      // outliers / pixels (0 when no pixel was judged)
   double luminance_floor = 0;  // floor_fraction * the reference's mean luminance over the judged pixels
 };
+// `where`, when given, receives the outlier pixels' indices (y * width + x), ascending.
 OutlierMetrics count_outliers(const Image& test, const Image& reference, const Image* mask = nullptr,
-                              const OutlierOptions& options = {});
+                              const OutlierOptions& options = {}, std::vector<size_t>* where = nullptr);
 
 }  // namespace pxf

@@ -89,6 +89,9 @@ TEST(OutlierMetrics, CountsPixelsAboveFiveTimesTheReference) {
   EXPECT_EQ(m.outliers, 2u);
   EXPECT_DOUBLE_EQ(m.fraction, 0.5);
   EXPECT_NEAR(m.luminance_floor, 0.0075, 1e-7);
+  std::vector<size_t> where{7};
+  count_outliers(test, ref, nullptr, {}, &where);
+  EXPECT_EQ(where, (std::vector<size_t>{1, 2}));
   for (int c = 0; c < 3; ++c) test.at(2, 0, c) = 0.035f;  // under 5 x floor: no longer an outlier
   EXPECT_EQ(count_outliers(test, ref).outliers, 1u);
   OutlierOptions looser;

@@ -14,6 +14,8 @@
 #include "pathtracer/lights.h"
 #include "pathtracer/texture.h"
 #include "pathtracer/shapes.h"
+#include "image/image.h"
+#include "image/metrics.h"
 
 namespace pxf {
 namespace {
@@ -706,21 +708,47 @@ TEST(FireflyFigures, DISABLED_Cornell) {
     total += y;
   }
   std::sort(ranked.begin(), ranked.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
-  const size_t top1000 = n / 1000, top100 = n / 100;
-  std::vector<size_t> all(kinds, 0), in1000(kinds, 0), in100(kinds, 0);
+  const size_t tops[4] = {n / 100, n / 1000, n / 10000, n / 100000};
+  std::vector<size_t> all(kinds, 0), in_top[4];
+  for (auto& t : in_top) t.assign(kinds, 0);
   for (size_t i = 0; i < n; ++i) {
     const size_t k = static_cast<size_t>(ranked[i].second);
     ++all[k];
-    if (i < top1000) ++in1000[k];
-    if (i < top100) ++in100[k];
+    for (int t = 0; t < 4; ++t) in_top[t][k] += i < tops[t];
   }
-  std::printf("cornell %dx%d, %d spp, %zu samples; HV luminance: max %.3g, 0.1 %% quantile %.3g, 1 %% quantile %.3g, "
-              "mean %.3g\n", size, size, spp, n, ranked[0].first, ranked[top1000].first, ranked[top100].first,
-              total / n);
-  std::printf("| class (largest HV contribution) | all samples | share of HV | top 1 %% | top 0.1 %% |\n|---|---|---|---|---|\n");
+  std::printf("cornell %dx%d, %d spp, %zu samples; HV luminance: max %.3g, mean %.3g, quantiles 1 %% %.3g, 0.1 %% %.3g, "
+              "0.01 %% %.3g, 0.001 %% %.3g\n", size, size, spp, n, ranked[0].first, total / n, ranked[tops[0]].first,
+              ranked[tops[1]].first, ranked[tops[2]].first, ranked[tops[3]].first);
+  // Outlier pixels of the unfiltered image against a reference (PXF_FIREFLY_REFERENCE, an EXR of the
+  // same size): the class of each outlier pixel's largest HV sample.
+  std::vector<size_t> outlier_class(kinds, 0);
+  size_t outliers = 0;
+  if (const char* reference_path = std::getenv("PXF_FIREFLY_REFERENCE")) {
+    const Image reference = read_exr(reference_path);
+    Image mean = Image::rgb(size, size);
+    const size_t pixels = static_cast<size_t>(size) * size;
+    for (size_t p = 0; p < pixels; ++p) {
+      glm::vec3 sum(0.0f);
+      for (int f = 0; f < spp; ++f) sum += c.samples[pixels * f + p].lv + c.samples[pixels * f + p].hv;
+      for (int ch = 0; ch < 3; ++ch) mean.pixels[3 * p + ch] = sum[ch] / static_cast<float>(spp);
+    }
+    std::vector<size_t> where;
+    outliers = count_outliers(mean, reference, nullptr, {}, &where).outliers;
+    for (size_t p : where) {
+      size_t best = 0;
+      for (int f = 1; f < spp; ++f)
+        if (luminance(c.samples[pixels * f + p].hv) > luminance(c.samples[pixels * best + p].hv)) best = static_cast<size_t>(f);
+      ++outlier_class[static_cast<size_t>(c.classes[pixels * best + p].dominant)];
+    }
+    std::printf("%zu outlier pixels (Y > 5x %s)\n", outliers, reference_path);
+  }
+  std::printf("| class (largest HV contribution) | all samples | share of HV | top 1 %% | top 0.1 %% | top 0.01 %% | "
+              "top 0.001 %% | outlier pixels |\n|---|---|---|---|---|---|---|---|\n");
   for (size_t k = 0; k < kinds; ++k)
-    std::printf("| %s | %.2f %% | %.1f %% | %.1f %% | %.1f %% |\n", hv_class_name(static_cast<HvClass>(k)),
-                100.0 * all[k] / n, 100.0 * energy[k] / total, 100.0 * in100[k] / top100, 100.0 * in1000[k] / top1000);
+    std::printf("| %s | %.2f %% | %.1f %% | %.1f %% | %.1f %% | %.1f %% | %.1f %% | %zu |\n",
+                hv_class_name(static_cast<HvClass>(k)), 100.0 * all[k] / n, 100.0 * energy[k] / total,
+                100.0 * in_top[0][k] / tops[0], 100.0 * in_top[1][k] / tops[1], 100.0 * in_top[2][k] / tops[2],
+                100.0 * in_top[3][k] / tops[3], outlier_class[k]);
   EXPECT_GT(total, 0.0);
 }
 
