@@ -51,6 +51,9 @@ void add_preview_options(CommandLine& cli, PreviewSettings& s) {
   cli.option("--threads", &s.trace.threads, "path-tracing threads (0 = all cores)", 0, 1024);
   cli.option("--max-vertices", &s.trace.max_vertices, "maximum path length in vertices, camera and light included", 2, 1024);
   cli.option("--rr-start", &s.trace.rr_start_vertex, "Russian roulette from this vertex on", 2, 1024);
+  cli.flag("--specular-sampling", &s.trace.specular_sampling,
+           "also sample the cones of mirror and glass objects at diffuse vertices, MIS-combined with BSDF\n"
+           "sampling: unbiased, fewer caustic fireflies, more rays (docs/sampling.md#fireflies)");
   cli.flag("--all-hv", &s.trace.all_hv, "put every contribution into the HV buffer but what the camera sees directly or through\nmirrors and glass (environment-lit scenes)");
   cli.option("--key", &s.tonemap.key, "Reinhard key a (default 0.18)", 1e-4f, 100.0f);
   cli.option("--white", &s.tonemap.white, "Reinhard white point (0 = none)", 0.0f, 1e9f);

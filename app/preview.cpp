@@ -11,7 +11,7 @@ namespace {
 
 bool same_trace_params(const TraceParams& a, const TraceParams& b) {
   return a.max_vertices == b.max_vertices && a.rr_start_vertex == b.rr_start_vertex && a.all_hv == b.all_hv &&
-         a.seed == b.seed && a.threads == b.threads;
+         a.specular_sampling == b.specular_sampling && a.seed == b.seed && a.threads == b.threads;
 }
 
 bool same_filter_params(const PreviewSettings& a, const PreviewSettings& b) {

@@ -23,6 +23,9 @@ struct PathState {
   float prev_pdf = 0.0f;   // solid-angle pdf of the last non-delta BSDF sample
   glm::vec3 prev_position{0.0f};  // the surface point the ray left (un-offset: the light pdf's origin)
   bool albedo_set = false;        // PathSample::albedo holds the first non-delta vertex's base color
+  // Specular sampling: the MIS weight of light found after the last non-delta sample through a
+  // chain of perfectly specular surfaces (D S+ L), against the specular strategy; 1 without it.
+  float chain_mis = 1.0f;
 };
 
 // Emission leaves a surface toward the ray only on its front face, unless it is double-sided.
@@ -143,8 +146,95 @@ bool PathSample::finite() const { return is_finite(lv) && is_finite(hv); }
 
 PathTracer::PathTracer(const Scene& scene) : geometry_(scene), lights_(scene) {
   for (const Mesh& mesh : scene.meshes)
-    if (!mesh.triangles.empty() && material_is_perfect_specular(scene.materials[mesh.material]))
+    if (!mesh.triangles.empty() && material_is_perfect_specular(scene.materials[mesh.material])) {
       has_perfect_specular_ = true;
+      glm::vec3 lo(INFINITY), hi(-INFINITY);
+      for (const glm::vec3& p : mesh.positions) {
+        lo = glm::min(lo, p);
+        hi = glm::max(hi, p);
+      }
+      SpecularTarget target;
+      target.center = 0.5f * (lo + hi);
+      for (const glm::vec3& p : mesh.positions) target.radius = std::max(target.radius, glm::length(p - target.center));
+      target.radius *= 1.0001f;
+      if (std::isfinite(target.radius) && target.radius > 0.0f) specular_targets_.push_back(target);
+    }
+}
+
+namespace {
+// The cone from p that holds the sphere: its axis and the cosine of its half angle. False when p
+// is inside the sphere or the cone is too narrow to sample in float.
+bool target_cone(glm::vec3 center, float radius, glm::vec3 p, glm::vec3* axis, float* cos_max) {
+  const glm::vec3 d = center - p;
+  const float dist2 = glm::dot(d, d);
+  if (!(dist2 > radius * radius)) return false;
+  *axis = d / std::sqrt(dist2);
+  *cos_max = std::sqrt(std::max(0.0f, 1.0f - radius * radius / dist2));
+  return 1.0f - *cos_max > 1e-6f;
+}
+}  // namespace
+
+float PathTracer::specular_pdf(glm::vec3 p, glm::vec3 wi) const {
+  float sum = 0.0f;
+  for (const SpecularTarget& t : specular_targets_) {
+    glm::vec3 axis;
+    float cos_max;
+    if (target_cone(t.center, t.radius, p, &axis, &cos_max) && glm::dot(wi, axis) >= cos_max)
+      sum += 1.0f / (2.0f * kPi * (1.0f - cos_max));
+  }
+  return sum / static_cast<float>(specular_targets_.size());
+}
+
+glm::vec3 PathTracer::specular_chain_light(const SurfacePoint& sp, const Bsdf& bsdf, glm::vec3 throughput, int vertex,
+                                           PathSampler& sampler, const TraceParams& params, uint32_t* rays,
+                                           bool* through_glass) const {
+  const Scene& scene = geometry_.scene();
+  const float u_select = sampler.get_1d(vertex, VertexDim::SpecularSelect);
+  const glm::vec2 u = sampler.get_2d(vertex, VertexDim::SpecularDirection);
+  const size_t n = specular_targets_.size();
+  const SpecularTarget& target = specular_targets_[std::min(n - 1, static_cast<size_t>(u_select * static_cast<float>(n)))];
+  glm::vec3 axis;
+  float cos_max;
+  if (!target_cone(target.center, target.radius, sp.position, &axis, &cos_max)) return glm::vec3(0.0f);
+  const float cos_t = 1.0f - u.x * (1.0f - cos_max), sin_t = std::sqrt(std::max(0.0f, 1.0f - cos_t * cos_t));
+  const float phi = 2.0f * kPi * u.y;
+  const glm::vec3 wi = glm::normalize(Frame::from_normal(axis).to_world(glm::vec3(std::cos(phi) * sin_t, std::sin(phi) * sin_t, cos_t)));
+  float bsdf_pdf;
+  const glm::vec3 f = bsdf.eval(wi, &bsdf_pdf);
+  const float pdf = specular_pdf(sp.position, wi);
+  if (!(max_component(f) > 0.0f) || !(pdf > 0.0f)) return glm::vec3(0.0f);
+  glm::vec3 t = throughput * f / pdf;
+  const float w = power_heuristic(pdf, bsdf_pdf);
+  glm::vec3 light(0.0f);
+  Ray ray{offset_ray_origin(sp.position, sp.geometric_normal, wi), wi};
+  // The chain's vertices get the indices the path's own would: the same length limit as BSDF sampling.
+  for (int v = vertex + 1; v <= params.max_vertices; ++v) {
+    const Hit hit = geometry_.intersect(ray);
+    ++*rays;
+    if (!hit.valid()) {
+      if (v > vertex + 1 && lights_.has_environment()) light += t * lights_.environment_radiance(ray.direction) * w;
+      break;
+    }
+    const SurfacePoint q = geometry_.surface_point(hit, ray);
+    const Material& material = *q.material;
+    if (!q.front_face && material.has_volume()) t *= volume_transmittance(material, hit.t);
+    // Emission at the first hit is D L (NEE and BSDF sampling); after a specular bounce it is D S+ L.
+    if (v > vertex + 1 && emission_visible(material, q)) light += t * eval_emission(scene, material, q.uv0, q.uv1) * w;
+    if (!material_is_perfect_specular(material) || v == params.max_vertices) break;
+    const BsdfParams p = eval_material(scene, material, q.uv0, q.uv1, q.color);
+    const Bsdf chain_bsdf(p, q.shading_normal, q.geometric_normal, -ray.direction, q.front_face);
+    if (chain_bsdf.is_black()) break;
+    float u_lobe;
+    glm::vec2 u_dir;
+    sampler.get_chain(vertex, v - vertex, &u_lobe, &u_dir);
+    BsdfSample bs;
+    if (!chain_bsdf.sample(u_lobe, u_dir, &bs) || !bs.delta) break;
+    if (p.transmission > 0.0f && p.metallic < 1.0f) *through_glass = true;
+    t *= bs.weight;
+    ray.origin = offset_ray_origin(q.position, q.geometric_normal, bs.wi);
+    ray.direction = bs.wi;
+  }
+  return light;
 }
 
 PathSample PathTracer::trace_pixel(const Camera& camera, int width, int height, int x, int y, uint32_t frame,
@@ -228,7 +318,7 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
   ++out.rays;
   if (!hit.valid()) {  // the environment is the light vertex
     if (lights_.has_environment()) {
-      float w = s.prev_delta ? 1.0f : power_heuristic(s.prev_pdf, lights_.pdf_environment(path.ray.direction));
+      float w = s.prev_delta ? s.chain_mis : power_heuristic(s.prev_pdf, lights_.pdf_environment(path.ray.direction));
       const glm::vec3 value = s.throughput * lights_.environment_radiance(path.ray.direction) * w;
       const bool lv = emission_goes_to_lv(s, params.all_hv);
       add_contribution(out, value, lv);
@@ -242,7 +332,7 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
   // Reaching a back face of an absorbing medium's boundary: the segment just traced ran inside it.
   if (!sp.front_face && material.has_volume()) s.throughput *= volume_transmittance(material, hit.t);
   if (emission_visible(material, sp)) {
-    float w = 1.0f;
+    float w = s.chain_mis;  // 1 unless specular sampling could have found this light (D S+ L)
     if (!s.prev_delta)
       w = power_heuristic(s.prev_pdf,
                           lights_.pdf_triangle(hit.mesh, hit.prim, s.prev_position, sp.position, sp.geometric_normal));
@@ -290,6 +380,23 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
     }
   }
 
+  // Specular sampling: light through a specular chain, which NEE cannot reach (HV: D S+ L).
+  const bool specular_sampling = params.specular_sampling && !specular_targets_.empty() && bsdf.has_nondelta() &&
+                                 vertex + 2 <= params.max_vertices;
+  if (specular_sampling) {
+    bool through_glass = false;
+    const glm::vec3 light =
+        specular_chain_light(sp, bsdf, s.throughput, vertex, sampler, params, &out.rays, &through_glass);
+    if (max_component(light) > 0.0f) {
+      out.hv += light;
+      if constexpr (kClassify) {
+        const HvClass c = cls->emitter_back_face ? HvClass::EmitterBackFace
+                                                 : (through_glass ? HvClass::CausticGlass : HvClass::CausticMirror);
+        record_hv(*cls->out, light, c);
+      }
+    }
+  }
+
   // Continue the path by sampling the BSDF.
   float u_lobe = sampler.get_1d(vertex, VertexDim::BsdfLobe);
   glm::vec2 u_dir = sampler.get_2d(vertex, VertexDim::BsdfDirection);
@@ -308,6 +415,10 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
     }
   }
   s.throughput *= bs.weight;
+  if (!bs.delta)
+    s.chain_mis = specular_sampling ? power_heuristic(bs.pdf, specular_pdf(sp.position, bs.wi)) : 1.0f;
+  else if (!material_is_perfect_specular(material))
+    s.chain_mis = 1.0f;  // a delta lobe of a surface the specular chains stop at
   if (!bs.delta) ++s.nonspecular;
   s.prev_delta = bs.delta;
   s.prev_pdf = bs.pdf;

@@ -2,13 +2,17 @@
 // sampling by the power heuristic, Russian roulette, and the LV/HV split of every contribution.
 #pragma once
 #include <cstdint>
+#include <vector>
 #include <glm/glm.hpp>
 #include "pathtracer/camera.h"
 #include "pathtracer/embree_scene.h"
 #include "pathtracer/lights.h"
 #include "pathtracer/pathtracer.h"
+#include "pathtracer/sampler.h"
 
 namespace pxf {
+
+class Bsdf;
 
 // One path's contributions. LV = E S* L and E S* D L (both MIS strategies at that D vertex);
 // HV = everything else. With all_hv, LV holds E S* L only (what the camera sees directly or through
@@ -92,8 +96,21 @@ class PathTracer {
   bool shade_vertex(Path& path, const Hit& hit, int vertex, const TraceParams& params, ShadowQueue& shadows,
                     ClassState* cls) const;
 
+  // Specular sampling (TraceParams::specular_sampling): the bounding spheres of the perfectly
+  // specular meshes, the solid-angle pdf of a direction from p under it, and the light one sampled
+  // direction from a diffuse vertex reaches through a specular chain (already MIS-weighted).
+  struct SpecularTarget {
+    glm::vec3 center{0.0f};
+    float radius = 0.0f;
+  };
+  float specular_pdf(glm::vec3 p, glm::vec3 wi) const;
+  glm::vec3 specular_chain_light(const SurfacePoint& sp, const Bsdf& bsdf, glm::vec3 throughput, int vertex,
+                                 PathSampler& sampler, const TraceParams& params, uint32_t* rays,
+                                 bool* through_glass) const;
+
   EmbreeScene geometry_;
   LightSampler lights_;
+  std::vector<SpecularTarget> specular_targets_;
   bool has_perfect_specular_ = false;
 };
 

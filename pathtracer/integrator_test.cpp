@@ -689,11 +689,13 @@ TEST(FireflyAttribution, ClassesFollowTheScene) {
 
 // Figures for docs/sampling.md#fireflies, not a pass/fail test. Run with
 //   pathtracer_tests --gtest_also_run_disabled_tests --gtest_filter=FireflyFigures.*
-// PXF_FIREFLY_SIZE (default 512) and PXF_FIREFLY_SPP (default 64) change the render.
+// PXF_FIREFLY_SIZE (default 512) and PXF_FIREFLY_SPP (default 64) change the render;
+// PXF_FIREFLY_SPECULAR=1 turns specular sampling on.
 TEST(FireflyFigures, DISABLED_Cornell) {
   const Scene scene = load_scene("cornell");
   const PathTracer tracer(scene);
   TraceParams params;  // the render's defaults
+  params.specular_sampling = std::getenv("PXF_FIREFLY_SPECULAR") != nullptr;
   const int size = std::getenv("PXF_FIREFLY_SIZE") ? std::atoi(std::getenv("PXF_FIREFLY_SIZE")) : 512;
   const int spp = std::getenv("PXF_FIREFLY_SPP") ? std::atoi(std::getenv("PXF_FIREFLY_SPP")) : 64;
   const ClassifiedFrames c = trace_classified(tracer, scene.camera, size, spp, params);
@@ -716,6 +718,10 @@ TEST(FireflyFigures, DISABLED_Cornell) {
     ++all[k];
     for (int t = 0; t < 4; ++t) in_top[t][k] += i < tops[t];
   }
+  uint64_t rays = 0;
+  for (const PathSample& sample : c.samples) rays += sample.rays;
+  std::printf("specular sampling %s, %.3f rays per path\n", params.specular_sampling ? "on" : "off",
+              static_cast<double>(rays) / static_cast<double>(n));
   std::printf("cornell %dx%d, %d spp, %zu samples; HV luminance: max %.3g, mean %.3g, quantiles 1 %% %.3g, 0.1 %% %.3g, "
               "0.01 %% %.3g, 0.001 %% %.3g\n", size, size, spp, n, ranked[0].first, total / n, ranked[tops[0]].first,
               ranked[tops[1]].first, ranked[tops[2]].first, ranked[tops[3]].first);
@@ -750,6 +756,96 @@ TEST(FireflyFigures, DISABLED_Cornell) {
                 100.0 * in_top[0][k] / tops[0], 100.0 * in_top[1][k] / tops[1], 100.0 * in_top[2][k] / tops[2],
                 100.0 * in_top[3][k] / tops[3], outlier_class[k]);
   EXPECT_GT(total, 0.0);
+}
+
+}  // namespace
+}  // namespace pxf
+
+// Specular sampling (TraceParams::specular_sampling) must not change the expected image.
+namespace pxf {
+namespace {
+
+// A white furnace with a mirror: a white Lambertian sphere beside a perfect mirror sphere in a
+// uniform sky of radiance 1. Every path ends in the sky with throughput 1, so every pixel is 1
+// exactly; the diffuse sphere sees much of the sky through the mirror (D S L), the light specular
+// sampling finds, so MIS weights that did not sum to 1 would show.
+TEST(SpecularSampling, WhiteFurnaceWithAMirrorStaysOne) {
+  Scene scene;
+  scene.materials = {make_diffuse(glm::vec3(1.0f)), make_mirror(glm::vec3(1.0f))};
+  scene.meshes.push_back(make_sphere(glm::vec3(-0.55f, 0, 0), 0.5f, 0, 64, 32));
+  scene.meshes.push_back(make_sphere(glm::vec3(0.55f, 0, 0), 0.5f, 1, 64, 32));
+  scene.environment = uniform_environment(1.0f);
+  scene.camera = look_at_camera(glm::vec3(0, 0, 3.0f), glm::vec3(0), glm::vec3(0, 1, 0), 0.75f);
+  TraceParams params = furnace_params();
+  double means[2];
+  for (bool on : {false, true}) {
+    params.specular_sampling = on;
+    double worst = 0;
+    means[on] = render_mean(scene, params, 32, 512, &worst, 1.0);
+    EXPECT_NEAR(means[on], 1.0, 1e-3) << on;  // double-counted D S L light would add about 0.05
+    EXPECT_LT(worst, 0.04) << on;             // the tessellated spheres' shading normals: about 0.02 either way
+  }
+  EXPECT_NEAR(means[1], means[0], 5e-4);
+}
+
+struct ChainPixelStats {
+  std::vector<double> sum, sum2;
+  uint64_t rays = 0;
+};
+ChainPixelStats chain_pixel_stats(const Scene& scene, const TraceParams& params, int size, int frames) {
+  const PathTracer tracer(scene);
+  ChainPixelStats r;
+  r.sum.assign(size * size, 0.0);
+  r.sum2.assign(size * size, 0.0);
+  std::vector<PathSample> samples(size * size);
+  for (int f = 0; f < frames; ++f) {
+    tracer.trace_pixels(scene.camera, size, size, PixelRect{0, 0, size, size}, static_cast<uint32_t>(f), params,
+                        samples.data());
+    for (int i = 0; i < size * size; ++i) {
+      const double y = luminance(samples[i].lv + samples[i].hv);
+      r.sum[i] += y;
+      r.sum2[i] += y * y;
+      r.rays += samples[i].rays;
+    }
+  }
+  return r;
+}
+
+// The Cornell box with the mirror and glass spheres, independent samples: the mean of every 4x4
+// block with and without specular sampling agree; the sum of the 16 blocks' squared z-scores is
+// chi-square with 16 degrees of freedom, below 39.25 with probability 0.999. Specular sampling
+// traces more rays (its chains) and lowers the variance of the caustic-lit pixels.
+TEST(SpecularSampling, CornellMeansAgreeWithoutIt) {
+  const Scene scene = make_cornell_box(true);
+  TraceParams params;
+  params.sampler = SamplerType::Independent;
+  const int size = 16, frames = 4096, block = 4;
+  const ChainPixelStats off = chain_pixel_stats(scene, params, size, frames);
+  params.specular_sampling = true;
+  params.seed = 2;
+  const ChainPixelStats on = chain_pixel_stats(scene, params, size, frames);
+  EXPECT_GT(on.rays, off.rays);
+  double chi2 = 0, var_off_total = 0, var_on_total = 0;
+  for (int by = 0; by < size; by += block)
+    for (int bx = 0; bx < size; bx += block) {
+      double m[2] = {0, 0}, v[2] = {0, 0};
+      for (int k = 0; k < 2; ++k) {
+        const ChainPixelStats& s = k ? on : off;
+        for (int y = by; y < by + block; ++y)
+          for (int x = bx; x < bx + block; ++x) {
+            const double mean = s.sum[y * size + x] / frames;
+            m[k] += mean / (block * block);
+            // variance of this pixel's mean, over the block's mean
+            v[k] += (s.sum2[y * size + x] / frames - mean * mean) / (frames - 1) / (block * block * block * block);
+          }
+      }
+      chi2 += (m[1] - m[0]) * (m[1] - m[0]) / (v[0] + v[1]);
+      var_off_total += v[0];
+      var_on_total += v[1];
+    }
+  EXPECT_LT(chi2, 39.25);
+  std::printf("chi2 %.2f (16 dof); summed variance of the block means: off %.3g, on %.3g\n", chi2, var_off_total,
+              var_on_total);
 }
 
 }  // namespace

@@ -27,6 +27,11 @@ struct TraceParams {
   // Default 1: K > 1 makes the estimate exact on average but costs unfiltered error (each
   // replicate is a shorter sequence), and s^2 / n overestimates by 1.1-1.4x only (docs/sampling.md).
   int replicates = 1;
+  // Specular sampling: at each diffuse vertex, a direction in the cone of one perfectly specular
+  // object's bounding sphere, followed through its specular chain to the light it reaches (the
+  // caustics that NEE cannot see), combined with BSDF sampling by the power heuristic
+  // (docs/sampling.md#fireflies). Off by default.
+  bool specular_sampling = false;
 };
 
 // What a scene may demand. The loader counts the instanced triangles (every mesh once per node

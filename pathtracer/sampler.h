@@ -15,7 +15,10 @@
 //   camera            : 0,1 pixel jitter (box filter; the pinhole camera has no lens)
 //   vertex v, light   : 0,1 point on the light (2D) | 2 light selection
 //   vertex v, bsdf    : 0,1 BSDF direction (2D) | 2 BSDF lobe | 3 Russian roulette
-// Group ids: camera = 0, light of vertex v = 2v, bsdf of vertex v = 2v + 1 (v >= 2).
+//   vertex v, specular: 0,1 direction in the chosen object's cone (2D) | 2 object selection
+//   (only with TraceParams::specular_sampling; the chain's delta choices: one group per bounce b)
+// Group ids: camera = 0, light of vertex v = 2v, bsdf of vertex v = 2v + 1 (v >= 2); specular
+// sampling of vertex v = 4096 + v, its chain bounce b = 8192 + 64 v + b.
 //
 // Replicates (for honest variance estimates under QMC): frame k belongs to replicate k mod K and is
 // point k div K of that replicate's independently scrambled sequence. The K replicate means are
@@ -38,7 +41,7 @@ inline const std::vector<std::string>& sampler_type_names() {
 }
 
 // The dimensions a path vertex uses, in the order the integrator asks for them.
-enum class VertexDim { LightSelect, LightPoint, BsdfLobe, BsdfDirection, Roulette };
+enum class VertexDim { LightSelect, LightPoint, BsdfLobe, BsdfDirection, Roulette, SpecularSelect, SpecularDirection };
 
 namespace sobol {
 
@@ -207,13 +210,28 @@ class PathSampler {
       case VertexDim::LightSelect: return sobol_1d(2 * vertex, 2);
       case VertexDim::BsdfLobe: return sobol_1d(2 * vertex + 1, 2);
       case VertexDim::Roulette: return sobol_1d(2 * vertex + 1, 3);
+      case VertexDim::SpecularSelect: return sobol_1d(4096 + vertex, 2);
       default: return sobol_1d(2 * vertex + 1, 0);  // a 2D dimension asked for as 1D: its first half
     }
   }
 
   glm::vec2 get_2d(int vertex, VertexDim dim) {
     if (type_ == SamplerType::Independent) return rng_.next_2d();
+    if (dim == VertexDim::SpecularDirection) return sobol_2d(4096 + vertex);
     return sobol_2d(dim == VertexDim::LightPoint ? 2 * vertex : 2 * vertex + 1);
+  }
+
+  // The delta choice (lobe, then direction numbers) of bounce `bounce` of the specular chain
+  // traced from vertex `vertex` by specular sampling.
+  void get_chain(int vertex, int bounce, float* u_lobe, glm::vec2* u_dir) {
+    if (type_ == SamplerType::Independent) {
+      *u_lobe = rng_.next_float();
+      *u_dir = rng_.next_2d();
+      return;
+    }
+    const sobol::ScrambledGroup g = group(8192 + 64 * vertex + bounce);
+    *u_dir = glm::vec2(sobol::to_unit_float(g.bits(0)), sobol::to_unit_float(g.bits(1)));
+    *u_lobe = sobol::to_unit_float(g.bits(2));
   }
 
  private:
