@@ -18,7 +18,7 @@
 //   vertex v, specular: 0,1 direction in the chosen object's cone (2D) | 2 object selection
 //   (only with TraceParams::specular_sampling; the chain's delta choices: one group per bounce b)
 // Group ids: camera = 0, light of vertex v = 2v, bsdf of vertex v = 2v + 1 (v >= 2); specular
-// sampling of vertex v = 4096 + v, its chain bounce b = 8192 + 64 v + b.
+// sampling of vertex v = 4096 + v, its chain bounce b = 8192 + 1024 v + b (v, b < 1024: --max-vertices caps both).
 //
 // Replicates (for honest variance estimates under QMC): frame k belongs to replicate k mod K and is
 // point k div K of that replicate's independently scrambled sequence. The K replicate means are
@@ -229,7 +229,7 @@ class PathSampler {
       *u_dir = rng_.next_2d();
       return;
     }
-    const sobol::ScrambledGroup g = group(8192 + 64 * vertex + bounce);
+    const sobol::ScrambledGroup g = group(8192 + 1024 * vertex + bounce);
     *u_dir = glm::vec2(sobol::to_unit_float(g.bits(0)), sobol::to_unit_float(g.bits(1)));
     *u_lobe = sobol::to_unit_float(g.bits(2));
   }
