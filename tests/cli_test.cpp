@@ -213,6 +213,10 @@ TEST(Cli, RenderWritesEveryOutput) {
   ASSERT_EQ(run("render --size 32x24 --spp 2 --demodulate on --quiet --out " + out).code, 0);
   EXPECT_EQ(nlohmann::json::parse(slurp(out + "/stats.json"))["settings"]["demodulate"], true);
   EXPECT_EQ(run("render --size 32x24 --spp 2 --demodulate maybe --quiet --out " + out).code, 2);
+  // Specular sampling is off unless asked for, and stats.json says which.
+  EXPECT_EQ(stats2["settings"]["specular_sampling"], false);
+  ASSERT_EQ(run("render --size 32x24 --spp 2 --specular-sampling --quiet --out " + out).code, 0);
+  EXPECT_EQ(nlohmann::json::parse(slurp(out + "/stats.json"))["settings"]["specular_sampling"], true);
   EXPECT_GT(stats2["unfiltered_vs_reference"]["nrmse_percent"].get<double>(), 0.0);
 }
 
