@@ -23,6 +23,9 @@ void take_settings_from_state(const SampleSettings& s, SceneOptions& scene, Prev
   preview.trace.max_vertices = s.max_vertices;
   preview.trace.rr_start_vertex = s.rr_start_vertex;
   preview.trace.all_hv = s.all_hv != 0;
+  preview.trace.sampler = static_cast<SamplerType>(s.sampler);
+  preview.trace.replicates = static_cast<int>(s.replicates);
+  preview.trace.specular_sampling = s.specular_sampling != 0;
 }
 
 }  // namespace

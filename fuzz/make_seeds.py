@@ -5,7 +5,9 @@
   exr_reader/   scanline EXRs, uncompressed, RLE, ZIPS and ZIP, float/half/uint, odd data windows;
   hdr_reader/   Radiance HDR, flat and run-length encoded scanlines;
   png_reader/   PNG in every colour type and bit depth stb reads, plus a few other formats.
-The state_reader seeds and rendered EXR/PNG outputs come from `pxf render` (scripts/fuzz.sh --seed).
+The state_reader seeds are states written by `pxf render --checkpoint` (named by their SHA-1, as
+libFuzzer names the inputs it keeps) and inputs the campaigns kept; rendered EXR/PNG outputs come
+from `pxf render` too.
 Usage: fuzz/make_seeds.py [corpus folder, default fuzz/corpus]"""
 import base64, json, math, os, struct, sys, zlib
 

@@ -19,6 +19,7 @@ namespace {
 constexpr char kMagic[8] = {'P', 'X', 'F', 'S', 'T', 'A', 'T', 'E'};
 constexpr uint32_t kMaxSide = 1u << 15;     // a bound that keeps a corrupt header from allocating
 constexpr uint32_t kMaxFrameRanges = 1u << 20;
+constexpr uint32_t kMaxReplicates = 64;       // --replicates' bound
 
 bool little_endian() {
   const uint16_t one = 1;
@@ -89,6 +90,9 @@ void put_settings(Writer& w, const SampleSettings& s) {
   w.put(s.max_vertices);
   w.put(s.rr_start_vertex);
   w.put(s.all_hv);
+  w.put(s.sampler);
+  w.put(s.replicates);
+  w.put(s.specular_sampling);
 }
 
 SampleSettings get_settings(Reader& r) {
@@ -100,6 +104,13 @@ SampleSettings get_settings(Reader& r) {
   s.max_vertices = r.get<int32_t>("header");
   s.rr_start_vertex = r.get<int32_t>("header");
   s.all_hv = r.get<uint32_t>("header");
+  s.sampler = r.get<uint32_t>("header");
+  s.replicates = r.get<uint32_t>("header");
+  s.specular_sampling = r.get<uint32_t>("header");
+  if (s.all_hv > 1 || s.specular_sampling > 1 || s.sampler > 1)
+    throw Error("state file has an invalid setting flag (all-hv, sampler or specular sampling)");
+  if (s.replicates < 1 || s.replicates > kMaxReplicates)
+    throw Error("state file has an invalid replicate count " + std::to_string(s.replicates));
   if (s.width == 0 || s.height == 0 || s.width > kMaxSide || s.height > kMaxSide)
     throw Error("state file has an invalid image size " + std::to_string(s.width) + "x" + std::to_string(s.height));
   return s;
@@ -177,6 +188,9 @@ std::string SampleSettings::difference(const SampleSettings& o) const {
   if (max_vertices != o.max_vertices) return diff("max vertices", max_vertices, o.max_vertices);
   if (rr_start_vertex != o.rr_start_vertex) return diff("Russian roulette start", rr_start_vertex, o.rr_start_vertex);
   if (all_hv != o.all_hv) return diff("all-hv", all_hv, o.all_hv);
+  if (sampler != o.sampler) return diff("sampler", sampler_type_names()[sampler], sampler_type_names()[o.sampler]);
+  if (replicates != o.replicates) return diff("replicates", replicates, o.replicates);
+  if (specular_sampling != o.specular_sampling) return diff("specular sampling", specular_sampling, o.specular_sampling);
   return "";
 }
 
@@ -195,6 +209,9 @@ SampleSettings sample_settings(uint64_t scene_hash, int width, int height, const
   s.max_vertices = params.max_vertices;
   s.rr_start_vertex = params.rr_start_vertex;
   s.all_hv = params.all_hv ? 1u : 0u;
+  s.sampler = static_cast<uint32_t>(params.sampler);
+  s.replicates = static_cast<uint32_t>(std::max(params.replicates, 1));
+  s.specular_sampling = params.specular_sampling ? 1u : 0u;
   return s;
 }
 

@@ -11,7 +11,7 @@
 
 namespace pxf {
 
-constexpr uint32_t kStateFormatVersion = 2;  // 2: the albedo mean (albedo demodulation)
+constexpr uint32_t kStateFormatVersion = 3;  // 2: the albedo mean; 3: sampler, replicates, specular sampling
 
 // The frames [begin, end) of the counter-based sample sequence.
 struct FrameRange {
@@ -29,6 +29,9 @@ struct SampleSettings {
   uint64_t seed = 0;
   int32_t max_vertices = 0, rr_start_vertex = 0;
   uint32_t all_hv = 0;
+  uint32_t sampler = 0;            // SamplerType: 0 sobol, 1 independent
+  uint32_t replicates = 1;         // TraceParams::replicates (which scrambled sequence frame k uses)
+  uint32_t specular_sampling = 0;  // 0/1
   bool operator==(const SampleSettings& o) const;
   // "" when equal, else one phrase naming the first difference ("seed 1 vs 2").
   std::string difference(const SampleSettings& o) const;

@@ -101,8 +101,8 @@ TEST(AccumulationState, EveryCorruptedByteIsRefused) {
 
 TEST(AccumulationState, OtherVersionIsRefusedByName) {
   std::vector<uint8_t> bytes = encode_state(render_frames({0, 2}));
-  bytes[8] = 1;  // the version follows the 8-byte magic; version 1 (no albedo mean) is refused
-  EXPECT_NE(decode_error(bytes).find("version 1 is not supported"), std::string::npos) << decode_error(bytes);
+  bytes[8] = 2;  // the version follows the 8-byte magic; version 2 (no sampler settings) is refused
+  EXPECT_NE(decode_error(bytes).find("version 2 is not supported"), std::string::npos) << decode_error(bytes);
   bytes[0] = 'Q';
   EXPECT_NE(decode_error(bytes).find("not a pxf state file"), std::string::npos);
 }
@@ -143,6 +143,41 @@ TEST(AccumulationState, OverlapAndMismatchAreRefused) {
   AccumulationState other_scene = render_frames({10, 12});
   other_scene.settings.scene_hash ^= 1;
   EXPECT_THROW(merge_states({render_frames({0, 10}), other_scene}), Error);
+}
+
+// Sampler, replicates and specular sampling decide the samples too: they round-trip, a state of
+// another value is refused by name, and a corrupt value is a clear error.
+TEST(AccumulationState, SamplerSettingsRoundTripAndAreChecked) {
+  TraceParams params;
+  params.sampler = SamplerType::Independent;
+  params.replicates = 4;
+  params.specular_sampling = true;
+  AccumulationState state = render_frames({0, 4});
+  state.settings = sample_settings(0x1234, kW, kH, params);
+  const std::vector<uint8_t> bytes = encode_state(state);
+  const AccumulationState back = decode_state(bytes.data(), bytes.size());
+  EXPECT_EQ(back.settings.sampler, 1u);
+  EXPECT_EQ(back.settings.replicates, 4u);
+  EXPECT_EQ(back.settings.specular_sampling, 1u);
+  const SampleSettings plain = sample_settings(0x1234, kW, kH, TraceParams{});
+  SampleSettings a = plain;
+  a.sampler = 1;
+  EXPECT_EQ(a.difference(plain), "sampler independent vs sobol");
+  a = plain;
+  a.replicates = 4;
+  EXPECT_EQ(a.difference(plain), "replicates 4 vs 1");
+  a = plain;
+  a.specular_sampling = 1;
+  EXPECT_EQ(a.difference(plain), "specular sampling 1 vs 0");
+  // A corrupt flag with a valid checksum: the header check names it.
+  AccumulationState bad = render_frames({0, 1});
+  bad.settings.specular_sampling = 7;
+  const std::vector<uint8_t> bad_bytes = encode_state(bad);
+  EXPECT_NE(decode_error(bad_bytes).find("invalid setting flag"), std::string::npos) << decode_error(bad_bytes);
+  bad.settings.specular_sampling = 0;
+  bad.settings.replicates = 0;
+  const std::vector<uint8_t> bad_replicates = encode_state(bad);
+  EXPECT_NE(decode_error(bad_replicates).find("replicate count 0"), std::string::npos);
 }
 
 TEST(AccumulationState, NonContiguousRangesStaySeparate) {

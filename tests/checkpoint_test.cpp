@@ -193,4 +193,11 @@ TEST(Checkpoint, ForeignOverlappingAndCorruptStatesAreRefused) {
   EXPECT_EQ(resume.code, 1);
   EXPECT_NE(resume.err.find("max vertices"), std::string::npos) << resume.err;
   EXPECT_EQ(slurp(a + "/final.exr"), before);
+  // The sampler's settings decide the samples too.
+  for (const char* flag : {"--sampler independent", "--specular-sampling", "--replicates 4"}) {
+    const Result other = pxf_run("render " + kScene + " --spp 8 " + flag + " --resume " + a + "/state.pxfs --out " + a);
+    EXPECT_EQ(other.code, 1) << flag;
+    EXPECT_NE(other.err.find(std::string(flag).substr(2, 7)), std::string::npos) << other.err;
+    EXPECT_EQ(slurp(a + "/final.exr"), before);
+  }
 }
