@@ -119,7 +119,10 @@ SampleSettings get_settings(Reader& r) {
 void check_frame_ranges(const std::vector<FrameRange>& ranges) {
   for (size_t i = 0; i < ranges.size(); ++i) {
     if (ranges[i].begin >= ranges[i].end) throw Error("state file has an empty or reversed frame range");
-    if (i > 0 && ranges[i].begin < ranges[i - 1].end) throw Error("state file has unsorted or overlapping frame ranges");
+    // Every writer joins adjacent ranges (a render writes one, a merge joins them), so adjacent
+    // ranges are not a state pxf wrote; refusing them keeps a decoded state canonical.
+    if (i > 0 && ranges[i].begin <= ranges[i - 1].end)
+      throw Error("state file has unsorted, overlapping or unjoined adjacent frame ranges");
   }
 }
 

@@ -180,6 +180,18 @@ TEST(AccumulationState, SamplerSettingsRoundTripAndAreChecked) {
   EXPECT_NE(decode_error(bad_replicates).find("replicate count 0"), std::string::npos);
 }
 
+// Found by the state_reader fuzzer (fuzz/crashers/state_reader/): ranges [0,1) and [1,N) decoded,
+// and merging the state with nothing joined them. Writers always join adjacent ranges.
+TEST(AccumulationState, AdjacentUnjoinedRangesAreRefused) {
+  AccumulationState state = render_frames({0, 4});
+  state.frames = {{0, 2}, {2, 4}};
+  const std::vector<uint8_t> bytes = encode_state(state);
+  EXPECT_NE(decode_error(bytes).find("unjoined adjacent frame ranges"), std::string::npos) << decode_error(bytes);
+  state.frames = {{0, 2}, {3, 5}};
+  const std::vector<uint8_t> gap = encode_state(state);
+  EXPECT_EQ(decode_error(gap), "");
+}
+
 TEST(AccumulationState, NonContiguousRangesStaySeparate) {
   const AccumulationState merged = merge_states({render_frames({8, 10}), render_frames({0, 4})});
   EXPECT_EQ(frame_ranges_text(merged.frames), "0:4,8:10");
