@@ -31,7 +31,7 @@ namespace pxf {
 struct PreviewSettings {
   TraceParams trace;
   // t: allowed perceived (relative) variance. The one threshold: the filter's case-2 skip and the
-  // blend are both given this value on every run.
+  // blend both get it, scaled for the sample count by threshold_now() on every run.
   float threshold = 0.001f;
   FilterParams filter;  // variant (FilterKind::None = plain path tracing) and sigmas
   // Albedo demodulation: filter HV divided by the first non-specular albedo and multiply L_f back
