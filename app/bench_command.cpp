@@ -515,7 +515,7 @@ int run_bench(const Args& args) {
            "blend the covariance of L_u and L_f)");
   cli.option("--spp", &spp_text, "LIST",
              "spp of --sampler-error (default 8,32,128), --variance-ratio (4,16,64,256) or --threshold-fidelity (16,64,256)");
-  cli.option("--seeds", &seeds, "seeds of --variance-ratio and --threshold-fidelity (default 32)", 2, 4096);
+  cli.option("--seeds", &seeds, "seeds of --variance-ratio and --threshold-fidelity (default 32), --sampler-error (8)", 2, 4096);
   cli.flag("--demodulation-ab", &demodulation_ab,
            "instead of 1-4: albedo demodulation off vs on at equal wall time (--budgets, --rounds rounds, back\n"
            "to back with the unfiltered run); writes demodulation.csv and demod_*.png");
@@ -554,7 +554,8 @@ int run_bench(const Args& args) {
                          b.height, out};
     if (sampler_error)
       run_sampler_error_bench(sb, cli.given("--reference-spp") ? reference_spp : 2048,
-                              parse_counts("--spp", spp_text.empty() ? "8,32,128" : spp_text), rounds);
+                              parse_counts("--spp", spp_text.empty() ? "8,32,128" : spp_text), rounds,
+                              cli.given("--seeds") ? seeds : 8);
     if (variance_ratio) run_variance_ratio_bench(sb, parse_counts("--spp", spp_text.empty() ? "4,16,64,256" : spp_text), seeds);
     return 0;
   }

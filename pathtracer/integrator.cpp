@@ -189,8 +189,9 @@ glm::vec3 PathTracer::specular_chain_light(const SurfacePoint& sp, const Bsdf& b
                                            PathSampler& sampler, const TraceParams& params, uint32_t* rays,
                                            bool* through_glass) const {
   const Scene& scene = geometry_.scene();
-  const float u_select = sampler.get_1d(vertex, VertexDim::SpecularSelect);
-  const glm::vec2 u = sampler.get_2d(vertex, VertexDim::SpecularDirection);
+  const PathSampler::SpecularNumbers numbers = sampler.specular_numbers(vertex);
+  const float u_select = numbers.select;
+  const glm::vec2 u = numbers.direction;
   const size_t n = specular_targets_.size();
   const SpecularTarget& target = specular_targets_[std::min(n - 1, static_cast<size_t>(u_select * static_cast<float>(n)))];
   glm::vec3 axis;
@@ -357,11 +358,11 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
   if (last_vertex || bsdf.is_black()) return false;
 
   // Next event estimation (the light vertex is vertex + 1 <= max_vertices).
-  float u_light = sampler.get_1d(vertex, VertexDim::LightSelect);
-  glm::vec2 u_light2 = sampler.get_2d(vertex, VertexDim::LightPoint);
+  const PathSampler::LightNumbers u_light = sampler.light_numbers(vertex, bsdf.has_nondelta());
   if (bsdf.has_nondelta()) {
     LightSample ls;
-    if (lights_.sample(sp.position, u_light, u_light2, &ls)) {
+    if (u_light.shared ? lights_.sample(sp.position, u_light.point, &ls)
+                       : lights_.sample(sp.position, u_light.select, u_light.point, &ls)) {
       float bsdf_pdf;
       glm::vec3 f = bsdf.eval(ls.wi, &bsdf_pdf);
       if (max_component(f) > 0.0f && max_component(ls.radiance) > 0.0f) {
@@ -398,11 +399,10 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
   }
 
   // Continue the path by sampling the BSDF.
-  float u_lobe = sampler.get_1d(vertex, VertexDim::BsdfLobe);
-  glm::vec2 u_dir = sampler.get_2d(vertex, VertexDim::BsdfDirection);
-  float u_rr = sampler.get_1d(vertex, VertexDim::Roulette);
+  const bool roulette = vertex >= params.rr_start_vertex;
+  const PathSampler::BsdfNumbers u = sampler.bsdf_numbers(vertex, bsdf.has_lobe_choice(), roulette);
   BsdfSample bs;
-  if (!bsdf.sample(u_lobe, u_dir, &bs)) return false;
+  if (!bsdf.sample(u.lobe, u.direction, &bs)) return false;
   if constexpr (kClassify) {
     if (bs.delta) {
       const bool glass = bsdf_params.transmission > 0.0f && bsdf_params.metallic < 1.0f;
@@ -420,11 +420,14 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
   else if (!material_is_perfect_specular(material))
     s.chain_mis = 1.0f;  // a delta lobe of a surface the specular chains stop at
   if (!bs.delta) ++s.nonspecular;
+  // Low-discrepancy numbers up to the first non-delta bounce only: deeper vertices gain nothing
+  // measurable from them and would pay the scrambling (docs/sampling.md).
+  if (s.nonspecular > 0) sampler.leave_qmc();
   s.prev_delta = bs.delta;
   s.prev_pdf = bs.pdf;
-  if (vertex >= params.rr_start_vertex) {
+  if (roulette) {
     float q = std::min(1.0f, max_component(s.throughput));
-    if (!(u_rr < q)) return false;
+    if (!(u.roulette < q)) return false;
     s.throughput /= q;
   }
   s.prev_position = sp.position;

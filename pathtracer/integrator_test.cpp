@@ -320,10 +320,14 @@ TEST(Integrator, AllHvKeepsWhatTheCameraSeesDirectlyInLv) {
         continue;
       }
       ++plane;
-      if (all_hv) EXPECT_EQ(s.lv, glm::vec3(0.0f)) << "plane light in LV with all_hv";
+      if (all_hv) {
+        EXPECT_EQ(s.lv, glm::vec3(0.0f)) << "plane light in LV with all_hv";
+      }
     }
     EXPECT_GT(plane, kSize * kSize / 4) << all_hv;
-    if (all_hv) EXPECT_GT(sky, kSize * kSize / 4) << "escaping camera rays: LV = sky radiance, HV = 0";
+    if (all_hv) {
+      EXPECT_GT(sky, kSize * kSize / 4) << "escaping camera rays: LV = sky radiance, HV = 0";
+    }
   }
 }
 

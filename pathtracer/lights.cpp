@@ -167,24 +167,60 @@ bool LightSampler::sample(glm::vec3 position, float u_select, glm::vec2 u, Light
   return sample_punctual(position, std::min(u_select / p_punctual_, 0x1.fffffep-1f), out);
 }
 
+bool LightSampler::sample(glm::vec3 position, glm::vec2 u, LightSample* out) const {
+  if (category_count_ == 0) return false;
+  // Rescale u.x within the chosen category (and below, within the chosen light).
+  const auto rescaled = [](float x, float lo, float width) { return std::min((x - lo) / width, 0x1.fffffep-1f); };
+  if (u.x < p_triangles_) {
+    glm::vec3 point;
+    glm::vec2 b;
+    float area_pdf;
+    const size_t i = sample_triangle_point(glm::vec2(rescaled(u.x, 0.0f, p_triangles_), u.y), &point, &b, &area_pdf);
+    return triangle_sample(position, i, point, b, area_pdf, out);
+  }
+  if (u.x < p_triangles_ + p_environment_)
+    return sample_environment(position, glm::vec2(rescaled(u.x, p_triangles_, p_environment_), u.y), out);
+  if (p_punctual_ <= 0.0f) return false;
+  return sample_punctual(position, rescaled(u.x, p_triangles_ + p_environment_, p_punctual_), out);
+}
+
 size_t LightSampler::sample_triangle_point(float u_select, glm::vec2 u, glm::vec3* point, glm::vec2* bary,
                                            float* area_pdf) const {
   float pmf;
-  size_t i = triangle_dist_.sample(u_select, nullptr, &pmf);
-  const EmissiveTriangle& e = triangles_[i];
-  glm::vec2 b = sample_triangle_barycentrics(u);
+  const size_t i = triangle_dist_.sample(u_select, nullptr, &pmf);
+  point_on_triangle(i, pmf, u, point, bary, area_pdf);
+  return i;
+}
+
+size_t LightSampler::sample_triangle_point(glm::vec2 u, glm::vec3* point, glm::vec2* bary, float* area_pdf) const {
+  float pmf;
+  glm::vec2 v = u;
+  const size_t i = triangle_dist_.sample(u.x, &v.x, &pmf);
+  point_on_triangle(i, pmf, v, point, bary, area_pdf);
+  return i;
+}
+
+void LightSampler::point_on_triangle(size_t light, float pmf, glm::vec2 u, glm::vec3* point, glm::vec2* bary,
+                                     float* area_pdf) const {
+  const EmissiveTriangle& e = triangles_[light];
+  const glm::vec2 b = sample_triangle_barycentrics(u);
   *point = e.p0 + b.x * e.e1 + b.y * e.e2;
   *bary = b;
   *area_pdf = e.area > 0.0f ? pmf / e.area : 0.0f;
-  return i;
 }
 
 bool LightSampler::sample_triangles(glm::vec3 position, float u_select, glm::vec2 u, LightSample* out) const {
   glm::vec3 point;
   glm::vec2 b;
   float area_pdf;
-  size_t i = sample_triangle_point(u_select, u, &point, &b, &area_pdf);
-  const EmissiveTriangle& e = triangles_[i];
+  const size_t i = sample_triangle_point(u_select, u, &point, &b, &area_pdf);
+  return triangle_sample(position, i, point, b, area_pdf, out);
+}
+
+// The light sample toward `point` on emissive triangle `light`, drawn with area pdf `area_pdf`.
+bool LightSampler::triangle_sample(glm::vec3 position, size_t light, glm::vec3 point, glm::vec2 b, float area_pdf,
+                                   LightSample* out) const {
+  const EmissiveTriangle& e = triangles_[light];
   glm::vec3 d = point - position;
   float dist2 = glm::dot(d, d);
   if (!(dist2 > 0.0f) || !(area_pdf > 0.0f)) return false;

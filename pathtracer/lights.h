@@ -32,6 +32,11 @@ class LightSampler {
   bool has_environment() const { return env_ != nullptr; }
 
   bool sample(glm::vec3 position, float u_select, glm::vec2 u, LightSample* out) const;
+  // The same distribution from one 2D number: u.x picks the light and, rescaled to the chosen
+  // light's share of [0,1), is reused as the first coordinate of the point on it. A stratified
+  // (low-discrepancy) u then stays stratified on every light, which a separate selection number
+  // does not give.
+  bool sample(glm::vec3 position, glm::vec2 u, LightSample* out) const;
 
   // Solid-angle pdf (incl. selection) with which sample() would pick this point of an emissive
   // triangle seen from `from`; 0 for triangles that are not lights.
@@ -44,6 +49,8 @@ class LightSampler {
   float triangle_selection_pmf(size_t light) const { return triangle_dist_.pmf(light); }
   // Samples a point on the emissive triangles: returns the light index and the area pdf.
   size_t sample_triangle_point(float u_select, glm::vec2 u, glm::vec3* point, glm::vec2* barycentrics, float* area_pdf) const;
+  // As above with u.x both selecting the triangle and, rescaled, the point's first coordinate.
+  size_t sample_triangle_point(glm::vec2 u, glm::vec3* point, glm::vec2* barycentrics, float* area_pdf) const;
   glm::vec3 sample_environment_direction(glm::vec2 u, float* pdf) const;  // pdf without selection
   float environment_direction_pdf(glm::vec3 direction) const;             // pdf without selection
 
@@ -65,6 +72,10 @@ class LightSampler {
 
  private:
   bool sample_triangles(glm::vec3 position, float u_select, glm::vec2 u, LightSample* out) const;
+  void point_on_triangle(size_t light, float pmf, glm::vec2 u, glm::vec3* point, glm::vec2* barycentrics,
+                         float* area_pdf) const;
+  bool triangle_sample(glm::vec3 position, size_t light, glm::vec3 point, glm::vec2 barycentrics, float area_pdf,
+                       LightSample* out) const;
   bool sample_environment(glm::vec3 position, glm::vec2 u, LightSample* out) const;
   bool sample_punctual(glm::vec3 position, float u_select, LightSample* out) const;
 

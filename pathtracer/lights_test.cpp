@@ -12,7 +12,7 @@
 namespace pxf {
 namespace {
 
-constexpr double kAlpha = 0.01 / 2;  // Bonferroni over the two distributions tested here
+constexpr double kAlpha = 0.01 / 3;  // Bonferroni over the three chi-square tests here
 
 Scene three_emitters() {
   Scene scene;
@@ -46,33 +46,40 @@ TEST(Lights, EmissiveTriangleSamplingIsPowerWeightedAndUniform) {
     double power = lights.triangle(i).area * luminance(lights.triangle(i).material->emissive);
     EXPECT_NEAR(lights.triangle_selection_pmf(i), power / total_power, 1e-6);
   }
-  const int n = 200000;
-  std::vector<double> observed(count * 4, 0.0), expected(count * 4, 0.0);
-  for (size_t i = 0; i < count; ++i)
-    for (int s = 0; s < 4; ++s) expected[i * 4 + s] = n * lights.triangle_selection_pmf(i) / 4.0;
-  Rng rng(9, 0, 0);
-  int pdf_mismatches = 0;
-  for (int k = 0; k < n; ++k) {
-    float u_select = rng.next_float();
-    glm::vec2 u = rng.next_2d();
-    glm::vec3 point;
-    glm::vec2 b;
-    float area_pdf;
-    size_t i = lights.sample_triangle_point(u_select, u, &point, &b, &area_pdf);
-    observed[i * 4 + sub_triangle(b)] += 1.0;
-    // The full light sample's solid-angle pdf equals pdf_triangle() for the same point.
-    LightSample ls;
-    glm::vec3 from(0.3f, 0.01f, 0.2f);
-    if (k % 50 == 0 && lights.sample(from, u_select, u, &ls)) {
-      const auto& tri = lights.triangle(i);
-      float pdf = lights.pdf_triangle(tri.mesh, tri.prim, from, ls.point, tri.normal);
-      if (std::abs(pdf - ls.pdf) > 1e-3f * pdf) ++pdf_mismatches;
+  // Both ways of drawing: a separate selection number, and one 2D number whose first coordinate
+  // selects and is reused, rescaled, for the point (what the Sobol sampler uses).
+  for (bool shared : {false, true}) {
+    SCOPED_TRACE(shared ? "selection from u.x" : "separate selection number");
+    const int n = 200000;
+    std::vector<double> observed(count * 4, 0.0), expected(count * 4, 0.0);
+    for (size_t i = 0; i < count; ++i)
+      for (int s = 0; s < 4; ++s) expected[i * 4 + s] = n * lights.triangle_selection_pmf(i) / 4.0;
+    Rng rng(shared ? 10 : 9, 0, 0);
+    int pdf_mismatches = 0;
+    for (int k = 0; k < n; ++k) {
+      float u_select = rng.next_float();
+      glm::vec2 u = rng.next_2d();
+      glm::vec3 point;
+      glm::vec2 b;
+      float area_pdf;
+      size_t i = shared ? lights.sample_triangle_point(u, &point, &b, &area_pdf)
+                        : lights.sample_triangle_point(u_select, u, &point, &b, &area_pdf);
+      observed[i * 4 + sub_triangle(b)] += 1.0;
+      // The full light sample's solid-angle pdf equals pdf_triangle() for the same point.
+      LightSample ls;
+      glm::vec3 from(0.3f, 0.01f, 0.2f);
+      if (k % 50 == 0 && (shared ? lights.sample(from, u, &ls) : lights.sample(from, u_select, u, &ls))) {
+        EXPECT_EQ(ls.point, point);
+        const auto& tri = lights.triangle(i);
+        float pdf = lights.pdf_triangle(tri.mesh, tri.prim, from, ls.point, tri.normal);
+        if (std::abs(pdf - ls.pdf) > 1e-3f * pdf) ++pdf_mismatches;
+      }
     }
+    EXPECT_EQ(pdf_mismatches, 0);
+    stat::ChiSquareResult r = stat::chi_square(observed, expected);
+    EXPECT_TRUE(r.problem.empty()) << r.problem;
+    EXPECT_GT(r.p_value, kAlpha) << "chi2 " << r.statistic << " dof " << r.dof;
   }
-  EXPECT_EQ(pdf_mismatches, 0);
-  stat::ChiSquareResult r = stat::chi_square(observed, expected);
-  EXPECT_TRUE(r.problem.empty()) << r.problem;
-  EXPECT_GT(r.p_value, kAlpha) << "chi2 " << r.statistic << " dof " << r.dof;
 }
 
 Scene random_environment(int width, int height, uint64_t seed) {

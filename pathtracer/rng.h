@@ -17,9 +17,11 @@ inline uint64_t mix64(uint64_t z) {
 class Rng {
  public:
   Rng() = default;  // a placeholder: assign a seeded stream before drawing
-  Rng(uint64_t seed, uint64_t pixel, uint64_t frame) {
-    uint64_t key = mix64(seed * 0x9e3779b97f4a7c15ULL + mix64(pixel + 0x632be59bd9b4e019ULL));
-    key = mix64(key ^ mix64(frame + 0x85ebca6b2e4f1b3bULL));
+  Rng(uint64_t seed, uint64_t pixel, uint64_t frame)
+      : Rng(mix64(mix64(seed * 0x9e3779b97f4a7c15ULL + mix64(pixel + 0x632be59bd9b4e019ULL)) ^
+                  mix64(frame + 0x85ebca6b2e4f1b3bULL))) {}
+  // A stream from an already mixed 64-bit key.
+  explicit Rng(uint64_t key) {
     increment_ = (mix64(key + 1) << 1u) | 1u;
     state_ = 0;
     next_u32();

@@ -13,12 +13,19 @@
 //
 // Dimension table (group: Sobol dimension -> use):
 //   camera            : 0,1 pixel jitter (box filter; the pinhole camera has no lens)
-//   vertex v, light   : 0,1 point on the light (2D) | 2 light selection
+//   vertex v, light   : 0,1 light selection and point on the light (2D: 0 picks the light and,
+//                       rescaled, is the point's first coordinate; dimension 2 is unused)
 //   vertex v, bsdf    : 0,1 BSDF direction (2D) | 2 BSDF lobe | 3 Russian roulette
 //   vertex v, specular: 0,1 direction in the chosen object's cone (2D) | 2 object selection
 //   (only with TraceParams::specular_sampling; the chain's delta choices: one group per bounce b)
 // Group ids: camera = 0, light of vertex v = 2v, bsdf of vertex v = 2v + 1 (v >= 2); specular
 // sampling of vertex v = 4096 + v, its chain bounce b = 8192 + 1024 v + b (v, b < 1024: --max-vertices caps both).
+// Only the coordinates a vertex uses are computed (no lobe with one lobe, no roulette before
+// --rr-start, no light sample on a delta surface).
+// The path leaves the Sobol sequences after its first non-delta bounce (leave_qmc): the vertices
+// after it draw PCG32 numbers. The light that reaches the eye directly or through delta surfaces
+// (LV), the first bounce's direction and everything before keep their low-discrepancy numbers;
+// the deeper vertices gained nothing measurable from them (docs/sampling.md) and cost the most.
 //
 // Replicates (for honest variance estimates under QMC): frame k belongs to replicate k mod K and is
 // point k div K of that replicate's independently scrambled sequence. The K replicate means are
@@ -39,9 +46,6 @@ inline const std::vector<std::string>& sampler_type_names() {
   static const std::vector<std::string> names = {"sobol", "independent"};
   return names;
 }
-
-// The dimensions a path vertex uses, in the order the integrator asks for them.
-enum class VertexDim { LightSelect, LightPoint, BsdfLobe, BsdfDirection, Roulette, SpecularSelect, SpecularDirection };
 
 namespace sobol {
 
@@ -148,14 +152,12 @@ inline uint32_t nested_uniform_scramble(uint32_t x, uint32_t seed) {
 
 inline float to_unit_float(uint32_t x) { return static_cast<float>(x >> 8) * 0x1p-24f; }
 
-// A 32-bit integer hash (Wellons' lowbias32): decorrelates the per-dimension scramble seeds.
-inline uint32_t hash32(uint32_t x) {
-  x ^= x >> 16;
-  x *= 0x7feb352du;
-  x ^= x >> 15;
-  x *= 0x846ca68bu;
-  x ^= x >> 16;
-  return x;
+// The Owen scramble seed of dimension `dim` of a group: the group's seed with a fixed random salt
+// per dimension (no hash: the group seed is already the output of a 64-bit mix, and the scramble
+// hashes its seed).
+inline uint32_t dimension_seed(uint32_t group_seed, int dim) {
+  constexpr uint32_t kSalt[kDimensions] = {0x68bc21ebu, 0x02e5be93u, 0x967a889bu, 0xb5f7b4c1u};
+  return group_seed ^ kSalt[dim];
 }
 
 // One group of dimensions of one path: its shuffled index and its scramble seeds, derived from
@@ -167,8 +169,8 @@ struct ScrambledGroup {
       : reversed_shuffled_index(laine_karras_permutation(reversed_index, static_cast<uint32_t>(key))),
         seed(static_cast<uint32_t>(key >> 32)) {}
   uint32_t bits(int dim) const {
-    const uint32_t dim_seed = hash32(seed + 0x9e3779b9u * static_cast<uint32_t>(dim));
-    return reverse_bits(laine_karras_permutation(reversed_sample_bits(reversed_shuffled_index, dim), dim_seed));
+    return reverse_bits(
+        laine_karras_permutation(reversed_sample_bits(reversed_shuffled_index, dim), dimension_seed(seed, dim)));
   }
 };
 
@@ -193,10 +195,63 @@ class PathSampler {
       rng_ = Rng(seed ^ 0x5bd1e9955bd1e995ULL, pixel, frame);
       return;
     }
+    frame_ = frame;
     const uint32_t k = replicates > 1 ? static_cast<uint32_t>(replicates) : 1u;
     reversed_index_ = sobol::reverse_bits(frame / k);
     key_ = mix64(seed * 0x9e3779b97f4a7c15ULL + mix64(pixel + 0x632be59bd9b4e019ULL));
     key_ = mix64(key_ ^ mix64((frame % k) + 0xd6e8feb86659fd93ULL));
+  }
+
+  // From here on the path draws independent numbers (the vertices after its first non-delta
+  // bounce: see the dimension table). No effect on an independent sampler.
+  void leave_qmc() {
+    if (type_ != SamplerType::Sobol) return;
+    type_ = SamplerType::Independent;
+    rng_ = Rng(key_ ^ mix64(frame_ + 0x2545f4914f6cdd1dULL));  // key_ holds only the replicate, not the frame
+  }
+  bool in_qmc() const { return type_ == SamplerType::Sobol; }
+
+  // The numbers of a vertex's light sample and BSDF sample. A Sobol sampler scrambles the group
+  // once and computes only the coordinates used (`*used`; an unused one reads 0). The
+  // independent sampler draws every number, used or not, in the integrator's old call order
+  // (light: selection, point; BSDF: lobe, direction, roulette), so its images stay those of before.
+  // Sobol: the light is picked with point.x (LightSampler::sample(position, u, out), which keeps
+  // the pair's strata on every light), `shared` is true and `select` unused.
+  struct LightNumbers {
+    float select = 0.0f;
+    glm::vec2 point{0.0f};
+    bool shared = false;
+  };
+  LightNumbers light_numbers(int vertex, bool used) {
+    LightNumbers n;
+    if (type_ == SamplerType::Independent) {
+      n.select = rng_.next_float();
+      n.point = rng_.next_2d();
+    } else if (used) {
+      const sobol::ScrambledGroup g = group(2 * vertex);
+      n.point = glm::vec2(sobol::to_unit_float(g.bits(0)), sobol::to_unit_float(g.bits(1)));
+      n.shared = true;
+    }
+    return n;
+  }
+  struct BsdfNumbers {
+    float lobe = 0.0f;
+    glm::vec2 direction{0.0f};
+    float roulette = 0.0f;
+  };
+  BsdfNumbers bsdf_numbers(int vertex, bool lobe_used, bool roulette_used) {
+    BsdfNumbers n;
+    if (type_ == SamplerType::Independent) {
+      n.lobe = rng_.next_float();
+      n.direction = rng_.next_2d();
+      n.roulette = rng_.next_float();
+      return n;
+    }
+    const sobol::ScrambledGroup g = group(2 * vertex + 1);
+    n.direction = glm::vec2(sobol::to_unit_float(g.bits(0)), sobol::to_unit_float(g.bits(1)));
+    if (lobe_used) n.lobe = sobol::to_unit_float(g.bits(2));
+    if (roulette_used) n.roulette = sobol::to_unit_float(g.bits(3));
+    return n;
   }
 
   glm::vec2 camera_jitter() {
@@ -204,21 +259,22 @@ class PathSampler {
     return sobol_2d(0);
   }
 
-  float get_1d(int vertex, VertexDim dim) {
-    if (type_ == SamplerType::Independent) return rng_.next_float();
-    switch (dim) {
-      case VertexDim::LightSelect: return sobol_1d(2 * vertex, 2);
-      case VertexDim::BsdfLobe: return sobol_1d(2 * vertex + 1, 2);
-      case VertexDim::Roulette: return sobol_1d(2 * vertex + 1, 3);
-      case VertexDim::SpecularSelect: return sobol_1d(4096 + vertex, 2);
-      default: return sobol_1d(2 * vertex + 1, 0);  // a 2D dimension asked for as 1D: its first half
+  // Specular sampling at vertex `vertex`: which object (select) and the direction in its cone.
+  struct SpecularNumbers {
+    float select = 0.0f;
+    glm::vec2 direction{0.0f};
+  };
+  SpecularNumbers specular_numbers(int vertex) {
+    SpecularNumbers n;
+    if (type_ == SamplerType::Independent) {
+      n.select = rng_.next_float();
+      n.direction = rng_.next_2d();
+      return n;
     }
-  }
-
-  glm::vec2 get_2d(int vertex, VertexDim dim) {
-    if (type_ == SamplerType::Independent) return rng_.next_2d();
-    if (dim == VertexDim::SpecularDirection) return sobol_2d(4096 + vertex);
-    return sobol_2d(dim == VertexDim::LightPoint ? 2 * vertex : 2 * vertex + 1);
+    const sobol::ScrambledGroup g = group(4096 + vertex);
+    n.direction = glm::vec2(sobol::to_unit_float(g.bits(0)), sobol::to_unit_float(g.bits(1)));
+    n.select = sobol::to_unit_float(g.bits(2));
+    return n;
   }
 
   // The delta choice (lobe, then direction numbers) of bounce `bounce` of the specular chain
@@ -238,7 +294,6 @@ class PathSampler {
   sobol::ScrambledGroup group(int id) const {
     return sobol::ScrambledGroup(reversed_index_, mix64(key_ + 0xbf58476d1ce4e5b9ULL * static_cast<uint64_t>(id + 1)));
   }
-  float sobol_1d(int group_id, int dim) const { return sobol::to_unit_float(group(group_id).bits(dim)); }
   glm::vec2 sobol_2d(int group_id) const {
     const sobol::ScrambledGroup g = group(group_id);
     return glm::vec2(sobol::to_unit_float(g.bits(0)), sobol::to_unit_float(g.bits(1)));
@@ -248,6 +303,7 @@ class PathSampler {
   Rng camera_rng_, rng_;
   uint32_t reversed_index_ = 0;  // the frame's index in its replicate, bit-reversed
   uint64_t key_ = 0;
+  uint32_t frame_ = 0;
 };
 
 }  // namespace pxf

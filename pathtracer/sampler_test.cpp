@@ -3,6 +3,7 @@
 // scrambled points, per-pixel decorrelation, and the replicate variance estimate.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -62,7 +63,7 @@ TEST(Sobol, FastPathEqualsTheNestedScrambleDefinition) {
     for (int d = 0; d < sobol::kDimensions; ++d) {
       ASSERT_EQ(sobol::reversed_sample_bits(sobol::reverse_bits(index), d), sobol::reverse_bits(sobol::sample_bits(index, d)));
       const uint32_t shuffled = sobol::nested_uniform_scramble(index, seed);
-      const uint32_t dim_seed = sobol::hash32(static_cast<uint32_t>(key >> 32) + 0x9e3779b9u * static_cast<uint32_t>(d));
+      const uint32_t dim_seed = sobol::dimension_seed(static_cast<uint32_t>(key >> 32), d);
       ASSERT_EQ(sobol::scrambled_bits(index, d, key),
                 sobol::nested_uniform_scramble(sobol::sample_bits(shuffled, d), dim_seed));
     }
@@ -102,8 +103,8 @@ TEST(Sobol, SamplerPairsOfEveryGroupStratifyAcrossFrames) {
     for (uint32_t frame = 0; frame < (1u << m); ++frame) {
       PathSampler sampler(SamplerType::Sobol, 7, 1234, frame, 1);
       glm::vec2 u = group == 0   ? sampler.camera_jitter()
-                    : group % 2 ? sampler.get_2d(2 + group / 2, VertexDim::LightPoint)
-                                : sampler.get_2d(2 + group / 2, VertexDim::BsdfDirection);
+                    : group % 2 ? sampler.light_numbers(2 + group / 2, true).point
+                                : sampler.bsdf_numbers(2 + group / 2, false, false).direction;
       points.emplace_back(static_cast<uint32_t>(u.x * 0x1p32f), static_cast<uint32_t>(u.y * 0x1p32f));
     }
     std::string problem;
@@ -117,16 +118,17 @@ TEST(Sobol, ScrambledPointsAreUniformAcrossPixels) {
   // bins of each 1D dimension.
   const int pixels = 25600, grid = 16, bins = 64;
   std::vector<double> cam(grid * grid, 0), light(grid * grid, 0), dir(grid * grid, 0);
-  std::vector<double> select(bins, 0), lobe(bins, 0), roulette(bins, 0);
+  std::vector<double> lobe(bins, 0), roulette(bins, 0), specular(bins, 0);
   auto cell = [&](glm::vec2 u) { return static_cast<int>(u.y * grid) * grid + static_cast<int>(u.x * grid); };
   for (int p = 0; p < pixels; ++p) {
     PathSampler s(SamplerType::Sobol, 3, static_cast<uint64_t>(p), 5, 4);
     ++cam[cell(s.camera_jitter())];
-    ++light[cell(s.get_2d(3, VertexDim::LightPoint))];
-    ++dir[cell(s.get_2d(3, VertexDim::BsdfDirection))];
-    ++select[static_cast<int>(s.get_1d(3, VertexDim::LightSelect) * bins)];
-    ++lobe[static_cast<int>(s.get_1d(3, VertexDim::BsdfLobe) * bins)];
-    ++roulette[static_cast<int>(s.get_1d(3, VertexDim::Roulette) * bins)];
+    ++light[cell(s.light_numbers(3, true).point)];
+    const PathSampler::BsdfNumbers b = s.bsdf_numbers(3, true, true);
+    ++dir[cell(b.direction)];
+    ++lobe[static_cast<int>(b.lobe * bins)];
+    ++roulette[static_cast<int>(b.roulette * bins)];
+    ++specular[static_cast<int>(s.specular_numbers(3).select * bins)];
   }
   auto check = [&](const std::vector<double>& observed, const char* name) {
     std::vector<double> expected(observed.size(), static_cast<double>(pixels) / observed.size());
@@ -136,9 +138,9 @@ TEST(Sobol, ScrambledPointsAreUniformAcrossPixels) {
   check(cam, "camera");
   check(light, "light point");
   check(dir, "bsdf direction");
-  check(select, "light select");
   check(lobe, "bsdf lobe");
   check(roulette, "roulette");
+  check(specular, "specular object");
 }
 
 TEST(Sobol, NeighbouringPixelsAndGroupsAreUncorrelated) {
@@ -150,7 +152,7 @@ TEST(Sobol, NeighbouringPixelsAndGroupsAreUncorrelated) {
     PathSampler a(SamplerType::Sobol, 1, 100, static_cast<uint32_t>(f), 1), b(SamplerType::Sobol, 1, 101, static_cast<uint32_t>(f), 1);
     double x = a.camera_jitter().x, y = b.camera_jitter().x;
     sxy += x * y, sx += x, sy += y, sxx += x * x, syy += y * y;
-    double l = a.get_2d(2, VertexDim::LightPoint).x, d = a.get_2d(2, VertexDim::BsdfDirection).x;
+    double l = a.light_numbers(2, true).point.x, d = a.bsdf_numbers(2, false, false).direction.x;
     gxy += l * d, gx += l, gy += d, gxx += l * l, gyy += d * d;
   }
   auto corr = [n](double xy, double x, double y, double xx, double yy) {
@@ -166,8 +168,41 @@ TEST(Sobol, IndependentSamplerKeepsTheOldStreams) {
   PathSampler s(SamplerType::Independent, 9, 77, 3, 4);
   Rng pixel(9, 77, 3), path(9 ^ 0x5bd1e9955bd1e995ULL, 77, 3);
   EXPECT_EQ(s.camera_jitter(), pixel.next_2d());
-  EXPECT_EQ(s.get_1d(2, VertexDim::LightSelect), path.next_float());
-  EXPECT_EQ(s.get_2d(2, VertexDim::LightPoint), path.next_2d());
+  // Every number is drawn, used or not, in the old order: light selection, light point, BSDF
+  // lobe, direction, roulette.
+  const PathSampler::LightNumbers light = s.light_numbers(2, false);
+  EXPECT_FALSE(light.shared);
+  EXPECT_EQ(light.select, path.next_float());
+  EXPECT_EQ(light.point, path.next_2d());
+  const PathSampler::BsdfNumbers bsdf = s.bsdf_numbers(2, false, false);
+  EXPECT_EQ(bsdf.lobe, path.next_float());
+  EXPECT_EQ(bsdf.direction, path.next_2d());
+  EXPECT_EQ(bsdf.roulette, path.next_float());
+}
+
+TEST(Sobol, PathTailAfterLeavingQmcIsFreshEveryFrame) {
+  // After leave_qmc() a path draws PCG32 numbers. The Sobol key holds the replicate, not the
+  // frame, so the tail stream must take the frame in: over the frames of one pixel and replicate
+  // the tail's numbers are i.i.d. uniform (chi-square, 64 bins) and never repeat a frame's.
+  const int frames = 8192, bins = 64;
+  std::vector<double> observed(bins, 0);
+  std::vector<float> first;
+  for (uint32_t f = 0; f < frames; ++f) {
+    PathSampler s(SamplerType::Sobol, 4, 321, f, 1);
+    s.leave_qmc();
+    EXPECT_FALSE(s.in_qmc());
+    const float u = s.bsdf_numbers(3, true, true).direction.x;
+    ++observed[static_cast<int>(u * bins)];
+    first.push_back(u);
+  }
+  std::vector<double> expected(bins, static_cast<double>(frames) / bins);
+  const stat::ChiSquareResult r = stat::chi_square(observed, expected);
+  EXPECT_GT(r.p_value, 1e-4) << "chi2 " << r.statistic << " dof " << r.dof;
+  // 24-bit values: about frames^2 / 2^25 = 2 equal pairs by chance; a repeating tail gives thousands.
+  std::sort(first.begin(), first.end());
+  int equal = 0;
+  for (size_t i = 1; i < first.size(); ++i) equal += first[i] == first[i - 1];
+  EXPECT_LT(equal, 16) << "the tails of different frames repeat";
 }
 
 TEST(Accumulation, ReplicateVarianceFromReplicateMeans) {
