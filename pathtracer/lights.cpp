@@ -118,6 +118,7 @@ LightSampler::LightSampler(const Scene& scene) : scene_(scene) {
     }
   }
   triangle_dist_ = Distribution1D(powers);
+  build_near_field_clusters(powers);
 
   if (scene.environment && scene.environment->strength > 0.0f && !scene.environment->image.texels.empty()) {
     const Texture& image = scene.environment->image;
@@ -175,7 +176,8 @@ bool LightSampler::sample(glm::vec3 position, glm::vec2 u, LightSample* out) con
     glm::vec3 point;
     glm::vec2 b;
     float area_pdf;
-    const size_t i = sample_triangle_point(glm::vec2(rescaled(u.x, 0.0f, p_triangles_), u.y), &point, &b, &area_pdf);
+    const size_t i =
+        sample_triangle_point(position, glm::vec2(rescaled(u.x, 0.0f, p_triangles_), u.y), &point, &b, &area_pdf);
     return triangle_sample(position, i, point, b, area_pdf, out);
   }
   if (u.x < p_triangles_ + p_environment_)
@@ -184,18 +186,88 @@ bool LightSampler::sample(glm::vec3 position, glm::vec2 u, LightSample* out) con
   return sample_punctual(position, rescaled(u.x, p_triangles_ + p_environment_, p_punctual_), out);
 }
 
-size_t LightSampler::sample_triangle_point(float u_select, glm::vec2 u, glm::vec3* point, glm::vec2* bary,
-                                           float* area_pdf) const {
+void LightSampler::build_near_field_clusters(const std::vector<float>& powers) {
+  std::vector<Cluster> clusters;
+  for (size_t i = 0; i < triangles_.size();) {
+    Cluster c;
+    c.first = i;
+    size_t end = i;
+    while (end < triangles_.size() && triangles_[end].mesh == triangles_[i].mesh) ++end;
+    glm::vec3 lo(kInf), hi(-kInf);
+    for (size_t t = i; t < end; ++t) {
+      const EmissiveTriangle& e = triangles_[t];
+      for (glm::vec3 p : {e.p0, e.p0 + e.e1, e.p0 + e.e2}) lo = glm::min(lo, p), hi = glm::max(hi, p);
+    }
+    c.lo = lo;
+    c.hi = hi;
+    c.floor2 = std::max(0.01f * 0.25f * glm::dot(hi - lo, hi - lo), 1e-12f);
+    c.triangles = Distribution1D(powers.data() + i, end - i);
+    for (size_t t = i; t < end; ++t) c.power += powers[t];
+    if (c.triangles.valid() && std::isfinite(c.power) && std::isfinite(c.floor2)) clusters.push_back(std::move(c));
+    i = end;
+  }
+  double total = 0;
+  for (const Cluster& c : clusters) total += c.power;
+  // One mesh (nothing to choose) or many (the per-sample loop over them would cost too much).
+  if (clusters.size() < 2 || clusters.size() > kMaxNearFieldClusters || !(total > 0.0)) return;
+  for (Cluster& c : clusters) c.power_share = c.power / total;
+  clusters_ = std::move(clusters);
+  triangle_cluster_.assign(triangles_.size(), -1);
+  for (size_t c = 0; c < clusters_.size(); ++c)
+    for (size_t t = clusters_[c].first; t < clusters_[c].first + clusters_[c].triangles.size(); ++t)
+      triangle_cluster_[t] = static_cast<int>(c);
+}
+
+void LightSampler::cluster_probabilities(glm::vec3 from, float* out) const {
+  float sum = 0.0f;
+  for (size_t c = 0; c < clusters_.size(); ++c) {
+    const glm::vec3 d = glm::max(glm::max(clusters_[c].lo - from, from - clusters_[c].hi), glm::vec3(0.0f));
+    out[c] = clusters_[c].power / (glm::dot(d, d) + clusters_[c].floor2);
+    sum += out[c];
+  }
+  const bool near_valid = sum > 0.0f && std::isfinite(sum);
+  for (size_t c = 0; c < clusters_.size(); ++c)
+    out[c] = 0.5f * static_cast<float>(clusters_[c].power_share) + (near_valid ? 0.5f * out[c] / sum
+                                                                               : 0.5f * static_cast<float>(clusters_[c].power_share));
+}
+
+size_t LightSampler::pick_triangle(glm::vec3 from, float u_select, float* u_remapped, float* pmf) const {
+  if (clusters_.empty()) return triangle_dist_.sample(u_select, u_remapped, pmf);
+  float p[kMaxNearFieldClusters];
+  cluster_probabilities(from, p);
+  size_t c = 0;
+  float lo = 0.0f;
+  while (c + 1 < clusters_.size() && !(u_select < lo + p[c])) lo += p[c++];
+  while (!(p[c] > 0.0f) && c > 0) lo -= p[--c];  // rounding left u past the last nonzero cluster
+  const float u = std::min(std::max((u_select - lo) / p[c], 0.0f), 0x1.fffffep-1f);
+  float pmf_in;
+  const size_t i = clusters_[c].first + clusters_[c].triangles.sample(u, u_remapped, &pmf_in);
+  *pmf = p[c] * pmf_in;
+  return i;
+}
+
+float LightSampler::triangle_selection_pmf(size_t light, glm::vec3 from) const {
+  if (clusters_.empty()) return triangle_dist_.pmf(light);
+  float p[kMaxNearFieldClusters];
+  cluster_probabilities(from, p);
+  if (triangle_cluster_[light] < 0) return 0.0f;  // a mesh without power
+  const Cluster& c = clusters_[static_cast<size_t>(triangle_cluster_[light])];
+  return p[triangle_cluster_[light]] * c.triangles.pmf(light - c.first);
+}
+
+size_t LightSampler::sample_triangle_point(glm::vec3 from, float u_select, glm::vec2 u, glm::vec3* point,
+                                           glm::vec2* bary, float* area_pdf) const {
   float pmf;
-  const size_t i = triangle_dist_.sample(u_select, nullptr, &pmf);
+  const size_t i = pick_triangle(from, u_select, nullptr, &pmf);
   point_on_triangle(i, pmf, u, point, bary, area_pdf);
   return i;
 }
 
-size_t LightSampler::sample_triangle_point(glm::vec2 u, glm::vec3* point, glm::vec2* bary, float* area_pdf) const {
+size_t LightSampler::sample_triangle_point(glm::vec3 from, glm::vec2 u, glm::vec3* point, glm::vec2* bary,
+                                           float* area_pdf) const {
   float pmf;
   glm::vec2 v = u;
-  const size_t i = triangle_dist_.sample(u.x, &v.x, &pmf);
+  const size_t i = pick_triangle(from, u.x, &v.x, &pmf);
   point_on_triangle(i, pmf, v, point, bary, area_pdf);
   return i;
 }
@@ -213,7 +285,7 @@ bool LightSampler::sample_triangles(glm::vec3 position, float u_select, glm::vec
   glm::vec3 point;
   glm::vec2 b;
   float area_pdf;
-  const size_t i = sample_triangle_point(u_select, u, &point, &b, &area_pdf);
+  const size_t i = sample_triangle_point(position, u_select, u, &point, &b, &area_pdf);
   return triangle_sample(position, i, point, b, area_pdf, out);
 }
 
@@ -253,7 +325,7 @@ float LightSampler::pdf_triangle(unsigned mesh, unsigned prim, glm::vec3 from, g
   float dist2 = glm::dot(d, d);
   float cos_light = std::abs(glm::dot(d, face_normal)) / std::sqrt(dist2);
   if (!(cos_light > 0.0f)) return 0.0f;
-  float pmf = triangle_dist_.pmf(static_cast<size_t>(mesh_light_offset_[mesh]) + prim);
+  const float pmf = triangle_selection_pmf(static_cast<size_t>(mesh_light_offset_[mesh]) + prim, from);
   return p_triangles_ * pmf / e.area * dist2 / cos_light;
 }
 

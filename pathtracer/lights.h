@@ -46,11 +46,25 @@ class LightSampler {
 
   // Parts exposed for the statistical tests.
   size_t emissive_triangle_count() const { return triangles_.size(); }
-  float triangle_selection_pmf(size_t light) const { return triangle_dist_.pmf(light); }
-  // Samples a point on the emissive triangles: returns the light index and the area pdf.
-  size_t sample_triangle_point(float u_select, glm::vec2 u, glm::vec3* point, glm::vec2* barycentrics, float* area_pdf) const;
+  // The probability of picking emissive triangle `light` among the triangles, seen from `from`
+  // (near-field selection, below); without near-field selection it is its share of the power.
+  float triangle_selection_pmf(size_t light, glm::vec3 from) const;
+  // Samples a point on the emissive triangles for a shading point at `from`: returns the light
+  // index and the area pdf (incl. the triangle's selection, not the category's).
+  size_t sample_triangle_point(glm::vec3 from, float u_select, glm::vec2 u, glm::vec3* point, glm::vec2* barycentrics,
+                               float* area_pdf) const;
   // As above with u.x both selecting the triangle and, rescaled, the point's first coordinate.
-  size_t sample_triangle_point(glm::vec2 u, glm::vec3* point, glm::vec2* barycentrics, float* area_pdf) const;
+  size_t sample_triangle_point(glm::vec3 from, glm::vec2 u, glm::vec3* point, glm::vec2* barycentrics,
+                               float* area_pdf) const;
+
+  // Near-field selection: with 2 to kMaxNearFieldClusters emissive meshes, the mesh is picked with
+  // probability 1/2 (its power share) + 1/2 (its share of power / (d^2 + (r/10)^2)), d the
+  // distance from the shading point to the mesh's bounding box and r the box's half diagonal (so
+  // a long thin strip counts as near all along it); inside a mesh the triangle goes by power. The
+  // power half keeps every light's probability at least half its power share wherever the
+  // distance term misjudges (orientation, occlusion).
+  static constexpr size_t kMaxNearFieldClusters = 16;
+  bool near_field_selection() const { return !clusters_.empty(); }
   glm::vec3 sample_environment_direction(glm::vec2 u, float* pdf) const;  // pdf without selection
   float environment_direction_pdf(glm::vec3 direction) const;             // pdf without selection
 
@@ -74,6 +88,12 @@ class LightSampler {
   bool sample_triangles(glm::vec3 position, float u_select, glm::vec2 u, LightSample* out) const;
   void point_on_triangle(size_t light, float pmf, glm::vec2 u, glm::vec3* point, glm::vec2* barycentrics,
                          float* area_pdf) const;
+  // Picks an emissive triangle for a shading point at `from`; u_remapped (may be null): u_select
+  // rescaled within the choice. pmf: the triangle's selection probability among the triangles.
+  size_t pick_triangle(glm::vec3 from, float u_select, float* u_remapped, float* pmf) const;
+  void build_near_field_clusters(const std::vector<float>& powers);
+  // p(cluster | from) of every cluster into `out` (kMaxNearFieldClusters entries).
+  void cluster_probabilities(glm::vec3 from, float* out) const;
   bool triangle_sample(glm::vec3 position, size_t light, glm::vec3 point, glm::vec2 barycentrics, float area_pdf,
                        LightSample* out) const;
   bool sample_environment(glm::vec3 position, glm::vec2 u, LightSample* out) const;
@@ -83,6 +103,16 @@ class LightSampler {
   std::vector<EmissiveTriangle> triangles_;
   std::vector<int> mesh_light_offset_;  // first light index of each mesh's triangles, -1: not emissive
   Distribution1D triangle_dist_;
+  struct Cluster {  // one emissive mesh for near-field selection
+    size_t first = 0;          // its first triangle in triangles_ (its triangles are contiguous)
+    Distribution1D triangles;  // by power inside the mesh
+    double power_share = 0.0;  // of all triangles' power
+    float power = 0.0f;        // the sum of its triangle weights
+    glm::vec3 lo{0.0f}, hi{0.0f};  // bounding box
+    float floor2 = 0.0f;           // (half diagonal / 10)^2, added to the squared distance
+  };
+  std::vector<Cluster> clusters_;          // empty: selection by power alone
+  std::vector<int> triangle_cluster_;      // per triangle, with clusters_
   const Environment* env_ = nullptr;
   Distribution2D env_dist_;
   std::vector<const PunctualLight*> punctual_;

@@ -2,6 +2,7 @@
 // (luminance x sin(theta)) against their pdfs by chi-square; punctual light falloffs.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "pathtracer/lights.h"
@@ -34,18 +35,62 @@ int sub_triangle(glm::vec2 b) {
   return 3;
 }
 
-TEST(Lights, EmissiveTriangleSamplingIsPowerWeightedAndUniform) {
+// The selection probability of each emissive triangle seen from `from`, written out from the
+// definition (LightSampler's near-field selection): per mesh 1/2 power share + 1/2 share of
+// power / (d^2 + (half diagonal / 10)^2), d the distance to the mesh's box; inside the mesh by power.
+std::vector<double> expected_triangle_pmfs(const Scene& scene, const LightSampler& lights, glm::vec3 from) {
+  std::vector<double> mesh_power(scene.meshes.size(), 0.0), near(scene.meshes.size(), 0.0);
+  for (size_t i = 0; i < lights.emissive_triangle_count(); ++i) {
+    const auto& t = lights.triangle(i);
+    mesh_power[t.mesh] += t.area * luminance(t.material->emissive);
+  }
+  double total = 0, near_total = 0;
+  for (size_t m = 0; m < scene.meshes.size(); ++m) {
+    if (!(mesh_power[m] > 0)) continue;
+    glm::vec3 lo(1e30f), hi(-1e30f);
+    for (glm::vec3 p : scene.meshes[m].positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
+    glm::dvec3 d(0.0);  // from `from` to the box
+    for (int k = 0; k < 3; ++k) d[k] = std::max({0.0, double(lo[k]) - from[k], double(from[k]) - hi[k]});
+    const double half_diagonal2 = 0.25 * glm::dot(glm::dvec3(hi - lo), glm::dvec3(hi - lo));
+    near[m] = mesh_power[m] / (glm::dot(d, d) + 0.01 * half_diagonal2);
+    total += mesh_power[m];
+    near_total += near[m];
+  }
+  std::vector<double> pmf;
+  for (size_t i = 0; i < lights.emissive_triangle_count(); ++i) {
+    const auto& t = lights.triangle(i);
+    const double p_mesh = 0.5 * mesh_power[t.mesh] / total + 0.5 * near[t.mesh] / near_total;
+    pmf.push_back(p_mesh * t.area * luminance(t.material->emissive) / mesh_power[t.mesh]);
+  }
+  return pmf;
+}
+
+TEST(Lights, EmissiveTriangleSamplingFollowsNearFieldSelectionAndIsUniform) {
   Scene scene = three_emitters();
   LightSampler lights(scene);
   ASSERT_FALSE(lights.empty());
+  ASSERT_TRUE(lights.near_field_selection());
   const size_t count = lights.emissive_triangle_count();
   ASSERT_EQ(count, 2u + 2u + 12u);
-  double total_power = 0;
-  for (size_t i = 0; i < count; ++i) total_power += lights.triangle(i).area * luminance(lights.triangle(i).material->emissive);
-  for (size_t i = 0; i < count; ++i) {
-    double power = lights.triangle(i).area * luminance(lights.triangle(i).material->emissive);
-    EXPECT_NEAR(lights.triangle_selection_pmf(i), power / total_power, 1e-6);
+  const glm::vec3 from(0.3f, 0.01f, 0.2f);
+  // From three places: the pmfs follow the definition and sum to 1; next to the small box its
+  // triangles get far more than their power share.
+  for (glm::vec3 at : {from, glm::vec3(-1.5f, 0.9f, -1.85f), glm::vec3(40.0f, 0.0f, 0.0f)}) {
+    const std::vector<double> want = expected_triangle_pmfs(scene, lights, at);
+    double sum = 0;
+    for (size_t i = 0; i < count; ++i) {
+      EXPECT_NEAR(lights.triangle_selection_pmf(i, at), want[i], 1e-5 + 1e-4 * want[i]) << i;
+      sum += lights.triangle_selection_pmf(i, at);
+    }
+    EXPECT_NEAR(sum, 1.0, 1e-5);
   }
+  double box_near = 0, box_far = 0;
+  for (size_t i = 4; i < count; ++i) {
+    box_near += lights.triangle_selection_pmf(i, glm::vec3(-1.5f, 0.9f, -1.85f));
+    box_far += lights.triangle_selection_pmf(i, glm::vec3(40.0f, 0.0f, 0.0f));
+  }
+  EXPECT_GT(box_near, 2.0 * box_far);
+
   // Both ways of drawing: a separate selection number, and one 2D number whose first coordinate
   // selects and is reused, rescaled, for the point (what the Sobol sampler uses).
   for (bool shared : {false, true}) {
@@ -53,7 +98,7 @@ TEST(Lights, EmissiveTriangleSamplingIsPowerWeightedAndUniform) {
     const int n = 200000;
     std::vector<double> observed(count * 4, 0.0), expected(count * 4, 0.0);
     for (size_t i = 0; i < count; ++i)
-      for (int s = 0; s < 4; ++s) expected[i * 4 + s] = n * lights.triangle_selection_pmf(i) / 4.0;
+      for (int s = 0; s < 4; ++s) expected[i * 4 + s] = n * lights.triangle_selection_pmf(i, from) / 4.0;
     Rng rng(shared ? 10 : 9, 0, 0);
     int pdf_mismatches = 0;
     for (int k = 0; k < n; ++k) {
@@ -62,12 +107,11 @@ TEST(Lights, EmissiveTriangleSamplingIsPowerWeightedAndUniform) {
       glm::vec3 point;
       glm::vec2 b;
       float area_pdf;
-      size_t i = shared ? lights.sample_triangle_point(u, &point, &b, &area_pdf)
-                        : lights.sample_triangle_point(u_select, u, &point, &b, &area_pdf);
+      size_t i = shared ? lights.sample_triangle_point(from, u, &point, &b, &area_pdf)
+                        : lights.sample_triangle_point(from, u_select, u, &point, &b, &area_pdf);
       observed[i * 4 + sub_triangle(b)] += 1.0;
       // The full light sample's solid-angle pdf equals pdf_triangle() for the same point.
       LightSample ls;
-      glm::vec3 from(0.3f, 0.01f, 0.2f);
       if (k % 50 == 0 && (shared ? lights.sample(from, u, &ls) : lights.sample(from, u_select, u, &ls))) {
         EXPECT_EQ(ls.point, point);
         const auto& tri = lights.triangle(i);
