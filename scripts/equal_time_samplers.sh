@@ -1,0 +1,55 @@
+#!/usr/bin/env bash
+# Equal wall time, Sobol against independent sampling (issue 11): for each scene, ROUNDS rounds of
+# four whole jobs back to back (`pxf render --time SECONDS`: sobol/independent x unfiltered/default
+# grid filter, seed 101, 102, ... per round), each judged against the scene's reference with
+# `pxf diff` (HDR and display NRMSE). Prints every run, then per scene the medians over rounds and
+# the Sobol / independent ratios of the medians.
+# Usage: scripts/equal_time_samplers.sh REFERENCE_DIR [SECONDS] [ROUNDS] [SCENES...]
+#   REFERENCE_DIR holds reference_<scene>_384x216_2048spp.exr for every scene (as `pxf bench
+#   --scene S --size 384x216 --reference-spp 2048 --out DIR` writes it: another seed, unfiltered).
+#   Defaults: 2 s, 3 rounds, cornell atrium kitchen envmap.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+refs=${1:?usage: scripts/equal_time_samplers.sh REFERENCE_DIR [SECONDS] [ROUNDS] [SCENES...]}
+seconds=${2:-2}
+rounds=${3:-3}
+shift $(($# < 3 ? $# : 3))
+scenes=("$@")
+[ ${#scenes[@]} -gt 0 ] || scenes=(cornell atrium kitchen envmap)
+pxf=build/app/pxf
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+echo "scene round sampler filter spp hdr_nrmse display_nrmse" | tee "$tmp/runs"
+for scene in "${scenes[@]}"; do
+  ref="$refs/reference_${scene}_384x216_2048spp.exr"
+  [ -f "$ref" ] || { echo "missing $ref" >&2; exit 2; }
+  for round in $(seq "$rounds"); do
+    for sampler in sobol independent; do
+      for filter in none grid; do
+        out="$tmp/$scene-$round-$sampler-$filter"
+        "$pxf" render --scene "$scene" --size 384x216 --time "$seconds" --sampler "$sampler" --filter "$filter" \
+          --seed $((100 + round)) --out "$out" >/dev/null 2>&1
+        spp=$(python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['time_budget']['spp_reached'])" "$out/stats.json")
+        line=$("$pxf" diff "$out/final.exr" "$ref" | grep '^all pixels')
+        hdr=$(sed -E 's/.*HDR NRMSE ([0-9.]+).*/\1/' <<<"$line")
+        display=$(sed -E 's/.*display NRMSE ([0-9.]+).*/\1/' <<<"$line")
+        echo "$scene $round $sampler $filter $spp $hdr $display" | tee -a "$tmp/runs"
+      done
+    done
+  done
+done
+python3 - "$tmp/runs" <<'PY'
+import collections, statistics, sys
+rows = [l.split() for l in open(sys.argv[1]).read().splitlines()[1:]]
+runs = collections.defaultdict(list)
+for scene, _, sampler, filt, spp, hdr, disp in rows:
+    runs[(scene, sampler, filt)].append((float(spp), float(hdr), float(disp)))
+med = {k: [statistics.median(v[i] for v in vals) for i in range(3)] for k, vals in runs.items()}
+print("\nmedians over rounds; ratio = sobol / independent")
+print("%-10s %-8s %16s %22s %22s" % ("scene", "filter", "spp sobol/indep", "HDR % (ratio)", "display % (ratio)"))
+for scene in dict.fromkeys(r[0] for r in rows):
+    for filt in ("none", "grid"):
+        s, i = med[(scene, "sobol", filt)], med[(scene, "independent", filt)]
+        print("%-10s %-8s %7.0f / %-7.0f %7.2f/%-6.2f (%.2f) %7.2f/%-6.2f (%.2f)" %
+              (scene, filt, s[0], i[0], s[1], i[1], s[1] / i[1], s[2], i[2], s[2] / i[2]))
+PY
