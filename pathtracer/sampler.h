@@ -152,6 +152,22 @@ inline uint32_t nested_uniform_scramble(uint32_t x, uint32_t seed) {
 
 inline float to_unit_float(uint32_t x) { return static_cast<float>(x >> 8) * 0x1p-24f; }
 
+// to_unit_float(reverse_bits(y)) with three byte look-ups instead of the full reversal: only the
+// 24 bits a float keeps are reversed.
+constexpr std::array<uint8_t, 256> make_byte_reversal() {
+  std::array<uint8_t, 256> t{};
+  for (uint32_t v = 0; v < 256; ++v)
+    for (int i = 0; i < 8; ++i) t[v] |= static_cast<uint8_t>(((v >> i) & 1u) << (7 - i));
+  return t;
+}
+inline constexpr std::array<uint8_t, 256> kByteReversal = make_byte_reversal();
+inline float reversed_to_unit_float(uint32_t y) {
+  const uint32_t top24 = (static_cast<uint32_t>(kByteReversal[y & 0xffu]) << 16) |
+                         (static_cast<uint32_t>(kByteReversal[(y >> 8) & 0xffu]) << 8) |
+                         kByteReversal[(y >> 16) & 0xffu];
+  return static_cast<float>(top24) * 0x1p-24f;
+}
+
 // The Owen scramble seed of dimension `dim` of a group: the group's seed with a fixed random salt
 // per dimension (no hash: the group seed is already the output of a 64-bit mix, and the scramble
 // hashes its seed).
@@ -168,10 +184,11 @@ struct ScrambledGroup {
   ScrambledGroup(uint32_t reversed_index, uint64_t key)
       : reversed_shuffled_index(laine_karras_permutation(reversed_index, static_cast<uint32_t>(key))),
         seed(static_cast<uint32_t>(key >> 32)) {}
-  uint32_t bits(int dim) const {
-    return reverse_bits(
-        laine_karras_permutation(reversed_sample_bits(reversed_shuffled_index, dim), dimension_seed(seed, dim)));
+  uint32_t reversed_bits(int dim) const {
+    return laine_karras_permutation(reversed_sample_bits(reversed_shuffled_index, dim), dimension_seed(seed, dim));
   }
+  uint32_t bits(int dim) const { return reverse_bits(reversed_bits(dim)); }
+  float unit(int dim) const { return reversed_to_unit_float(reversed_bits(dim)); }  // = to_unit_float(bits(dim))
 };
 
 // Point `index` of the shuffled, Owen-scrambled sequence with scramble key `key`, dimension `dim`:
@@ -229,7 +246,7 @@ class PathSampler {
       n.point = rng_.next_2d();
     } else if (used) {
       const sobol::ScrambledGroup g = group(2 * vertex);
-      n.point = glm::vec2(sobol::to_unit_float(g.bits(0)), sobol::to_unit_float(g.bits(1)));
+      n.point = glm::vec2(g.unit(0), g.unit(1));
       n.shared = true;
     }
     return n;
@@ -248,9 +265,9 @@ class PathSampler {
       return n;
     }
     const sobol::ScrambledGroup g = group(2 * vertex + 1);
-    n.direction = glm::vec2(sobol::to_unit_float(g.bits(0)), sobol::to_unit_float(g.bits(1)));
-    if (lobe_used) n.lobe = sobol::to_unit_float(g.bits(2));
-    if (roulette_used) n.roulette = sobol::to_unit_float(g.bits(3));
+    n.direction = glm::vec2(g.unit(0), g.unit(1));
+    if (lobe_used) n.lobe = g.unit(2);
+    if (roulette_used) n.roulette = g.unit(3);
     return n;
   }
 
@@ -272,8 +289,8 @@ class PathSampler {
       return n;
     }
     const sobol::ScrambledGroup g = group(4096 + vertex);
-    n.direction = glm::vec2(sobol::to_unit_float(g.bits(0)), sobol::to_unit_float(g.bits(1)));
-    n.select = sobol::to_unit_float(g.bits(2));
+    n.direction = glm::vec2(g.unit(0), g.unit(1));
+    n.select = g.unit(2);
     return n;
   }
 
@@ -286,8 +303,8 @@ class PathSampler {
       return;
     }
     const sobol::ScrambledGroup g = group(8192 + 1024 * vertex + bounce);
-    *u_dir = glm::vec2(sobol::to_unit_float(g.bits(0)), sobol::to_unit_float(g.bits(1)));
-    *u_lobe = sobol::to_unit_float(g.bits(2));
+    *u_dir = glm::vec2(g.unit(0), g.unit(1));
+    *u_lobe = g.unit(2);
   }
 
  private:
@@ -296,7 +313,7 @@ class PathSampler {
   }
   glm::vec2 sobol_2d(int group_id) const {
     const sobol::ScrambledGroup g = group(group_id);
-    return glm::vec2(sobol::to_unit_float(g.bits(0)), sobol::to_unit_float(g.bits(1)));
+    return glm::vec2(g.unit(0), g.unit(1));
   }
 
   SamplerType type_ = SamplerType::Independent;

@@ -66,6 +66,8 @@ TEST(Sobol, FastPathEqualsTheNestedScrambleDefinition) {
       const uint32_t dim_seed = sobol::dimension_seed(static_cast<uint32_t>(key >> 32), d);
       ASSERT_EQ(sobol::scrambled_bits(index, d, key),
                 sobol::nested_uniform_scramble(sobol::sample_bits(shuffled, d), dim_seed));
+      const sobol::ScrambledGroup g(sobol::reverse_bits(index), key);
+      ASSERT_EQ(g.unit(d), sobol::to_unit_float(g.bits(d)));  // the byte-table reversal to float
     }
   }
 }
