@@ -159,6 +159,23 @@ double rectangle_form_factor(double x0, double x1, double z0, double z1, double 
          corner_form_factor(x0, z0, c);
 }
 
+// The mean of Y(LV + HV) over n frames of a one-pixel camera, and its standard error from the
+// per-sample variance (which bounds a Sobol mean's from above).
+struct PixelMean {
+  double mean = 0, stderr_ = 0;
+};
+PixelMean one_pixel_mean(const PathTracer& tracer, const Camera& camera, int n, const TraceParams& params) {
+  double sum = 0, sum2 = 0;
+  for (int f = 0; f < n; ++f) {
+    PathSample p = tracer.trace_pixel(camera, 1, 1, 0, 0, static_cast<uint32_t>(f), params);
+    double v = luminance(p.lv + p.hv);
+    sum += v;
+    sum2 += v * v;
+  }
+  const double mean = sum / n;
+  return {mean, std::sqrt(std::max(0.0, sum2 / n - mean * mean) / n)};
+}
+
 // Direct light on a Lambertian ceiling from a parallel emitter just below it: the reflected
 // radiance at a point is albedo x Le x F (F the point-to-rectangle form factor). Points beyond the
 // emitter's edge receive light at grazing elevations over both planes: the case where shadow rays
@@ -180,15 +197,7 @@ TEST(Integrator, NearFieldEmitterLightsParallelCeilingAsFormFactor) {
       const glm::vec3 point(0.2f, gap, size / 2 + beyond * gap);
       // A pixel-sized view of that point from below, past the emitter's edge.
       Camera camera = look_at_camera(glm::vec3(0, -3, 8), point, glm::vec3(0, 1, 0), 1e-5f);
-      const int n = 20000;
-      double sum = 0, sum2 = 0;
-      for (int f = 0; f < n; ++f) {
-        PathSample p = tracer.trace_pixel(camera, 1, 1, 0, 0, static_cast<uint32_t>(f), params);
-        double v = luminance(p.lv + p.hv);
-        sum += v;
-        sum2 += v * v;
-      }
-      const double mean = sum / n, stderr_ = std::sqrt(std::max(0.0, sum2 / n - mean * mean) / n);
+      const auto [mean, stderr_] = one_pixel_mean(tracer, camera, 20000, params);
       const double h = size / 2;
       const double expected =
           albedo * le * rectangle_form_factor(-h - point.x, h - point.x, -h - point.z, h - point.z, gap);
@@ -228,16 +237,7 @@ TEST(Integrator, NearFieldLightSelectionKeepsDirectLightExact) {
     for (float x : {-4.0f, 0.5f, 3.2f}) {
       const glm::vec3 point(x, gap, 3.0f);  // the camera's ray passes beside the panels (z > 3 at y = 0)
       Camera camera = look_at_camera(glm::vec3(x, -3, 10), point, glm::vec3(0, 1, 0), 1e-5f);
-      const int n = 16384;
-      double sum = 0, sum2 = 0;
-      for (int f = 0; f < n; ++f) {
-        PathSample p = tracer.trace_pixel(camera, 1, 1, 0, 0, static_cast<uint32_t>(f), params);
-        double v = luminance(p.lv + p.hv);
-        sum += v;
-        sum2 += v * v;
-      }
-      // The per-sample variance over n bounds the Sobol mean's variance from above.
-      const double mean = sum / n, stderr_ = std::sqrt(std::max(0.0, sum2 / n - mean * mean) / n);
+      const auto [mean, stderr_] = one_pixel_mean(tracer, camera, 16384, params);
       double expected = 0;
       for (const Panel& q : panels)
         expected += albedo * q.le * rectangle_form_factor(q.x0 - point.x, q.x1 - point.x, q.z0 - point.z, q.z1 - point.z, gap);
