@@ -158,32 +158,32 @@ LightSampler::LightSampler(const Scene& scene) : scene_(scene) {
 }
 
 bool LightSampler::sample(glm::vec3 position, float u_select, glm::vec2 u, LightSample* out) const {
-  if (category_count_ == 0) return false;
-  // Remap u_select within the chosen category so it can pick the light inside it.
-  if (u_select < p_triangles_) return sample_triangles(position, u_select / p_triangles_, u, out);
-  u_select -= p_triangles_;
-  if (u_select < p_environment_) return sample_environment(position, u, out);
-  u_select -= p_environment_;
-  if (p_punctual_ <= 0.0f) return false;
-  return sample_punctual(position, std::min(u_select / p_punctual_, 0x1.fffffep-1f), out);
+  return sample_light(position, u_select, u, false, out);
 }
 
 bool LightSampler::sample(glm::vec3 position, glm::vec2 u, LightSample* out) const {
+  return sample_light(position, u.x, u, true, out);
+}
+
+bool LightSampler::sample_light(glm::vec3 position, float u_select, glm::vec2 u, bool reuse_select,
+                                LightSample* out) const {
   if (category_count_ == 0) return false;
-  // Rescale u.x within the chosen category (and below, within the chosen light).
-  const auto rescaled = [](float x, float lo, float width) { return std::min((x - lo) / width, 0x1.fffffep-1f); };
-  if (u.x < p_triangles_) {
+  // Remap u_select within the chosen category so it can pick the light inside it.
+  if (u_select < p_triangles_) {
     glm::vec3 point;
     glm::vec2 b;
     float area_pdf;
-    const size_t i =
-        sample_triangle_point(position, glm::vec2(rescaled(u.x, 0.0f, p_triangles_), u.y), &point, &b, &area_pdf);
+    const size_t i = triangle_point(position, u_select / p_triangles_, u, reuse_select, &point, &b, &area_pdf);
     return triangle_sample(position, i, point, b, area_pdf, out);
   }
-  if (u.x < p_triangles_ + p_environment_)
-    return sample_environment(position, glm::vec2(rescaled(u.x, p_triangles_, p_environment_), u.y), out);
+  u_select -= p_triangles_;
+  if (u_select < p_environment_) {
+    if (reuse_select) u.x = std::min(u_select / p_environment_, 0x1.fffffep-1f);
+    return sample_environment(position, u, out);
+  }
+  u_select -= p_environment_;
   if (p_punctual_ <= 0.0f) return false;
-  return sample_punctual(position, rescaled(u.x, p_triangles_ + p_environment_, p_punctual_), out);
+  return sample_punctual(position, std::min(u_select / p_punctual_, 0x1.fffffep-1f), out);
 }
 
 void LightSampler::build_near_field_clusters(const std::vector<float>& powers) {
@@ -248,45 +248,33 @@ size_t LightSampler::pick_triangle(glm::vec3 from, float u_select, float* u_rema
 
 float LightSampler::triangle_selection_pmf(size_t light, glm::vec3 from) const {
   if (clusters_.empty()) return triangle_dist_.pmf(light);
+  if (triangle_cluster_[light] < 0) return 0.0f;  // a mesh without power
   float p[kMaxNearFieldClusters];
   cluster_probabilities(from, p);
-  if (triangle_cluster_[light] < 0) return 0.0f;  // a mesh without power
   const Cluster& c = clusters_[static_cast<size_t>(triangle_cluster_[light])];
   return p[triangle_cluster_[light]] * c.triangles.pmf(light - c.first);
 }
 
 size_t LightSampler::sample_triangle_point(glm::vec3 from, float u_select, glm::vec2 u, glm::vec3* point,
                                            glm::vec2* bary, float* area_pdf) const {
-  float pmf;
-  const size_t i = pick_triangle(from, u_select, nullptr, &pmf);
-  point_on_triangle(i, pmf, u, point, bary, area_pdf);
-  return i;
+  return triangle_point(from, u_select, u, false, point, bary, area_pdf);
 }
 
 size_t LightSampler::sample_triangle_point(glm::vec3 from, glm::vec2 u, glm::vec3* point, glm::vec2* bary,
                                            float* area_pdf) const {
-  float pmf;
-  glm::vec2 v = u;
-  const size_t i = pick_triangle(from, u.x, &v.x, &pmf);
-  point_on_triangle(i, pmf, v, point, bary, area_pdf);
-  return i;
+  return triangle_point(from, u.x, u, true, point, bary, area_pdf);
 }
 
-void LightSampler::point_on_triangle(size_t light, float pmf, glm::vec2 u, glm::vec3* point, glm::vec2* bary,
-                                     float* area_pdf) const {
-  const EmissiveTriangle& e = triangles_[light];
+size_t LightSampler::triangle_point(glm::vec3 from, float u_select, glm::vec2 u, bool reuse_select, glm::vec3* point,
+                                    glm::vec2* bary, float* area_pdf) const {
+  float pmf;
+  const size_t i = pick_triangle(from, u_select, reuse_select ? &u.x : nullptr, &pmf);
+  const EmissiveTriangle& e = triangles_[i];
   const glm::vec2 b = sample_triangle_barycentrics(u);
   *point = e.p0 + b.x * e.e1 + b.y * e.e2;
   *bary = b;
   *area_pdf = e.area > 0.0f ? pmf / e.area : 0.0f;
-}
-
-bool LightSampler::sample_triangles(glm::vec3 position, float u_select, glm::vec2 u, LightSample* out) const {
-  glm::vec3 point;
-  glm::vec2 b;
-  float area_pdf;
-  const size_t i = sample_triangle_point(position, u_select, u, &point, &b, &area_pdf);
-  return triangle_sample(position, i, point, b, area_pdf, out);
+  return i;
 }
 
 // The light sample toward `point` on emissive triangle `light`, drawn with area pdf `area_pdf`.

@@ -85,9 +85,11 @@ class LightSampler {
   static double punctual_power(const PunctualLight& light, float scene_radius);
 
  private:
-  bool sample_triangles(glm::vec3 position, float u_select, glm::vec2 u, LightSample* out) const;
-  void point_on_triangle(size_t light, float pmf, glm::vec2 u, glm::vec3* point, glm::vec2* barycentrics,
-                         float* area_pdf) const;
+  // Both sample() overloads: with reuse_select, u.x is replaced by u_select rescaled within the
+  // chosen category and light.
+  bool sample_light(glm::vec3 position, float u_select, glm::vec2 u, bool reuse_select, LightSample* out) const;
+  size_t triangle_point(glm::vec3 from, float u_select, glm::vec2 u, bool reuse_select, glm::vec3* point,
+                        glm::vec2* barycentrics, float* area_pdf) const;
   // Picks an emissive triangle for a shading point at `from`; u_remapped (may be null): u_select
   // rescaled within the choice. pmf: the triangle's selection probability among the triangles.
   size_t pick_triangle(glm::vec3 from, float u_select, float* u_remapped, float* pmf) const;

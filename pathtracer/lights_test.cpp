@@ -1,5 +1,7 @@
-// Light sampling: emissive triangles (power-weighted choice, uniform on area) and the environment
-// (luminance x sin(theta)) against their pdfs by chi-square; punctual light falloffs.
+// Light sampling: emissive triangles (near-field choice, uniform on area), the environment
+// (luminance x sin(theta)) and the light types (by power) against their pdfs by chi-square, each
+// with a separate selection number and with the selection taken from the point's u.x; punctual
+// light falloffs.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -13,7 +15,7 @@
 namespace pxf {
 namespace {
 
-constexpr double kAlpha = 0.01 / 3;  // Bonferroni over the three chi-square tests here
+constexpr double kAlpha = 0.01 / 6;  // Bonferroni over the six chi-square tests here
 
 Scene three_emitters() {
   Scene scene;
@@ -145,36 +147,56 @@ Scene random_environment(int width, int height, uint64_t seed) {
 }
 
 TEST(Lights, EnvironmentSamplingMatchesItsPdf) {
-  Scene scene = random_environment(16, 8, 21);
-  LightSampler lights(scene);
-  ASSERT_TRUE(lights.has_environment());
-  // Bins finer than the texels, in (u, v); expected counts integrate pdf(direction) over each bin.
-  const int bu = 48, bv = 24, sub = 6, n = 300000;
-  std::vector<double> observed(bu * bv, 0.0), expected(bu * bv, 0.0);
-  for (int y = 0; y < bv * sub; ++y) {
-    for (int x = 0; x < bu * sub; ++x) {
-      glm::vec2 uv((x + 0.5f) / (bu * sub), (y + 0.5f) / (bv * sub));
-      glm::vec3 d = equirect_direction(uv);
-      double jacobian = 2.0 * M_PI * M_PI * std::sin(M_PI * uv.y);  // dω = 2 pi^2 sin(theta) du dv
-      expected[(y / sub) * bu + x / sub] +=
-          n * lights.environment_direction_pdf(d) * jacobian / (double(bu * sub) * double(bv * sub));
+  // Directly, and through the whole light choice from one 2D number (a quad emitter beside the
+  // environment, so u.x must be rescaled into the environment's share before it picks the column).
+  for (bool shared : {false, true}) {
+    SCOPED_TRACE(shared ? "through sample(position, u)" : "sample_environment_direction");
+    Scene scene = random_environment(16, 8, 21);
+    if (shared) {
+      scene.materials.push_back(make_emitter(glm::vec3(3.0f)));
+      scene.meshes.push_back(make_quad(glm::vec3(0, 2, 0), glm::vec3(1, 0, 0), glm::vec3(0, 0, 1), 1));
     }
+    LightSampler lights(scene);
+    ASSERT_TRUE(lights.has_environment());
+    const int bu = 48, bv = 24, sub = 6, n = 300000;
+    std::vector<double> observed(bu * bv, 0.0);
+    Rng rng(4, 0, 0);
+    int pdf_mismatches = 0, drawn = 0;
+    for (int k = 0; k < n; ++k) {
+      float pdf;
+      glm::vec3 d;
+      if (shared) {
+        LightSample ls;
+        if (!lights.sample(glm::vec3(0.0f), rng.next_2d(), &ls) || !std::isinf(ls.distance)) continue;
+        d = ls.wi;
+        pdf = ls.pdf / lights.environment_probability();
+      } else {
+        d = lights.sample_environment_direction(rng.next_2d(), &pdf);
+      }
+      glm::vec2 uv = equirect_uv(d);
+      int x = std::min(bu - 1, static_cast<int>(uv.x * bu)), y = std::min(bv - 1, static_cast<int>(uv.y * bv));
+      observed[y * bu + x] += 1.0;
+      ++drawn;
+      float again = lights.environment_direction_pdf(d);
+      if (std::abs(again - pdf) > 2e-3f * pdf) ++pdf_mismatches;
+    }
+    if (shared) EXPECT_GT(drawn, n / 4);
+    // Bins finer than the texels, in (u, v); expected counts integrate pdf(direction) over each bin.
+    std::vector<double> expected(bu * bv, 0.0);
+    for (int y = 0; y < bv * sub; ++y) {
+      for (int x = 0; x < bu * sub; ++x) {
+        glm::vec2 uv((x + 0.5f) / (bu * sub), (y + 0.5f) / (bv * sub));
+        glm::vec3 d = equirect_direction(uv);
+        double jacobian = 2.0 * M_PI * M_PI * std::sin(M_PI * uv.y);  // dω = 2 pi^2 sin(theta) du dv
+        expected[(y / sub) * bu + x / sub] +=
+            drawn * lights.environment_direction_pdf(d) * jacobian / (double(bu * sub) * double(bv * sub));
+      }
+    }
+    EXPECT_LE(pdf_mismatches, n / 10000);  // texel-boundary round-off only
+    stat::ChiSquareResult r = stat::chi_square(observed, expected);
+    EXPECT_TRUE(r.problem.empty()) << r.problem;
+    EXPECT_GT(r.p_value, kAlpha) << "chi2 " << r.statistic << " dof " << r.dof;
   }
-  Rng rng(4, 0, 0);
-  int pdf_mismatches = 0;
-  for (int k = 0; k < n; ++k) {
-    float pdf;
-    glm::vec3 d = lights.sample_environment_direction(rng.next_2d(), &pdf);
-    glm::vec2 uv = equirect_uv(d);
-    int x = std::min(bu - 1, static_cast<int>(uv.x * bu)), y = std::min(bv - 1, static_cast<int>(uv.y * bv));
-    observed[y * bu + x] += 1.0;
-    float again = lights.environment_direction_pdf(d);
-    if (std::abs(again - pdf) > 2e-3f * pdf) ++pdf_mismatches;
-  }
-  EXPECT_LE(pdf_mismatches, n / 10000);  // texel-boundary round-off only
-  stat::ChiSquareResult r = stat::chi_square(observed, expected);
-  EXPECT_TRUE(r.problem.empty()) << r.problem;
-  EXPECT_GT(r.p_value, kAlpha) << "chi2 " << r.statistic << " dof " << r.dof;
 }
 
 TEST(Lights, LightTypesAreSelectedByPower) {
@@ -219,16 +241,22 @@ TEST(Lights, LightTypesAreSelectedByPower) {
   lights.sample_environment_direction(glm::vec2(0.3f, 0.6f), &env_pdf);
   EXPECT_NEAR(lights.pdf_environment(glm::vec3(0, 0, -1)), lights.environment_probability() / (4 * kPi), 1e-3f);
   // Frequencies of the selected category over many draws, from a point every light reaches: chi-square against the probabilities.
-  const int n = 100000;
-  std::vector<double> observed(3, 0.0);
-  Rng rng(17, 0, 0);
-  for (int k = 0; k < n; ++k) {
-    if (!lights.sample(glm::vec3(0.5f, 1.0f, 0.25f), rng.next_float(), rng.next_2d(), &ls)) continue;
-    observed[ls.delta ? 2 : std::isinf(ls.distance) ? 1 : 0] += 1.0;
+  // With a separate selection number and with the selection taken from u.x.
+  for (bool shared : {false, true}) {
+    const int n = 100000;
+    std::vector<double> observed(3, 0.0);
+    Rng rng(shared ? 18 : 17, 0, 0);
+    const glm::vec3 at(0.5f, 1.0f, 0.25f);
+    for (int k = 0; k < n; ++k) {
+      const float u_select = rng.next_float();
+      const glm::vec2 u = rng.next_2d();
+      if (!(shared ? lights.sample(at, u, &ls) : lights.sample(at, u_select, u, &ls))) continue;
+      observed[ls.delta ? 2 : std::isinf(ls.distance) ? 1 : 0] += 1.0;
+    }
+    const std::vector<double> expected = {n * tri / total, n * sky / total, n * punctual / total};
+    stat::ChiSquareResult r = stat::chi_square(observed, expected);
+    EXPECT_GT(r.p_value, kAlpha) << (shared ? "shared: " : "") << "chi2 " << r.statistic << " dof " << r.dof;
   }
-  const std::vector<double> expected = {n * tri / total, n * sky / total, n * punctual / total};
-  stat::ChiSquareResult r = stat::chi_square(observed, expected);
-  EXPECT_GT(r.p_value, kAlpha) << "chi2 " << r.statistic << " dof " << r.dof;
 }
 
 TEST(Lights, EquirectRoundTrip) {

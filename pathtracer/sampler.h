@@ -189,6 +189,7 @@ struct ScrambledGroup {
   }
   uint32_t bits(int dim) const { return reverse_bits(reversed_bits(dim)); }
   float unit(int dim) const { return reversed_to_unit_float(reversed_bits(dim)); }  // = to_unit_float(bits(dim))
+  glm::vec2 unit_pair() const { return glm::vec2(unit(0), unit(1)); }  // dimensions 0 and 1: a (0,2)-sequence
 };
 
 // Point `index` of the shuffled, Owen-scrambled sequence with scramble key `key`, dimension `dim`:
@@ -246,7 +247,7 @@ class PathSampler {
       n.point = rng_.next_2d();
     } else if (used) {
       const sobol::ScrambledGroup g = group(2 * vertex);
-      n.point = glm::vec2(g.unit(0), g.unit(1));
+      n.point = g.unit_pair();
       n.shared = true;
     }
     return n;
@@ -265,7 +266,7 @@ class PathSampler {
       return n;
     }
     const sobol::ScrambledGroup g = group(2 * vertex + 1);
-    n.direction = glm::vec2(g.unit(0), g.unit(1));
+    n.direction = g.unit_pair();
     if (lobe_used) n.lobe = g.unit(2);
     if (roulette_used) n.roulette = g.unit(3);
     return n;
@@ -273,7 +274,7 @@ class PathSampler {
 
   glm::vec2 camera_jitter() {
     if (type_ == SamplerType::Independent) return camera_rng_.next_2d();
-    return sobol_2d(0);
+    return group(0).unit_pair();
   }
 
   // Specular sampling at vertex `vertex`: which object (select) and the direction in its cone.
@@ -289,7 +290,7 @@ class PathSampler {
       return n;
     }
     const sobol::ScrambledGroup g = group(4096 + vertex);
-    n.direction = glm::vec2(g.unit(0), g.unit(1));
+    n.direction = g.unit_pair();
     n.select = g.unit(2);
     return n;
   }
@@ -303,17 +304,13 @@ class PathSampler {
       return;
     }
     const sobol::ScrambledGroup g = group(8192 + 1024 * vertex + bounce);
-    *u_dir = glm::vec2(g.unit(0), g.unit(1));
+    *u_dir = g.unit_pair();
     *u_lobe = g.unit(2);
   }
 
  private:
   sobol::ScrambledGroup group(int id) const {
     return sobol::ScrambledGroup(reversed_index_, mix64(key_ + 0xbf58476d1ce4e5b9ULL * static_cast<uint64_t>(id + 1)));
-  }
-  glm::vec2 sobol_2d(int group_id) const {
-    const sobol::ScrambledGroup g = group(group_id);
-    return glm::vec2(g.unit(0), g.unit(1));
   }
 
   SamplerType type_ = SamplerType::Independent;
