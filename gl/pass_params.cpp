@@ -28,17 +28,19 @@ FilterKind parse_filter_kind(const std::string& name) {
   throw Error("unknown filter '" + name + "' (expected " + expected + ")");
 }
 
+// t (n - 3) / (n - 1): the Jensen excess of a variance from n Gaussian samples removed in
+// expectation (docs/method.md 3.5); n below 4 counts as 4.
+float effective_threshold(float t, uint64_t samples) {
+  const double n = static_cast<double>(std::max<uint64_t>(samples, 4));
+  return static_cast<float>(t * ((n - 3.0) / (n - 1.0)));
+}
+
 // Pass i of the à-trous filter convolves with the B3 spline at hole spacing 2^i, whose variance is
 // 4^i px^2 per axis (the taps 1/16 [1 4 6 4 1] have variance 1 at spacing 1), and the variances
 // of successive convolutions add: k passes have (4^k - 1) / 3. Passes are added while that is
 // below the Gaussian's sigma_s^2 (sigma_s = 8: 4 passes, variance 85 = (9.2 px)^2, footprint
 // radius 30 px against the exact kernel's 24), as long as the footprint radius 2 (2^k - 1) of the
 // next count fits kMaxFilterRadius (at most 5 passes).
-float effective_threshold(float t, uint64_t samples) {
-  const double n = static_cast<double>(std::max<uint64_t>(samples, 4));
-  return static_cast<float>(t * ((n - 3.0) / (n - 1.0)));
-}
-
 int atrous_iterations(float sigma_s) {
   const double target = double(sigma_s) * sigma_s;
   int passes = 1;
