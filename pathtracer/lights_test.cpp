@@ -180,7 +180,9 @@ TEST(Lights, EnvironmentSamplingMatchesItsPdf) {
       float again = lights.environment_direction_pdf(d);
       if (std::abs(again - pdf) > 2e-3f * pdf) ++pdf_mismatches;
     }
-    if (shared) EXPECT_GT(drawn, n / 4);
+    if (shared) {
+      EXPECT_GT(drawn, n / 4);
+    }
     // Bins finer than the texels, in (u, v); expected counts integrate pdf(direction) over each bin.
     std::vector<double> expected(bu * bv, 0.0);
     for (int y = 0; y < bv * sub; ++y) {
