@@ -25,7 +25,7 @@ struct TraceParams {
   // Independently scrambled interleaved Sobol replicates (frame k is in replicate k mod K): their
   // means give Var[L_u] of the pixel mean under QMC. 1 = one sequence and the estimate s^2 / n.
   // Default 1: K > 1 makes the estimate exact on average but costs unfiltered error (each
-  // replicate is a shorter sequence), and s^2 / n overestimates by 1.1-1.4x only (docs/sampling.md).
+  // replicate is a shorter sequence), and s^2 / n overestimates only mildly (docs/sampling.md).
   int replicates = 1;
   // Specular sampling: at each diffuse vertex, a direction in the cone of one perfectly specular
   // object's bounding sphere, followed through its specular chain to the light it reaches (the

@@ -1,0 +1,38 @@
+// Preview::set_settings keeps the accumulated samples only while they are still samples of the
+// render asked for: any change of the trace parameters (sampler and replicates included) starts
+// over, a change of the passes' parameters only filters again.
+#include <gtest/gtest.h>
+
+#include <functional>
+
+#include "app/preview.h"
+#include "pathtracer/pathtracer.h"
+#include "tests/test_support.h"
+
+using namespace pxf;
+
+namespace {
+
+int samples_after_change(const Scene& scene, const std::function<void(PreviewSettings&)>& change) {
+  PreviewSettings settings;
+  Preview preview(scene, settings, 16, 16);
+  preview.add_frame();
+  preview.add_frame();
+  EXPECT_EQ(preview.samples(), 2);
+  change(settings);
+  preview.set_settings(settings);
+  return preview.samples();
+}
+
+TEST(PreviewSettings, TraceChangesRestartAndPassChangesKeepTheSamples) {
+  test_support::headless_context();
+  const Scene scene = load_scene("cornell");
+  EXPECT_EQ(samples_after_change(scene, [](PreviewSettings& s) { s.trace.sampler = SamplerType::Independent; }), 0);
+  EXPECT_EQ(samples_after_change(scene, [](PreviewSettings& s) { s.trace.replicates = 4; }), 0);
+  EXPECT_EQ(samples_after_change(scene, [](PreviewSettings& s) { s.trace.specular_sampling = true; }), 0);
+  EXPECT_EQ(samples_after_change(scene, [](PreviewSettings& s) { s.trace.max_vertices = 4; }), 0);
+  EXPECT_EQ(samples_after_change(scene, [](PreviewSettings& s) { s.threshold = 0.01f; }), 2);
+  EXPECT_EQ(samples_after_change(scene, [](PreviewSettings& s) { s.filter.sigma_s = 4.0f; }), 2);
+}
+
+}  // namespace
