@@ -116,6 +116,7 @@ LightSampler::LightSampler(const Scene& scene) : scene_(scene) {
       triangles_.push_back(e);
       powers.push_back(e.area * weight * (material.double_sided ? 2.0f : 1.0f));
     }
+    find_parallelograms(static_cast<size_t>(mesh_light_offset_[m]), triangles_.size());
   }
   triangle_dist_ = Distribution1D(powers);
   build_near_field_clusters(powers);
@@ -184,6 +185,57 @@ bool LightSampler::sample_light(glm::vec3 position, float u_select, glm::vec2 u,
   u_select -= p_environment_;
   if (p_punctual_ <= 0.0f) return false;
   return sample_punctual(position, std::min(u_select / p_punctual_, 0x1.fffffep-1f), out);
+}
+
+// Pairs triangles [first, end) of one mesh (one emission, so one power per area): triangles t and
+// t + 1 form a parallelogram when they share two corners and the other two sum to the shared ones.
+void LightSampler::find_parallelograms(size_t first, size_t end) {
+  for (size_t t = first; t + 1 < end;) {
+    const EmissiveTriangle &a = triangles_[t], &b = triangles_[t + 1];
+    const glm::vec3 pa[3] = {a.p0, a.p0 + a.e1, a.p0 + a.e2}, pb[3] = {b.p0, b.p0 + b.e1, b.p0 + b.e2};
+    // A corner shared with b is one of b's corners exactly (both come from the same positions).
+    int shared_a[3], shared_count = 0, b_used = 0;
+    for (int i = 0; i < 3; ++i) {
+      shared_a[i] = -1;
+      for (int j = 0; j < 3; ++j)
+        if (pa[i] == pb[j]) shared_a[i] = j;
+      if (shared_a[i] >= 0) ++shared_count, b_used |= 1 << shared_a[i];
+    }
+    if (shared_count != 2 || !(a.area > 0.0f) || !(b.area > 0.0f)) {
+      ++t;
+      continue;
+    }
+    const int c = shared_a[0] < 0 ? 0 : shared_a[1] < 0 ? 1 : 2;  // a's own corner
+    const int d = (b_used & 1) == 0 ? 0 : (b_used & 2) == 0 ? 1 : 2;   // b's own corner
+    const glm::vec3 s1 = pa[(c + 1) % 3], s2 = pa[(c + 2) % 3];
+    const float scale = std::max({glm::length(s1 - pa[c]), glm::length(s2 - pa[c]), glm::length(s1 - s2)});
+    if (!(glm::length(pa[c] + pb[d] - s1 - s2) <= 1e-5f * scale)) {
+      ++t;
+      continue;
+    }
+    const int index = static_cast<int>(parallelograms_.size());
+    // Selection within a mesh goes by power, and power per area is the mesh's: the first
+    // triangle's share of the pair is its share of the area.
+    parallelograms_.push_back(Parallelogram{t, pa[c], s1 - pa[c], s2 - pa[c], a.area / (a.area + b.area)});
+    triangles_[t].parallelogram = triangles_[t + 1].parallelogram = index;
+    t += 2;
+  }
+}
+
+size_t LightSampler::parallelogram_point(size_t light, float u_pair, float v, glm::vec3* point,
+                                         glm::vec2* barycentrics) const {
+  const Parallelogram& q = parallelograms_[static_cast<size_t>(triangles_[light].parallelogram)];
+  *point = q.origin + u_pair * q.edge_u + v * q.edge_v;
+  const size_t i = u_pair + v <= 1.0f ? q.first : q.first + 1;
+  // Barycentrics of the point in triangle i's own corner order (texture coordinates of emission).
+  const EmissiveTriangle& e = triangles_[i];
+  const glm::vec3 n = glm::cross(e.e1, e.e2), r = *point - e.p0;
+  const float inv = 1.0f / glm::dot(n, n);
+  glm::vec2 b(glm::dot(glm::cross(r, e.e2), n) * inv, glm::dot(glm::cross(e.e1, r), n) * inv);
+  b = glm::clamp(b, 0.0f, 1.0f);
+  if (b.x + b.y > 1.0f) b /= b.x + b.y;
+  *barycentrics = b;
+  return i;
 }
 
 void LightSampler::build_near_field_clusters(const std::vector<float>& powers) {
@@ -269,6 +321,17 @@ size_t LightSampler::triangle_point(glm::vec3 from, float u_select, glm::vec2 u,
                                     glm::vec2* bary, float* area_pdf) const {
   float pmf;
   const size_t i = pick_triangle(from, u_select, reuse_select ? &u.x : nullptr, &pmf);
+  if (reuse_select && triangles_[i].parallelogram >= 0) {
+    // u.x spans the pair's contiguous share of the selection: [0, 1) over both triangles.
+    const Parallelogram& q = parallelograms_[static_cast<size_t>(triangles_[i].parallelogram)];
+    const size_t first = q.first;
+    const float share_first = q.share_first;
+    const float u_pair = std::min(i == first ? u.x * share_first : share_first + u.x * (1.0f - share_first),
+                                  0x1.fffffep-1f);
+    // Both triangles have the same power per area, so the density is the same on either.
+    *area_pdf = triangles_[i].area > 0.0f ? pmf / triangles_[i].area : 0.0f;
+    return parallelogram_point(i, u_pair, u.y, point, bary);
+  }
   const EmissiveTriangle& e = triangles_[i];
   const glm::vec2 b = sample_triangle_barycentrics(u);
   *point = e.p0 + b.x * e.e1 + b.y * e.e2;

@@ -73,6 +73,7 @@ class LightSampler {
     glm::vec3 p0, e1, e2, normal;
     float area;
     const Material* material;
+    int parallelogram = -1;  // index into parallelograms_ when this and a neighbour form one
   };
   const EmissiveTriangle& triangle(size_t light) const { return triangles_[light]; }
 
@@ -101,8 +102,23 @@ class LightSampler {
   bool sample_environment(glm::vec3 position, glm::vec2 u, LightSample* out) const;
   bool sample_punctual(glm::vec3 position, float u_select, LightSample* out) const;
 
+  // Two consecutive triangles of one emissive mesh that form a parallelogram (a quad split on its
+  // diagonal): origin + u edge_u + v edge_v, u + v <= 1 being the first triangle. With the shared
+  // selection the point goes on the whole parallelogram, so the 2D strata of u cover the quad as
+  // an affine image instead of half of them warped onto each triangle.
+  struct Parallelogram {
+    size_t first = 0;  // its first triangle; the second is first + 1
+    glm::vec3 origin{0.0f}, edge_u{0.0f}, edge_v{0.0f};
+    float share_first = 0.5f;  // the first triangle's share of the pair's selection probability
+  };
+  void find_parallelograms(size_t first, size_t end);
+  // The point of the parallelogram holding triangle `light` for (u_pair, v); returns the triangle
+  // it falls in and its barycentrics there.
+  size_t parallelogram_point(size_t light, float u_pair, float v, glm::vec3* point, glm::vec2* barycentrics) const;
+
   const Scene& scene_;
   std::vector<EmissiveTriangle> triangles_;
+  std::vector<Parallelogram> parallelograms_;
   std::vector<int> mesh_light_offset_;  // first light index of each mesh's triangles, -1: not emissive
   Distribution1D triangle_dist_;
   struct Cluster {  // one emissive mesh for near-field selection

@@ -128,6 +128,50 @@ TEST(Lights, EmissiveTriangleSamplingFollowsNearFieldSelectionAndIsUniform) {
   }
 }
 
+TEST(Lights, SharedSelectionKeepsStrataOnAQuadEmitter) {
+  // A quad is two triangles; from one 2D number the points go on the quad as an affine image of the
+  // unit square (a parallelogram), so the 16 cell centres of a 4 x 4 grid land one in each cell
+  // of the quad. Drawn per triangle (half of u.x each, warped by the square-to-triangle map) they
+  // would not. A trapezoid is left to its triangles.
+  const glm::vec3 corner(0.0f, 2.0f, 0.0f), edge_u(1.0f, 0.0f, 0.3f), edge_v(0.2f, 0.0f, 0.8f);
+  Scene scene;
+  scene.materials = {make_emitter(glm::vec3(1.0f))};
+  scene.meshes.push_back(make_quad(corner, edge_u, edge_v, 0));
+  LightSampler lights(scene);
+  ASSERT_EQ(lights.emissive_triangle_count(), 2u);
+  const glm::vec3 from(0.3f, 0.0f, 0.4f);
+  // Coordinates in the quad's frame: p = corner + x edge_u + y edge_v.
+  const glm::vec3 n = glm::cross(edge_u, edge_v);
+  auto quad_coordinates = [&](glm::vec3 p) {
+    const glm::vec3 r = p - corner;
+    return glm::vec2(glm::dot(glm::cross(r, edge_v), n), glm::dot(glm::cross(edge_u, r), n)) / glm::dot(n, n);
+  };
+  std::vector<int> count(16, 0);
+  for (int j = 0; j < 4; ++j)
+    for (int i = 0; i < 4; ++i) {
+      glm::vec3 point;
+      glm::vec2 b;
+      float area_pdf;
+      const size_t light = lights.sample_triangle_point(from, glm::vec2((i + 0.5f) / 4, (j + 0.5f) / 4), &point, &b, &area_pdf);
+      // The triangle and barycentrics returned are those of the point.
+      const auto& t = lights.triangle(light);
+      EXPECT_LT(glm::length(t.p0 + b.x * t.e1 + b.y * t.e2 - point), 1e-5f);
+      EXPECT_NEAR(area_pdf, 1.0f / glm::length(n), 1e-5f);
+      const glm::vec2 q = quad_coordinates(point);
+      ASSERT_TRUE(q.x >= 0.0f && q.x < 1.0f && q.y >= 0.0f && q.y < 1.0f) << q.x << " " << q.y;
+      ++count[static_cast<int>(q.y * 4) * 4 + static_cast<int>(q.x * 4)];
+    }
+  for (int c = 0; c < 16; ++c) EXPECT_EQ(count[c], 1) << "cell " << c;
+
+  EXPECT_GE(lights.triangle(0).parallelogram, 0);
+  Mesh trapezoid = make_quad(corner, edge_u, edge_v, 0);
+  trapezoid.positions[2] += 0.01f * edge_u;
+  scene.meshes = {trapezoid};
+  const LightSampler trapezoid_lights(scene);
+  EXPECT_EQ(trapezoid_lights.triangle(0).parallelogram, -1);
+  EXPECT_EQ(trapezoid_lights.triangle(1).parallelogram, -1);
+}
+
 Scene random_environment(int width, int height, uint64_t seed) {
   Scene scene;
   scene.materials = {make_diffuse(glm::vec3(0.5f))};
