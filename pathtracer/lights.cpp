@@ -254,6 +254,7 @@ void LightSampler::build_near_field_clusters(const std::vector<float>& powers) {
     c.hi = hi;
     c.floor2 = std::max(0.01f * 0.25f * glm::dot(hi - lo, hi - lo), 1e-12f);
     c.triangles = Distribution1D(powers.data() + i, end - i);
+    c.one_sided_plane = one_sided_plane(i, end, &c.plane_normal, &c.plane_point);
     for (size_t t = i; t < end; ++t) c.power += powers[t];
     if (c.triangles.valid() && std::isfinite(c.power) && std::isfinite(c.floor2)) clusters.push_back(std::move(c));
     i = end;
@@ -270,17 +271,47 @@ void LightSampler::build_near_field_clusters(const std::vector<float>& powers) {
       triangle_cluster_[t] = static_cast<int>(c);
 }
 
+// Whether triangles [first, end) lie in one plane with one facing and emit from the front only.
+bool LightSampler::one_sided_plane(size_t first, size_t end, glm::vec3* normal, glm::vec3* point) const {
+  const EmissiveTriangle& a = triangles_[first];
+  if (a.material->double_sided || !(a.area > 0.0f)) return false;
+  float extent = 0.0f;
+  for (size_t t = first; t < end; ++t) extent = std::max({extent, glm::length(triangles_[t].e1), glm::length(triangles_[t].e2)});
+  for (size_t t = first; t < end; ++t) {
+    const EmissiveTriangle& e = triangles_[t];
+    if (!(e.area > 0.0f) || glm::dot(e.normal, a.normal) < 1.0f - 1e-5f) return false;
+    for (glm::vec3 p : {e.p0, e.p0 + e.e1, e.p0 + e.e2})
+      if (!(std::abs(glm::dot(p - a.p0, a.normal)) <= 1e-5f * extent)) return false;
+  }
+  *normal = a.normal;
+  *point = a.p0;
+  return true;
+}
+
 void LightSampler::cluster_probabilities(glm::vec3 from, float* out) const {
+  // Power shares and near-field weights over the clusters that can light `from`.
+  bool lit[kMaxNearFieldClusters];
+  double power = 0.0;
+  for (size_t c = 0; c < clusters_.size(); ++c) {
+    const Cluster& k = clusters_[c];
+    lit[c] = !k.one_sided_plane || glm::dot(from - k.plane_point, k.plane_normal) > 0.0f;
+    if (lit[c]) power += k.power_share;
+  }
+  if (!(power > 0.0)) {  // behind every panel: nothing can light it, any choice will do
+    for (size_t c = 0; c < clusters_.size(); ++c) lit[c] = true;
+    power = 1.0;
+  }
   float sum = 0.0f;
   for (size_t c = 0; c < clusters_.size(); ++c) {
     const glm::vec3 d = glm::max(glm::max(clusters_[c].lo - from, from - clusters_[c].hi), glm::vec3(0.0f));
-    out[c] = clusters_[c].power / (glm::dot(d, d) + clusters_[c].floor2);
+    out[c] = lit[c] ? clusters_[c].power / (glm::dot(d, d) + clusters_[c].floor2) : 0.0f;
     sum += out[c];
   }
   const bool near_valid = sum > 0.0f && std::isfinite(sum);
-  for (size_t c = 0; c < clusters_.size(); ++c)
-    out[c] = 0.5f * static_cast<float>(clusters_[c].power_share) + (near_valid ? 0.5f * out[c] / sum
-                                                                               : 0.5f * static_cast<float>(clusters_[c].power_share));
+  for (size_t c = 0; c < clusters_.size(); ++c) {
+    const float share = lit[c] ? static_cast<float>(clusters_[c].power_share / power) : 0.0f;
+    out[c] = 0.5f * share + (near_valid ? 0.5f * out[c] / sum : 0.5f * share);
+  }
 }
 
 size_t LightSampler::pick_triangle(glm::vec3 from, float u_select, float* u_remapped, float* pmf) const {

@@ -62,7 +62,9 @@ class LightSampler {
   // distance from the shading point to the mesh's bounding box and r the box's half diagonal (so
   // a long thin strip counts as near all along it); inside a mesh the triangle goes by power. The
   // power half keeps every light's probability at least half its power share wherever the
-  // distance term misjudges (orientation, occlusion).
+  // distance term misjudges (occlusion, the shading normal). A one-sided planar mesh (a panel, an
+  // LED strip) gets probability 0 at points behind its plane, where it cannot light them, and the
+  // others share its part.
   static constexpr size_t kMaxNearFieldClusters = 16;
   bool near_field_selection() const { return !clusters_.empty(); }
   glm::vec3 sample_environment_direction(glm::vec2 u, float* pdf) const;  // pdf without selection
@@ -95,6 +97,7 @@ class LightSampler {
   // rescaled within the choice. pmf: the triangle's selection probability among the triangles.
   size_t pick_triangle(glm::vec3 from, float u_select, float* u_remapped, float* pmf) const;
   void build_near_field_clusters(const std::vector<float>& powers);
+  bool one_sided_plane(size_t first, size_t end, glm::vec3* normal, glm::vec3* point) const;
   // p(cluster | from) of every cluster into `out` (kMaxNearFieldClusters entries).
   void cluster_probabilities(glm::vec3 from, float* out) const;
   bool triangle_sample(glm::vec3 position, size_t light, glm::vec3 point, glm::vec2 barycentrics, float area_pdf,
@@ -128,6 +131,10 @@ class LightSampler {
     float power = 0.0f;        // the sum of its triangle weights
     glm::vec3 lo{0.0f}, hi{0.0f};  // bounding box
     float floor2 = 0.0f;           // (half diagonal / 10)^2, added to the squared distance
+    // A one-sided planar mesh lights only the side its normal points to: behind that plane its
+    // probability is 0 (its light is exactly 0 there, so nothing is lost).
+    bool one_sided_plane = false;
+    glm::vec3 plane_normal{0.0f}, plane_point{0.0f};
   };
   std::vector<Cluster> clusters_;          // empty: selection by power alone
   std::vector<int> triangle_cluster_;      // per triangle, with clusters_

@@ -15,7 +15,7 @@
 namespace pxf {
 namespace {
 
-constexpr double kAlpha = 0.01 / 6;  // Bonferroni over the six chi-square tests here
+constexpr double kAlpha = 0.01 / 8;  // Bonferroni over the eight chi-square tests here
 
 Scene three_emitters() {
   Scene scene;
@@ -39,13 +39,21 @@ int sub_triangle(glm::vec2 b) {
 
 // The selection probability of each emissive triangle seen from `from`, written out from the
 // definition (LightSampler's near-field selection): per mesh 1/2 power share + 1/2 share of
-// power / (d^2 + (half diagonal / 10)^2), d the distance to the mesh's box; inside the mesh by power.
+// power / (d^2 + (half diagonal / 10)^2), d the distance to the mesh's box, both over the meshes
+// that can light `from` (a one-sided flat mesh cannot light a point behind its plane); inside the
+// mesh by power.
 std::vector<double> expected_triangle_pmfs(const Scene& scene, const LightSampler& lights, glm::vec3 from) {
   std::vector<double> mesh_power(scene.meshes.size(), 0.0), near(scene.meshes.size(), 0.0);
+  std::vector<bool> flat(scene.meshes.size(), true), behind(scene.meshes.size(), false);
   for (size_t i = 0; i < lights.emissive_triangle_count(); ++i) {
     const auto& t = lights.triangle(i);
     mesh_power[t.mesh] += t.area * luminance(t.material->emissive);
+    const auto& first = lights.triangle(static_cast<size_t>(&t - &lights.triangle(0)) - t.prim);
+    flat[t.mesh] = flat[t.mesh] && glm::dot(t.normal, first.normal) > 0.9999f;
+    behind[t.mesh] = glm::dot(from - t.p0, t.normal) <= 0.0f;
   }
+  for (size_t m = 0; m < scene.meshes.size(); ++m)
+    if (flat[m] && behind[m] && !scene.materials[scene.meshes[m].material].double_sided) mesh_power[m] = 0.0;
   double total = 0, near_total = 0;
   for (size_t m = 0; m < scene.meshes.size(); ++m) {
     if (!(mesh_power[m] > 0)) continue;
@@ -62,7 +70,7 @@ std::vector<double> expected_triangle_pmfs(const Scene& scene, const LightSample
   for (size_t i = 0; i < lights.emissive_triangle_count(); ++i) {
     const auto& t = lights.triangle(i);
     const double p_mesh = 0.5 * mesh_power[t.mesh] / total + 0.5 * near[t.mesh] / near_total;
-    pmf.push_back(p_mesh * t.area * luminance(t.material->emissive) / mesh_power[t.mesh]);
+    pmf.push_back(mesh_power[t.mesh] > 0 ? p_mesh * t.area * luminance(t.material->emissive) / mesh_power[t.mesh] : 0.0);
   }
   return pmf;
 }
@@ -74,10 +82,11 @@ TEST(Lights, EmissiveTriangleSamplingFollowsNearFieldSelectionAndIsUniform) {
   ASSERT_TRUE(lights.near_field_selection());
   const size_t count = lights.emissive_triangle_count();
   ASSERT_EQ(count, 2u + 2u + 12u);
-  const glm::vec3 from(0.3f, 0.01f, 0.2f);
-  // From three places: the pmfs follow the definition and sum to 1; next to the small box its
-  // triangles get far more than their power share.
-  for (glm::vec3 at : {from, glm::vec3(-1.5f, 0.9f, -1.85f), glm::vec3(40.0f, 0.0f, 0.0f)}) {
+  const glm::vec3 below(0.3f, 0.01f, 0.2f);
+  // From four places: the pmfs follow the definition and sum to 1; next to the small box its
+  // triangles get far more than their power share; above the first quad (it faces down) it gets 0.
+  const glm::vec3 above(0.5f, 2.5f, 0.5f);
+  for (glm::vec3 at : {below, glm::vec3(-1.5f, 0.9f, -1.85f), glm::vec3(40.0f, 0.0f, 0.0f), above}) {
     const std::vector<double> want = expected_triangle_pmfs(scene, lights, at);
     double sum = 0;
     for (size_t i = 0; i < count; ++i) {
@@ -92,11 +101,17 @@ TEST(Lights, EmissiveTriangleSamplingFollowsNearFieldSelectionAndIsUniform) {
     box_far += lights.triangle_selection_pmf(i, glm::vec3(40.0f, 0.0f, 0.0f));
   }
   EXPECT_GT(box_near, 2.0 * box_far);
+  EXPECT_EQ(lights.triangle_selection_pmf(0, above), 0.0f);
+  EXPECT_EQ(lights.triangle_selection_pmf(1, above), 0.0f);
+  EXPECT_GT(lights.triangle_selection_pmf(2, above), 0.0f);
 
   // Both ways of drawing: a separate selection number, and one 2D number whose first coordinate
-  // selects and is reused, rescaled, for the point (what the Sobol sampler uses).
+  // selects and is reused, rescaled, for the point (what the Sobol sampler uses); below the quads
+  // and above the first one.
+  for (glm::vec3 from : {below, above})
   for (bool shared : {false, true}) {
     SCOPED_TRACE(shared ? "selection from u.x" : "separate selection number");
+    SCOPED_TRACE(from == above ? "above the first quad" : "below the quads");
     const int n = 200000;
     std::vector<double> observed(count * 4, 0.0), expected(count * 4, 0.0);
     for (size_t i = 0; i < count; ++i)
