@@ -213,29 +213,39 @@ void LightSampler::find_parallelograms(size_t first, size_t end) {
       ++t;
       continue;
     }
-    const int index = static_cast<int>(parallelograms_.size());
+    Parallelogram q;
+    q.first = t;
+    q.origin = pa[c];
+    q.edge_u = s1 - pa[c];
+    q.edge_v = s2 - pa[c];
     // Selection within a mesh goes by power, and power per area is the mesh's: the first
     // triangle's share of the pair is its share of the area.
-    parallelograms_.push_back(Parallelogram{t, pa[c], s1 - pa[c], s2 - pa[c], a.area / (a.area + b.area)});
-    triangles_[t].parallelogram = triangles_[t + 1].parallelogram = index;
+    q.share_first = a.area / (a.area + b.area);
+    q.rectangle = std::abs(glm::dot(q.edge_u, q.edge_v)) <= 1e-5f * glm::length(q.edge_u) * glm::length(q.edge_v);
+    q.one_sided = !a.material->double_sided;
+    q.normal = a.normal;
+    q.inv_length2_u = 1.0f / glm::dot(q.edge_u, q.edge_u);
+    q.inv_length2_v = 1.0f / glm::dot(q.edge_v, q.edge_v);
+    q.diagonal2 = glm::dot(q.edge_u + q.edge_v, q.edge_u + q.edge_v);
+    for (int k = 0; k < 3; ++k) {
+      q.role[0][k] = static_cast<uint8_t>(k == c ? 0 : k == (c + 1) % 3 ? 1 : 2);
+      q.role[1][k] = static_cast<uint8_t>(k == d ? 0 : pb[k] == s1 ? 1 : 2);
+    }
+    triangles_[t].parallelogram = triangles_[t + 1].parallelogram = static_cast<int>(parallelograms_.size());
+    parallelograms_.push_back(q);
     t += 2;
   }
 }
 
-size_t LightSampler::parallelogram_point(size_t light, float u_pair, float v, glm::vec3* point,
-                                         glm::vec2* barycentrics) const {
-  const Parallelogram& q = parallelograms_[static_cast<size_t>(triangles_[light].parallelogram)];
-  *point = q.origin + u_pair * q.edge_u + v * q.edge_v;
-  const size_t i = u_pair + v <= 1.0f ? q.first : q.first + 1;
-  // Barycentrics of the point in triangle i's own corner order (texture coordinates of emission).
-  const EmissiveTriangle& e = triangles_[i];
-  const glm::vec3 n = glm::cross(e.e1, e.e2), r = *point - e.p0;
-  const float inv = 1.0f / glm::dot(n, n);
-  glm::vec2 b(glm::dot(glm::cross(r, e.e2), n) * inv, glm::dot(glm::cross(e.e1, r), n) * inv);
-  b = glm::clamp(b, 0.0f, 1.0f);
-  if (b.x + b.y > 1.0f) b /= b.x + b.y;
-  *barycentrics = b;
-  return i;
+size_t LightSampler::pair_triangle(const Parallelogram& q, glm::vec2 uv, glm::vec2* barycentrics) const {
+  // Weights of the corners by role (own corner, origin + edge_u, origin + edge_v): the first
+  // triangle is origin, +u, +v; the second origin + u + v, +u, +v.
+  const float a = uv.x, b = uv.y;
+  const bool first = a + b <= 1.0f;
+  const float w[3] = {first ? 1.0f - a - b : a + b - 1.0f, first ? a : 1.0f - b, first ? b : 1.0f - a};
+  const uint8_t* role = q.role[first ? 0 : 1];
+  *barycentrics = glm::clamp(glm::vec2(w[role[1]], w[role[2]]), 0.0f, 1.0f);  // of the triangle's corners 1 and 2
+  return first ? q.first : q.first + 1;
 }
 
 void LightSampler::build_near_field_clusters(const std::vector<float>& powers) {
@@ -352,16 +362,34 @@ size_t LightSampler::triangle_point(glm::vec3 from, float u_select, glm::vec2 u,
                                     glm::vec2* bary, float* area_pdf) const {
   float pmf;
   const size_t i = pick_triangle(from, u_select, reuse_select ? &u.x : nullptr, &pmf);
-  if (reuse_select && triangles_[i].parallelogram >= 0) {
-    // u.x spans the pair's contiguous share of the selection: [0, 1) over both triangles.
+  if (triangles_[i].parallelogram >= 0) {
     const Parallelogram& q = parallelograms_[static_cast<size_t>(triangles_[i].parallelogram)];
-    const size_t first = q.first;
-    const float share_first = q.share_first;
-    const float u_pair = std::min(i == first ? u.x * share_first : share_first + u.x * (1.0f - share_first),
-                                  0x1.fffffep-1f);
-    // Both triangles have the same power per area, so the density is the same on either.
-    *area_pdf = triangles_[i].area > 0.0f ? pmf / triangles_[i].area : 0.0f;
-    return parallelogram_point(i, u_pair, u.y, point, bary);
+    const float share = i == q.first ? q.share_first : 1.0f - q.share_first;
+    // With the shared selection u.x spans the pair's contiguous share of the selection: [0, 1)
+    // over both triangles, so the pair is sampled as one.
+    const glm::vec2 v(reuse_select ? std::min(i == q.first ? u.x * share : q.share_first + u.x * share, 0x1.fffffep-1f)
+                                   : u.x,
+                      u.y);
+    SphericalRectangle sr;
+    if (solid_angle_sampling(q, from, &sr)) {
+      *point = sr.sample(v);
+      const glm::vec3 r = *point - q.origin;
+      const glm::vec2 uv = glm::clamp(glm::vec2(glm::dot(r, q.edge_u) * q.inv_length2_u, glm::dot(r, q.edge_v) * q.inv_length2_v),
+                                      0.0f, 1.0f);
+      const size_t j = pair_triangle(q, uv, bary);
+      // The area density that is 1 / solid angle in solid angle (cos / r^2 of the point).
+      const glm::vec3 d = *point - from;
+      const float dist2 = glm::dot(d, d);
+      const float cos_light = std::abs(glm::dot(d, triangles_[j].normal)) / std::sqrt(dist2);
+      *area_pdf = dist2 > 0.0f ? pmf / share / sr.solid_angle() * cos_light / dist2 : 0.0f;
+      return j;
+    }
+    if (reuse_select) {
+      // Both triangles have the same power per area, so the density is the same on either.
+      *point = q.origin + v.x * q.edge_u + v.y * q.edge_v;
+      *area_pdf = triangles_[i].area > 0.0f ? pmf / triangles_[i].area : 0.0f;
+      return pair_triangle(q, v, bary);
+    }
   }
   const EmissiveTriangle& e = triangles_[i];
   const glm::vec2 b = sample_triangle_barycentrics(u);
@@ -407,7 +435,14 @@ float LightSampler::pdf_triangle(unsigned mesh, unsigned prim, glm::vec3 from, g
   float dist2 = glm::dot(d, d);
   float cos_light = std::abs(glm::dot(d, face_normal)) / std::sqrt(dist2);
   if (!(cos_light > 0.0f)) return 0.0f;
-  const float pmf = triangle_selection_pmf(static_cast<size_t>(mesh_light_offset_[mesh]) + prim, from);
+  const size_t light = static_cast<size_t>(mesh_light_offset_[mesh]) + prim;
+  const float pmf = triangle_selection_pmf(light, from);
+  if (e.parallelogram >= 0) {
+    const Parallelogram& q = parallelograms_[static_cast<size_t>(e.parallelogram)];
+    SphericalRectangle sr;
+    if (solid_angle_sampling(q, from, &sr))
+      return p_triangles_ * pmf / (light == q.first ? q.share_first : 1.0f - q.share_first) / sr.solid_angle();
+  }
   return p_triangles_ * pmf / e.area * dist2 / cos_light;
 }
 

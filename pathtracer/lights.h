@@ -66,6 +66,10 @@ class LightSampler {
   // LED strip) gets probability 0 at points behind its plane, where it cannot light them, and the
   // others share its part.
   static constexpr size_t kMaxNearFieldClusters = 16;
+  // A rectangular emitter (a quad of two triangles with perpendicular edges) is sampled uniformly
+  // in the solid angle it subtends where its diagonal is at least its distance (this factor on
+  // the squares), else uniformly in area (docs/sampling.md: measured choice).
+  static constexpr float kSolidAngleNearness = 1.0f;
   bool near_field_selection() const { return !clusters_.empty(); }
   glm::vec3 sample_environment_direction(glm::vec2 u, float* pdf) const;  // pdf without selection
   float environment_direction_pdf(glm::vec3 direction) const;             // pdf without selection
@@ -78,6 +82,31 @@ class LightSampler {
     int parallelogram = -1;  // index into parallelograms_ when this and a neighbour form one
   };
   const EmissiveTriangle& triangle(size_t light) const { return triangles_[light]; }
+  // Two consecutive triangles of one emissive mesh that form a parallelogram (a quad split on its
+  // diagonal): origin + u edge_u + v edge_v, u + v <= 1 being the first triangle. With the shared
+  // selection the point goes on the whole parallelogram, so the 2D strata of u cover the quad as
+  // an affine image instead of half of them warped onto each triangle.
+  struct Parallelogram {
+    size_t first = 0;  // its first triangle; the second is first + 1
+    glm::vec3 origin{0.0f}, edge_u{0.0f}, edge_v{0.0f};
+    float share_first = 0.5f;  // the first triangle's share of the pair's selection probability
+    bool rectangle = false;    // edges perpendicular: solid-angle sampling applies
+    bool one_sided = false;    // emits only toward `normal` (the triangles' face normal)
+    glm::vec3 normal{0.0f};
+    float inv_length2_u = 0.0f, inv_length2_v = 0.0f, diagonal2 = 0.0f;
+    // Each triangle's corners (its own order) by role: 0 its own corner, 1 origin + edge_u, 2 origin + edge_v.
+    uint8_t role[2][3] = {{0, 1, 2}, {0, 1, 2}};
+  };
+  // A rectangle large against its distance (squared diagonal at least kSolidAngleNearness times
+  // the squared distance to its centre): there area sampling's density, which follows cos / r^2
+  // over the light, varies most; elsewhere it is nearly constant and area sampling is as good.
+  // A point behind a one-sided rectangle gets nothing from it whichever way it is sampled.
+  static bool near_enough_for_solid_angle(const Parallelogram& q, glm::vec3 from) {
+    if (q.one_sided && !(glm::dot(from - q.origin, q.normal) > 0.0f)) return false;
+    const glm::vec3 to_center = q.origin + 0.5f * (q.edge_u + q.edge_v) - from;
+    return q.diagonal2 >= kSolidAngleNearness * glm::dot(to_center, to_center);
+  }
+  const Parallelogram& parallelogram(size_t index) const { return parallelograms_[index]; }
 
   // Category selection probabilities and the power estimates they come from.
   float triangles_probability() const { return p_triangles_; }
@@ -105,19 +134,15 @@ class LightSampler {
   bool sample_environment(glm::vec3 position, glm::vec2 u, LightSample* out) const;
   bool sample_punctual(glm::vec3 position, float u_select, LightSample* out) const;
 
-  // Two consecutive triangles of one emissive mesh that form a parallelogram (a quad split on its
-  // diagonal): origin + u edge_u + v edge_v, u + v <= 1 being the first triangle. With the shared
-  // selection the point goes on the whole parallelogram, so the 2D strata of u cover the quad as
-  // an affine image instead of half of them warped onto each triangle.
-  struct Parallelogram {
-    size_t first = 0;  // its first triangle; the second is first + 1
-    glm::vec3 origin{0.0f}, edge_u{0.0f}, edge_v{0.0f};
-    float share_first = 0.5f;  // the first triangle's share of the pair's selection probability
-  };
+  // Whether points of rectangle q seen from `from` are drawn uniformly in solid angle (a rectangle
+  // that is large against its distance and not seen edge-on) rather than uniformly in area; sr is
+  // then set up. Sampling and pdf_triangle() ask the same question, so they agree.
+  bool solid_angle_sampling(const Parallelogram& q, glm::vec3 from, SphericalRectangle* sr) const {
+    return q.rectangle && near_enough_for_solid_angle(q, from) && sr->init(from, q.origin, q.edge_u, q.edge_v);
+  }
+  // The triangle of pair q holding its point origin + uv.x edge_u + uv.y edge_v, and its barycentrics there.
+  size_t pair_triangle(const Parallelogram& q, glm::vec2 uv, glm::vec2* barycentrics) const;
   void find_parallelograms(size_t first, size_t end);
-  // The point of the parallelogram holding triangle `light` for (u_pair, v); returns the triangle
-  // it falls in and its barycentrics there.
-  size_t parallelogram_point(size_t light, float u_pair, float v, glm::vec3* point, glm::vec2* barycentrics) const;
 
   const Scene& scene_;
   std::vector<EmissiveTriangle> triangles_;

@@ -15,7 +15,7 @@
 namespace pxf {
 namespace {
 
-constexpr double kAlpha = 0.01 / 8;  // Bonferroni over the eight chi-square tests here
+constexpr double kAlpha = 0.01 / 11;  // Bonferroni over the eleven chi-square tests here
 
 Scene three_emitters() {
   Scene scene;
@@ -75,6 +75,31 @@ std::vector<double> expected_triangle_pmfs(const Scene& scene, const LightSample
   return pmf;
 }
 
+// Expected counts of n light samples from `from` in each emissive triangle's 4 midpoint
+// sub-triangles: the area density the sampler claims, pdf_triangle() x cos / r^2 (without the
+// category's probability), integrated over each sub-triangle on a 32 x 32 grid of equal small
+// triangles. Uniform in area it is pmf / 4 each; solid-angle sampling weights the nearer parts.
+std::vector<double> expected_sub_triangle_counts(const LightSampler& lights, glm::vec3 from, int n) {
+  const int grid = 32;
+  std::vector<double> expected(lights.emissive_triangle_count() * 4, 0.0);
+  for (size_t i = 0; i < lights.emissive_triangle_count(); ++i) {
+    const auto& t = lights.triangle(i);
+    for (int a = 0; a < grid; ++a)
+      for (int b = 0; a + b < grid; ++b)
+        for (int flip = 0; flip < 2 && a + b + flip < grid; ++flip) {
+          // Small triangle (a, b) upright or flipped; its centroid in barycentrics.
+          const glm::vec2 bary = flip ? glm::vec2(a + 2.0f / 3.0f, b + 2.0f / 3.0f) / float(grid)
+                                      : glm::vec2(a + 1.0f / 3.0f, b + 1.0f / 3.0f) / float(grid);
+          const glm::vec3 x = t.p0 + bary.x * t.e1 + bary.y * t.e2, d = x - from;
+          const double r2 = glm::dot(d, d), cosine = std::abs(glm::dot(d, t.normal)) / std::sqrt(r2);
+          const double density = lights.pdf_triangle(t.mesh, t.prim, from, x, t.normal) * cosine / r2 /
+                                 lights.triangles_probability();
+          expected[i * 4 + sub_triangle(bary)] += n * density * t.area / (grid * grid);
+        }
+  }
+  return expected;
+}
+
 TEST(Lights, EmissiveTriangleSamplingFollowsNearFieldSelectionAndIsUniform) {
   Scene scene = three_emitters();
   LightSampler lights(scene);
@@ -106,16 +131,18 @@ TEST(Lights, EmissiveTriangleSamplingFollowsNearFieldSelectionAndIsUniform) {
   EXPECT_GT(lights.triangle_selection_pmf(2, above), 0.0f);
 
   // Both ways of drawing: a separate selection number, and one 2D number whose first coordinate
-  // selects and is reused, rescaled, for the point (what the Sobol sampler uses); below the quads
-  // and above the first one.
-  for (glm::vec3 from : {below, above})
+  // selects and is reused, rescaled, for the point (what the Sobol sampler uses); below the quads,
+  // above the first one, and just under it (close enough for solid-angle sampling of the quad).
+  const glm::vec3 under(0.6f, 1.6f, 0.45f);
+  ASSERT_TRUE(LightSampler::near_enough_for_solid_angle(lights.parallelogram(0), under));
+  ASSERT_FALSE(LightSampler::near_enough_for_solid_angle(lights.parallelogram(0), below));
+  for (glm::vec3 from : {below, above, under})
   for (bool shared : {false, true}) {
     SCOPED_TRACE(shared ? "selection from u.x" : "separate selection number");
-    SCOPED_TRACE(from == above ? "above the first quad" : "below the quads");
+    SCOPED_TRACE(from == above ? "above the first quad" : from == under ? "under the first quad" : "below the quads");
     const int n = 200000;
-    std::vector<double> observed(count * 4, 0.0), expected(count * 4, 0.0);
-    for (size_t i = 0; i < count; ++i)
-      for (int s = 0; s < 4; ++s) expected[i * 4 + s] = n * lights.triangle_selection_pmf(i, from) / 4.0;
+    std::vector<double> observed(count * 4, 0.0);
+    const std::vector<double> expected = expected_sub_triangle_counts(lights, from, n);
     Rng rng(shared ? 10 : 9, 0, 0);
     int pdf_mismatches = 0;
     for (int k = 0; k < n; ++k) {
@@ -141,6 +168,40 @@ TEST(Lights, EmissiveTriangleSamplingFollowsNearFieldSelectionAndIsUniform) {
     EXPECT_TRUE(r.problem.empty()) << r.problem;
     EXPECT_GT(r.p_value, kAlpha) << "chi2 " << r.statistic << " dof " << r.dof;
   }
+}
+
+TEST(Lights, SphericalRectangleSolidAngle) {
+  // On the axis of a 2 x 1 rectangle at distance 0.7: 4 asin(ab / sqrt((a^2 + d^2)(b^2 + d^2))).
+  SphericalRectangle sr;
+  ASSERT_TRUE(sr.init(glm::vec3(0.0f), glm::vec3(-1.0f, -0.5f, 0.7f), glm::vec3(2, 0, 0), glm::vec3(0, 1, 0)));
+  const double a = 1.0, b = 0.5, d = 0.7;
+  EXPECT_NEAR(sr.solid_angle(), 4.0 * std::asin(a * b / std::sqrt((a * a + d * d) * (b * b + d * d))), 1e-5);
+  // Off the axis, seen from behind its normal, edges in either order: the integral of cos / r^2.
+  const glm::vec3 corner(0.3f, -0.2f, -1.0f), ex(1.5f, 0.0f, 0.0f), ey(0.0f, 0.8f, 0.0f);
+  double integral = 0.0;
+  const int steps = 400;
+  for (int i = 0; i < steps; ++i)
+    for (int j = 0; j < steps; ++j) {
+      const glm::dvec3 x = glm::dvec3(corner) + (i + 0.5) / steps * glm::dvec3(ex) + (j + 0.5) / steps * glm::dvec3(ey);
+      const double r2 = glm::dot(x, x);
+      integral += std::abs(x.z) / std::sqrt(r2) / r2 * (1.5 * 0.8) / (steps * steps);
+    }
+  ASSERT_TRUE(sr.init(glm::vec3(0.0f), corner, ex, ey));
+  EXPECT_NEAR(sr.solid_angle(), integral, 1e-5 * integral);
+  ASSERT_TRUE(sr.init(glm::vec3(0.0f), corner + ex, ey, -ex));
+  EXPECT_NEAR(sr.solid_angle(), integral, 1e-5 * integral);
+  // Its samples lie on the rectangle.
+  ASSERT_TRUE(sr.init(glm::vec3(0.0f), corner, ex, ey));
+  for (glm::vec2 u : {glm::vec2(0.0f), glm::vec2(0.5f), glm::vec2(0.99f, 0.01f), glm::vec2(0x1.fffffep-1f)}) {
+    const glm::vec3 p = sr.sample(u) - corner;
+    EXPECT_NEAR(p.z, 0.0f, 1e-5f);
+    EXPECT_GE(p.x, -1e-5f);
+    EXPECT_LE(p.x, 1.5f + 1e-5f);
+    EXPECT_GE(p.y, -1e-5f);
+    EXPECT_LE(p.y, 0.8f + 1e-5f);
+  }
+  // Edge-on (the viewpoint in its plane): nothing to sample this way.
+  EXPECT_FALSE(sr.init(glm::vec3(0.0f, 0.0f, -1.0f), corner, ex, ey));
 }
 
 TEST(Lights, SharedSelectionKeepsStrataOnAQuadEmitter) {

@@ -64,6 +64,66 @@ inline glm::vec2 sample_triangle_barycentrics(glm::vec2 u) {
   return glm::vec2(1.0f - s, u.y * s);
 }
 
+// Uniform sampling of the solid angle a rectangle subtends from a point (Ureña, Fajardo and King
+// 2013, "An Area-Preserving Parametrization for Spherical Rectangles", as in pbrt-v4): for a light
+// that is large or near, area sampling's density varies with cos / r^2 over it and solid-angle
+// sampling removes that variance. The map from [0,1)^2 is continuous, so strata stay strata.
+class SphericalRectangle {
+ public:
+  // Corner, perpendicular edges, the viewing point. False when the rectangle is degenerate or has
+  // (nearly) no solid angle from `from` (edge-on); then there is nothing to sample this way.
+  bool init(glm::vec3 from, glm::vec3 corner, glm::vec3 edge_x, glm::vec3 edge_y) {
+    const float lx = glm::length(edge_x), ly = glm::length(edge_y);
+    if (!(lx > 0.0f) || !(ly > 0.0f)) return false;
+    from_ = from;
+    x_ = edge_x / lx;
+    y_ = edge_y / ly;
+    z_ = glm::cross(x_, y_);
+    const glm::vec3 d = corner - from;
+    z0_ = glm::dot(d, z_);
+    if (z0_ > 0.0f) z_ = -z_, z0_ = -z0_;  // z points away from the rectangle
+    x0_ = glm::dot(d, x_);
+    y0_ = glm::dot(d, y_);
+    x1_ = x0_ + lx;
+    y1_ = y0_ + ly;
+    // The normals of the planes through `from` and each edge, in the rectangle's frame, written
+    // out: n0 = (0, z0, -y0) / a0, n1 = (-z0, 0, x1) / a1, n2 = (0, -z0, y1) / a2, n3 = (z0, 0, -x0) / a3.
+    const float z2 = z0_ * z0_;
+    const float a0 = std::sqrt(z2 + y0_ * y0_), a1 = std::sqrt(z2 + x1_ * x1_);
+    const float a2 = std::sqrt(z2 + y1_ * y1_), a3 = std::sqrt(z2 + x0_ * x0_);
+    // The interior angles g_i = angle(-n_i, n_(i+1)) of the spherical rectangle.
+    auto angle = [](float cosine) { return std::acos(std::clamp(cosine, -1.0f, 1.0f)); };
+    const float g0 = angle(y0_ * x1_ / (a0 * a1)), g1 = angle(-x1_ * y1_ / (a1 * a2));
+    const float g2 = angle(y1_ * x0_ / (a2 * a3)), g3 = angle(-x0_ * y0_ / (a3 * a0));
+    const double solid_angle = double(g0) + double(g1) + double(g2) + double(g3) - 2.0 * 3.14159265358979323846;
+    b0_ = -y0_ / a0;
+    b1_ = y1_ / a2;
+    k_ = static_cast<float>(2.0 * 3.14159265358979323846 - double(g2) - double(g3));
+    solid_angle_ = static_cast<float>(solid_angle);
+    return solid_angle > 1e-3 && std::isfinite(solid_angle) && std::isfinite(b0_) && std::isfinite(b1_);
+  }
+  float solid_angle() const { return solid_angle_; }
+  // The point on the rectangle for u; density 1 / solid_angle() in solid angle at `from`.
+  glm::vec3 sample(glm::vec2 u) const {
+    const float au = u.x * solid_angle_ + k_;
+    const float fu = (std::cos(au) * b0_ - b1_) / std::sin(au);
+    float cu = std::copysign(1.0f, fu) / std::sqrt(fu * fu + b0_ * b0_);
+    cu = std::clamp(std::isfinite(cu) ? cu : 0.0f, -0.99999994f, 0.99999994f);
+    const float xu = std::clamp(-(cu * z0_) / std::sqrt(1.0f - cu * cu), x0_, x1_);
+    const float d2 = xu * xu + z0_ * z0_;
+    const float h0 = y0_ / std::sqrt(d2 + y0_ * y0_), h1 = y1_ / std::sqrt(d2 + y1_ * y1_);
+    const float hv = h0 + u.y * (h1 - h0), hv2 = hv * hv;
+    const float yv = hv2 < 1.0f - 1e-6f ? std::clamp(hv * std::sqrt(d2) / std::sqrt(1.0f - hv2), y0_, y1_) : y1_;
+    return from_ + xu * x_ + yv * y_ + z0_ * z_;
+  }
+
+ private:
+  // Set by init() (left uninitialized before: it runs on every light sample near a rectangle).
+  glm::vec3 from_, x_, y_, z_;
+  float x0_, y0_, x1_, y1_, z0_;
+  float b0_, b1_, k_, solid_angle_;
+};
+
 inline float power_heuristic(float pdf_a, float pdf_b) {
   float a = pdf_a * pdf_a, b = pdf_b * pdf_b;
   return a > 0.0f ? a / (a + b) : 0.0f;
