@@ -1,5 +1,5 @@
-// Light sampling for next event estimation: emissive triangles (area sampling, power-weighted
-// triangle choice), the environment (luminance x sin(theta) importance sampling on the equirect
+// Light sampling for next event estimation: emissive triangles (power-weighted near-field choice;
+// area sampling, or solid-angle sampling of a quad near the shading point), the environment (luminance x sin(theta) importance sampling on the equirect
 // image) and KHR punctual lights (delta lights, NEE only). One light sample per call: a category
 // (triangles / environment / punctual) is picked first, in proportion to its estimated power.
 #pragma once

@@ -1,4 +1,5 @@
-// Light sampling: emissive triangles (near-field choice, uniform on area), the environment
+// Light sampling: emissive triangles (near-field choice, uniform in area or, on a near rectangle,
+// in solid angle; quads kept stratified), the environment
 // (luminance x sin(theta)) and the light types (by power) against their pdfs by chi-square, each
 // with a separate selection number and with the selection taken from the point's u.x; punctual
 // light falloffs.
@@ -100,7 +101,7 @@ std::vector<double> expected_sub_triangle_counts(const LightSampler& lights, glm
   return expected;
 }
 
-TEST(Lights, EmissiveTriangleSamplingFollowsNearFieldSelectionAndIsUniform) {
+TEST(Lights, EmissiveTriangleSamplingFollowsNearFieldSelectionAndItsDensity) {
   Scene scene = three_emitters();
   LightSampler lights(scene);
   ASSERT_FALSE(lights.empty());
