@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Equal wall time, Sobol against independent sampling (issue 11): for each scene, ROUNDS rounds of
 # four whole jobs back to back (`pxf render --time SECONDS`: sobol/independent x unfiltered/default
-# grid filter, seed 101, 102, ... per round), each judged against the scene's reference with
+# grid filter, seed 101, 102, ... per round; which sampler goes first alternates by round), each
+# judged against the scene's reference with
 # `pxf diff` (HDR and display NRMSE). Prints every run, then per scene the medians over rounds and
 # the Sobol / independent ratios of the medians.
 # Usage: scripts/equal_time_samplers.sh REFERENCE_DIR [SECONDS] [ROUNDS] [SCENES...]
@@ -24,7 +25,11 @@ for scene in "${scenes[@]}"; do
   ref="$refs/reference_${scene}_384x216_2048spp.exr"
   [ -f "$ref" ] || { echo "missing $ref" >&2; exit 2; }
   for round in $(seq "$rounds"); do
-    for sampler in sobol independent; do
+    # Alternate which sampler goes first: on a shared machine the first jobs of a round can run
+    # at another speed than the last ones.
+    order=(sobol independent)
+    [ $((round % 2)) -eq 0 ] && order=(independent sobol)
+    for sampler in "${order[@]}"; do
       for filter in none grid; do
         out="$tmp/$scene-$round-$sampler-$filter"
         "$pxf" render --scene "$scene" --size 384x216 --time "$seconds" --sampler "$sampler" --filter "$filter" \
