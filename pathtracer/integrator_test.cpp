@@ -230,6 +230,11 @@ TEST(Integrator, NearFieldLightSelectionKeepsDirectLightExact) {
   }
   PathTracer tracer(scene);
   ASSERT_TRUE(tracer.lights().near_field_selection());
+  // The large panel is sampled in solid angle from the first two points, in area from the third.
+  const auto& large_panel = tracer.lights().parallelogram(0);
+  ASSERT_TRUE(LightSampler::near_enough_for_solid_angle(large_panel, glm::vec3(-4.0f, gap, 3.0f)));
+  ASSERT_TRUE(LightSampler::near_enough_for_solid_angle(large_panel, glm::vec3(0.5f, gap, 3.0f)));
+  ASSERT_FALSE(LightSampler::near_enough_for_solid_angle(large_panel, glm::vec3(3.2f, gap, 3.0f)));
   for (SamplerType sampler : {SamplerType::Sobol, SamplerType::Independent}) {
     TraceParams params;
     params.max_vertices = 3;

@@ -222,8 +222,7 @@ void LightSampler::find_parallelograms(size_t first, size_t end) {
     // triangle's share of the pair is its share of the area.
     q.share_first = a.area / (a.area + b.area);
     q.rectangle = std::abs(glm::dot(q.edge_u, q.edge_v)) <= 1e-5f * glm::length(q.edge_u) * glm::length(q.edge_v);
-    q.one_sided = !a.material->double_sided;
-    q.normal = a.normal;
+    q.front = front_side(t, t + 2);
     q.inv_length2_u = 1.0f / glm::dot(q.edge_u, q.edge_u);
     q.inv_length2_v = 1.0f / glm::dot(q.edge_v, q.edge_v);
     q.diagonal2 = glm::dot(q.edge_u + q.edge_v, q.edge_u + q.edge_v);
@@ -264,7 +263,7 @@ void LightSampler::build_near_field_clusters(const std::vector<float>& powers) {
     c.hi = hi;
     c.floor2 = std::max(0.01f * 0.25f * glm::dot(hi - lo, hi - lo), 1e-12f);
     c.triangles = Distribution1D(powers.data() + i, end - i);
-    c.one_sided_plane = one_sided_plane(i, end, &c.plane_normal, &c.plane_point);
+    c.front = front_side(i, end);
     for (size_t t = i; t < end; ++t) c.power += powers[t];
     if (c.triangles.valid() && std::isfinite(c.power) && std::isfinite(c.floor2)) clusters.push_back(std::move(c));
     i = end;
@@ -281,21 +280,19 @@ void LightSampler::build_near_field_clusters(const std::vector<float>& powers) {
       triangle_cluster_[t] = static_cast<int>(c);
 }
 
-// Whether triangles [first, end) lie in one plane with one facing and emit from the front only.
-bool LightSampler::one_sided_plane(size_t first, size_t end, glm::vec3* normal, glm::vec3* point) const {
+// One-sided when triangles [first, end) lie in one plane with one facing and emit from the front only.
+LightSampler::FrontSide LightSampler::front_side(size_t first, size_t end) const {
   const EmissiveTriangle& a = triangles_[first];
-  if (a.material->double_sided || !(a.area > 0.0f)) return false;
+  if (a.material->double_sided || !(a.area > 0.0f)) return FrontSide{};
   float extent = 0.0f;
   for (size_t t = first; t < end; ++t) extent = std::max({extent, glm::length(triangles_[t].e1), glm::length(triangles_[t].e2)});
   for (size_t t = first; t < end; ++t) {
     const EmissiveTriangle& e = triangles_[t];
-    if (!(e.area > 0.0f) || glm::dot(e.normal, a.normal) < 1.0f - 1e-5f) return false;
+    if (!(e.area > 0.0f) || glm::dot(e.normal, a.normal) < 1.0f - 1e-5f) return FrontSide{};
     for (glm::vec3 p : {e.p0, e.p0 + e.e1, e.p0 + e.e2})
-      if (!(std::abs(glm::dot(p - a.p0, a.normal)) <= 1e-5f * extent)) return false;
+      if (!(std::abs(glm::dot(p - a.p0, a.normal)) <= 1e-5f * extent)) return FrontSide{};
   }
-  *normal = a.normal;
-  *point = a.p0;
-  return true;
+  return FrontSide{true, a.normal, a.p0};
 }
 
 void LightSampler::cluster_probabilities(glm::vec3 from, float* out) const {
@@ -303,9 +300,8 @@ void LightSampler::cluster_probabilities(glm::vec3 from, float* out) const {
   bool lit[kMaxNearFieldClusters];
   double power = 0.0;
   for (size_t c = 0; c < clusters_.size(); ++c) {
-    const Cluster& k = clusters_[c];
-    lit[c] = !k.one_sided_plane || glm::dot(from - k.plane_point, k.plane_normal) > 0.0f;
-    if (lit[c]) power += k.power_share;
+    lit[c] = clusters_[c].front.can_light(from);
+    if (lit[c]) power += clusters_[c].power_share;
   }
   if (!(power > 0.0)) {  // behind every panel: nothing can light it, any choice will do
     for (size_t c = 0; c < clusters_.size(); ++c) lit[c] = true;

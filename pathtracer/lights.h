@@ -1,6 +1,7 @@
 // Light sampling for next event estimation: emissive triangles (power-weighted near-field choice;
-// area sampling, or solid-angle sampling of a quad near the shading point), the environment (luminance x sin(theta) importance sampling on the equirect
-// image) and KHR punctual lights (delta lights, NEE only). One light sample per call: a category
+// area sampling, or solid-angle sampling of a quad near the shading point), the environment
+// (luminance x sin(theta) importance sampling on the equirect image) and KHR punctual lights
+// (delta lights, NEE only). One light sample per call: a category
 // (triangles / environment / punctual) is picked first, in proportion to its estimated power.
 #pragma once
 #include <limits>
@@ -82,6 +83,13 @@ class LightSampler {
     int parallelogram = -1;  // index into parallelograms_ when this and a neighbour form one
   };
   const EmissiveTriangle& triangle(size_t light) const { return triangles_[light]; }
+  // The side a flat one-sided emitter (a panel, an LED strip, a quad) lights: a point behind its
+  // plane gets nothing from it, however it is sampled.
+  struct FrontSide {
+    bool one_sided = false;  // false: lights both sides (double-sided, or not flat)
+    glm::vec3 normal{0.0f}, point{0.0f};
+    bool can_light(glm::vec3 from) const { return !one_sided || glm::dot(from - point, normal) > 0.0f; }
+  };
   // Two consecutive triangles of one emissive mesh that form a parallelogram (a quad split on its
   // diagonal): origin + u edge_u + v edge_v, u + v <= 1 being the first triangle. With the shared
   // selection the point goes on the whole parallelogram, so the 2D strata of u cover the quad as
@@ -91,8 +99,7 @@ class LightSampler {
     glm::vec3 origin{0.0f}, edge_u{0.0f}, edge_v{0.0f};
     float share_first = 0.5f;  // the first triangle's share of the pair's selection probability
     bool rectangle = false;    // edges perpendicular: solid-angle sampling applies
-    bool one_sided = false;    // emits only toward `normal` (the triangles' face normal)
-    glm::vec3 normal{0.0f};
+    FrontSide front;
     float inv_length2_u = 0.0f, inv_length2_v = 0.0f, diagonal2 = 0.0f;
     // Each triangle's corners (its own order) by role: 0 its own corner, 1 origin + edge_u, 2 origin + edge_v.
     uint8_t role[2][3] = {{0, 1, 2}, {0, 1, 2}};
@@ -102,7 +109,7 @@ class LightSampler {
   // over the light, varies most; elsewhere it is nearly constant and area sampling is as good.
   // A point behind a one-sided rectangle gets nothing from it whichever way it is sampled.
   static bool near_enough_for_solid_angle(const Parallelogram& q, glm::vec3 from) {
-    if (q.one_sided && !(glm::dot(from - q.origin, q.normal) > 0.0f)) return false;
+    if (!q.front.can_light(from)) return false;
     const glm::vec3 to_center = q.origin + 0.5f * (q.edge_u + q.edge_v) - from;
     return q.diagonal2 >= kSolidAngleNearness * glm::dot(to_center, to_center);
   }
@@ -126,7 +133,7 @@ class LightSampler {
   // rescaled within the choice. pmf: the triangle's selection probability among the triangles.
   size_t pick_triangle(glm::vec3 from, float u_select, float* u_remapped, float* pmf) const;
   void build_near_field_clusters(const std::vector<float>& powers);
-  bool one_sided_plane(size_t first, size_t end, glm::vec3* normal, glm::vec3* point) const;
+  FrontSide front_side(size_t first, size_t end) const;  // of triangles [first, end)
   // p(cluster | from) of every cluster into `out` (kMaxNearFieldClusters entries).
   void cluster_probabilities(glm::vec3 from, float* out) const;
   bool triangle_sample(glm::vec3 position, size_t light, glm::vec3 point, glm::vec2 barycentrics, float area_pdf,
@@ -156,10 +163,8 @@ class LightSampler {
     float power = 0.0f;        // the sum of its triangle weights
     glm::vec3 lo{0.0f}, hi{0.0f};  // bounding box
     float floor2 = 0.0f;           // (half diagonal / 10)^2, added to the squared distance
-    // A one-sided planar mesh lights only the side its normal points to: behind that plane its
-    // probability is 0 (its light is exactly 0 there, so nothing is lost).
-    bool one_sided_plane = false;
-    glm::vec3 plane_normal{0.0f}, plane_point{0.0f};
+    // Behind a one-sided flat mesh its probability is 0 (its light is exactly 0 there).
+    FrontSide front;
   };
   std::vector<Cluster> clusters_;          // empty: selection by power alone
   std::vector<int> triangle_cluster_;      // per triangle, with clusters_

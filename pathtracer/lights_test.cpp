@@ -45,12 +45,14 @@ int sub_triangle(glm::vec2 b) {
 // mesh by power.
 std::vector<double> expected_triangle_pmfs(const Scene& scene, const LightSampler& lights, glm::vec3 from) {
   std::vector<double> mesh_power(scene.meshes.size(), 0.0), near(scene.meshes.size(), 0.0);
+  // A mesh is flat here when all its triangles share the first one's normal (the quads; not the box).
   std::vector<bool> flat(scene.meshes.size(), true), behind(scene.meshes.size(), false);
+  std::vector<glm::vec3> first_normal(scene.meshes.size(), glm::vec3(0.0f));
   for (size_t i = 0; i < lights.emissive_triangle_count(); ++i) {
     const auto& t = lights.triangle(i);
     mesh_power[t.mesh] += t.area * luminance(t.material->emissive);
-    const auto& first = lights.triangle(static_cast<size_t>(&t - &lights.triangle(0)) - t.prim);
-    flat[t.mesh] = flat[t.mesh] && glm::dot(t.normal, first.normal) > 0.9999f;
+    if (t.prim == 0) first_normal[t.mesh] = t.normal;
+    flat[t.mesh] = flat[t.mesh] && glm::dot(t.normal, first_normal[t.mesh]) > 0.9999f;
     behind[t.mesh] = glm::dot(from - t.p0, t.normal) <= 0.0f;
   }
   for (size_t m = 0; m < scene.meshes.size(); ++m)
