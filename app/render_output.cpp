@@ -14,12 +14,6 @@
 
 namespace pxf {
 
-const Image& layer_image(const std::vector<Layer>& buffers, const std::string& name) {
-  for (const Layer& l : buffers)
-    if (l.name == name) return l.image;
-  throw Error("no buffer named '" + name + "'");
-}
-
 Image unfiltered_image(const std::vector<Layer>& buffers) {
   Image sum = layer_image(buffers, "lv");
   const Image& hv = layer_image(buffers, "hv");

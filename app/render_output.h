@@ -25,7 +25,6 @@ struct RenderReport {
 
 // The unfiltered image L_lv + L_u (what plain path tracing shows), from the preview's buffers.
 Image unfiltered_image(const std::vector<Layer>& buffers);
-const Image& layer_image(const std::vector<Layer>& buffers, const std::string& name);
 
 // Reads the --reference EXR and checks that it matches the render size, so that a bad reference is
 // reported before the render rather than after it; throws pxf::Error naming the file.

@@ -95,4 +95,10 @@ float linear_from_srgb(float v) {
   return std::pow((v + 0.055f) / 1.055f, 2.4f);
 }
 
+const Image& layer_image(const std::vector<Layer>& layers, const std::string& name) {
+  for (const Layer& l : layers)
+    if (l.name == name) return l.image;
+  throw Error("no buffer named '" + name + "'");
+}
+
 }  // namespace pxf

@@ -37,6 +37,8 @@ struct Layer {
   std::string name;
   Image image;
 };
+// The layer called `name`; throws pxf::Error naming it when there is none.
+const Image& layer_image(const std::vector<Layer>& layers, const std::string& name);
 
 // Writes go to "<path>.tmp-<pid>" and are renamed, so an interrupted run never leaves a truncated file.
 void write_file_atomically(const std::string& path, const std::function<void(const std::string& tmp_path)>& write);

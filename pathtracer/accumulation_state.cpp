@@ -28,16 +28,25 @@ bool little_endian() {
   return first == 1;
 }
 
-// The per-pixel arrays of an Accumulation, in file order. A new field of Accumulation is one line
-// here: the writer, the reader and the size check all go through this list.
+// The per-pixel arrays of an Accumulation, in file order, with their elements per pixel. A new
+// field of Accumulation is one line here: the writer, the reader and the size check all go through
+// this list. The replicate sums exist only with replicates (acc.replicates > 1, K per pixel).
 template <class Acc, class Visit>
 void visit_arrays(Acc& acc, Visit&& visit) {
-  visit(acc.lv_mean);
-  visit(acc.hv_mean);
-  visit(acc.hv_lum_mean);
-  visit(acc.hv_lum_m2);
-  visit(acc.samples);
-  visit(acc.albedo_mean);
+  visit(acc.lv_mean, 1);
+  visit(acc.hv_mean, 1);
+  visit(acc.hv_lum_mean, 1);
+  visit(acc.hv_lum_m2, 1);
+  visit(acc.samples, 1);
+  visit(acc.albedo_mean, 1);
+  const size_t replicate_slots = acc.replicates > 1 ? static_cast<size_t>(acc.replicates) : 0;
+  visit(acc.replicate_lum_sum, replicate_slots);
+  visit(acc.replicate_samples, replicate_slots);
+}
+
+// The replicates a state's accumulation has sums for.
+int state_replicates(const SampleSettings& s) {
+  return accumulated_replicates(static_cast<SamplerType>(s.sampler), static_cast<int>(s.replicates));
 }
 
 class Writer {
@@ -138,6 +147,16 @@ void check_pixels(const AccumulationState& state) {
                         std::isfinite(a.z) && std::isfinite(acc.hv_lum_mean[i]) &&
                         std::isfinite(acc.hv_lum_m2[i]) && acc.hv_lum_m2[i] >= 0.0;
     if (!finite) throw Error("state file has a non-finite or negative value at pixel " + std::to_string(i));
+    if (acc.replicates < 2) continue;
+    // The replicate sums split the pixel's samples: their counts add up to its count.
+    uint64_t replicate_count = 0;
+    for (size_t k = i * static_cast<size_t>(acc.replicates); k < (i + 1) * static_cast<size_t>(acc.replicates); ++k) {
+      if (!std::isfinite(acc.replicate_lum_sum[k]))
+        throw Error("state file has a non-finite replicate sum at pixel " + std::to_string(i));
+      replicate_count += acc.replicate_samples[k];
+    }
+    if (replicate_count != acc.samples[i])
+      throw Error("state file's replicate sample counts do not add up to the samples at pixel " + std::to_string(i));
   }
 }
 
@@ -170,6 +189,11 @@ void merge_into(Accumulation& into, const Accumulation& from) {
     into.hv_lum_mean[i] += delta * nb / n;
     into.hv_lum_m2[i] += from.hv_lum_m2[i] + delta * delta * (static_cast<double>(na) * nb / n);
     into.samples[i] = na + nb;
+  }
+  // Each replicate's samples of disjoint frame ranges add up (frame k is in replicate k mod K).
+  for (size_t k = 0; k < into.replicate_samples.size(); ++k) {
+    into.replicate_lum_sum[k] += from.replicate_lum_sum[k];
+    into.replicate_samples[k] += from.replicate_samples[k];
   }
 }
 
@@ -256,7 +280,10 @@ std::vector<uint8_t> encode_state(const AccumulationState& state) {
     w.put(r.begin);
     w.put(r.end);
   }
-  visit_arrays(state.acc, [&](const auto& array) { w.put_array(array); });
+  if (state.acc.replicates != state_replicates(state.settings))
+    throw Error("cannot save a state whose accumulation has " + std::to_string(state.acc.replicates) +
+                " replicates under settings with " + std::to_string(state_replicates(state.settings)));
+  visit_arrays(state.acc, [&](const auto& array, size_t) { w.put_array(array); });
   w.put(fnv1a64(w.bytes.data(), w.bytes.size()));
   return std::move(w.bytes);
 }
@@ -291,7 +318,10 @@ AccumulationState decode_state(const uint8_t* data, size_t size) {
   const size_t pixels = static_cast<size_t>(state.settings.width) * state.settings.height;
   state.acc.width = static_cast<int>(state.settings.width);
   state.acc.height = static_cast<int>(state.settings.height);
-  visit_arrays(state.acc, [&](auto& array) { r.get_array(array, pixels, "the pixel arrays"); });
+  state.acc.replicates = state_replicates(state.settings);
+  visit_arrays(state.acc, [&](auto& array, size_t per_pixel) {
+    r.get_array(array, pixels * per_pixel, per_pixel > 1 ? "the replicate arrays" : "the pixel arrays");
+  });
   if (r.remaining() != sizeof(uint64_t)) throw Error("state file has trailing bytes");
   check_pixels(state);
   return state;

@@ -11,7 +11,7 @@
 
 namespace pxf {
 
-constexpr uint32_t kStateFormatVersion = 3;  // 2: the albedo mean; 3: sampler, replicates, specular sampling
+constexpr uint32_t kStateFormatVersion = 4;  // 2: the albedo mean; 3: sampler, replicates, specular sampling; 4: replicate sums
 
 // The frames [begin, end) of the counter-based sample sequence.
 struct FrameRange {

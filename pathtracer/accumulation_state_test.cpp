@@ -3,6 +3,7 @@
 // accumulation (Chan's combination of the Welford state).
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <random>
 
 #include "pathtracer/accumulation_state.h"
@@ -22,11 +23,15 @@ void sample_of(size_t p, uint32_t frame, glm::vec3& lv, glm::vec3& hv) {
   hv = glm::vec3(radiance(rng), radiance(rng), radiance(rng)) * (frame % 5 == 0 ? 20.0f : 1.0f);
 }
 
-AccumulationState render_frames(FrameRange range) {
+// The frames' accumulation; with replicates (Sobol), frame f goes to replicate f mod K as in the
+// renderer.
+AccumulationState render_frames(FrameRange range, int replicates = 1) {
   AccumulationState state;
-  state.settings = sample_settings(0x1234, kW, kH, TraceParams{});
+  TraceParams params;
+  params.replicates = replicates;
+  state.settings = sample_settings(0x1234, kW, kH, params);
   state.frames = {range};
-  resize_accumulation(state.acc, kW, kH);
+  resize_accumulation(state.acc, kW, kH, replicates);
   for (uint32_t f = range.begin; f < range.end; ++f)
     for (size_t p = 0; p < state.acc.samples.size(); ++p) {
       if ((p + f) % 11 == 3) continue;  // a dropped (non-finite) sample: counts differ per pixel
@@ -34,7 +39,7 @@ AccumulationState render_frames(FrameRange range) {
       sample_of(p, f, lv, hv);
       // The albedo of a textured pixel varies with the sample's position in the pixel.
       const glm::vec3 albedo(0.1f + 0.05f * static_cast<float>((p * 7 + f) % 13), 0.5f, (f % 3) * 0.4f);
-      accumulate_sample(state.acc, p, lv, hv, 0, albedo);
+      accumulate_sample(state.acc, p, lv, hv, static_cast<int>(f % static_cast<uint32_t>(replicates)), albedo);
     }
   return state;
 }
@@ -78,31 +83,35 @@ TEST(AccumulationState, RoundTripIsExact) {
 }
 
 TEST(AccumulationState, EveryTruncationIsRefused) {
-  const std::vector<uint8_t> bytes = encode_state(render_frames({0, 3}));
-  for (size_t size = 0; size < bytes.size(); ++size) {
-    const std::vector<uint8_t> cut(bytes.begin(), bytes.begin() + size);
-    const std::string error = decode_error(cut);
-    EXPECT_FALSE(error.empty()) << "a state cut to " << size << " bytes was accepted";
-    EXPECT_EQ(error.find('\n'), std::string::npos);
+  for (const int replicates : {1, 3}) {
+    const std::vector<uint8_t> bytes = encode_state(render_frames({0, 3}, replicates));
+    for (size_t size = 0; size < bytes.size(); ++size) {
+      const std::vector<uint8_t> cut(bytes.begin(), bytes.begin() + size);
+      const std::string error = decode_error(cut);
+      EXPECT_FALSE(error.empty()) << "a state cut to " << size << " bytes was accepted";
+      EXPECT_EQ(error.find('\n'), std::string::npos);
+    }
+    std::vector<uint8_t> longer = bytes;
+    longer.push_back(0);
+    EXPECT_FALSE(decode_error(longer).empty());
   }
-  std::vector<uint8_t> longer = bytes;
-  longer.push_back(0);
-  EXPECT_FALSE(decode_error(longer).empty());
 }
 
 TEST(AccumulationState, EveryCorruptedByteIsRefused) {
-  const std::vector<uint8_t> bytes = encode_state(render_frames({0, 3}));
-  for (size_t i = 0; i < bytes.size(); ++i) {
-    std::vector<uint8_t> bad = bytes;
-    bad[i] ^= 0x5a;
-    EXPECT_FALSE(decode_error(bad).empty()) << "byte " << i;
+  for (const int replicates : {1, 3}) {
+    const std::vector<uint8_t> bytes = encode_state(render_frames({0, 3}, replicates));
+    for (size_t i = 0; i < bytes.size(); ++i) {
+      std::vector<uint8_t> bad = bytes;
+      bad[i] ^= 0x5a;
+      EXPECT_FALSE(decode_error(bad).empty()) << "byte " << i << ", " << replicates << " replicates";
+    }
   }
 }
 
 TEST(AccumulationState, OtherVersionIsRefusedByName) {
   std::vector<uint8_t> bytes = encode_state(render_frames({0, 2}));
-  bytes[8] = 2;  // the version follows the 8-byte magic; version 2 (no sampler settings) is refused
-  EXPECT_NE(decode_error(bytes).find("version 2 is not supported"), std::string::npos) << decode_error(bytes);
+  bytes[8] = 3;  // the version follows the 8-byte magic; version 3 (no replicate sums) is refused
+  EXPECT_NE(decode_error(bytes).find("version 3 is not supported"), std::string::npos) << decode_error(bytes);
   bytes[0] = 'Q';
   EXPECT_NE(decode_error(bytes).find("not a pxf state file"), std::string::npos);
 }
@@ -196,4 +205,57 @@ TEST(AccumulationState, NonContiguousRangesStaySeparate) {
   const AccumulationState merged = merge_states({render_frames({8, 10}), render_frames({0, 4})});
   EXPECT_EQ(frame_ranges_text(merged.frames), "0:4,8:10");
   EXPECT_EQ(merged.frame_count(), 6u);
+}
+
+// With replicates the per-replicate sums are part of the state: a resumed or merged accumulation
+// estimates Var[L_u] from the same replicate means as one uninterrupted render (before format 4,
+// they were dropped and resumed renders of --replicates K > 1 had other variances and images).
+TEST(AccumulationState, ReplicateSumsRoundTripAndMerge) {
+  constexpr int kReplicates = 4;
+  const AccumulationState whole = render_frames({0, 40}, kReplicates);
+  ASSERT_EQ(whole.acc.replicate_samples.size(), static_cast<size_t>(kW * kH * kReplicates));
+  const std::vector<uint8_t> bytes = encode_state(whole);
+  EXPECT_EQ(bytes.size(), encode_state(render_frames({0, 40})).size() + kW * kH * kReplicates * (8 + 4));
+  const AccumulationState back = decode_state(bytes.data(), bytes.size());
+  EXPECT_EQ(back.acc.replicates, kReplicates);
+  EXPECT_EQ(back.acc.replicate_lum_sum, whole.acc.replicate_lum_sum);
+  EXPECT_EQ(back.acc.replicate_samples, whole.acc.replicate_samples);
+  EXPECT_EQ(back.acc.variance_of_mean_image(), whole.acc.variance_of_mean_image());
+
+  // Shards that cut replicates mid-cycle merge into the whole render's replicate sums.
+  const AccumulationState merged = merge_states({render_frames({27, 40}, kReplicates), render_frames({0, 9}, kReplicates),
+                                                 render_frames({9, 27}, kReplicates)});
+  expect_same_accumulation(merged.acc, whole.acc);
+  EXPECT_EQ(merged.acc.replicate_samples, whole.acc.replicate_samples);
+  const std::vector<float> merged_var = merged.acc.variance_of_mean_image(), whole_var = whole.acc.variance_of_mean_image();
+  for (size_t p = 0; p < whole_var.size(); ++p) {
+    EXPECT_GT(whole.acc.replicate_variance_of_mean(p), 0.0f);
+    EXPECT_NEAR(merged.acc.replicate_variance_of_mean(p), whole.acc.replicate_variance_of_mean(p),
+                1e-5f * whole.acc.replicate_variance_of_mean(p)) << p;
+    EXPECT_NEAR(merged_var[p], whole_var[p], 1e-5f * whole_var[p]) << p;
+  }
+
+  // The independent sampler keeps no replicate sums, whatever --replicates says.
+  TraceParams independent;
+  independent.sampler = SamplerType::Independent;
+  independent.replicates = kReplicates;
+  AccumulationState plain = render_frames({0, 4});
+  plain.settings = sample_settings(0x1234, kW, kH, independent);
+  EXPECT_EQ(decode_state(encode_state(plain).data(), encode_state(plain).size()).acc.replicates, 1);
+  // A state whose arrays do not match its settings is not written.
+  AccumulationState mismatched = render_frames({0, 4});
+  mismatched.settings.replicates = kReplicates;
+  EXPECT_THROW(encode_state(mismatched), Error);
+}
+
+TEST(AccumulationState, ReplicateCountsThatDoNotAddUpAreRefused) {
+  AccumulationState state = render_frames({0, 8}, 2);
+  state.acc.replicate_samples[3] += 1;  // pixel 1 now claims one more replicate sample than samples
+  const std::vector<uint8_t> bytes = encode_state(state);
+  EXPECT_NE(decode_error(bytes).find("replicate sample counts do not add up to the samples at pixel 1"),
+            std::string::npos) << decode_error(bytes);
+  state = render_frames({0, 8}, 2);
+  state.acc.replicate_lum_sum[0] = std::numeric_limits<double>::infinity();
+  const std::vector<uint8_t> inf_bytes = encode_state(state);
+  EXPECT_NE(decode_error(inf_bytes).find("non-finite replicate sum at pixel 0"), std::string::npos);
 }

@@ -1,6 +1,7 @@
 // Public API of the path tracer (docs/method.md section 1.1): a progressive state with make/step/get functions in the
 // style of yocto_trace. No GL here; the GL passes read these buffers and upload them.
 #pragma once
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <memory>
@@ -33,6 +34,12 @@ struct TraceParams {
   // (docs/sampling.md#fireflies). Off by default.
   bool specular_sampling = false;
 };
+
+// The replicates an accumulation keeps sums for: only the Sobol sampler has any (independent
+// samples are their own replicates). The renderer and the state files both go by this.
+inline int accumulated_replicates(SamplerType sampler, int replicates) {
+  return sampler == SamplerType::Sobol ? std::max(replicates, 1) : 1;
+}
 
 // What a scene may demand. The loader counts the instanced triangles (every mesh once per node
 // that references it) and reads the used images' headers before it reads any geometry or decodes

@@ -37,8 +37,7 @@ struct ProgressiveRenderer::Impl {
     make_arena();
   }
 
-  // The replicates only mean something for the Sobol sampler; independent samples are their own.
-  int accumulation_replicates() const { return params.sampler == SamplerType::Sobol ? params.replicates : 1; }
+  int accumulation_replicates() const { return accumulated_replicates(params.sampler, params.replicates); }
 
   void make_arena() {
     int threads = params.threads > 0 ? params.threads : static_cast<int>(tbb::task_arena::automatic);
@@ -139,6 +138,9 @@ void ProgressiveRenderer::restore(const Accumulation& acc, uint32_t first, int f
   if (acc.width != impl_->width || acc.height != impl_->height || acc.samples.size() != impl_->acc.samples.size())
     throw Error("saved accumulation is " + std::to_string(acc.width) + "x" + std::to_string(acc.height) +
                 ", the render " + std::to_string(impl_->width) + "x" + std::to_string(impl_->height));
+  if (acc.replicates != impl_->accumulation_replicates())
+    throw Error("saved accumulation has " + std::to_string(acc.replicates) + " replicates, the render " +
+                std::to_string(impl_->accumulation_replicates()));
   impl_->acc = acc;
   impl_->first_frame = first;
   impl_->frames = frames;

@@ -144,15 +144,40 @@ TEST(Checkpoint, MergeOfUnevenShardsEqualsOneRender) {
     const Result r = pxf_run("merge" + states + " --scene cornell --out " + merged_dir);
     ASSERT_EQ(r.code, 0) << r.err;
     const std::vector<Layer> merged = read_exr_layers(merged_dir + "/buffers.exr");
-    for (const char* layer : {"lv", "hv", "var_u", "samples", "final"}) {
-      const auto find = [&](const std::vector<Layer>& layers) -> const Image& {
-        for (const Layer& l : layers)
-          if (l.name == layer) return l.image;
-        throw Error(std::string("no layer ") + layer);
-      };
-      expect_merge_close(find(merged), find(single), layer);
-    }
+    for (const char* layer : {"lv", "hv", "var_u", "samples", "final"})
+      expect_merge_close(layer_image(merged, layer), layer_image(single, layer), layer);
   }
+}
+
+// With --replicates K > 1 (Var[L_u] from independently scrambled Sobol replicates) the state
+// carries the per-replicate sums: a resumed render is bit-identical and a merge of shards that cut
+// the replicate cycle equals one render, variance and blended image included.
+TEST(Checkpoint, ResumeAndMergeKeepTheReplicateVariance) {
+  const std::string scene = kScene + " --replicates 4";
+  const std::string ref = temp_dir("replicates_single");
+  ASSERT_EQ(pxf_run("render " + scene + " --spp " + std::to_string(kSpp) + " --out " + ref).code, 0);
+  const std::vector<Layer> single = read_exr_layers(ref + "/buffers.exr");
+
+  const std::string part = temp_dir("replicates_part");
+  ASSERT_EQ(pxf_run("render " + scene + " --spp 9 --checkpoint 100 --out " + part).code, 0);
+  const Result resumed = pxf_run("render " + scene + " --spp " + std::to_string(kSpp) + " --resume " + part +
+                                 "/state.pxfs --out " + part);
+  ASSERT_EQ(resumed.code, 0) << resumed.err;
+  EXPECT_TRUE(same_pixels(read_exr_layers(part + "/buffers.exr"), single));
+
+  std::string states;
+  for (const char* frames : {"0:9", "9:14", "14:24"}) {
+    const std::string dir = temp_dir(std::string("replicates_shard_") + frames);
+    const Result r = pxf_run("render " + scene + " --frames " + frames + " --out " + dir);
+    ASSERT_EQ(r.code, 0) << r.err;
+    states += " " + dir + "/state.pxfs";
+  }
+  const std::string merged_dir = temp_dir("replicates_merged");
+  const Result r = pxf_run("merge" + states + " --scene cornell --out " + merged_dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::vector<Layer> merged = read_exr_layers(merged_dir + "/buffers.exr");
+  for (const char* layer : {"var_u", "final"})
+    expect_merge_close(layer_image(merged, layer), layer_image(single, layer), layer);
 }
 
 TEST(Checkpoint, ForeignOverlappingAndCorruptStatesAreRefused) {

@@ -283,12 +283,6 @@ class Cluster {
 
 using test_support::expect_merge_close;
 
-const Image& layer(const std::vector<Layer>& layers, const std::string& name) {
-  for (const Layer& l : layers)
-    if (l.name == name) return l.image;
-  throw Error("no layer " + name);
-}
-
 }  // namespace
 
 TEST(Slurm, ShardArrayAndDependentMergeEqualOneRender) {
@@ -337,7 +331,7 @@ TEST(Slurm, ShardArrayAndDependentMergeEqualOneRender) {
   const std::vector<Layer> merged = read_exr_layers(out + "/merged/buffers.exr");
   const std::vector<Layer> reference = read_exr_layers(ref + "/buffers.exr");
   for (const char* name : {"lv", "hv", "var_u", "samples", "final"})
-    expect_merge_close(layer(merged, name), layer(reference, name), std::string("buffers.exr ") + name);
+    expect_merge_close(layer_image(merged, name), layer_image(reference, name), std::string("buffers.exr ") + name);
   expect_merge_close(read_exr(out + "/merged/final.exr"), read_exr(ref + "/final.exr"), "final.exr");
   std::printf("[ slurm    ] jobs done in %.1f s\n", std::chrono::duration<double>(Clock::now() - started).count());
 }
