@@ -202,6 +202,30 @@ TEST(BlendFactorShader, MatchesCpuOnGridAndBoundaries) {
   }
 }
 
+// The kernel sums every filter variant shares (shaders/pass_formulas.h), against the formulas
+// written out: L_f = sum w L / sum w; Var[L_f] = (sum_known w^2 v + sum_unknown w^2 * vbar) / (sum w)^2
+// with vbar = sum_known w v / sum_known w.
+TEST(KernelSums, MeanAndVarianceWithUnknownNeighbours) {
+  shared::KernelSums s = shared::kernel_sums_zero();
+  shared::kernel_sums_add(s, 1.0, glm::vec3(1.0f, 2.0f, 3.0f), 0.04f);
+  shared::kernel_sums_add(s, 0.5, glm::vec3(3.0f, 0.0f, 1.0f), 0.16f);
+  shared::kernel_sums_add(s, 0.25, glm::vec3(5.0f, 4.0f, 0.0f), kVarUnknown);  // n < 2
+  shared::kernel_sums_add(s, 0.25, glm::vec3(1.0f, 0.0f, 0.0f), 0.0f);         // all samples equal
+  const double sw = 2.0;
+  const glm::vec3 mean = shared::kernel_sums_mean(s);
+  EXPECT_FLOAT_EQ(mean.r, float((1.0 + 1.5 + 1.25 + 0.25) / sw));
+  EXPECT_FLOAT_EQ(mean.g, float((2.0 + 0.0 + 1.0 + 0.0) / sw));
+  EXPECT_FLOAT_EQ(mean.b, float((3.0 + 0.5 + 0.0 + 0.0) / sw));
+  const double vbar = (1.0 * 0.04 + 0.5 * 0.16) / 1.5;
+  const double var = (1.0 * 0.04 + 0.25 * 0.16 + 2 * 0.0625 * vbar) / (sw * sw);
+  EXPECT_NEAR(shared::kernel_sums_variance(s, 1.0f), var, 1e-8);
+  EXPECT_NEAR(shared::kernel_sums_variance(s, 3.0f), 3.0 * var, 3e-8);
+  // No known variance at all: unknown.
+  shared::KernelSums unknown = shared::kernel_sums_zero();
+  shared::kernel_sums_add(unknown, 1.0, glm::vec3(1.0f), 0.0f);
+  EXPECT_EQ(shared::kernel_sums_variance(unknown, 1.0f), kVarUnknown);
+}
+
 // 5x3: range color 0.5 for x <= 2, 0.1 for x >= 3 (an edge), equal depth.
 struct PoolingScene {
   Image range = Image::rgb(5, 3), depth = Image::gray(5, 3, "Y", 2.0f), var = Image::gray(5, 3);

@@ -42,31 +42,19 @@ double range_exponent(const Image& range_color, const Image& depth, int px, int 
   return shared::range_exponent(texelFetch(guide, {px, py}, 0), texelFetch(guide, {qx, qy}, 0), range.k_c, range.k_d);
 }
 
-// One pixel's kernel sums: L_f = sum w L / sum w, Var[L_f] = sum w^2 Var / (sum w)^2. Neighbours
-// of unknown variance (n < 2, or 0: all samples equal, no evidence) count with the kernel-weighted
-// mean of the known ones.
+// One pixel's kernel sums (shared::KernelSums, in double here), accumulated from images.
 struct KernelSums {
-  double w = 0, wl[3] = {0, 0, 0};
-  double w2_var_known = 0, w2_unknown = 0, w_known = 0, w_var_known = 0;
+  shared::KernelSums sums = shared::kernel_sums_zero();
 
-  void add(double wq, const Px& l, float var) {
-    w += wq;
-    for (int c = 0; c < 3; ++c) wl[c] += wq * l.c[c];
-    if (var > 0.0f) {
-      w2_var_known += wq * wq * var;
-      w_known += wq;
-      w_var_known += wq * var;
-    } else {
-      w2_unknown += wq * wq;
-    }
+  void add(double w, const Image& signal, const Image& signal_var, int qx, int qy) {
+    const Px l = rgb_at(signal, qx, qy);
+    shared::kernel_sums_add(sums, w, glm::vec3(l.c[0], l.c[1], l.c[2]), clean_var(signal_var.at(qx, qy, 0)));
   }
-  // w > 0: the center tap always has range weight 1.
   void write(FilterOutput& out, int x, int y, float variance_factor = 1.0f) const {
-    for (int c = 0; c < 3; ++c) out.filtered.at(x, y, c) = static_cast<float>(wl[c] / w);
-    out.variance.at(x, y, 0) =
-        w_known > 0 ? static_cast<float>(variance_factor * (w2_var_known + w2_unknown * (w_var_known / w_known)) / (w * w))
-                    : kVarUnknown;
-    if (!out.centre_weight.pixels.empty()) out.centre_weight.at(x, y, 0) = static_cast<float>(1.0 / w);
+    const glm::vec3 mean = shared::kernel_sums_mean(sums);
+    for (int c = 0; c < 3; ++c) out.filtered.at(x, y, c) = mean[c];
+    out.variance.at(x, y, 0) = shared::kernel_sums_variance(sums, variance_factor);
+    if (!out.centre_weight.pixels.empty()) out.centre_weight.at(x, y, 0) = static_cast<float>(1.0 / sums.w);
   }
 };
 
@@ -126,7 +114,7 @@ FilterOutput filter_once(const Image& signal, const Image& signal_var, const Ima
         for (int qx = std::max(0, x - radius * ex); qx <= std::min(w - 1, x + radius * ex); ++qx) {
           double e = double((qx - x) * (qx - x) + (qy - y) * (qy - y)) * ks +
                      range_exponent(range_color, depth, x, y, qx, qy, range);
-          sums.add(std::exp(-e), rgb_at(signal, qx, qy), clean_var(signal_var.at(qx, qy, 0)));
+          sums.add(std::exp(-e), signal, signal_var, qx, qy);
         }
       sums.write(out, x, y);
     }
@@ -153,7 +141,7 @@ FilterOutput atrous_pass(const Image& signal, const Image& signal_var, const Ima
           const int qx = x + (i - 2) * step, qy = y + (j - 2) * step;
           if (qx < 0 || qx >= w || qy < 0 || qy >= h) continue;
           const double range_weight = std::exp(-range_exponent(range_color, depth, x, y, qx, qy, range));
-          sums.add(double(shared::kB3[i]) * shared::kB3[j] * range_weight, rgb_at(signal, qx, qy), clean_var(signal_var.at(qx, qy, 0)));
+          sums.add(double(shared::kB3[i]) * shared::kB3[j] * range_weight, signal, signal_var, qx, qy);
         }
       sums.write(out, x, y, variance_factor);  // sum w >= h(0,0) = 0.14: the center tap has range weight 1
     }
@@ -194,7 +182,7 @@ FilterOutput cpu_subsampled(const Image& hv, const Image& var_u, const Image& lv
         const int qx = x + taps[i].dx, qy = y + taps[i].dy;
         if (qx < 0 || qx >= w || qy < 0 || qy >= h) continue;
         const double weight = taps[i].count * std::exp(-range_exponent(range_color, depth, x, y, qx, qy, range));
-        sums.add(weight, rgb_at(hv, qx, qy), clean_var(var_u.at(qx, qy, 0)));
+        sums.add(weight, hv, var_u, qx, qy);
       }
       sums.write(out, x, y);  // sum w >= 1: the centre tap is in every rotation
     }

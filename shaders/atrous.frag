@@ -32,8 +32,7 @@ void main() {
   }
   if (final_pass != 0) atomicAdd(filtered_pixels, 1u);
   vec4 g_p = texelFetch(guide_tex, p, 0);
-  float sw = 0.0, sw2v = 0.0, sw2u = 0.0, swk = 0.0, swv = 0.0;
-  vec3 swl = vec3(0.0);
+  KernelSums sums = kernel_sums_zero();
   for (int j = 0; j < 5; ++j) {
     int qy = p.y + (j - 2) * step_px;
     if (qy < 0 || qy >= size.y) continue;
@@ -43,20 +42,9 @@ void main() {
       ivec2 q = ivec2(qx, qy);
       float w = kB3[i] * kB3[j] * range_weight(g_p, texelFetch(guide_tex, q, 0), k_c, k_d);
       vec4 s_q = texelFetch(signal_tex, q, 0);
-      float v_q = clean_var(s_q.a);
-      sw += w;
-      swl += w * clean(s_q.rgb);
-      if (v_q > 0.0) {  // unknown (n < 2) or 0 (all samples equal): no evidence
-        sw2v += w * w * v_q;
-        swk += w;
-        swv += w * v_q;
-      } else {
-        sw2u += w * w;
-      }
+      kernel_sums_add(sums, w, clean(s_q.rgb), clean_var(s_q.a));
     }
   }
-  // sw >= h(0,0) = 0.14 (the center's range weight is 1). Unknown neighbour variances count with
-  // the kernel-weighted mean of the known ones.
-  float var_f = swk > 0.0 ? variance_correction * (sw2v + sw2u * (swv / swk)) / (sw * sw) : kVarUnknown;
-  out_filtered = vec4(swl / sw, var_f);
+  // sums.w >= h(0,0) = 0.14: the center's range weight is 1.
+  out_filtered = vec4(kernel_sums_mean(sums), kernel_sums_variance(sums, variance_correction));
 }

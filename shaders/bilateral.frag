@@ -34,36 +34,18 @@ void main() {
   }
   if (final_pass != 0) atomicAdd(filtered_pixels, 1u);
   vec4 g_p = texelFetch(guide_tex, p, 0);
-  vec3 r_p = clean(g_p.rgb);
-  float d_p = clean(g_p.a);
-  float sw = 0.0, sw2v = 0.0, sw2u = 0.0, swk = 0.0, swv = 0.0;
-  vec3 swl = vec3(0.0);
+  KernelSums sums = kernel_sums_zero();
   ivec2 lo = max(p - radius * extent, ivec2(0)), hi = min(p + radius * extent, size - 1);
   for (int qy = lo.y; qy <= hi.y; ++qy) {
     float dy2 = float((qy - p.y) * (qy - p.y));
     for (int qx = lo.x; qx <= hi.x; ++qx) {
       ivec2 q = ivec2(qx, qy);
-      vec4 g_q = texelFetch(guide_tex, q, 0);
-      vec3 dr = r_p - clean(g_q.rgb);
-      float dd = d_p - clean(g_q.a);
-      float e = (float((qx - p.x) * (qx - p.x)) + dy2) * k_s + dot(dr, dr) * k_c + dd * dd * k_d;
-      float w = exp(-e);
+      float e = (float((qx - p.x) * (qx - p.x)) + dy2) * k_s + range_exponent(g_p, texelFetch(guide_tex, q, 0), k_c, k_d);
       vec4 hv_q = texelFetch(signal_tex, q, 0);
-      float v_q = clean_var(hv_q.a);
-      sw += w;
-      swl += w * clean(hv_q.rgb);
-      if (v_q > 0.0) {
-        sw2v += w * w * v_q;
-        swk += w;
-        swv += w * v_q;
-      } else {
-        sw2u += w * w;
-      }
+      kernel_sums_add(sums, exp(-e), clean(hv_q.rgb), clean_var(hv_q.a));
     }
   }
-  // sw >= 1 (the center's weight is exp(0)). Unknown neighbour variances (n < 2, or 0 because all
-  // samples were equal) count with the kernel-weighted mean of the known ones.
-  float var_f = swk > 0.0 ? (sw2v + sw2u * (swv / swk)) / (sw * sw) : kVarUnknown;
-  out_filtered = vec4(swl / sw, var_f);
-  out_centre_weight = 1.0 / sw;
+  // sums.w >= 1: the center's weight is exp(0).
+  out_filtered = vec4(kernel_sums_mean(sums), kernel_sums_variance(sums, 1.0));
+  out_centre_weight = 1.0 / sums.w;
 }

@@ -10,6 +10,7 @@
 //   PXF_CONST         a compile-time constant (const / constexpr)
 //   PXF_INLINE        a function (nothing / inline)
 //   PXF_OUT(T)        an out parameter (out T / T&)
+//   PXF_INOUT(T)      an in-out parameter (inout T / T&)
 //   PXF_SAMPLER_FN    a function reading textures: in C++ a template on its sampler2D arguments,
 //                     which the caller provides with texelFetch(s, ivec2, 0) and textureSize(s, 0)
 //   PXF_FLOAT_ARRAY3(a, b, c), PXF_FLOAT_ARRAY5(...)  the initializer of a const float array
@@ -25,6 +26,7 @@
 #define PXF_CONST constexpr
 #define PXF_INLINE inline
 #define PXF_OUT(T) T&
+#define PXF_INOUT(T) T&
 #define PXF_SAMPLER_FN template <class sampler2D>
 #define PXF_FLOAT_ARRAY3(a, b, c) {a, b, c}
 #define PXF_FLOAT_ARRAY5(a, b, c, d, e) {a, b, c, d, e}
@@ -42,6 +44,7 @@ using wide_vec3 = glm::dvec3;
 #define PXF_CONST const
 #define PXF_INLINE
 #define PXF_OUT(T) out T
+#define PXF_INOUT(T) inout T
 #define PXF_SAMPLER_FN
 #define PXF_FLOAT_ARRAY3(a, b, c) float[3](a, b, c)
 #define PXF_FLOAT_ARRAY5(a, b, c, d, e) float[5](a, b, c, d, e)

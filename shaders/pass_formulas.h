@@ -87,6 +87,51 @@ PXF_INLINE wide_float range_weight(vec4 g_p, vec4 g_q, float k_c, float k_d) {
   return exp(-range_exponent(g_p, g_q, k_c, k_d));
 }
 
+// ---- Kernel sums ----
+
+// One pixel's sums over a filter kernel: L_f = sum w L / sum w and Var[L_f] = sum w^2 Var / (sum w)^2
+// (the pixels' samples are independent). Neighbours of unknown variance (n < 2, or 0: all samples
+// equal, no evidence) count with the kernel-weighted mean of the known ones. Every filter variant
+// (bilateral, subsampled, à-trous) and the CPU reference accumulate through these.
+struct KernelSums {
+  wide_float w;             // sum w
+  wide_vec3 wl;             // sum w L
+  wide_float w2_var_known;  // sum w^2 Var over the neighbours of known variance
+  wide_float w2_unknown;    // sum w^2 over the others
+  wide_float w_known;       // sum w and sum w Var over the known ones: their weighted mean variance
+  wide_float w_var_known;
+};
+PXF_INLINE KernelSums kernel_sums_zero() {
+  KernelSums s;
+  s.w = 0.0f;
+  s.wl = wide_vec3(0.0f);
+  s.w2_var_known = 0.0f;
+  s.w2_unknown = 0.0f;
+  s.w_known = 0.0f;
+  s.w_var_known = 0.0f;
+  return s;
+}
+// Tap of weight w, radiance l and variance var (clean_var: negative = unknown).
+PXF_INLINE void kernel_sums_add(PXF_INOUT(KernelSums) s, wide_float w, vec3 l, float var) {
+  s.w += w;
+  s.wl += wide_vec3(l) * w;
+  if (var > 0.0f) {
+    s.w2_var_known += w * w * var;
+    s.w_known += w;
+    s.w_var_known += w * var;
+  } else {
+    s.w2_unknown += w * w;
+  }
+}
+// s.w > 0 in every filter: the centre tap has range weight 1.
+PXF_INLINE vec3 kernel_sums_mean(KernelSums s) { return vec3(s.wl / s.w); }
+// Var[L_f] times `factor` (the à-trous correction for correlated inputs, else 1); kVarUnknown when no
+// neighbour's variance is known.
+PXF_INLINE float kernel_sums_variance(KernelSums s, float factor) {
+  if (!(s.w_known > 0.0f)) return kVarUnknown;
+  return float(factor * (s.w2_var_known + s.w2_unknown * (s.w_var_known / s.w_known)) / (s.w * s.w));
+}
+
 // ---- Perceived variance ----
 
 // var / lb^2 without overflow in the intermediate; 0 when var <= 0, +inf when lb <= 0.

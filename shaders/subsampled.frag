@@ -32,8 +32,7 @@ void main() {
   }
   atomicAdd(filtered_pixels, 1u);
   vec4 g_p = texelFetch(guide_tex, p, 0);
-  float sw = 0.0, sw2v = 0.0, sw2u = 0.0, swk = 0.0, swv = 0.0;
-  vec3 swl = vec3(0.0);
+  KernelSums sums = kernel_sums_zero();
   int first = subsampled_rotation(p, rotations) * taps_per_rotation;
   for (int i = 0; i < taps_per_rotation; ++i) {
     ivec4 tap = taps[first + i];
@@ -42,19 +41,8 @@ void main() {
     if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) continue;
     float w = float(tap.z) * range_weight(g_p, texelFetch(guide_tex, q, 0), k_c, k_d);
     vec4 hv_q = texelFetch(hv_tex, q, 0);
-    float v_q = clean_var(hv_q.a);
-    sw += w;
-    swl += w * clean(hv_q.rgb);
-    if (v_q > 0.0) {  // unknown (n < 2) or 0 (all samples equal): no evidence
-      sw2v += w * w * v_q;
-      swk += w;
-      swv += w * v_q;
-    } else {
-      sw2u += w * w;
-    }
+    kernel_sums_add(sums, w, clean(hv_q.rgb), clean_var(hv_q.a));
   }
-  // sw >= 1: the centre tap is in every rotation with range weight 1. Unknown neighbour variances
-  // count with the kernel-weighted mean of the known ones.
-  float var_f = swk > 0.0 ? (sw2v + sw2u * (swv / swk)) / (sw * sw) : kVarUnknown;
-  out_filtered = vec4(swl / sw, var_f);
+  // sums.w >= 1: the centre tap is in every rotation with range weight 1.
+  out_filtered = vec4(kernel_sums_mean(sums), kernel_sums_variance(sums, 1.0));
 }
