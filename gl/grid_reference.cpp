@@ -8,9 +8,10 @@
 // which drops the cross terms 2 a_j a_k g(j - c) g(k - c) of the exact sum: two corners of the slice
 // share pixels through the blur. Along each spatial axis that omission is corrected by the factor
 // grid_interpolation_correction(a) (shaders/pass_formulas.h), exact for uniformly occupied cells of
-// uniform variance (a flat guide: Grid.WhiteNoiseVariance in gl/passes_test.cpp checks it). Not
-// corrected: the same cross term along z, where a pixel's luminance lies between two range cells
-// (up to 0.53x low at a_z = 1/2 when only one range cell is occupied), and non-uniform occupancy.
+// uniform variance (a flat guide: Grid.WhiteNoiseVarianceMatchesExactSum checks it). Along z it is
+// corrected by grid_range_correction(a_z), exact when the pixels that matter lie in the pixel's own
+// range cell (a surface of one range colour between two range cells: checked by the same test).
+// Not corrected: non-uniform occupancy.
 // Unknown variances (n < 2, or 0) count with the weighted mean of the known ones, as in the
 // other variants.
 #include "gl/grid_reference.h"
@@ -123,7 +124,8 @@ void slice(const Grid& g, int x, int y, float luminance_y, FilterOutput& out) {
   out.centre_weight.at(x, y, 0) = own_weight / sum[3];
   // sum[3] > 0: the pixel's own nearest cell is a corner with weight >= 1/2 per axis.
   for (int ch = 0; ch < 3; ++ch) out.filtered.at(x, y, ch) = sum[ch] / sum[3];
-  const float correction = grid_interpolation_correction(frac[0]) * grid_interpolation_correction(frac[1]);
+  const float correction = grid_interpolation_correction(frac[0]) * grid_interpolation_correction(frac[1]) *
+                           shared::grid_range_correction(frac[2], c0[2], own[2]);
   out.variance.at(x, y, 0) =
       sum[6] > 0.0f ? correction * (sum[4] + sum[5] * (sum[7] / sum[6])) / (sum[3] * sum[3]) : kVarUnknown;
 }

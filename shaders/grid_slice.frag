@@ -1,9 +1,9 @@
 #version 450 core
 // Bilateral grid, step 4: slice. Each pixel interpolates the blurred grid trilinearly at its own
 // (x / cell_s, y / cell_s, z): the value sums with the weights a, the squared-weight sums with a^2.
-// L_f = sum a / sum count; Var[L_f] = c(a_x) c(a_y) (sum w^2 Var + sum w^2 (unknown) x mean known
-// Var) / (sum w)^2, c = grid_interpolation_correction (gl/grid_layout.h) for the correlation of
-// the interpolated cells along the spatial axes. Case-2 pixels are skipped as in the other variants.
+// L_f = sum a / sum count; Var[L_f] = c(a_x) c(a_y) c_z (sum w^2 Var + sum w^2 (unknown) x mean
+// known Var) / (sum w)^2, c = grid_interpolation_correction and c_z = grid_range_correction
+// (pass_formulas.h) for the correlation of the interpolated cells along the spatial and range axes. Case-2 pixels are skipped as in the other variants.
 // Mirrors slice() in gl/grid_reference.cpp.
 #include "pass_formulas.h"
 #include "grid_common.glsl"
@@ -50,7 +50,8 @@ void main() {
         b += vec4(w * w, w * w, w, w) * cells[2 * cell + 1];
       }
   // a.w > 0: the pixel's own nearest cell is a corner with interpolation weight >= 1/2 per axis.
-  float correction = grid_interpolation_correction(frac.x) * grid_interpolation_correction(frac.y);
+  float correction = grid_interpolation_correction(frac.x) * grid_interpolation_correction(frac.y) *
+                     grid_range_correction(frac.z, c0.z, own.z);
   float var_f = b.z > 0.0 ? correction * (b.x + b.y * (b.w / b.z)) / (a.w * a.w) : kVarUnknown;
   out_filtered = vec4(a.rgb / a.w, var_f);
   out_centre_weight = own_weight / a.w;

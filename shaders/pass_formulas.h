@@ -328,6 +328,18 @@ PXF_INLINE float grid_interpolation_correction(float a) {
   return 1.0f + 2.0f * a * b * g1 / (g0 * (a * a + b * b));
 }
 
+// The same correction along the range axis z, for a pixel at fraction a between range cells k0 and
+// k0 + 1 whose own (nearest) cell is `own`. The range neighbours that matter lie in the pixel's own
+// cell (a surface of one range colour), so the two interpolated cells hold the same pixels through
+// the blur with taps g0 = g(k0 - own), g1 = g(k0 + 1 - own): the exact variance is
+// ((1 - a) g0 + a g1)^2 against ((1 - a)^2 g0^2 + a^2 g1^2) propagated (the cells hold g^2 Var).
+// 1 at a = 0 and 1; 1.8 at a = 1/2, where leaving it out made Var[L_f] 0.56x the truth: averaged
+// over a, Var[L_f] read 0.72x the variance measured over seeds (cornell, 128^2, 16 spp).
+PXF_INLINE float grid_range_correction(float a, int k0, int own) {
+  float w0 = (1.0f - a) * grid_blur_tap(k0 - own), w1 = a * grid_blur_tap(k0 + 1 - own);
+  return (w0 + w1) * (w0 + w1) / (w0 * w0 + w1 * w1);  // > 0: own is k0 or k0 + 1, with weight >= 1/2
+}
+
 // Nearest cell of a grid coordinate (cell centers at integers).
 PXF_INLINE int nearest_cell(float u) { return int(floor(u + 0.5f)); }
 
