@@ -136,14 +136,16 @@ FilterOutput atrous_pass(const Image& signal, const Image& signal_var, const Ima
     for (int x = 0; x < w; ++x) {
       if (final_pass && p.skip_case2 && skip_as_case2(hv, var_u, lv, range_color, depth, p, t, x, y, out)) continue;
       KernelSums sums;
+      double h_sum = 0;
       for (int j = 0; j < 5; ++j)
         for (int i = 0; i < 5; ++i) {
           const int qx = x + (i - 2) * step, qy = y + (j - 2) * step;
           if (qx < 0 || qx >= w || qy < 0 || qy >= h) continue;
           const double range_weight = std::exp(-range_exponent(range_color, depth, x, y, qx, qy, range));
+          h_sum += double(shared::kB3[i]) * shared::kB3[j];
           sums.add(double(shared::kB3[i]) * shared::kB3[j] * range_weight, signal, signal_var, qx, qy);
         }
-      sums.write(out, x, y, variance_factor);  // sum w >= h(0,0) = 0.14: the center tap has range weight 1
+      sums.write(out, x, y, shared::atrous_local_correction(variance_factor, float(sums.sums.w / h_sum)));  // sum w >= h(0,0) = 0.14: the center tap has range weight 1
     }
   return out;
 }
@@ -151,7 +153,8 @@ FilterOutput atrous_pass(const Image& signal, const Image& signal_var, const Ima
 // atrous_iterations(sigma_s) passes at spacing 1, 2, 4, ...; each pass is a linear filter of the
 // previous pass's output. Its Var[L_f] is propagated as if that output's pixels were independent
 // and then multiplied by atrous_variance_correction(pass), which makes it exact where all range
-// weights are 1 (Atrous.WhiteNoiseVarianceShrinksBySumOfSquaredWeights in gl/passes_test.cpp).
+// weights are 1 (Atrous.WhiteNoiseVarianceShrinksBySumOfSquaredWeights in gl/passes_test.cpp),
+// scaled per pixel by the share of the kernel its range weights keep (atrous_local_correction).
 FilterOutput cpu_atrous(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
                         const Image& depth, const FilterParams& p, float t) {
   const int passes = atrous_iterations(p.sigma_s);

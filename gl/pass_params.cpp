@@ -56,8 +56,9 @@ int atrous_iterations(float sigma_s) {
 // independent underestimates it (28.8x at sigma_s = 8 for white noise). Where all range weights are
 // 1 the passes are plain convolutions with the separable kernel K_k = K_{k-1} * h_k (h_k: B3 taps
 // at spacing 2^k), whose exact white-noise variance is (sum K_k^2)^2; the factor is that over
-// (sum h^2)^2 times the previous pass's exact variance: 1, 2.73, 3.20, 3.31, 3.33. At range edges
-// the correlation is smaller, so the corrected variance errs on the high (safe) side there.
+// (sum h^2)^2 times the previous pass's exact variance: 1, 2.73, 3.20, 3.31, 3.33. Where range
+// weights are below 1 the correlation is smaller: the passes scale the factor by the share of the
+// kernel the range weights keep (shared::atrous_local_correction).
 float atrous_variance_correction(int pass) {
   static const std::vector<float> factors = [] {
     std::vector<float> out;

@@ -2,8 +2,9 @@
 // One pass of the edge-avoiding à-trous wavelet filter (Dammertz et al. 2010; FilterKind::Atrous):
 // the 5x5 B3-spline kernel h at hole spacing `step_px` (1, 2, 4, ... over the passes), each tap
 // weighted by h x the range weights of the cross bilateral filter (color, depth; no spatial
-// Gaussian beyond h): L_f = sum w L / sum w, Var[L_f] = c_k sum w^2 Var / (sum w)^2 with the
-// correction c_k for the correlation between the previous pass's pixels (atrous_variance_correction).
+// Gaussian beyond h): L_f = sum w L / sum w, Var[L_f] = c sum w^2 Var / (sum w)^2 with the
+// correction c for the correlation between the previous pass's pixels: atrous_variance_correction
+// scaled by the share of the kernel the range weights keep (atrous_local_correction).
 // Taps outside the image are left out.
 // Mirrors atrous_pass() in gl/cpu_reference.cpp.
 #include "pass_formulas.h"
@@ -33,6 +34,7 @@ void main() {
   if (final_pass != 0) atomicAdd(filtered_pixels, 1u);
   vec4 g_p = texelFetch(guide_tex, p, 0);
   KernelSums sums = kernel_sums_zero();
+  float h_sum = 0.0;  // sum h over the taps inside the image
   for (int j = 0; j < 5; ++j) {
     int qy = p.y + (j - 2) * step_px;
     if (qy < 0 || qy >= size.y) continue;
@@ -40,11 +42,12 @@ void main() {
       int qx = p.x + (i - 2) * step_px;
       if (qx < 0 || qx >= size.x) continue;
       ivec2 q = ivec2(qx, qy);
+      h_sum += kB3[i] * kB3[j];
       float w = kB3[i] * kB3[j] * range_weight(g_p, texelFetch(guide_tex, q, 0), k_c, k_d);
       vec4 s_q = texelFetch(signal_tex, q, 0);
       kernel_sums_add(sums, w, clean(s_q.rgb), clean_var(s_q.a));
     }
   }
   // sums.w >= h(0,0) = 0.14: the center's range weight is 1.
-  out_filtered = vec4(kernel_sums_mean(sums), kernel_sums_variance(sums, variance_correction));
+  out_filtered = vec4(kernel_sums_mean(sums), kernel_sums_variance(sums, atrous_local_correction(variance_correction, float(sums.w) / h_sum)));
 }

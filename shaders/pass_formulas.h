@@ -132,6 +132,13 @@ PXF_INLINE float kernel_sums_variance(KernelSums s, float factor) {
   return float(factor * (s.w2_var_known + s.w2_unknown * (s.w_var_known / s.w_known)) / (s.w * s.w));
 }
 
+// The à-trous pass correction c (atrous_variance_correction, exact for a plain convolution) at a
+// pixel whose range weights keep the share rho = sum h r / sum h of the pass's kernel: c where
+// rho = 1, 1 where only the centre tap counts (its variance is the previous pass's own); in between
+// linear, an interpolation measured rather than derived: on cornell 64^2 at 16 spp the claim is
+// 1.12x the variance of L_f over 32 seeds (median over pixels; 3.38x with c everywhere).
+PXF_INLINE float atrous_local_correction(float c, float rho) { return 1.0f + (c - 1.0f) * clamp(rho, 0.0f, 1.0f); }
+
 // ---- Perceived variance ----
 
 // var / lb^2 without overflow in the intermediate; 0 when var <= 0, +inf when lb <= 0.
