@@ -80,6 +80,7 @@ class Reader {
   }
   void get_bytes(void* out, size_t n, const char* what) {
     if (n > remaining()) throw Error(std::string("state file truncated in ") + what);
+    if (n == 0) return;  // an empty array (no replicates): its data() may be null, which memcpy must not get
     std::memcpy(out, data_ + pos_, n);
     pos_ += n;
   }
