@@ -145,7 +145,8 @@ FilterOutput atrous_pass(const Image& signal, const Image& signal_var, const Ima
           h_sum += double(shared::kB3[i]) * shared::kB3[j];
           sums.add(double(shared::kB3[i]) * shared::kB3[j] * range_weight, signal, signal_var, qx, qy);
         }
-      sums.write(out, x, y, shared::atrous_local_correction(variance_factor, float(sums.sums.w / h_sum)));  // sum w >= h(0,0) = 0.14: the center tap has range weight 1
+      // sum w >= h(0,0) = 0.14: the center tap has range weight 1.
+      sums.write(out, x, y, shared::atrous_local_correction(variance_factor, float(sums.sums.w / h_sum)));
     }
   return out;
 }

@@ -49,5 +49,6 @@ void main() {
     }
   }
   // sums.w >= h(0,0) = 0.14: the center's range weight is 1.
-  out_filtered = vec4(kernel_sums_mean(sums), kernel_sums_variance(sums, atrous_local_correction(variance_correction, float(sums.w) / h_sum)));
+  float correction = atrous_local_correction(variance_correction, float(sums.w) / h_sum);
+  out_filtered = vec4(kernel_sums_mean(sums), kernel_sums_variance(sums, correction));
 }

@@ -3,7 +3,8 @@
 // (x / cell_s, y / cell_s, z): the value sums with the weights a, the squared-weight sums with a^2.
 // L_f = sum a / sum count; Var[L_f] = c(a_x) c(a_y) c_z (sum w^2 Var + sum w^2 (unknown) x mean
 // known Var) / (sum w)^2, c = grid_interpolation_correction and c_z = grid_range_correction
-// (pass_formulas.h) for the correlation of the interpolated cells along the spatial and range axes. Case-2 pixels are skipped as in the other variants.
+// (pass_formulas.h) for the correlation of the interpolated cells along the spatial and range axes.
+// Case-2 pixels are skipped as in the other variants.
 // Mirrors slice() in gl/grid_reference.cpp.
 #include "pass_formulas.h"
 #include "grid_common.glsl"
