@@ -360,7 +360,7 @@ size_t LightSampler::triangle_point(glm::vec3 from, float u_select, glm::vec2 u,
   const size_t i = pick_triangle(from, u_select, reuse_select ? &u.x : nullptr, &pmf);
   if (triangles_[i].parallelogram >= 0) {
     const Parallelogram& q = parallelograms_[static_cast<size_t>(triangles_[i].parallelogram)];
-    const float share = i == q.first ? q.share_first : 1.0f - q.share_first;
+    const float share = q.share(i);
     // With the shared selection u.x spans the pair's contiguous share of the selection: [0, 1)
     // over both triangles, so the pair is sampled as one.
     const glm::vec2 v(reuse_select ? std::min(i == q.first ? u.x * share : q.share_first + u.x * share, 0x1.fffffep-1f)
@@ -437,7 +437,7 @@ float LightSampler::pdf_triangle(unsigned mesh, unsigned prim, glm::vec3 from, g
     const Parallelogram& q = parallelograms_[static_cast<size_t>(e.parallelogram)];
     SphericalRectangle sr;
     if (solid_angle_sampling(q, from, &sr))
-      return p_triangles_ * pmf / (light == q.first ? q.share_first : 1.0f - q.share_first) / sr.solid_angle();
+      return p_triangles_ * pmf / q.share(light) / sr.solid_angle();
   }
   return p_triangles_ * pmf / e.area * dist2 / cos_light;
 }

@@ -98,6 +98,7 @@ class LightSampler {
     size_t first = 0;  // its first triangle; the second is first + 1
     glm::vec3 origin{0.0f}, edge_u{0.0f}, edge_v{0.0f};
     float share_first = 0.5f;  // the first triangle's share of the pair's selection probability
+    float share(size_t triangle) const { return triangle == first ? share_first : 1.0f - share_first; }
     bool rectangle = false;    // edges perpendicular: solid-angle sampling applies
     FrontSide front;
     float inv_length2_u = 0.0f, inv_length2_v = 0.0f, diagonal2 = 0.0f;

@@ -95,10 +95,11 @@ class SphericalRectangle {
     auto angle = [](float cosine) { return std::acos(std::clamp(cosine, -1.0f, 1.0f)); };
     const float g0 = angle(y0_ * x1_ / (a0 * a1)), g1 = angle(-x1_ * y1_ / (a1 * a2));
     const float g2 = angle(y1_ * x0_ / (a2 * a3)), g3 = angle(-x0_ * y0_ / (a3 * a0));
-    const double solid_angle = double(g0) + double(g1) + double(g2) + double(g3) - 2.0 * 3.14159265358979323846;
+    constexpr double kTwoPi = 2.0 * 3.14159265358979323846;  // in double: the sum cancels to a small angle
+    const double solid_angle = double(g0) + double(g1) + double(g2) + double(g3) - kTwoPi;
     b0_ = -y0_ / a0;
     b1_ = y1_ / a2;
-    k_ = static_cast<float>(2.0 * 3.14159265358979323846 - double(g2) - double(g3));
+    k_ = static_cast<float>(kTwoPi - double(g2) - double(g3));
     solid_angle_ = static_cast<float>(solid_angle);
     return solid_angle > 1e-3 && std::isfinite(solid_angle) && std::isfinite(b0_) && std::isfinite(b1_);
   }
