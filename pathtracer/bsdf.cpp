@@ -114,6 +114,9 @@ Bsdf::Bsdf(const BsdfParams& params, glm::vec3 shading_normal, glm::vec3 geometr
   float r0 = (p_.ior - 1.0f) / (p_.ior + 1.0f);
   f0_dielectric_ = glm::min(glm::vec3(r0 * r0) * p_.specular_color, glm::vec3(1.0f)) * p_.specular;
   f90_dielectric_ = p_.specular;
+  // metallic schlick(base, 1) + c_diffuse schlick(f0, f90), both f0 + (f90 - f0) m^5.
+  fresnel_at_0_ = m * p_.base_color + c_diffuse_ * f0_dielectric_;
+  fresnel_slope_ = m * (glm::vec3(1.0f) - p_.base_color) + c_diffuse_ * (glm::vec3(f90_dielectric_) - f0_dielectric_);
 
   float cos_o = wo_local_.z;
   glm::vec3 fd_o = schlick(f0_dielectric_, f90_dielectric_, cos_o);
@@ -128,12 +131,14 @@ Bsdf::Bsdf(const BsdfParams& params, glm::vec3 shading_normal, glm::vec3 geometr
   p_glossy_ = w_glossy / total;
   p_glass_ = w_glass / total;
   has_nondelta_ = p_diffuse_ > 0.0f || (p_glossy_ > 0.0f && !glossy_delta_);
+  inv_4cos_o_ = 1.0f / (4.0f * cos_o);
+  glossy_pdf_scale_ = p_glossy_ * inv_4cos_o_ / (1.0f + lambda_o_);
 }
 
 // Fresnel of the GGX layer: the conductor and the dielectric specular share one microfacet lobe.
 glm::vec3 Bsdf::glossy_fresnel(float cos_oh) const {
-  return p_.metallic * schlick(p_.base_color, 1.0f, cos_oh) +
-         c_diffuse_ * schlick(f0_dielectric_, f90_dielectric_, cos_oh);
+  const float m = saturate(1.0f - cos_oh), m2 = m * m;
+  return fresnel_at_0_ + fresnel_slope_ * (m2 * m2 * m);
 }
 
 glm::vec3 Bsdf::eval_local(glm::vec3 wi, float* pdf) const {
@@ -145,9 +150,9 @@ glm::vec3 Bsdf::eval_local(glm::vec3 wi, float* pdf) const {
     glm::vec3 h = glm::normalize(wo_local_ + wi);
     float d = ggx_d(h, alpha_);
     float g2 = 1.0f / (1.0f + lambda_o_ + ggx_lambda(wi, alpha_));
-    float spec = d * g2 / (4.0f * wo_local_.z);  // D G2 / (4 cos_o cos_i), times cos_i
+    float spec = d * g2 * inv_4cos_o_;  // D G2 / (4 cos_o cos_i), times cos_i
     f += glossy_fresnel(std::max(0.0f, glm::dot(wo_local_, h))) * spec;
-    *pdf += p_glossy_ * d / ((1.0f + lambda_o_) * 4.0f * wo_local_.z);  // VNDF: G1(wo) D / (4 cos_o)
+    *pdf += glossy_pdf_scale_ * d;  // VNDF: G1(wo) D / (4 cos_o)
   }
   return f;
 }

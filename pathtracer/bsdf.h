@@ -78,11 +78,17 @@ class Bsdf {
   BsdfParams p_{};
   float alpha_ = 1.0f;
   float lambda_o_ = 0.0f;  // Smith Lambda(wo), fixed per shading point
+  // Fixed per shading point, so eval_local() divides once per BSDF instead of once per call:
+  float inv_4cos_o_ = 0.0f;         // 1 / (4 cos_o)
+  float glossy_pdf_scale_ = 0.0f;   // p_glossy G1(wo) / (4 cos_o): the glossy pdf is this times D(h)
   bool glossy_delta_ = false;
   bool front_face_ = true;
   float c_diffuse_ = 0.0f, c_glass_ = 0.0f;  // mixing coefficients
   glm::vec3 f0_dielectric_{0.0f};
   float f90_dielectric_ = 1.0f;
+  // glossy_fresnel(c) = fresnel_at_0_ + fresnel_slope_ (1 - c)^5: the metal's and the dielectric's
+  // Schlick terms share the power, so their sum is one line.
+  glm::vec3 fresnel_at_0_{0.0f}, fresnel_slope_{0.0f};
   glm::vec3 diffuse_factor_{0.0f};  // c_diffuse * base / pi * (1 - F_dielectric(cos_o))
   float p_diffuse_ = 0.0f, p_glossy_ = 0.0f, p_glass_ = 0.0f;  // lobe selection probabilities
   bool has_nondelta_ = false;

@@ -113,6 +113,7 @@ LightSampler::LightSampler(const Scene& scene) : scene_(scene) {
       e.area = 0.5f * len;
       e.normal = len > 0.0f ? n / len : glm::vec3(0.0f, 0.0f, 1.0f);
       e.material = &material;
+      e.textured = material.emissive_texture.valid();
       triangles_.push_back(e);
       powers.push_back(e.area * weight * (material.double_sided ? 2.0f : 1.0f));
     }
@@ -407,11 +408,14 @@ bool LightSampler::triangle_sample(glm::vec3 position, size_t light, glm::vec3 p
   float cos_light = -glm::dot(wi, e.normal);
   if (e.material->double_sided) cos_light = std::abs(cos_light);
   if (cos_light <= 1e-7f) return false;  // the back of a one-sided emitter, or edge-on
-  const Mesh& mesh = scene_.meshes[e.mesh];
-  const glm::uvec3& tri = mesh.triangles[e.prim];
-  float b0 = 1.0f - b.x - b.y;
-  glm::vec2 uv0 = mesh.uv0.empty() ? glm::vec2(0.0f) : mesh.uv0[tri.x] * b0 + mesh.uv0[tri.y] * b.x + mesh.uv0[tri.z] * b.y;
-  glm::vec2 uv1 = mesh.uv1.empty() ? glm::vec2(0.0f) : mesh.uv1[tri.x] * b0 + mesh.uv1[tri.y] * b.x + mesh.uv1[tri.z] * b.y;
+  glm::vec2 uv0(0.0f), uv1(0.0f);
+  if (e.textured) {
+    const Mesh& mesh = scene_.meshes[e.mesh];
+    const glm::uvec3& tri = mesh.triangles[e.prim];
+    const float b0 = 1.0f - b.x - b.y;
+    if (!mesh.uv0.empty()) uv0 = mesh.uv0[tri.x] * b0 + mesh.uv0[tri.y] * b.x + mesh.uv0[tri.z] * b.y;
+    if (!mesh.uv1.empty()) uv1 = mesh.uv1[tri.x] * b0 + mesh.uv1[tri.y] * b.x + mesh.uv1[tri.z] * b.y;
+  }
   out->wi = wi;
   out->distance = dist;
   out->radiance = eval_emission(scene_, *e.material, uv0, uv1);

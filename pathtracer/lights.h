@@ -80,6 +80,7 @@ class LightSampler {
     glm::vec3 p0, e1, e2, normal;
     float area;
     const Material* material;
+    bool textured = false;   // its emission varies over it (an emissive texture): needs its uvs
     int parallelogram = -1;  // index into parallelograms_ when this and a neighbour form one
   };
   const EmissiveTriangle& triangle(size_t light) const { return triangles_[light]; }

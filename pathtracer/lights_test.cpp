@@ -425,6 +425,49 @@ TEST(Lights, LightTypesAreSelectedByPower) {
   }
 }
 
+TEST(Lights, TexturedEmitterSampleCarriesTheTexelUnderItsPoint) {
+  // A quad emitter with a 2 x 2 nearest-filtered emissive texture (a different colour per quarter)
+  // and a plain one: every light sample's radiance is the texel under its point (uv0 of make_quad:
+  // u along edge_u, v = 1 - t along edge_v), from near (solid angle) and from far (area), with
+  // both selections; the plain emitter's is its factor.
+  Scene scene;
+  Texture glow;
+  glow.width = glow.height = 2;
+  glow.nearest = true;
+  glow.texels = {glm::vec4(1, 0, 0, 1), glm::vec4(0, 1, 0, 1), glm::vec4(0, 0, 1, 1), glm::vec4(1, 1, 0, 1)};
+  scene.textures = {glow};
+  Material textured = make_emitter(glm::vec3(2.0f));
+  textured.emissive_texture.texture = 0;
+  scene.materials = {textured, make_emitter(glm::vec3(0.5f, 0.25f, 0.125f))};
+  const glm::vec3 corner(0, 2, 0), edge_u(1, 0, 0), edge_v(0, 0, 1);
+  scene.meshes.push_back(make_quad(corner, edge_u, edge_v, 0));
+  scene.meshes.push_back(make_quad(glm::vec3(5, 2, 5), edge_u, edge_v, 1));
+  const LightSampler lights(scene);
+  Rng rng(31, 0, 0);
+  int textured_samples = 0, plain_samples = 0;
+  for (glm::vec3 from : {glm::vec3(0.4f, 1.6f, 0.3f), glm::vec3(0.5f, -6.0f, 0.5f)})
+    for (bool shared : {false, true})
+      for (int k = 0; k < 4000; ++k) {
+        const float u_select = rng.next_float();
+        const glm::vec2 u = rng.next_2d();
+        LightSample ls;
+        if (!(shared ? lights.sample(from, u, &ls) : lights.sample(from, u_select, u, &ls))) continue;
+        if (ls.point.x > 2.0f) {
+          ++plain_samples;
+          ASSERT_EQ(ls.radiance, glm::vec3(0.5f, 0.25f, 0.125f));
+          continue;
+        }
+        ++textured_samples;
+        const glm::vec2 uv(glm::dot(ls.point - corner, edge_u), 1.0f - glm::dot(ls.point - corner, edge_v));
+        const float margin = std::min({uv.x, 1.0f - uv.x, uv.y, 1.0f - uv.y, std::abs(uv.x - 0.5f), std::abs(uv.y - 0.5f)});
+        if (margin < 1e-4f) continue;  // on a texel edge: either texel is right within float error
+        const glm::vec4 texel = glow.texels[(uv.y < 0.5f ? 0 : 2) + (uv.x < 0.5f ? 0 : 1)];
+        ASSERT_EQ(ls.radiance, 2.0f * glm::vec3(texel)) << "uv " << uv.x << " " << uv.y;
+      }
+  EXPECT_GT(textured_samples, 1000);
+  EXPECT_GT(plain_samples, 100);
+}
+
 TEST(Lights, EquirectRoundTrip) {
   for (glm::vec3 d : {glm::vec3(0, 0, -1), glm::vec3(1, 0, 0), glm::normalize(glm::vec3(0.3f, 0.8f, 0.5f))}) {
     glm::vec3 back = equirect_direction(equirect_uv(d));
