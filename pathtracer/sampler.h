@@ -214,10 +214,12 @@ class PathSampler {
       return;
     }
     frame_ = frame;
+    // One replicate (the default) needs no integer division, which costs a path more than a hash.
     const uint32_t k = replicates > 1 ? static_cast<uint32_t>(replicates) : 1u;
-    reversed_index_ = sobol::reverse_bits(frame / k);
+    const uint32_t index = k == 1 ? frame : frame / k, replicate = k == 1 ? 0u : frame % k;
+    reversed_index_ = sobol::reverse_bits(index);
     key_ = mix64(seed * 0x9e3779b97f4a7c15ULL + mix64(pixel + 0x632be59bd9b4e019ULL));
-    key_ = mix64(key_ ^ mix64((frame % k) + 0xd6e8feb86659fd93ULL));
+    key_ = mix64(key_ ^ mix64(replicate + 0xd6e8feb86659fd93ULL));
   }
 
   // From here on the path draws independent numbers (the vertices after its first non-delta
