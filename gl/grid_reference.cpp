@@ -126,8 +126,7 @@ void slice(const Grid& g, int x, int y, float luminance_y, FilterOutput& out) {
   for (int ch = 0; ch < 3; ++ch) out.filtered.at(x, y, ch) = sum[ch] / sum[3];
   const float correction = grid_interpolation_correction(frac[0]) * grid_interpolation_correction(frac[1]) *
                            shared::grid_range_correction(frac[2], c0[2], own[2]);
-  out.variance.at(x, y, 0) =
-      sum[6] > 0.0f ? correction * (sum[4] + sum[5] * (sum[7] / sum[6])) / (sum[3] * sum[3]) : kVarUnknown;
+  out.variance.at(x, y, 0) = shared::propagated_variance(sum[3], sum[4], sum[5], sum[6], sum[7], correction);
 }
 
 }  // namespace

@@ -10,10 +10,14 @@ namespace {
 
 inline float saturate(float x) { return std::min(std::max(x, 0.0f), 1.0f); }
 
+// Schlick's (1 - cos)^5, the weight of f90 against f0.
+inline float schlick_weight(float cos_theta) {
+  const float m = saturate(1.0f - cos_theta), m2 = m * m;
+  return m2 * m2 * m;
+}
+
 inline glm::vec3 schlick(glm::vec3 f0, float f90, float cos_theta) {
-  float m = saturate(1.0f - cos_theta);
-  float m2 = m * m;
-  return f0 + (glm::vec3(f90) - f0) * (m2 * m2 * m);
+  return f0 + (glm::vec3(f90) - f0) * schlick_weight(cos_theta);
 }
 
 // A smooth or textured parameter is "delta-capable" only when it is a constant factor.
@@ -105,22 +109,22 @@ Bsdf::Bsdf(const BsdfParams& params, glm::vec3 shading_normal, glm::vec3 geometr
   wo_local_ = frame_.to_local(wo);
   wo_local_.z = std::max(wo_local_.z, 1e-6f);
 
-  float m = p_.metallic, t = p_.transmission;
-  c_diffuse_ = (1.0f - m) * (1.0f - t);
+  const float m = p_.metallic, t = p_.transmission;
+  const float c_diffuse = (1.0f - m) * (1.0f - t);
   c_glass_ = (1.0f - m) * t;
   glossy_delta_ = p_.roughness < kDeltaRoughness;
   alpha_ = std::max(p_.roughness * p_.roughness, kMinAlpha);
   lambda_o_ = ggx_lambda(wo_local_, alpha_);
   float r0 = (p_.ior - 1.0f) / (p_.ior + 1.0f);
-  f0_dielectric_ = glm::min(glm::vec3(r0 * r0) * p_.specular_color, glm::vec3(1.0f)) * p_.specular;
-  f90_dielectric_ = p_.specular;
-  // metallic schlick(base, 1) + c_diffuse schlick(f0, f90), both f0 + (f90 - f0) m^5.
-  fresnel_at_0_ = m * p_.base_color + c_diffuse_ * f0_dielectric_;
-  fresnel_slope_ = m * (glm::vec3(1.0f) - p_.base_color) + c_diffuse_ * (glm::vec3(f90_dielectric_) - f0_dielectric_);
+  const glm::vec3 f0_dielectric = glm::min(glm::vec3(r0 * r0) * p_.specular_color, glm::vec3(1.0f)) * p_.specular;
+  const float f90_dielectric = p_.specular;
+  // metallic schlick(base, 1) + c_diffuse schlick(f0, f90), both f0 + (f90 - f0) schlick_weight.
+  fresnel_at_0_ = m * p_.base_color + c_diffuse * f0_dielectric;
+  fresnel_slope_ = m * (glm::vec3(1.0f) - p_.base_color) + c_diffuse * (glm::vec3(f90_dielectric) - f0_dielectric);
 
   float cos_o = wo_local_.z;
-  glm::vec3 fd_o = schlick(f0_dielectric_, f90_dielectric_, cos_o);
-  diffuse_factor_ = c_diffuse_ * p_.base_color * kInvPi * (glm::vec3(1.0f) - fd_o);
+  glm::vec3 fd_o = schlick(f0_dielectric, f90_dielectric, cos_o);
+  diffuse_factor_ = c_diffuse * p_.base_color * kInvPi * (glm::vec3(1.0f) - fd_o);
   float w_diffuse = std::max(0.0f, luminance(diffuse_factor_) * kPi);
   float w_glossy = std::max(0.0f, luminance(glossy_fresnel(cos_o)));
   float w_glass = std::max(0.0f, c_glass_);
@@ -137,8 +141,7 @@ Bsdf::Bsdf(const BsdfParams& params, glm::vec3 shading_normal, glm::vec3 geometr
 
 // Fresnel of the GGX layer: the conductor and the dielectric specular share one microfacet lobe.
 glm::vec3 Bsdf::glossy_fresnel(float cos_oh) const {
-  const float m = saturate(1.0f - cos_oh), m2 = m * m;
-  return fresnel_at_0_ + fresnel_slope_ * (m2 * m2 * m);
+  return fresnel_at_0_ + fresnel_slope_ * schlick_weight(cos_oh);
 }
 
 glm::vec3 Bsdf::eval_local(glm::vec3 wi, float* pdf) const {

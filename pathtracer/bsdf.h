@@ -83,9 +83,7 @@ class Bsdf {
   float glossy_pdf_scale_ = 0.0f;   // p_glossy G1(wo) / (4 cos_o): the glossy pdf is this times D(h)
   bool glossy_delta_ = false;
   bool front_face_ = true;
-  float c_diffuse_ = 0.0f, c_glass_ = 0.0f;  // mixing coefficients
-  glm::vec3 f0_dielectric_{0.0f};
-  float f90_dielectric_ = 1.0f;
+  float c_glass_ = 0.0f;  // the glass lobe's mixing coefficient
   // glossy_fresnel(c) = fresnel_at_0_ + fresnel_slope_ (1 - c)^5: the metal's and the dielectric's
   // Schlick terms share the power, so their sum is one line.
   glm::vec3 fresnel_at_0_{0.0f}, fresnel_slope_{0.0f};

@@ -214,7 +214,7 @@ class PathSampler {
       return;
     }
     frame_ = frame;
-    // One replicate (the default) needs no integer division, which costs a path more than a hash.
+    // One replicate (the default): no integer division per path.
     const uint32_t k = replicates > 1 ? static_cast<uint32_t>(replicates) : 1u;
     const uint32_t index = k == 1 ? frame : frame / k, replicate = k == 1 ? 0u : frame % k;
     reversed_index_ = sobol::reverse_bits(index);

@@ -53,7 +53,7 @@ void main() {
   // a.w > 0: the pixel's own nearest cell is a corner with interpolation weight >= 1/2 per axis.
   float correction = grid_interpolation_correction(frac.x) * grid_interpolation_correction(frac.y) *
                      grid_range_correction(frac.z, c0.z, own.z);
-  float var_f = b.z > 0.0 ? correction * (b.x + b.y * (b.w / b.z)) / (a.w * a.w) : kVarUnknown;
-  out_filtered = vec4(a.rgb / a.w, var_f);
+  // b: sum w^2 Var (known), sum w^2 (unknown), sum w and sum w Var (known).
+  out_filtered = vec4(a.rgb / a.w, propagated_variance(a.w, b.x, b.y, b.z, b.w, correction));
   out_centre_weight = own_weight / a.w;
 }

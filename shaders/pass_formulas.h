@@ -89,6 +89,16 @@ PXF_INLINE wide_float range_weight(vec4 g_p, vec4 g_q, float k_c, float k_d) {
 
 // ---- Kernel sums ----
 
+// Var[L_f] = factor (sum_known w^2 Var + sum_unknown w^2 vbar) / (sum w)^2 with vbar = sum_known w Var /
+// sum_known w, the kernel-weighted mean of the known variances; kVarUnknown when none is known. The
+// formula of every filter variant: the kernel sums below and the grid's slice (its cells carry the
+// same sums through the blur). `factor` corrects for correlated inputs (à-trous, grid), else 1.
+PXF_INLINE float propagated_variance(wide_float w, wide_float w2_var_known, wide_float w2_unknown, wide_float w_known,
+                                     wide_float w_var_known, float factor) {
+  if (!(w_known > 0.0f)) return kVarUnknown;
+  return float(factor * (w2_var_known + w2_unknown * (w_var_known / w_known)) / (w * w));
+}
+
 // One pixel's sums over a filter kernel: L_f = sum w L / sum w and Var[L_f] = sum w^2 Var / (sum w)^2
 // (the pixels' samples are independent). Neighbours of unknown variance (n < 2, or 0: all samples
 // equal, no evidence) count with the kernel-weighted mean of the known ones. Every filter variant
@@ -128,8 +138,7 @@ PXF_INLINE vec3 kernel_sums_mean(KernelSums s) { return vec3(s.wl / s.w); }
 // Var[L_f] times `factor` (the à-trous correction for correlated inputs, else 1); kVarUnknown when no
 // neighbour's variance is known.
 PXF_INLINE float kernel_sums_variance(KernelSums s, float factor) {
-  if (!(s.w_known > 0.0f)) return kVarUnknown;
-  return float(factor * (s.w2_var_known + s.w2_unknown * (s.w_var_known / s.w_known)) / (s.w * s.w));
+  return propagated_variance(s.w, s.w2_var_known, s.w2_unknown, s.w_known, s.w_var_known, factor);
 }
 
 // The à-trous pass correction c (atrous_variance_correction, exact for a plain convolution) at a
