@@ -130,9 +130,12 @@ TEST(BlendFactorCpu, CovarianceTermHitsTheThreshold) {
       ++mixed;
       ASSERT_NEAR(blend_variance(d.s, u, f, w), t, 1e-4 * t + 1e-6 * std::max(u, f));
     }
-    if (d.blend_case == kCaseFilteredOnly)
+    if (d.blend_case == kCaseFilteredOnly) {
       for (int k = 0; k <= 100; ++k) ASSERT_GT(blend_variance(k / 100.0, u, f, w), t * (1 - 1e-4));
-    if (d.blend_case == kCaseUnfiltered) ASSERT_LE(u, t);
+    }
+    if (d.blend_case == kCaseUnfiltered) {
+      ASSERT_LE(u, t);
+    }
   }
   EXPECT_GT(mixed, 1000);
 }
@@ -260,7 +263,7 @@ TEST(PooledVariance, QuietPixelTakesTheMeanOfItsRangeNeighbours) {
 TEST(PooledVariance, DarkSpeckleIsFilteredNotKept) {
   PoolingScene p;
   Image lv = Image::rgb(5, 3), hv = Image::rgb(5, 3, 1.0f);
-  FilterOutput filtered{Image::rgb(5, 3, 1.0f), Image::gray(5, 3, "Y", 1e-4f)};
+  FilterOutput filtered{Image::rgb(5, 3, 1.0f), Image::gray(5, 3, "Y", 1e-4f), Image{}};
   for (int c = 0; c < 3; ++c) hv.at(1, 1, c) = 0.01f;  // few small samples: mean and variance tiny
   p.var.at(1, 1, 0) = 1e-7f;
   // Pooled u = (8e-2 + 1e-7) / 9 / L_b^2 with L_b = Y(L_f) = 1: above t = 0.005.

@@ -130,7 +130,7 @@ FilterOutput atrous_pass(const Image& signal, const Image& signal_var, const Ima
                          const Image& lv, const Image& range_color, const Image& depth, const FilterParams& p,
                          float t, int step, float variance_factor, bool final_pass) {
   const int w = hv.width, h = hv.height;
-  FilterOutput out{Image::rgb(w, h), Image::gray(w, h)};
+  FilterOutput out{Image::rgb(w, h), Image::gray(w, h), Image{}};
   const RangeWeights range = range_weights(p);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
@@ -159,7 +159,7 @@ FilterOutput atrous_pass(const Image& signal, const Image& signal_var, const Ima
 FilterOutput cpu_atrous(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
                         const Image& depth, const FilterParams& p, float t) {
   const int passes = atrous_iterations(p.sigma_s);
-  FilterOutput level{hv, var_u};
+  FilterOutput level{hv, var_u, Image{}};
   for (int i = 0; i < passes; ++i)
     level = atrous_pass(level.filtered, level.variance, hv, var_u, lv, range_color, depth, p, t, 1 << i,
                         atrous_variance_correction(i), i + 1 == passes);
@@ -174,7 +174,7 @@ FilterOutput cpu_atrous(const Image& hv, const Image& var_u, const Image& lv, co
 FilterOutput cpu_subsampled(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
                             const Image& depth, const FilterParams& p, float t) {
   const int w = hv.width, h = hv.height;
-  FilterOutput out{Image::rgb(w, h), Image::gray(w, h)};
+  FilterOutput out{Image::rgb(w, h), Image::gray(w, h), Image{}};
   const RangeWeights range = range_weights(p);
   const SubsampledTapTable table = subsampled_tap_table(p.sigma_s, p.subsampled_taps > 0 ? p.subsampled_taps : kSubsampledTaps);
   for (int y = 0; y < h; ++y)
