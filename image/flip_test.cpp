@@ -96,7 +96,9 @@ TEST(Flip, OnePixelChangeStaysLocal) {
   EXPECT_GT(e.at(cx, cy, 0), 0.05f);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x)
-      if (std::max(std::abs(x - cx), std::abs(y - cy)) > radius) EXPECT_EQ(e.at(x, y, 0), 0.0f) << x << "," << y;
+      if (std::max(std::abs(x - cx), std::abs(y - cy)) > radius) {
+        EXPECT_EQ(e.at(x, y, 0), 0.0f) << x << "," << y;
+      }
   EXPECT_GT(e.at(cx + radius - 2, cy, 0), 0.0f);  // the neighbourhood is affected
 }
 
