@@ -47,14 +47,26 @@ python3 - "$tmp/runs" <<'PY'
 import collections, statistics, sys
 rows = [l.split() for l in open(sys.argv[1]).read().splitlines()[1:]]
 runs = collections.defaultdict(list)
-for scene, _, sampler, filt, spp, hdr, disp in rows:
+paired = collections.defaultdict(dict)  # (scene, filter, round) -> sampler -> (hdr, display)
+for scene, rnd, sampler, filt, spp, hdr, disp in rows:
     runs[(scene, sampler, filt)].append((float(spp), float(hdr), float(disp)))
+    paired[(scene, filt, rnd)][sampler] = (float(hdr), float(disp))
 med = {k: [statistics.median(v[i] for v in vals) for i in range(3)] for k, vals in runs.items()}
-print("\nmedians over rounds; ratio = sobol / independent")
+print("\nmedians over rounds; ratio = sobol / independent of the medians")
 print("%-10s %-8s %16s %22s %22s" % ("scene", "filter", "spp sobol/indep", "HDR % (ratio)", "display % (ratio)"))
 for scene in dict.fromkeys(r[0] for r in rows):
     for filt in ("none", "grid"):
         s, i = med[(scene, "sobol", filt)], med[(scene, "independent", filt)]
         print("%-10s %-8s %7.0f / %-7.0f %7.2f/%-6.2f (%.2f) %7.2f/%-6.2f (%.2f)" %
               (scene, filt, s[0], i[0], s[1], i[1], s[1] / i[1], s[2], i[2], s[2] / i[2]))
+# The same rounds paired (one seed, both samplers back to back): how far single rounds spread.
+print("\nper-round ratios sobol / independent: median [min - max]")
+for scene in dict.fromkeys(r[0] for r in rows):
+    for filt in ("none", "grid"):
+        pairs = [v for (sc, f, _), v in paired.items() if sc == scene and f == filt and len(v) == 2]
+        cells = []
+        for k, name in ((0, "HDR"), (1, "display")):
+            r = [v["sobol"][k] / v["independent"][k] for v in pairs]
+            cells.append("%s %.3f [%.3f - %.3f]" % (name, statistics.median(r), min(r), max(r)))
+        print("%-10s %-8s %s   %s" % (scene, filt, cells[0], cells[1]))
 PY
