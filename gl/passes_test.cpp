@@ -241,22 +241,51 @@ std::vector<double> composite_b3_kernel(int passes) {
   return kernel;
 }
 
+// White noise, uniform in [0, 2] (mean 1, variance 1/3), filtered over a flat guide: there a filter
+// is a fixed linear kernel, so what it does to the noise's variance is known, and the Var[L_f] it
+// claims can be checked against it. One realization per run().
+class WhiteNoiseOnFlatGuide {
+ public:
+  static constexpr float kNoiseVar = 1.0f / 3.0f;
+  WhiteNoiseOnFlatGuide(int n, unsigned seed)
+      : context_(test::osmesa_context()),
+        n_(n),
+        lv_(Image::rgb(n, n)),
+        var_(Image::gray(n, n, "Y", kNoiseVar)),
+        inputs_(n, n),
+        guide_(n, n, TextureFormat::RGBA32F),
+        filter_(n, n),
+        rng_(seed) {
+    guide_.upload(Image::rgba(n, n, 0.5f));
+  }
+  const FilterPass& run(const FilterParams& p) {
+    Image hv = Image::rgb(n_, n_);
+    for (float& v : hv.pixels) v = noise_(rng_);
+    inputs_.upload(lv_, hv, var_);
+    filter_.run(inputs_, guide_, p, test::kTestThreshold);
+    return filter_;
+  }
+
+ private:
+  GlContext& context_;  // first: the GL objects below need it current
+  int n_;
+  Image lv_, var_;
+  PreviewInputs inputs_;
+  Texture2D guide_;
+  FilterPass filter_;
+  std::mt19937 rng_;
+  std::uniform_real_distribution<float> noise_{0.0f, 2.0f};
+};
+
 TEST(Atrous, WhiteNoiseVarianceShrinksBySumOfSquaredWeights) {
   // On a flat guide the à-trous filter is a fixed linear kernel W (the composite of the passes),
   // so white noise of variance v comes out with variance v sum W^2 = v (sum_i c_i^2)^2 (c: the
   // composite 1D kernel). One pass: W = h and the propagated Var[L_f] = v sum h^2 is exact. More
   // passes: each pass's inputs are correlated; without atrous_variance_correction the propagated
   // Var[L_f] would be (sum h^2)^passes, 28.8x too low at sigma_s = 8. With it, it is exact here.
-  test::osmesa_context();
   constexpr int N = 192;
-  constexpr float kNoiseVar = 1.0f / 3.0f;  // uniform in [0, 2]
-  Image lv = Image::rgb(N, N), var = Image::gray(N, N, "Y", kNoiseVar), guide = Image::rgba(N, N, 0.5f);
-  PreviewInputs inputs(N, N);
-  Texture2D guide_tex(N, N, TextureFormat::RGBA32F);
-  guide_tex.upload(guide);
-  FilterPass filter(N, N);
-  std::mt19937 rng(5);
-  std::uniform_real_distribution<float> noise(0.0f, 2.0f);
+  constexpr float kNoiseVar = WhiteNoiseOnFlatGuide::kNoiseVar;
+  WhiteNoiseOnFlatGuide rig(N, 5);
   for (float sigma_s : {1.0f, 8.0f}) {
     FilterParams p;
     p.kind = FilterKind::Atrous;
@@ -269,17 +298,15 @@ TEST(Atrous, WhiteNoiseVarianceShrinksBySumOfSquaredWeights) {
     const double expected = sum_c2 * sum_c2;
     double sum_sq = 0;
     size_t count = 0;
+    double propagated = 0;
     for (int realization = 0; realization < 12; ++realization) {
-      Image hv = Image::rgb(N, N);
-      for (float& v : hv.pixels) v = noise(rng);
-      inputs.upload(lv, hv, var);
-      filter.run(inputs, guide_tex, p, test::kTestThreshold);
-      Image f = filter.filtered_image();
+      const FilterPass& filter = rig.run(p);
+      const Image f = filter.filtered_image();
+      propagated = filter.raw_variance_image().at(N / 2, N / 2, 0) / kNoiseVar;
       for (int y = margin; y < N - margin; ++y)
         for (int x = margin; x < N - margin; ++x, ++count) sum_sq += (f.at(x, y, 0) - 1.0) * (f.at(x, y, 0) - 1.0);
     }
     const double measured = sum_sq / count / kNoiseVar;
-    const double propagated = filter.raw_variance_image().at(N / 2, N / 2, 0) / kNoiseVar;
     const double per_pass = std::pow(70.0 / 256.0, 2);  // sum h^2 of the 5x5 kernel: (sum b3^2)^2
     const double uncorrected = std::pow(per_pass, passes);
     std::printf("sigma_s %g, %d passes: white-noise variance x %.3g measured, x %.3g expected (sum W^2), "
@@ -343,16 +370,9 @@ TEST(Subsampled, WhiteNoiseVarianceIsExactForTheWeightsUsed) {
   // so white noise of variance v comes out with variance v sum c^2 / (sum c)^2 per pixel, which is
   // the propagated Var[L_f] if duplicates are merged (a tap counted twice contributes 4 v, not 2 v).
   // Checked as the mean of (L_f - 1)^2 / Var[L_f] over pixels and realizations, which must be 1.
-  test::osmesa_context();
   constexpr int N = 96;
-  constexpr float kNoiseVar = 1.0f / 3.0f;  // uniform in [0, 2]
-  Image lv = Image::rgb(N, N), var = Image::gray(N, N, "Y", kNoiseVar), guide = Image::rgba(N, N, 0.5f);
-  PreviewInputs inputs(N, N);
-  Texture2D guide_tex(N, N, TextureFormat::RGBA32F);
-  guide_tex.upload(guide);
-  FilterPass filter(N, N);
-  std::mt19937 rng(11);
-  std::uniform_real_distribution<float> noise(0.0f, 2.0f);
+  constexpr float kNoiseVar = WhiteNoiseOnFlatGuide::kNoiseVar;
+  WhiteNoiseOnFlatGuide rig(N, 11);
   for (float sigma_s : {1.5f, 8.0f}) {
     FilterParams p;
     p.kind = FilterKind::Subsampled;
@@ -361,10 +381,7 @@ TEST(Subsampled, WhiteNoiseVarianceIsExactForTheWeightsUsed) {
     double ratio_sum = 0, independent_sum = 0;
     size_t count = 0;
     for (int realization = 0; realization < 12; ++realization) {
-      Image hv = Image::rgb(N, N);
-      for (float& v : hv.pixels) v = noise(rng);
-      inputs.upload(lv, hv, var);
-      filter.run(inputs, guide_tex, p, test::kTestThreshold);
+      const FilterPass& filter = rig.run(p);
       const Image f = filter.filtered_image(), vf = filter.raw_variance_image();
       const SubsampledTapTable table = subsampled_tap_table(sigma_s, kSubsampledTaps);
       for (int y = 0; y < N; ++y)
