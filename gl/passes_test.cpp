@@ -265,6 +265,7 @@ class WhiteNoiseOnFlatGuide {
     filter_.run(inputs_, guide_, p, test::kTestThreshold);
     return filter_;
   }
+  const FilterPass& filter() const { return filter_; }  // as the last run() left it
 
  private:
   GlContext& context_;  // first: the GL objects below need it current
@@ -298,15 +299,13 @@ TEST(Atrous, WhiteNoiseVarianceShrinksBySumOfSquaredWeights) {
     const double expected = sum_c2 * sum_c2;
     double sum_sq = 0;
     size_t count = 0;
-    double propagated = 0;
     for (int realization = 0; realization < 12; ++realization) {
-      const FilterPass& filter = rig.run(p);
-      const Image f = filter.filtered_image();
-      propagated = filter.raw_variance_image().at(N / 2, N / 2, 0) / kNoiseVar;
+      const Image f = rig.run(p).filtered_image();
       for (int y = margin; y < N - margin; ++y)
         for (int x = margin; x < N - margin; ++x, ++count) sum_sq += (f.at(x, y, 0) - 1.0) * (f.at(x, y, 0) - 1.0);
     }
     const double measured = sum_sq / count / kNoiseVar;
+    const double propagated = rig.filter().raw_variance_image().at(N / 2, N / 2, 0) / kNoiseVar;
     const double per_pass = std::pow(70.0 / 256.0, 2);  // sum h^2 of the 5x5 kernel: (sum b3^2)^2
     const double uncorrected = std::pow(per_pass, passes);
     std::printf("sigma_s %g, %d passes: white-noise variance x %.3g measured, x %.3g expected (sum W^2), "
