@@ -222,14 +222,27 @@ void LightSampler::find_parallelograms(size_t first, size_t end) {
     // Selection within a mesh goes by power, and power per area is the mesh's: the first
     // triangle's share of the pair is its share of the area.
     q.share_first = a.area / (a.area + b.area);
+    q.share_of[0] = q.share_first;
+    q.share_of[1] = 1.0f - q.share_first;
+    q.share_start[0] = 0.0f;
+    q.share_start[1] = q.share_first;
     q.rectangle = std::abs(glm::dot(q.edge_u, q.edge_v)) <= 1e-5f * glm::length(q.edge_u) * glm::length(q.edge_v);
     q.front = front_side(t, t + 2);
     q.inv_length2_u = 1.0f / glm::dot(q.edge_u, q.edge_u);
     q.inv_length2_v = 1.0f / glm::dot(q.edge_v, q.edge_v);
     q.diagonal2 = glm::dot(q.edge_u + q.edge_v, q.edge_u + q.edge_v);
-    for (int k = 0; k < 3; ++k) {
-      q.role[0][k] = static_cast<uint8_t>(k == c ? 0 : k == (c + 1) % 3 ? 1 : 2);
-      q.role[1][k] = static_cast<uint8_t>(k == d ? 0 : pb[k] == s1 ? 1 : 2);
+    // The pair's corners by role: 0 the triangle's own corner, 1 origin + edge_u, 2 origin + edge_v;
+    // their weights as affine functions (1, a, b) of the pair's coordinates, on either triangle.
+    // The first triangle is origin, +u, +v: weights 1 - a - b, a, b. The second is origin + u + v,
+    // +u, +v: weights a + b - 1, 1 - b, 1 - a.
+    constexpr float kRoleWeight[2][3][3] = {{{1, -1, -1}, {0, 1, 0}, {0, 0, 1}}, {{-1, 1, 1}, {1, 0, -1}, {1, -1, 0}}};
+    for (int k = 1; k < 3; ++k) {
+      const int role_a = k == c ? 0 : k == (c + 1) % 3 ? 1 : 2;
+      const int role_b = k == d ? 0 : pb[k] == s1 ? 1 : 2;
+      for (int j = 0; j < 3; ++j) {
+        q.bary_coef[0][k - 1][j] = kRoleWeight[0][role_a][j];
+        q.bary_coef[1][k - 1][j] = kRoleWeight[1][role_b][j];
+      }
     }
     triangles_[t].parallelogram = triangles_[t + 1].parallelogram = static_cast<int>(parallelograms_.size());
     parallelograms_.push_back(q);
@@ -238,14 +251,13 @@ void LightSampler::find_parallelograms(size_t first, size_t end) {
 }
 
 size_t LightSampler::pair_triangle(const Parallelogram& q, glm::vec2 uv, glm::vec2* barycentrics) const {
-  // Weights of the corners by role (own corner, origin + edge_u, origin + edge_v): the first
-  // triangle is origin, +u, +v; the second origin + u + v, +u, +v.
+  // Which triangle is a coin flip per sample: its coefficients are looked up, not branched on.
   const float a = uv.x, b = uv.y;
-  const bool first = a + b <= 1.0f;
-  const float w[3] = {first ? 1.0f - a - b : a + b - 1.0f, first ? a : 1.0f - b, first ? b : 1.0f - a};
-  const uint8_t* role = q.role[first ? 0 : 1];
-  *barycentrics = glm::clamp(glm::vec2(w[role[1]], w[role[2]]), 0.0f, 1.0f);  // of the triangle's corners 1 and 2
-  return first ? q.first : q.first + 1;
+  const int second = !(a + b <= 1.0f);
+  const float(*coef)[3] = q.bary_coef[second];
+  const float b1 = coef[0][0] + coef[0][1] * a + coef[0][2] * b, b2 = coef[1][0] + coef[1][1] * a + coef[1][2] * b;
+  *barycentrics = glm::vec2(std::min(std::max(b1, 0.0f), 1.0f), std::min(std::max(b2, 0.0f), 1.0f));
+  return q.first + static_cast<size_t>(second);
 }
 
 void LightSampler::build_near_field_clusters(const std::vector<float>& powers) {
@@ -364,8 +376,7 @@ size_t LightSampler::triangle_point(glm::vec3 from, float u_select, glm::vec2 u,
     const float share = q.share(i);
     // With the shared selection u.x spans the pair's contiguous share of the selection: [0, 1)
     // over both triangles, so the pair is sampled as one.
-    const glm::vec2 v(reuse_select ? std::min(i == q.first ? u.x * share : q.share_first + u.x * share, 0x1.fffffep-1f)
-                                   : u.x,
+    const glm::vec2 v(reuse_select ? std::min(q.share_start[i - q.first] + u.x * share, 0x1.fffffep-1f) : u.x,
                       u.y);
     SphericalRectangle sr;
     if (solid_angle_sampling(q, from, &sr)) {

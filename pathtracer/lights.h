@@ -99,12 +99,17 @@ class LightSampler {
     size_t first = 0;  // its first triangle; the second is first + 1
     glm::vec3 origin{0.0f}, edge_u{0.0f}, edge_v{0.0f};
     float share_first = 0.5f;  // the first triangle's share of the pair's selection probability
-    float share(size_t triangle) const { return triangle == first ? share_first : 1.0f - share_first; }
+    // Indexed by which triangle (0 first, 1 second): its share, and where its share starts in the
+    // pair's. Tables, not branches: which triangle a light sample lands in is a coin flip, and a
+    // branch on it was mispredicted half the time (docs/sampling.md).
+    float share_of[2] = {0.5f, 0.5f}, share_start[2] = {0.0f, 0.5f};
+    float share(size_t triangle) const { return share_of[triangle - first]; }
     bool rectangle = false;    // edges perpendicular: solid-angle sampling applies
     FrontSide front;
     float inv_length2_u = 0.0f, inv_length2_v = 0.0f, diagonal2 = 0.0f;
-    // Each triangle's corners (its own order) by role: 0 its own corner, 1 origin + edge_u, 2 origin + edge_v.
-    uint8_t role[2][3] = {{0, 1, 2}, {0, 1, 2}};
+    // The barycentrics of triangle s's corners 1 and 2 (its own order) at the pair's point
+    // origin + a edge_u + b edge_v: bary_coef[s][k] . (1, a, b), affine in (a, b) on each triangle.
+    float bary_coef[2][2][3] = {{{0, 1, 0}, {0, 0, 1}}, {{0, 1, 0}, {0, 0, 1}}};
   };
   // A rectangle large against its distance (squared diagonal at least kSolidAngleNearness times
   // the squared distance to its centre): there area sampling's density, which follows cos / r^2

@@ -135,7 +135,8 @@ inline float luminance(glm::vec3 c) { return 0.2126f * c.r + 0.7152f * c.g + 0.0
 inline bool is_finite(glm::vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 // Piecewise-constant distribution over n bins from non-negative weights (non-finite or negative
-// weights count as 0). Sampling is a binary search in the CDF; O(log n), no allocation.
+// weights count as 0). Sampling is a binary search in the CDF (a linear count for up to 8 bins);
+// O(log n), no allocation.
 class Distribution1D {
  public:
   Distribution1D() = default;
@@ -149,7 +150,7 @@ class Distribution1D {
 
   // Returns the bin and the position u' in [0,1) within the bin (reused as a fresh random number).
   size_t sample(float u, float* u_remapped = nullptr, float* pmf = nullptr) const {
-    size_t i = static_cast<size_t>(std::upper_bound(cdf_.begin(), cdf_.end(), u) - cdf_.begin());
+    size_t i = upper_bound_index(u);
     i = std::min(i == 0 ? size_t(0) : i - 1, pmf_.size() - 1);
     // Skip zero-probability bins that share a CDF value (u exactly on a boundary).
     while (pmf_[i] == 0.0f && i + 1 < pmf_.size()) ++i;
@@ -163,6 +164,17 @@ class Distribution1D {
   }
 
  private:
+  // std::upper_bound's index in cdf_. A few bins (a light's two triangles) are counted without
+  // branches: a binary search's branch there is a coin flip per sample, mispredicted half the time.
+  size_t upper_bound_index(float u) const {
+    if (cdf_.size() > kLinearScanEntries)
+      return static_cast<size_t>(std::upper_bound(cdf_.begin(), cdf_.end(), u) - cdf_.begin());
+    size_t count = 0;  // entries that are not above u: upper_bound's index in a sorted array
+    for (float c : cdf_) count += !(u < c);
+    return count;
+  }
+  static constexpr size_t kLinearScanEntries = 9;
+
   void build(const float* weights, size_t n) {
     pmf_.assign(n, 0.0f);
     cdf_.assign(n + 1, 0.0f);

@@ -1,0 +1,86 @@
+#include "pathtracer/sampling.h"
+
+#include <cmath>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+namespace pxf {
+namespace {
+
+// Bins of every size around the switch from the linear count to the binary search, with empty
+// bins first, inside and last; weights whose CDF lands on exact binary fractions so that u can
+// sit exactly on a boundary.
+std::vector<std::vector<float>> weight_sets() {
+  std::vector<std::vector<float>> sets;
+  for (size_t n = 1; n <= 12; ++n) {
+    std::vector<float> w(n);
+    for (size_t i = 0; i < n; ++i) w[i] = static_cast<float>((i * 7 + 3) % 5);  // 3 0 2 4 1 3 0 ...
+    if (n > 2) w.front() = 0.0f;
+    sets.push_back(w);
+  }
+  sets.push_back({1.0f, 0.0f, 1.0f, 2.0f});  // CDF 0, 1/4, 1/4, 1/2, 1
+  sets.push_back({0.0f, 0.0f, 4.0f, 0.0f, 4.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 8.0f, 0.0f});
+  return sets;
+}
+
+TEST(Distribution1D, SamplesEachBinInProportionToItsWeight) {
+  constexpr int kSteps = 1 << 14;
+  for (const std::vector<float>& weights : weight_sets()) {
+    SCOPED_TRACE(::testing::PrintToString(weights));
+    const Distribution1D dist(weights);
+    ASSERT_TRUE(dist.valid());
+    std::vector<int> counts(weights.size(), 0);
+    size_t previous = 0;
+    float previous_remapped = -1.0f;
+    for (int k = 0; k < kSteps; ++k) {
+      const float u = (k + 0.5f) / kSteps;
+      float remapped = -1.0f, pmf = -1.0f;
+      const size_t i = dist.sample(u, &remapped, &pmf);
+      ASSERT_LT(i, weights.size());
+      EXPECT_GT(weights[i], 0.0f) << "u " << u << " picked an empty bin";
+      EXPECT_EQ(pmf, dist.pmf(i));
+      EXPECT_GE(remapped, 0.0f);
+      EXPECT_LT(remapped, 1.0f);
+      EXPECT_GE(i, previous) << "u " << u << ": the bins must follow u in order";
+      if (i == previous) {
+        EXPECT_GE(remapped, previous_remapped) << "u " << u;
+      }
+      previous = i;
+      previous_remapped = remapped;
+      ++counts[i];
+    }
+    double total = 0.0;
+    for (float w : weights) total += w;
+    for (size_t i = 0; i < weights.size(); ++i)
+      EXPECT_NEAR(counts[i] / static_cast<double>(kSteps), weights[i] / total, 1.0 / kSteps) << "bin " << i;
+  }
+}
+
+TEST(Distribution1D, UOnABoundaryPicksTheBinThatStartsThere) {
+  const Distribution1D dist(std::vector<float>{1.0f, 0.0f, 1.0f, 2.0f});  // CDF 0, 1/4, 1/4, 1/2, 1
+  float remapped = -1.0f;
+  EXPECT_EQ(dist.sample(0.0f, &remapped), 0u);
+  EXPECT_EQ(remapped, 0.0f);
+  EXPECT_EQ(dist.sample(0.25f, &remapped), 2u);  // not the empty bin 1 that also starts at 1/4
+  EXPECT_EQ(remapped, 0.0f);
+  EXPECT_EQ(dist.sample(0.5f, &remapped), 3u);
+  EXPECT_EQ(remapped, 0.0f);
+  EXPECT_EQ(dist.sample(0x1.fffffep-1f, &remapped), 3u);
+  EXPECT_LT(remapped, 1.0f);
+}
+
+TEST(Distribution1D, NonFiniteUStillPicksABin) {
+  for (const std::vector<float>& weights : weight_sets()) {
+    const Distribution1D dist(weights);
+    for (float u : {std::nanf(""), std::numeric_limits<float>::infinity(), -1.0f, 2.0f}) {
+      float remapped = -1.0f;
+      const size_t i = dist.sample(u, &remapped);
+      EXPECT_LT(i, weights.size());
+      EXPECT_FALSE(remapped < 0.0f || remapped >= 1.0f) << "u " << u;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace pxf
