@@ -221,11 +221,11 @@ void LightSampler::find_parallelograms(size_t first, size_t end) {
     q.edge_v = s2 - pa[c];
     // Selection within a mesh goes by power, and power per area is the mesh's: the first
     // triangle's share of the pair is its share of the area.
-    q.share_first = a.area / (a.area + b.area);
-    q.share_of[0] = q.share_first;
-    q.share_of[1] = 1.0f - q.share_first;
+    const float share_first = a.area / (a.area + b.area);
+    q.share_of[0] = share_first;
+    q.share_of[1] = 1.0f - share_first;
     q.share_start[0] = 0.0f;
-    q.share_start[1] = q.share_first;
+    q.share_start[1] = share_first;
     q.rectangle = std::abs(glm::dot(q.edge_u, q.edge_v)) <= 1e-5f * glm::length(q.edge_u) * glm::length(q.edge_v);
     q.front = front_side(t, t + 2);
     q.inv_length2_u = 1.0f / glm::dot(q.edge_u, q.edge_u);

@@ -98,10 +98,10 @@ class LightSampler {
   struct Parallelogram {
     size_t first = 0;  // its first triangle; the second is first + 1
     glm::vec3 origin{0.0f}, edge_u{0.0f}, edge_v{0.0f};
-    float share_first = 0.5f;  // the first triangle's share of the pair's selection probability
-    // Indexed by which triangle (0 first, 1 second): its share, and where its share starts in the
-    // pair's. Tables, not branches: which triangle a light sample lands in is a coin flip, and a
-    // branch on it was mispredicted half the time (docs/sampling.md).
+    // Indexed by which triangle (0 first, 1 second): its share of the pair's selection probability,
+    // and where that share starts in the pair's. Tables, not branches: which triangle a light
+    // sample lands in is a coin flip, and a branch on it was mispredicted half the time
+    // (docs/sampling.md).
     float share_of[2] = {0.5f, 0.5f}, share_start[2] = {0.0f, 0.5f};
     float share(size_t triangle) const { return share_of[triangle - first]; }
     bool rectangle = false;    // edges perpendicular: solid-angle sampling applies
