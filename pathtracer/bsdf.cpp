@@ -40,6 +40,11 @@ BsdfParams eval_material(const Scene& scene, const Material& m, glm::vec2 uv0, g
   return p;
 }
 
+bool eval_material_is_constant(const Material& m) {  // the textures eval_material() reads
+  return constant(m.base_color_texture) && constant(m.metallic_roughness_texture) && constant(m.transmission_texture) &&
+         constant(m.specular_texture) && constant(m.specular_color_texture);
+}
+
 glm::vec3 eval_emission(const Scene& scene, const Material& m, glm::vec2 uv0, glm::vec2 uv1) {
   if (!m.is_emissive()) return glm::vec3(0.0f);
   return m.emissive * glm::vec3(eval_texture(scene, m.emissive_texture, uv0, uv1));
@@ -98,9 +103,33 @@ float fresnel_dielectric(float cos_i, float eta) {
   return 0.5f * (rs * rs + rp * rp);
 }
 
-Bsdf::Bsdf(const BsdfParams& params, glm::vec3 shading_normal, glm::vec3 geometric_normal, glm::vec3 wo,
-           bool front_face)
-    : p_(params), front_face_(front_face) {
+BsdfMaterial bsdf_material(const BsdfParams& params) {
+  BsdfMaterial k;
+  k.params = params;
+  const float m = params.metallic, t = params.transmission;
+  k.c_diffuse = (1.0f - m) * (1.0f - t);
+  k.c_glass = (1.0f - m) * t;
+  k.glossy_delta = params.roughness < kDeltaRoughness;
+  k.alpha = std::max(params.roughness * params.roughness, kMinAlpha);
+  const float r0 = (params.ior - 1.0f) / (params.ior + 1.0f);
+  k.f0_dielectric = glm::min(glm::vec3(r0 * r0) * params.specular_color, glm::vec3(1.0f)) * params.specular;
+  k.f90_dielectric = params.specular;
+  // metallic schlick(base, 1) + c_diffuse schlick(f0, f90), both f0 + (f90 - f0) schlick_weight.
+  k.fresnel_at_0 = m * params.base_color + k.c_diffuse * k.f0_dielectric;
+  k.fresnel_slope = m * (glm::vec3(1.0f) - params.base_color) + k.c_diffuse * (glm::vec3(k.f90_dielectric) - k.f0_dielectric);
+  k.diffuse_albedo = k.c_diffuse * params.base_color * kInvPi;
+  return k;
+}
+
+Bsdf::Bsdf(const BsdfMaterial& k, glm::vec3 shading_normal, glm::vec3 geometric_normal, glm::vec3 wo, bool front_face)
+    : base_color_(k.params.base_color),
+      ior_(k.params.ior),
+      alpha_(k.alpha),
+      glossy_delta_(k.glossy_delta),
+      front_face_(front_face),
+      c_glass_(k.c_glass),
+      fresnel_at_0_(k.fresnel_at_0),
+      fresnel_slope_(k.fresnel_slope) {
   ng_ = glm::dot(wo, geometric_normal) >= 0.0f ? geometric_normal : -geometric_normal;
   glm::vec3 ns = glm::dot(shading_normal, ng_) >= 0.0f ? shading_normal : -shading_normal;
   // Interpolated or mapped normals can put wo below the shading horizon: fall back to the face.
@@ -108,23 +137,11 @@ Bsdf::Bsdf(const BsdfParams& params, glm::vec3 shading_normal, glm::vec3 geometr
   frame_ = Frame::from_normal(ns);
   wo_local_ = frame_.to_local(wo);
   wo_local_.z = std::max(wo_local_.z, 1e-6f);
-
-  const float m = p_.metallic, t = p_.transmission;
-  const float c_diffuse = (1.0f - m) * (1.0f - t);
-  c_glass_ = (1.0f - m) * t;
-  glossy_delta_ = p_.roughness < kDeltaRoughness;
-  alpha_ = std::max(p_.roughness * p_.roughness, kMinAlpha);
   lambda_o_ = ggx_lambda(wo_local_, alpha_);
-  float r0 = (p_.ior - 1.0f) / (p_.ior + 1.0f);
-  const glm::vec3 f0_dielectric = glm::min(glm::vec3(r0 * r0) * p_.specular_color, glm::vec3(1.0f)) * p_.specular;
-  const float f90_dielectric = p_.specular;
-  // metallic schlick(base, 1) + c_diffuse schlick(f0, f90), both f0 + (f90 - f0) schlick_weight.
-  fresnel_at_0_ = m * p_.base_color + c_diffuse * f0_dielectric;
-  fresnel_slope_ = m * (glm::vec3(1.0f) - p_.base_color) + c_diffuse * (glm::vec3(f90_dielectric) - f0_dielectric);
 
   float cos_o = wo_local_.z;
-  glm::vec3 fd_o = schlick(f0_dielectric, f90_dielectric, cos_o);
-  diffuse_factor_ = c_diffuse * p_.base_color * kInvPi * (glm::vec3(1.0f) - fd_o);
+  glm::vec3 fd_o = schlick(k.f0_dielectric, k.f90_dielectric, cos_o);
+  diffuse_factor_ = k.diffuse_albedo * (glm::vec3(1.0f) - fd_o);
   float w_diffuse = std::max(0.0f, luminance(diffuse_factor_) * kPi);
   float w_glossy = std::max(0.0f, luminance(glossy_fresnel(cos_o)));
   float w_glass = std::max(0.0f, c_glass_);
@@ -209,7 +226,7 @@ bool Bsdf::sample(float u_lobe, glm::vec2 u, BsdfSample* out) const {
     return true;
   }
   // Smooth dielectric: reflect with probability F, else refract (tinted by the base color).
-  float eta = front_face_ ? p_.ior : 1.0f / p_.ior;  // eta_t / eta_i
+  float eta = front_face_ ? ior_ : 1.0f / ior_;  // eta_t / eta_i
   float cos_i = wo.z;
   float fresnel = fresnel_dielectric(cos_i, eta);
   glm::vec3 wi;
@@ -223,7 +240,7 @@ bool Bsdf::sample(float u_lobe, glm::vec2 u, BsdfSample* out) const {
     float cos_t = std::sqrt(std::max(0.0f, 1.0f - sin2_t));
     wi = -wo / eta + (cos_i / eta - cos_t) * glm::vec3(0.0f, 0.0f, 1.0f);
     // Radiance is compressed by eta^2 entering a denser medium (and expanded leaving it).
-    weight = p_.base_color * (c_glass_ / (p_glass_ * eta * eta));
+    weight = base_color_ * (c_glass_ / (p_glass_ * eta * eta));
     out->transmitted = true;
   }
   out->wi = glm::normalize(frame_.to_world(wi));

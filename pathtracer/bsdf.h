@@ -29,6 +29,9 @@ struct BsdfParams {
 // The material evaluated at a surface point: base color x texture x vertex color, etc.
 BsdfParams eval_material(const Scene& scene, const Material& material, glm::vec2 uv0, glm::vec2 uv1,
                          glm::vec4 vertex_color);
+// True when eval_material() reads no texture of the material: its parameters are then the same at
+// every point with a white vertex color.
+bool eval_material_is_constant(const Material& material);
 // Emitted radiance of the material's front side (emissive factor x emissive texture).
 glm::vec3 eval_emission(const Scene& scene, const Material& material, glm::vec2 uv0, glm::vec2 uv1);
 // Base color alpha x texture alpha x vertex alpha (for MASK cutouts).
@@ -38,6 +41,22 @@ float eval_opacity(const Scene& scene, const Material& material, glm::vec2 uv0, 
 inline glm::vec3 volume_transmittance(const Material& material, float distance) {
   return glm::exp(-material.attenuation * distance);
 }
+
+// What a Bsdf takes from its material's parameters alone, not from the shading point: computed
+// once per untextured material by the integrator (PathTracer::bsdf_material), per vertex otherwise.
+struct BsdfMaterial {
+  BsdfParams params;
+  float c_diffuse = 0.0f, c_glass = 0.0f;  // the diffuse and glass lobes' mixing coefficients
+  bool glossy_delta = false;               // roughness below kDeltaRoughness: a mirror lobe
+  float alpha = 1.0f;                      // GGX alpha
+  glm::vec3 f0_dielectric{0.0f};           // the dielectric specular's Schlick terms
+  float f90_dielectric = 1.0f;
+  // glossy_fresnel(c) = fresnel_at_0 + fresnel_slope (1 - c)^5: the metal's and the dielectric's
+  // Schlick terms share the power, so their sum is one line.
+  glm::vec3 fresnel_at_0{0.0f}, fresnel_slope{0.0f};
+  glm::vec3 diffuse_albedo{0.0f};  // c_diffuse * base / pi
+};
+BsdfMaterial bsdf_material(const BsdfParams& params);
 
 struct BsdfSample {
   glm::vec3 wi{0.0f};      // world space, unit
@@ -52,8 +71,11 @@ class Bsdf {
   Bsdf() = default;
   // shading_normal and geometric_normal: unit, any orientation (flipped to wo's side here);
   // front_face: wo is on the side the geometric normal points to (outside of a dielectric).
-  Bsdf(const BsdfParams& params, glm::vec3 shading_normal, glm::vec3 geometric_normal, glm::vec3 wo,
+  Bsdf(const BsdfMaterial& material, glm::vec3 shading_normal, glm::vec3 geometric_normal, glm::vec3 wo,
        bool front_face);
+  Bsdf(const BsdfParams& params, glm::vec3 shading_normal, glm::vec3 geometric_normal, glm::vec3 wo,
+       bool front_face)
+      : Bsdf(bsdf_material(params), shading_normal, geometric_normal, wo, front_face) {}
 
   glm::vec3 eval(glm::vec3 wi) const;  // f(wo, wi) |cos(wi)| of the non-delta lobes
   float pdf(glm::vec3 wi) const;       // combined pdf of the non-delta lobes
@@ -75,7 +97,8 @@ class Bsdf {
   Frame frame_{};
   glm::vec3 ng_{0.0f};      // geometric normal on wo's side
   glm::vec3 wo_local_{0.0f};
-  BsdfParams p_{};
+  glm::vec3 base_color_{1.0f};  // the glass lobe's tint
+  float ior_ = 1.5f;
   float alpha_ = 1.0f;
   float lambda_o_ = 0.0f;  // Smith Lambda(wo), fixed per shading point
   // Fixed per shading point, so eval_local() divides once per BSDF instead of once per call:
@@ -84,9 +107,7 @@ class Bsdf {
   bool glossy_delta_ = false;
   bool front_face_ = true;
   float c_glass_ = 0.0f;  // the glass lobe's mixing coefficient
-  // glossy_fresnel(c) = fresnel_at_0_ + fresnel_slope_ (1 - c)^5: the metal's and the dielectric's
-  // Schlick terms share the power, so their sum is one line.
-  glm::vec3 fresnel_at_0_{0.0f}, fresnel_slope_{0.0f};
+  glm::vec3 fresnel_at_0_{0.0f}, fresnel_slope_{0.0f};  // BsdfMaterial's
   glm::vec3 diffuse_factor_{0.0f};  // c_diffuse * base / pi * (1 - F_dielectric(cos_o))
   float p_diffuse_ = 0.0f, p_glossy_ = 0.0f, p_glass_ = 0.0f;  // lobe selection probabilities
   bool has_nondelta_ = false;

@@ -256,5 +256,45 @@ TEST(Bsdf, MaterialClassification) {
   EXPECT_FALSE(material_is_perfect_specular(make_diffuse(glm::vec3(0.5f))));
 }
 
+// The integrator precomputes the BSDF of a material that eval_material_is_constant() calls
+// constant. So every texture slot eval_material() reads must make it non-constant, and the ones
+// it does not read must not: each slot gets a texture whose two texels differ in every channel,
+// and eval_material at the two texels must differ exactly when the material is non-constant.
+TEST(Bsdf, ConstantMaterialIsOneWhoseParametersDoNotVaryOverTheSurface) {
+  Scene scene;
+  Texture two_texels;
+  two_texels.width = 2;
+  two_texels.height = 1;
+  two_texels.nearest = true;
+  two_texels.texels = {glm::vec4(0.9f, 0.8f, 0.7f, 0.6f), glm::vec4(0.3f, 0.2f, 0.1f, 0.4f)};
+  scene.textures = {two_texels};
+  Material base = make_diffuse(glm::vec3(0.5f));
+  base.metallic = 0.5f;
+  base.roughness = 0.5f;
+  base.transmission = 0.5f;
+  base.specular = 0.5f;
+  EXPECT_TRUE(eval_material_is_constant(base));
+  TextureRef Material::*const slots[] = {&Material::base_color_texture, &Material::metallic_roughness_texture,
+                                         &Material::normal_texture,     &Material::emissive_texture,
+                                         &Material::transmission_texture, &Material::specular_texture,
+                                         &Material::specular_color_texture};
+  const glm::vec2 left(0.25f, 0.5f), right(0.75f, 0.5f);
+  auto same = [](const BsdfParams& a, const BsdfParams& b) {
+    return a.base_color == b.base_color && a.metallic == b.metallic && a.roughness == b.roughness &&
+           a.transmission == b.transmission && a.ior == b.ior && a.specular == b.specular &&
+           a.specular_color == b.specular_color;
+  };
+  for (size_t i = 0; i < std::size(slots); ++i) {
+    Material m = base;
+    (m.*slots[i]).texture = 0;
+    const bool varies = !same(eval_material(scene, m, left, left, glm::vec4(1.0f)),
+                              eval_material(scene, m, right, right, glm::vec4(1.0f)));
+    EXPECT_EQ(eval_material_is_constant(m), !varies) << "texture slot " << i;
+  }
+  // A constant material's parameters are its factors exactly: what the integrator precomputes.
+  EXPECT_TRUE(same(eval_material(scene, base, left, right, glm::vec4(1.0f)),
+                   eval_material(scene, base, right, left, glm::vec4(1.0f))));
+}
+
 }  // namespace
 }  // namespace pxf

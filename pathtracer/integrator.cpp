@@ -145,6 +145,13 @@ struct PathTracer::ShadowQueue {
 bool PathSample::finite() const { return is_finite(lv) && is_finite(hv); }
 
 PathTracer::PathTracer(const Scene& scene) : geometry_(scene), lights_(scene) {
+  for (const Material& material : scene.materials) {
+    const bool constant = eval_material_is_constant(material);
+    constant_material_.push_back(constant);
+    constant_bsdf_materials_.push_back(
+        constant ? bsdf_material(eval_material(scene, material, glm::vec2(0.0f), glm::vec2(0.0f), glm::vec4(1.0f)))
+                 : BsdfMaterial{});
+  }
   for (const Mesh& mesh : scene.meshes)
     if (!mesh.triangles.empty() && material_is_perfect_specular(scene.materials[mesh.material])) {
       has_perfect_specular_ = true;
@@ -159,6 +166,14 @@ PathTracer::PathTracer(const Scene& scene) : geometry_(scene), lights_(scene) {
       target.radius *= 1.0001f;
       if (std::isfinite(target.radius) && target.radius > 0.0f) specular_targets_.push_back(target);
     }
+}
+
+const BsdfMaterial& PathTracer::bsdf_material_at(const SurfacePoint& sp, BsdfMaterial* scratch) const {
+  const Scene& scene = geometry_.scene();
+  const size_t index = static_cast<size_t>(sp.material - scene.materials.data());
+  if (constant_material_[index] && sp.color == glm::vec4(1.0f)) return constant_bsdf_materials_[index];
+  *scratch = bsdf_material(eval_material(scene, *sp.material, sp.uv0, sp.uv1, sp.color));
+  return *scratch;
 }
 
 namespace {
@@ -222,8 +237,10 @@ glm::vec3 PathTracer::specular_chain_light(const SurfacePoint& sp, const Bsdf& b
     // Emission at the first hit is D L (NEE and BSDF sampling); after a specular bounce it is D S+ L.
     if (v > vertex + 1 && emission_visible(material, q)) light += t * eval_emission(scene, material, q.uv0, q.uv1) * w;
     if (!material_is_perfect_specular(material) || v == params.max_vertices) break;
-    const BsdfParams p = eval_material(scene, material, q.uv0, q.uv1, q.color);
-    const Bsdf chain_bsdf(p, q.shading_normal, q.geometric_normal, -ray.direction, q.front_face);
+    BsdfMaterial scratch;
+    const BsdfMaterial& lobes = bsdf_material_at(q, &scratch);
+    const BsdfParams& p = lobes.params;
+    const Bsdf chain_bsdf(lobes, q.shading_normal, q.geometric_normal, -ray.direction, q.front_face);
     if (chain_bsdf.is_black()) break;
     float u_lobe;
     glm::vec2 u_dir;
@@ -349,8 +366,10 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
   if (last_vertex && s.albedo_set) return false;
 
   glm::vec3 wo = -path.ray.direction;
-  const BsdfParams bsdf_params = eval_material(scene, material, sp.uv0, sp.uv1, sp.color);
-  Bsdf bsdf(bsdf_params, sp.shading_normal, sp.geometric_normal, wo, sp.front_face);
+  BsdfMaterial scratch;
+  const BsdfMaterial& lobes = bsdf_material_at(sp, &scratch);
+  const BsdfParams& bsdf_params = lobes.params;
+  Bsdf bsdf(lobes, sp.shading_normal, sp.geometric_normal, wo, sp.front_face);
   if (!s.albedo_set && (bsdf.has_nondelta() || bsdf.is_black())) {
     out.albedo = bsdf_params.base_color;
     s.albedo_set = true;

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <vector>
 #include <glm/glm.hpp>
+#include "pathtracer/bsdf.h"
 #include "pathtracer/camera.h"
 #include "pathtracer/embree_scene.h"
 #include "pathtracer/lights.h"
@@ -108,8 +109,15 @@ class PathTracer {
                                  PathSampler& sampler, const TraceParams& params, uint32_t* rays,
                                  bool* through_glass) const;
 
+  // The BsdfMaterial at sp: the one precomputed for its material when eval_material() reads no
+  // texture of it and the vertex color is white (base color x 1 is exact, so the values are the
+  // same), else evaluated into *scratch.
+  const BsdfMaterial& bsdf_material_at(const SurfacePoint& sp, BsdfMaterial* scratch) const;
+
   EmbreeScene geometry_;
   LightSampler lights_;
+  std::vector<BsdfMaterial> constant_bsdf_materials_;  // per scene material, used where constant_material_
+  std::vector<bool> constant_material_;
   std::vector<SpecularTarget> specular_targets_;
   bool has_perfect_specular_ = false;
 };

@@ -643,6 +643,39 @@ TEST(Integrator, AlbedoIsTheFirstNonSpecularBaseColor) {
   expect_albedo(16, 2, glm::vec3(1.0f));               // the environment
 }
 
+// Where the BSDF comes from per vertex: precomputed for an untextured material, evaluated where a
+// texture or a vertex color varies it. Left: an untextured white quad with vertex colors (0.2, 0.4,
+// 0.6); middle: the same material without them; right: a base-color texture (0.7, 0.3, 0.1).
+TEST(Integrator, AlbedoFollowsVertexColorsAndTextures) {
+  Scene scene;
+  Texture texture;
+  texture.width = texture.height = 1;
+  texture.texels = {glm::vec4(0.7f, 0.3f, 0.1f, 1.0f)};
+  scene.textures = {texture};
+  Material textured = make_diffuse(glm::vec3(1.0f));
+  textured.base_color_texture.texture = 0;
+  scene.materials = {make_diffuse(glm::vec3(1.0f)), textured};
+  // The 48 x 16 view spans x in [-4.1, 4.1] at z = -2: the quads are 2.4 wide, centred on pixels
+  // 10, 24 and 38.
+  Mesh colored = make_quad(glm::vec3(-3.6f, -4, -2), glm::vec3(2.4f, 0, 0), glm::vec3(0, 8, 0), 0);
+  colored.colors.assign(colored.positions.size(), glm::vec4(0.2f, 0.4f, 0.6f, 1.0f));
+  scene.meshes = {colored, make_quad(glm::vec3(-1.2f, -4, -2), glm::vec3(2.4f, 0, 0), glm::vec3(0, 8, 0), 0),
+                  make_quad(glm::vec3(1.2f, -4, -2), glm::vec3(2.4f, 0, 0), glm::vec3(0, 8, 0), 1)};
+  scene.environment = uniform_environment(1.0f);
+  scene.camera = look_at_camera(glm::vec3(0), glm::vec3(0, 0, -1), glm::vec3(0, 1, 0), 1.2f);
+  TraceParams params;
+  params.threads = 2;
+  ProgressiveRenderer renderer(scene, params, 48, 16);
+  for (int i = 0; i < 4; ++i) renderer.add_frame();
+  const Image albedo = renderer.albedo_image();
+  auto expect_albedo = [&](int x, glm::vec3 expected) {
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(albedo.at(x, 8, c), expected[c], 1e-5f) << x << " " << c;
+  };
+  expect_albedo(10, glm::vec3(0.2f, 0.4f, 0.6f));
+  expect_albedo(24, glm::vec3(1.0f));
+  expect_albedo(38, glm::vec3(0.7f, 0.3f, 0.1f));
+}
+
 }  // namespace
 }  // namespace pxf
 
