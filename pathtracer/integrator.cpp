@@ -146,11 +146,12 @@ bool PathSample::finite() const { return is_finite(lv) && is_finite(hv); }
 
 PathTracer::PathTracer(const Scene& scene) : geometry_(scene), lights_(scene) {
   for (const Material& material : scene.materials) {
-    const bool constant = eval_material_is_constant(material);
-    constant_material_.push_back(constant);
-    constant_bsdf_materials_.push_back(
-        constant ? bsdf_material(eval_material(scene, material, glm::vec2(0.0f), glm::vec2(0.0f), glm::vec4(1.0f)))
-                 : BsdfMaterial{});
+    PrecomputedBsdfMaterial precomputed;
+    precomputed.constant = eval_material_is_constant(material);
+    if (precomputed.constant)
+      precomputed.material =
+          bsdf_material(eval_material(scene, material, glm::vec2(0.0f), glm::vec2(0.0f), glm::vec4(1.0f)));
+    precomputed_materials_.push_back(precomputed);
   }
   for (const Mesh& mesh : scene.meshes)
     if (!mesh.triangles.empty() && material_is_perfect_specular(scene.materials[mesh.material])) {
@@ -171,7 +172,8 @@ PathTracer::PathTracer(const Scene& scene) : geometry_(scene), lights_(scene) {
 const BsdfMaterial& PathTracer::bsdf_material_at(const SurfacePoint& sp, BsdfMaterial* scratch) const {
   const Scene& scene = geometry_.scene();
   const size_t index = static_cast<size_t>(sp.material - scene.materials.data());
-  if (constant_material_[index] && sp.color == glm::vec4(1.0f)) return constant_bsdf_materials_[index];
+  const PrecomputedBsdfMaterial& precomputed = precomputed_materials_[index];
+  if (precomputed.constant && sp.color == glm::vec4(1.0f)) return precomputed.material;
   *scratch = bsdf_material(eval_material(scene, *sp.material, sp.uv0, sp.uv1, sp.color));
   return *scratch;
 }

@@ -116,8 +116,11 @@ class PathTracer {
 
   EmbreeScene geometry_;
   LightSampler lights_;
-  std::vector<BsdfMaterial> constant_bsdf_materials_;  // per scene material, used where constant_material_
-  std::vector<bool> constant_material_;
+  struct PrecomputedBsdfMaterial {
+    bool constant = false;  // eval_material_is_constant: `material` holds its BsdfMaterial
+    BsdfMaterial material;
+  };
+  std::vector<PrecomputedBsdfMaterial> precomputed_materials_;  // per scene material
   std::vector<SpecularTarget> specular_targets_;
   bool has_perfect_specular_ = false;
 };
