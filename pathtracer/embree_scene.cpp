@@ -12,8 +12,9 @@
 namespace pxf {
 namespace {
 
+// Inlined: at every hit (position, normal, uvs), where a call cost about a third of its work.
 template <typename T>
-T interpolate(const std::vector<T>& attribute, const glm::uvec3& tri, float u, float v) {
+[[gnu::always_inline]] inline T interpolate(const std::vector<T>& attribute, const glm::uvec3& tri, float u, float v) {
   return attribute[tri.x] * (1.0f - u - v) + attribute[tri.y] * u + attribute[tri.z] * v;
 }
 

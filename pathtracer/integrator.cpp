@@ -286,6 +286,7 @@ template <bool kClassify>
 void PathTracer::trace_batch(const Camera& camera, int width, int height, const PixelRect& rect, int first, int count,
                              uint32_t frame, const TraceParams& params, PathSample* out, HvSampleClass* classes) const {
   const CameraRays camera_rays(camera, width, height);
+  const FrameSampling frame_sampling(params.seed, frame, params.replicates);
   Path paths[kBatchPaths];
   ClassState class_states[kClassify ? kBatchPaths : 1];
   if constexpr (kClassify)
@@ -299,7 +300,7 @@ void PathTracer::trace_batch(const Camera& camera, int width, int height, const 
     const uint64_t pixel = static_cast<uint64_t>(y) * static_cast<uint64_t>(width) + static_cast<uint64_t>(x);
     out[i] = PathSample{};
     Path& path = paths[i];
-    path.sampler = PathSampler(params.sampler, params.seed, pixel, frame, params.replicates);
+    path.sampler = PathSampler(params.sampler, frame_sampling, pixel);
     const glm::vec2 jitter = path.sampler.camera_jitter();  // box filter: uniform in the pixel
     path.ray = camera_rays(static_cast<float>(x) + jitter.x, static_cast<float>(y) + jitter.y);
     path.state = PathState{};

@@ -202,24 +202,38 @@ inline uint32_t scrambled_bits(uint32_t index, int dim, uint64_t key) {
 
 // The sampler of one path (one pixel, one frame). Calls follow the dimension table above; the
 // independent sampler ignores the dimension and draws in call order, as the integrator always did.
+// What the Sobol sampler derives from the frame alone, once per batch instead of once per path.
+struct FrameSampling {
+  FrameSampling(uint64_t seed, uint32_t frame, int replicates) : seed(seed), frame(frame) {
+    // One replicate (the default): no integer division.
+    const uint32_t k = replicates > 1 ? static_cast<uint32_t>(replicates) : 1u;
+    const uint32_t index = k == 1 ? frame : frame / k, replicate = k == 1 ? 0u : frame % k;
+    reversed_index = sobol::reverse_bits(index);
+    replicate_mix = mix64(replicate + 0xd6e8feb86659fd93ULL);
+    frame_mix = mix64(frame + 0x2545f4914f6cdd1dULL);
+  }
+  uint64_t seed;
+  uint32_t frame;
+  uint32_t reversed_index;  // the frame's index in its replicate, bit-reversed
+  uint64_t replicate_mix, frame_mix;
+};
+
 class PathSampler {
  public:
   PathSampler() = default;  // a placeholder: assign a seeded sampler before drawing
   PathSampler(SamplerType type, uint64_t seed, uint64_t pixel, uint32_t frame, int replicates)
-      : type_(type) {
+      : PathSampler(type, FrameSampling(seed, frame, replicates), pixel) {}
+  PathSampler(SamplerType type, const FrameSampling& f, uint64_t pixel) : type_(type) {
     if (type == SamplerType::Independent) {
       // The pixel stream's first two draws are the jitter; the path has a second stream.
-      camera_rng_ = Rng(seed, pixel, frame);
-      rng_ = Rng(seed ^ 0x5bd1e9955bd1e995ULL, pixel, frame);
+      camera_rng_ = Rng(f.seed, pixel, f.frame);
+      rng_ = Rng(f.seed ^ 0x5bd1e9955bd1e995ULL, pixel, f.frame);
       return;
     }
-    frame_ = frame;
-    // One replicate (the default): no integer division per path.
-    const uint32_t k = replicates > 1 ? static_cast<uint32_t>(replicates) : 1u;
-    const uint32_t index = k == 1 ? frame : frame / k, replicate = k == 1 ? 0u : frame % k;
-    reversed_index_ = sobol::reverse_bits(index);
-    key_ = mix64(seed * 0x9e3779b97f4a7c15ULL + mix64(pixel + 0x632be59bd9b4e019ULL));
-    key_ = mix64(key_ ^ mix64(replicate + 0xd6e8feb86659fd93ULL));
+    frame_mix_ = f.frame_mix;
+    reversed_index_ = f.reversed_index;
+    key_ = mix64(f.seed * 0x9e3779b97f4a7c15ULL + mix64(pixel + 0x632be59bd9b4e019ULL));
+    key_ = mix64(key_ ^ f.replicate_mix);
   }
 
   // From here on the path draws independent numbers (the vertices after its first non-delta
@@ -227,7 +241,7 @@ class PathSampler {
   void leave_qmc() {
     if (type_ != SamplerType::Sobol) return;
     type_ = SamplerType::Independent;
-    rng_ = Rng(key_ ^ mix64(frame_ + 0x2545f4914f6cdd1dULL));  // key_ holds only the replicate, not the frame
+    rng_ = Rng(key_ ^ frame_mix_);  // key_ holds only the replicate, not the frame
   }
   bool in_qmc() const { return type_ == SamplerType::Sobol; }
 
@@ -319,7 +333,7 @@ class PathSampler {
   Rng camera_rng_, rng_;
   uint32_t reversed_index_ = 0;  // the frame's index in its replicate, bit-reversed
   uint64_t key_ = 0;
-  uint32_t frame_ = 0;
+  uint64_t frame_mix_ = 0;  // FrameSampling::frame_mix
 };
 
 }  // namespace pxf
