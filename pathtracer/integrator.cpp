@@ -295,14 +295,21 @@ void PathTracer::trace_batch(const Camera& camera, int width, int height, const 
       class_states[i] = ClassState{};
       class_states[i].out = &classes[i];
     }
+  // Three passes over the batch, each a loop of independent iterations: the samplers' key hashes,
+  // then the jitters, then the camera rays. In one loop each path's chain of dependent hashes
+  // stalled the next; apart, the processor overlaps many paths' hashes.
+  glm::vec2 jitters[kBatchPaths];
   for (int i = 0; i < count; ++i) {
     const int x = rect.x0 + (first + i) % rect.width(), y = rect.y0 + (first + i) / rect.width();
     const uint64_t pixel = static_cast<uint64_t>(y) * static_cast<uint64_t>(width) + static_cast<uint64_t>(x);
+    paths[i].sampler = PathSampler(params.sampler, frame_sampling, pixel);
+  }
+  for (int i = 0; i < count; ++i) jitters[i] = paths[i].sampler.camera_jitter();  // box filter: uniform in the pixel
+  for (int i = 0; i < count; ++i) {
+    const int x = rect.x0 + (first + i) % rect.width(), y = rect.y0 + (first + i) / rect.width();
     out[i] = PathSample{};
     Path& path = paths[i];
-    path.sampler = PathSampler(params.sampler, frame_sampling, pixel);
-    const glm::vec2 jitter = path.sampler.camera_jitter();  // box filter: uniform in the pixel
-    path.ray = camera_rays(static_cast<float>(x) + jitter.x, static_cast<float>(y) + jitter.y);
+    path.ray = camera_rays(static_cast<float>(x) + jitters[i].x, static_cast<float>(y) + jitters[i].y);
     path.state = PathState{};
     path.out = &out[i];
   }
@@ -312,14 +319,21 @@ void PathTracer::trace_batch(const Camera& camera, int width, int height, const 
   for (int i = 0; i < count; ++i) live[i] = i;
   Ray rays[kBatchPaths];
   Hit hits[kBatchPaths];
+  PathSampler::VertexNumbers numbers[kBatchPaths];
   ShadowQueue shadows;
   for (int vertex = 2; vertex <= params.max_vertices && live_count > 0; ++vertex) {
     for (int k = 0; k < live_count; ++k) rays[k] = paths[live[k]].ray;
     geometry_.intersect(rays, static_cast<size_t>(live_count),
                         vertex == 2 ? RayCoherence::Coherent : RayCoherence::Incoherent, hits);
+    // The Sobol numbers of this vertex for every path still in QMC, before any is shaded (see
+    // PathSampler::vertex_numbers).
+    const bool roulette = vertex >= params.rr_start_vertex;
+    for (int k = 0; k < live_count; ++k)
+      if (paths[live[k]].sampler.in_qmc()) numbers[k] = paths[live[k]].sampler.vertex_numbers(vertex, roulette);
     int still_live = 0;
     for (int k = 0; k < live_count; ++k)
       if (shade_vertex<kClassify>(paths[live[k]], hits[k], vertex, params, shadows,
+                                  paths[live[k]].sampler.in_qmc() ? &numbers[k] : nullptr,
                                   kClassify ? &class_states[live[k]] : nullptr))
         live[still_live++] = live[k];
     live_count = still_live;
@@ -331,7 +345,7 @@ void PathTracer::trace_batch(const Camera& camera, int width, int height, const 
 // `shadows`) and the BSDF sample that continues the path into path.ray. False: the path ends here.
 template <bool kClassify>
 bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const TraceParams& params, ShadowQueue& shadows,
-                              [[maybe_unused]] ClassState* cls) const {
+                              const PathSampler::VertexNumbers* numbers, [[maybe_unused]] ClassState* cls) const {
   const Scene& scene = geometry_.scene();
   PathState& s = path.state;
   PathSample& out = *path.out;
@@ -380,7 +394,7 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
   if (last_vertex || bsdf.is_black()) return false;
 
   // Next event estimation (the light vertex is vertex + 1 <= max_vertices).
-  const PathSampler::LightNumbers u_light = sampler.light_numbers(vertex, bsdf.has_nondelta());
+  const PathSampler::LightNumbers u_light = numbers ? numbers->light : sampler.light_numbers(vertex, bsdf.has_nondelta());
   if (bsdf.has_nondelta()) {
     LightSample ls;
     if (u_light.shared ? lights_.sample(sp.position, u_light.point, &ls)
@@ -422,7 +436,7 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
 
   // Continue the path by sampling the BSDF.
   const bool roulette = vertex >= params.rr_start_vertex;
-  const PathSampler::BsdfNumbers u = sampler.bsdf_numbers(vertex, bsdf.has_lobe_choice(), roulette);
+  const PathSampler::BsdfNumbers u = numbers ? numbers->bsdf : sampler.bsdf_numbers(vertex, bsdf.has_lobe_choice(), roulette);
   BsdfSample bs;
   if (!bsdf.sample(u.lobe, u.direction, &bs)) return false;
   if constexpr (kClassify) {

@@ -95,7 +95,7 @@ class PathTracer {
                    uint32_t frame, const TraceParams& params, PathSample* out, HvSampleClass* classes) const;
   template <bool kClassify>
   bool shade_vertex(Path& path, const Hit& hit, int vertex, const TraceParams& params, ShadowQueue& shadows,
-                    ClassState* cls) const;
+                    const PathSampler::VertexNumbers* numbers, ClassState* cls) const;
 
   // Specular sampling (TraceParams::specular_sampling): the bounding spheres of the perfectly
   // specular meshes, the solid-angle pdf of a direction from p under it, and the light one sampled

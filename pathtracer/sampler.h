@@ -288,6 +288,25 @@ class PathSampler {
     return n;
   }
 
+  // Every Sobol number of vertex `vertex`'s light and BSDF samples, used or not (an unused one is
+  // never read): what light_numbers(vertex, true) and bsdf_numbers(vertex, true, roulette_used)
+  // return. For a whole batch in one loop before its vertex is shaded, where many paths' hash
+  // chains overlap (in shading each path's stalled the next). Sobol paths in QMC only.
+  struct VertexNumbers {
+    LightNumbers light;
+    BsdfNumbers bsdf;
+  };
+  VertexNumbers vertex_numbers(int vertex, bool roulette_used) const {
+    VertexNumbers n;
+    n.light.point = group(2 * vertex).unit_pair();
+    n.light.shared = true;
+    const sobol::ScrambledGroup g = group(2 * vertex + 1);
+    n.bsdf.direction = g.unit_pair();
+    n.bsdf.lobe = g.unit(2);
+    if (roulette_used) n.bsdf.roulette = g.unit(3);
+    return n;
+  }
+
   glm::vec2 camera_jitter() {
     if (type_ == SamplerType::Independent) return camera_rng_.next_2d();
     return group(0).unit_pair();

@@ -182,6 +182,30 @@ TEST(Sobol, IndependentSamplerKeepsTheOldStreams) {
   EXPECT_EQ(bsdf.roulette, path.next_float());
 }
 
+TEST(Sobol, VertexNumbersAreTheNumbersTheVertexWouldDraw) {
+  // The batch loop takes a vertex's Sobol numbers from vertex_numbers() before shading; they must
+  // be the ones light_numbers() and bsdf_numbers() give, bit for bit, on every vertex, pixel,
+  // frame and replicate count, with and without roulette.
+  for (int replicates : {1, 4})
+    for (uint32_t frame : {0u, 1u, 7u, 100u, 4097u})
+      for (uint64_t pixel : {0ull, 5ull, 123457ull})
+        for (int vertex : {2, 3, 6})
+          for (bool roulette : {false, true}) {
+            const PathSampler sampler(SamplerType::Sobol, 11, pixel, frame, replicates);
+            const PathSampler::VertexNumbers n = sampler.vertex_numbers(vertex, roulette);
+            PathSampler drawn = sampler;
+            const PathSampler::LightNumbers light = drawn.light_numbers(vertex, true);
+            const PathSampler::BsdfNumbers bsdf = drawn.bsdf_numbers(vertex, true, roulette);
+            const std::string where = "frame " + std::to_string(frame) + " pixel " + std::to_string(pixel) +
+                                      " vertex " + std::to_string(vertex);
+            EXPECT_EQ(n.light.point, light.point) << where;
+            EXPECT_EQ(n.light.shared, light.shared) << where;
+            EXPECT_EQ(n.bsdf.direction, bsdf.direction) << where;
+            EXPECT_EQ(n.bsdf.lobe, bsdf.lobe) << where;
+            EXPECT_EQ(n.bsdf.roulette, bsdf.roulette) << where;
+          }
+}
+
 TEST(Sobol, PathTailAfterLeavingQmcIsFreshEveryFrame) {
   // After leave_qmc() a path draws PCG32 numbers. The Sobol key holds the replicate, not the
   // frame, so the tail stream must take the frame in: over the frames of one pixel and replicate
