@@ -200,9 +200,7 @@ inline uint32_t scrambled_bits(uint32_t index, int dim, uint64_t key) {
 
 }  // namespace sobol
 
-// The sampler of one path (one pixel, one frame). Calls follow the dimension table above; the
-// independent sampler ignores the dimension and draws in call order, as the integrator always did.
-// What the Sobol sampler derives from the frame alone, once per batch instead of once per path.
+// What the samplers derive from the frame alone, once per batch instead of once per path.
 struct FrameSampling {
   FrameSampling(uint64_t seed, uint32_t frame, int replicates) : seed(seed), frame(frame) {
     // One replicate (the default): no integer division.
@@ -218,6 +216,8 @@ struct FrameSampling {
   uint64_t replicate_mix, frame_mix;
 };
 
+// The sampler of one path (one pixel, one frame). Calls follow the dimension table above; the
+// independent sampler ignores the dimension and draws in call order, as the integrator always did.
 class PathSampler {
  public:
   PathSampler() = default;  // a placeholder: assign a seeded sampler before drawing
