@@ -107,7 +107,7 @@ BsdfMaterial bsdf_material(const BsdfParams& params) {
   BsdfMaterial k;
   k.params = params;
   const float m = params.metallic, t = params.transmission;
-  k.c_diffuse = (1.0f - m) * (1.0f - t);
+  const float c_diffuse = (1.0f - m) * (1.0f - t);
   k.c_glass = (1.0f - m) * t;
   k.glossy_delta = params.roughness < kDeltaRoughness;
   k.alpha = std::max(params.roughness * params.roughness, kMinAlpha);
@@ -115,9 +115,9 @@ BsdfMaterial bsdf_material(const BsdfParams& params) {
   k.f0_dielectric = glm::min(glm::vec3(r0 * r0) * params.specular_color, glm::vec3(1.0f)) * params.specular;
   k.f90_dielectric = params.specular;
   // metallic schlick(base, 1) + c_diffuse schlick(f0, f90), both f0 + (f90 - f0) schlick_weight.
-  k.fresnel_at_0 = m * params.base_color + k.c_diffuse * k.f0_dielectric;
-  k.fresnel_slope = m * (glm::vec3(1.0f) - params.base_color) + k.c_diffuse * (glm::vec3(k.f90_dielectric) - k.f0_dielectric);
-  k.diffuse_albedo = k.c_diffuse * params.base_color * kInvPi;
+  k.fresnel_at_0 = m * params.base_color + c_diffuse * k.f0_dielectric;
+  k.fresnel_slope = m * (glm::vec3(1.0f) - params.base_color) + c_diffuse * (glm::vec3(k.f90_dielectric) - k.f0_dielectric);
+  k.diffuse_albedo = c_diffuse * params.base_color * kInvPi;
   return k;
 }
 

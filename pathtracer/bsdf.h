@@ -43,10 +43,10 @@ inline glm::vec3 volume_transmittance(const Material& material, float distance) 
 }
 
 // What a Bsdf takes from its material's parameters alone, not from the shading point: computed
-// once per untextured material by the integrator (PathTracer::bsdf_material), per vertex otherwise.
+// once per untextured material by the integrator (PathTracer::bsdf_material_at), per vertex otherwise.
 struct BsdfMaterial {
   BsdfParams params;
-  float c_diffuse = 0.0f, c_glass = 0.0f;  // the diffuse and glass lobes' mixing coefficients
+  float c_glass = 0.0f;                    // the glass lobe's mixing coefficient
   bool glossy_delta = false;               // roughness below kDeltaRoughness: a mirror lobe
   float alpha = 1.0f;                      // GGX alpha
   glm::vec3 f0_dielectric{0.0f};           // the dielectric specular's Schlick terms
@@ -54,7 +54,7 @@ struct BsdfMaterial {
   // glossy_fresnel(c) = fresnel_at_0 + fresnel_slope (1 - c)^5: the metal's and the dielectric's
   // Schlick terms share the power, so their sum is one line.
   glm::vec3 fresnel_at_0{0.0f}, fresnel_slope{0.0f};
-  glm::vec3 diffuse_albedo{0.0f};  // c_diffuse * base / pi
+  glm::vec3 diffuse_albedo{0.0f};  // c_diffuse * base / pi, c_diffuse = (1 - metallic)(1 - transmission)
 };
 BsdfMaterial bsdf_material(const BsdfParams& params);
 

@@ -224,8 +224,6 @@ void LightSampler::find_parallelograms(size_t first, size_t end) {
     const float share_first = a.area / (a.area + b.area);
     q.share_of[0] = share_first;
     q.share_of[1] = 1.0f - share_first;
-    q.share_start[0] = 0.0f;
-    q.share_start[1] = share_first;
     q.rectangle = std::abs(glm::dot(q.edge_u, q.edge_v)) <= 1e-5f * glm::length(q.edge_u) * glm::length(q.edge_v);
     q.front = front_side(t, t + 2);
     q.inv_length2_u = 1.0f / glm::dot(q.edge_u, q.edge_u);
@@ -376,7 +374,7 @@ size_t LightSampler::triangle_point(glm::vec3 from, float u_select, glm::vec2 u,
     const float share = q.share(i);
     // With the shared selection u.x spans the pair's contiguous share of the selection: [0, 1)
     // over both triangles, so the pair is sampled as one.
-    const glm::vec2 v(reuse_select ? std::min(q.share_start[i - q.first] + u.x * share, 0x1.fffffep-1f) : u.x,
+    const glm::vec2 v(reuse_select ? std::min(q.share_start(i) + u.x * share, 0x1.fffffep-1f) : u.x,
                       u.y);
     SphericalRectangle sr;
     if (solid_angle_sampling(q, from, &sr)) {

@@ -98,12 +98,13 @@ class LightSampler {
   struct Parallelogram {
     size_t first = 0;  // its first triangle; the second is first + 1
     glm::vec3 origin{0.0f}, edge_u{0.0f}, edge_v{0.0f};
-    // Indexed by which triangle (0 first, 1 second): its share of the pair's selection probability,
-    // and where that share starts in the pair's. Tables, not branches: which triangle a light
-    // sample lands in is a coin flip, and a branch on it was mispredicted half the time
-    // (docs/sampling.md).
-    float share_of[2] = {0.5f, 0.5f}, share_start[2] = {0.0f, 0.5f};
+    // Indexed by which triangle (0 first, 1 second): its share of the pair's selection probability.
+    // A table and index arithmetic, not branches: which triangle a light sample lands in is a coin
+    // flip, and a branch on it was mispredicted half the time (docs/sampling.md).
+    float share_of[2] = {0.5f, 0.5f};
     float share(size_t triangle) const { return share_of[triangle - first]; }
+    // Where the triangle's share starts in the pair's: 0 for the first, the first's share for the second.
+    float share_start(size_t triangle) const { return static_cast<float>(triangle - first) * share_of[0]; }
     bool rectangle = false;    // edges perpendicular: solid-angle sampling applies
     FrontSide front;
     float inv_length2_u = 0.0f, inv_length2_v = 0.0f, diagonal2 = 0.0f;
