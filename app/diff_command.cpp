@@ -4,10 +4,14 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <optional>
+
+#include <nlohmann/json.hpp>
 
 #include "app/cli.h"
 #include "app/commands.h"
+#include "gl/cpu_reference.h"
 #include "image/image.h"
 #include "image/metrics.h"
 
@@ -66,6 +70,78 @@ void write_display_images(const std::string& dir, const Image& test, const Image
   std::printf("wrote %s/test.png, reference.png, error.png (4 x |display difference|)\n", dir.c_str());
 }
 
+// The blend's settings of the render that wrote TEST (its stats.json beside it: threshold t and the
+// range sigmas of the variance pooling), else the defaults.
+struct BlendSettings {
+  float threshold = 0.001f;
+  FilterParams filter;
+  std::string source = "the defaults";
+};
+BlendSettings blend_settings_of(const std::string& buffers_path) {
+  BlendSettings b;
+  const std::filesystem::path stats = std::filesystem::path(buffers_path).parent_path() / "stats.json";
+  std::ifstream in(stats);
+  if (!in) return b;
+  const nlohmann::json json = nlohmann::json::parse(in, nullptr, false);
+  if (json.is_discarded() || !json.contains("settings")) return b;
+  const nlohmann::json& s = json["settings"];
+  b.threshold = s.value("threshold", b.threshold);
+  b.filter.sigma_c = s.value("sigma_c", b.filter.sigma_c);
+  b.filter.sigma_d = s.value("sigma_d", b.filter.sigma_d);
+  b.source = stats.string();
+  return b;
+}
+
+const Image& layer_of(const std::vector<Layer>& layers, const std::string& name, const std::string& path) {
+  try {
+    return layer_image(layers, name);
+  } catch (const Error&) {
+    throw Error(path + ": no '" + name + "' layer (--perfect-filter needs the buffers.exr of a render)");
+  }
+}
+
+Image plus(Image a, const Image& b) {
+  for (size_t i = 0; i < a.pixels.size(); ++i) a.pixels[i] += b.pixels[i];
+  return a;
+}
+
+void print_error_line(const char* label, const Image& test, const Image& reference, const DisplayMetricOptions& o) {
+  const DisplayMetrics m = compare_display(test, reference, nullptr, o);
+  std::printf("%s: HDR NRMSE %.4f %%  display NRMSE %.4f %%\n", label, m.hdr.nrmse_percent, m.display_nrmse_percent);
+}
+
+// --perfect-filter: where TEST's error comes from. The blend is run again on TEST's own buffers
+// with a perfect filter, L_f = REFERENCE's HV and Var[L_f] = 0, at TEST's threshold and sample
+// count: what remains is the noise the blend keeps at t and LV's error, the least any filter could
+// leave under this blend. Beside it TEST unfiltered (lv + hv) and TEST's LV with REFERENCE's HV
+// (LV's error alone), all against REFERENCE's final.
+void print_perfect_filter(const std::string& test_path, const std::string& reference_path,
+                          const DisplayMetricOptions& display) {
+  const std::vector<Layer> test = read_exr_layers(test_path), reference = read_exr_layers(reference_path);
+  const Image& lv = layer_of(test, "lv", test_path);
+  const Image& hv = layer_of(test, "hv", test_path);
+  const Image& samples = layer_of(test, "samples", test_path);
+  const Image& ref_final = layer_of(reference, "final", reference_path);
+  const Image& ref_hv = layer_of(reference, "hv", reference_path);
+  if (ref_hv.width != hv.width || ref_hv.height != hv.height)
+    throw Error(reference_path + ": " + std::to_string(ref_hv.width) + "x" + std::to_string(ref_hv.height) +
+                ", " + test_path + ": " + std::to_string(hv.width) + "x" + std::to_string(hv.height));
+  const BlendSettings settings = blend_settings_of(test_path);
+  const float spp = samples.pixels.empty() ? 0.0f : *std::max_element(samples.pixels.begin(), samples.pixels.end());
+  const float t = effective_threshold(settings.threshold, static_cast<uint64_t>(spp));
+  FilterOutput perfect;
+  perfect.filtered = ref_hv;
+  perfect.variance = Image::gray(hv.width, hv.height);
+  const BlendOutput blended =
+      cpu_blend(lv, hv, layer_of(test, "var_u", test_path), &perfect, t, BlendParams{range_weights(settings.filter)},
+                &layer_of(test, "range_color", test_path), &layer_of(test, "depth", test_path));
+  std::printf("perfect filter: t %g (%g at %.0f spp), sigma_c %g, sigma_d %g from %s\n", settings.threshold, t, spp,
+              settings.filter.sigma_c, settings.filter.sigma_d, settings.source.c_str());
+  print_error_line("blend with a perfect filter", blended.final_rgb, ref_final, display);
+  print_error_line("unfiltered (lv + hv)", plus(lv, hv), ref_final, display);
+  print_error_line("lv + reference hv", plus(lv, ref_hv), ref_final, display);
+}
+
 void print_display(const char* label, const DisplayMetrics& m, const OutlierMetrics& o) {
   std::printf("%s: HDR NRMSE %.4f %%  display NRMSE %.4f %%  FLIP %.6f  outliers (Y > 5x reference) %zu (%.4f %%)\n",
               label, m.hdr.nrmse_percent, m.display_nrmse_percent, m.flip_mean, o.outliers, 100.0 * o.fraction);
@@ -75,6 +151,7 @@ void print_display(const char* label, const DisplayMetrics& m, const OutlierMetr
 int run_diff(const Args& args) {
   std::string test_path, reference_path, layer, reference_layer, mask_path, images_dir;
   double max_nrmse = -1, max_flip = -1;
+  bool perfect_filter = false;
   DisplayMetricOptions display;
   CommandLine cli("diff", "TEST.exr REFERENCE.exr [options]",
                   "Prints NRMSE (% of the reference mean), RMSE, relative MSE, max |difference| and the\n"
@@ -95,6 +172,10 @@ int run_diff(const Args& args) {
   cli.option("--max-flip", &max_flip, "exit with code 1 when the mean FLIP (all pixels) is above this", 0.0, 1.0);
   cli.option("--images", &images_dir, "DIR",
              "write DIR/test.png, reference.png (display values) and error.png (4 x |difference|)");
+  cli.flag("--perfect-filter", &perfect_filter,
+           "TEST and REFERENCE are a render's and a reference render's buffers.exr: also the error of\n"
+           "TEST blended again with a perfect filter (L_f = REFERENCE's hv, Var[L_f] = 0; t and sigmas\n"
+           "from TEST's stats.json), of TEST unfiltered, and of TEST's lv with REFERENCE's hv");
   if (!cli.parse(args)) return 0;
   if (!cli.given("--reference-layer")) reference_layer = layer;
 
@@ -127,6 +208,7 @@ int run_diff(const Args& args) {
   } else {
     std::printf("display metrics: skipped, the images have no R,G,B channels\n");
   }
+  if (perfect_filter) print_perfect_filter(test_path, reference_path, display);
   if (max_nrmse >= 0 && m.nrmse_percent > max_nrmse) {
     std::fprintf(stderr, "pxf diff: NRMSE %.4f %% is above --max-nrmse %.4f %%\n", m.nrmse_percent, max_nrmse);
     return 1;

@@ -390,6 +390,34 @@ TEST(Cli, DiffReportsDisplayMetricsWithAndWithoutEmitters) {
   EXPECT_NE(bad.err.find("--images"), std::string::npos) << bad.err;
 }
 
+// --perfect-filter blends TEST's own buffers again with L_f = REFERENCE's HV and Var[L_f] = 0, at
+// the t of TEST's stats.json: with t huge every pixel keeps L_u (the unfiltered line), with t = 0
+// every pixel takes L_f (the lv + reference hv line). Square, so that the default camera sees no
+// background, where the blend's background rule keeps L_u = 0 whatever t.
+TEST(Cli, DiffPerfectFilterBlendsTheTestBuffersWithTheReferenceHv) {
+  const std::string keep = temp_dir("perfect_keep"), take = temp_dir("perfect_take"), ref = temp_dir("perfect_ref");
+  ASSERT_EQ(run("render --size 40x40 --spp 16 --threshold 1e6 --quiet --out " + keep).code, 0);
+  ASSERT_EQ(run("render --size 40x40 --spp 16 --threshold 0 --quiet --out " + take).code, 0);
+  ASSERT_EQ(run("render --size 40x40 --spp 64 --filter none --seed 9 --quiet --out " + ref).code, 0);
+  for (const std::string& dir : {keep, take}) {
+    const Result r = run("diff " + dir + "/buffers.exr " + ref + "/buffers.exr --perfect-filter");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.out.find("from " + dir + "/stats.json"), std::string::npos) << r.out;
+    const double perfect = number_after(r.out, "blend with a perfect filter:", "display NRMSE ");
+    const double unfiltered = number_after(r.out, "unfiltered (lv + hv):", "display NRMSE ");
+    const double lv_only = number_after(r.out, "lv + reference hv:", "display NRMSE ");
+    EXPECT_GT(unfiltered, 2 * lv_only) << r.out;  // 16 spp of HV noise against LV's
+    EXPECT_NEAR(perfect, dir == keep ? unfiltered : lv_only, 1e-4) << r.out;
+    EXPECT_NEAR(number_after(r.out, "blend with a perfect filter:", "HDR NRMSE "),
+                number_after(r.out, dir == keep ? "unfiltered (lv + hv):" : "lv + reference hv:", "HDR NRMSE "), 1e-4)
+        << r.out;
+  }
+  // A final.exr has no buffers: a clear error naming the file and the layer.
+  const Result bad = run("diff " + keep + "/final.exr " + ref + "/buffers.exr --perfect-filter");
+  EXPECT_EQ(bad.code, 1);
+  EXPECT_NE(bad.err.find(keep + "/final.exr: no 'lv' layer"), std::string::npos) << bad.err;
+}
+
 // ---------------------------------------------------------------------------------------------
 // Issue 12: very bright but finite input still gives a finished render with finite layers.
 
