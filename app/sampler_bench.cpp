@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "core/timing.h"
+#include "image/metrics.h"
 
 namespace pxf {
 namespace {
@@ -27,6 +28,23 @@ TraceParams with_sampler(TraceParams params, SamplerType type, uint64_t seed) {
   return params;
 }
 
+// Squared errors summed over seeds: the unfiltered image's, LV's (and on the pixels that see an
+// emitter), HV's (and on each image's worst 1 % of pixels, where fireflies sit).
+struct ErrorSums {
+  double all = 0, lv = 0, lv_emitters = 0, hv = 0, hv_worst = 0;
+  void add(const ProgressiveRenderer& r, const Image& reference_all, const Image& reference_lv,
+           const Image& reference_hv, const Image& emitters) {
+    all += total_squared_error(pixel_squared_errors(r.unfiltered_image(), reference_all));
+    const std::vector<double> lv_errors = pixel_squared_errors(r.lv_image(), reference_lv);
+    lv += total_squared_error(lv_errors);
+    lv_emitters += masked_squared_error(lv_errors, emitters);
+    const std::vector<double> hv_errors = pixel_squared_errors(r.hv_image(), reference_hv);
+    const double hv_total = total_squared_error(hv_errors);
+    hv += hv_total;
+    hv_worst += hv_total * worst_pixels_share(hv_errors, 0.01);
+  }
+};
+
 // paths/s of a renderer over `frames` frames (after the caller's warm-up).
 double paths_per_second(ProgressiveRenderer& renderer, int frames) {
   const uint64_t before = renderer.stats().paths;
@@ -46,17 +64,19 @@ void run_sampler_error_bench(const SamplerBenchSetup& b, int reference_spp, cons
   std::printf("%s %dx%d: reference %d spp in %.1f s\n", b.scene_name.c_str(), b.width, b.height, reference_spp,
               elapsed_ms(start) / 1000);
   const Image reference_all = reference.unfiltered_image(), reference_lv = reference.lv_image(),
-              reference_hv = reference.hv_image();
+              reference_hv = reference.hv_image(), emitters = reference.emitter_coverage_image();
   const int max_spp = *std::max_element(spps.begin(), spps.end());
 
   // One seed's NRMSE is dominated by the few fireflies it happens to catch: the figures are the
   // root mean square over `seeds` seeds (the NRMSE of the expected squared error).
   std::ostringstream csv;
-  csv << "scene,sampler,spp,seeds,nrmse_percent,lv_nrmse_percent,hv_nrmse_percent\n";
+  csv << "scene,sampler,spp,seeds,nrmse_percent,lv_nrmse_percent,hv_nrmse_percent,lv_share,lv_emitter_share,hv_share,"
+         "hv_worst1_share\n";
   std::printf("RMS over %d seeds; LV and HV each against the reference's own LV and HV mean\n", seeds);
   std::printf("%-12s %6s %14s %14s %14s\n", "sampler", "spp", "NRMSE %", "LV NRMSE %", "HV NRMSE %");
   constexpr size_t kMaxSpps = 16;
   double square[2][3][kMaxSpps] = {};  // [sampler][all, LV, HV][spp]: sum over seeds of NRMSE^2
+  ErrorSums sums[2][kMaxSpps] = {};
   for (int s = 0; s < 2; ++s) {
     for (int seed = 0; seed < seeds; ++seed) {
       ProgressiveRenderer renderer(b.scene, with_sampler(b.trace, kSamplers[s], b.trace.seed + 100 * seed), b.width,
@@ -70,6 +90,7 @@ void run_sampler_error_bench(const SamplerBenchSetup& b, int reference_spp, cons
                              compare_images(renderer.lv_image(), reference_lv).nrmse_percent,
                              compare_images(renderer.hv_image(), reference_hv).nrmse_percent};
         for (int c = 0; c < 3; ++c) square[s][c][k] += e[c] * e[c];
+        sums[s][k].add(renderer, reference_all, reference_lv, reference_hv, emitters);
       }
     }
   }
@@ -79,13 +100,24 @@ void run_sampler_error_bench(const SamplerBenchSetup& b, int reference_spp, cons
       for (int c = 0; c < 3; ++c) nrmse[s][c][k] = std::sqrt(square[s][c][k] / seeds);
       std::printf("%-12s %6d %14.2f %14.2f %14.2f\n", sampler_name(kSamplers[s]), spps[k], nrmse[s][0][k],
                   nrmse[s][1][k], nrmse[s][2][k]);
+      const ErrorSums& e = sums[s][k];
       csv << b.scene_name << "," << sampler_name(kSamplers[s]) << "," << spps[k] << "," << seeds << ","
-          << nrmse[s][0][k] << "," << nrmse[s][1][k] << "," << nrmse[s][2][k] << "\n";
+          << nrmse[s][0][k] << "," << nrmse[s][1][k] << "," << nrmse[s][2][k] << "," << e.lv / e.all << ","
+          << e.lv_emitters / e.all << "," << e.hv / e.all << "," << e.hv_worst / e.all << "\n";
     }
   for (size_t k = 0; k < spps.size() && k < kMaxSpps; ++k)
     std::printf("%d spp: sobol / independent NRMSE %.3f, LV %.3f, HV %.3f\n", spps[k], nrmse[1][0][k] / nrmse[0][0][k],
                 nrmse[1][1][k] / nrmse[0][1][k], nrmse[1][2][k] / nrmse[0][2][k]);
   write_csv(b.out + "/sampler_error_" + b.scene_name + ".csv", csv.str());
+  std::printf("where the squared error sits, summed over the seeds (%% of the unfiltered image's): LV's and HV's\n"
+              "own; of LV's, the pixels that see an emitter (its edges); of HV's, each image's worst 1 %% of pixels\n");
+  std::printf("%-12s %6s %10s %16s %10s %16s\n", "sampler", "spp", "LV", "emitter pixels", "HV", "worst 1 %");
+  for (int s = 0; s < 2; ++s)
+    for (size_t k = 0; k < spps.size() && k < kMaxSpps; ++k) {
+      const ErrorSums& e = sums[s][k];
+      std::printf("%-12s %6d %9.1f%% %15.1f%% %9.1f%% %15.1f%%\n", sampler_name(kSamplers[s]), spps[k],
+                  100 * e.lv / e.all, 100 * e.lv_emitters / e.all, 100 * e.hv / e.all, 100 * e.hv_worst / e.all);
+    }
 
   // Throughput: both samplers in one process, alternating rounds; the median of each.
   std::vector<double> rate[2];

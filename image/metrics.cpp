@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 
 #include "image/flip.h"
 #include "image/image.h"
@@ -77,6 +78,46 @@ ImageMetrics compare_images(const Image& test, const Image& reference, const Ima
   m.nrmse_percent = m.reference_mean > 0 ? 100.0 * m.rmse / m.reference_mean : (m.rmse > 0 ? INFINITY : 0.0);
   m.rel_mse = sum_rel / n;
   return m;
+}
+
+std::vector<double> pixel_squared_errors(const Image& test, const Image& reference) {
+  check_same_size(test, reference, "image");
+  const auto pairs = shared_channels(test, reference);
+  if (pairs.empty()) throw Error("the images share no color channel");
+  const size_t tn = test.channels.size(), rn = reference.channels.size();
+  std::vector<double> errors(reference.pixel_count(), 0.0);
+  for (size_t p = 0; p < errors.size(); ++p)
+    for (auto [t, r] : pairs) {
+      const double d = static_cast<double>(test.pixels[p * tn + t]) - reference.pixels[p * rn + r];
+      if (std::isfinite(d)) errors[p] += d * d;
+    }
+  return errors;
+}
+
+double worst_pixels_share(std::vector<double> squared_errors, double fraction) {
+  const double total = total_squared_error(squared_errors);
+  if (!(total > 0)) return 0.0;
+  const size_t count = std::min(squared_errors.size(),
+                                static_cast<size_t>(std::ceil(std::clamp(fraction, 0.0, 1.0) * squared_errors.size())));
+  std::nth_element(squared_errors.begin(), squared_errors.begin() + count, squared_errors.end(), std::greater<>());
+  double worst = 0;
+  for (size_t i = 0; i < count; ++i) worst += squared_errors[i];
+  return worst / total;
+}
+
+double masked_squared_error(const std::vector<double>& squared_errors, const Image& mask) {
+  if (mask.pixel_count() != squared_errors.size() || mask.channels.empty())
+    throw Error("the mask does not match the image");
+  double sum = 0;
+  for (size_t p = 0; p < squared_errors.size(); ++p)
+    if (mask.pixels[p * mask.channels.size()] > 0) sum += squared_errors[p];
+  return sum;
+}
+
+double total_squared_error(const std::vector<double>& squared_errors) {
+  double sum = 0;
+  for (double e : squared_errors) sum += e;
+  return sum;
 }
 
 std::string format_metrics(const ImageMetrics& m) {

@@ -48,4 +48,15 @@ struct OutlierMetrics {
 OutlierMetrics count_outliers(const Image& test, const Image& reference, const Image* mask = nullptr,
                               const OutlierOptions& options = {}, std::vector<size_t>* where = nullptr);
 
+// Where the squared error sits. Per pixel, |test - reference|^2 summed over the shared color
+// channels (non-finite samples left out, as compare_images does).
+std::vector<double> pixel_squared_errors(const Image& test, const Image& reference);
+// The share of the summed squared error carried by the ceil(fraction * pixels) pixels with the
+// largest errors: near `fraction` for noise spread evenly, near 1 for a few fireflies. 0 without error.
+double worst_pixels_share(std::vector<double> squared_errors, double fraction);
+// The summed squared error of the pixels the mask selects (mask > 0; a mask, like the emitter
+// layer, whose pixels are the ones of interest), and of all pixels.
+double masked_squared_error(const std::vector<double>& squared_errors, const Image& mask);
+double total_squared_error(const std::vector<double>& squared_errors);
+
 }  // namespace pxf

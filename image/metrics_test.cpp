@@ -129,3 +129,26 @@ TEST(OutlierMetrics, NonFiniteAndMask) {
   EXPECT_THROW(count_outliers(Image::gray(3, 1), ref), Error);
   EXPECT_EQ(count_outliers(test, Image::rgb(3, 1, NAN)).pixels, 0u);
 }
+
+// The squared error per pixel, the share of its worst pixels and of a mask's pixels.
+TEST(ErrorConcentration, WorstPixelsAndMaskShares) {
+  Image reference = Image::rgb(10, 10, 1.0f), test = reference;
+  for (int i = 0; i < 100; ++i) test.at(i % 10, i / 10, 0) += 0.1f;  // noise spread evenly: 0.01 per pixel
+  test.at(3, 4, 1) += 3.0f;                                          // one firefly: 9
+  test.at(5, 5, 2) = NAN;                                            // left out
+  const std::vector<double> e = pixel_squared_errors(test, reference);
+  ASSERT_EQ(e.size(), 100u);
+  EXPECT_NEAR(e[4 * 10 + 3], 9.01, 1e-5);
+  EXPECT_NEAR(e[5 * 10 + 5], 0.01, 1e-6);
+  EXPECT_NEAR(total_squared_error(e), 10.0, 1e-4);
+  EXPECT_NEAR(worst_pixels_share(e, 0.01), 0.901, 1e-5);         // the firefly's pixel
+  EXPECT_NEAR(worst_pixels_share(e, 0.02), 0.902, 1e-5);         // and one more
+  EXPECT_NEAR(worst_pixels_share(e, 0.001), 0.901, 1e-5);        // at least one pixel
+  EXPECT_NEAR(worst_pixels_share(e, 1.0), 1.0, 1e-12);
+  EXPECT_EQ(worst_pixels_share(pixel_squared_errors(reference, reference), 0.01), 0.0);
+  Image mask = Image::gray(10, 10);
+  mask.at(3, 4, 0) = 0.25f;
+  mask.at(0, 0, 0) = 1.0f;
+  EXPECT_NEAR(masked_squared_error(e, mask), 9.02, 1e-5);
+  EXPECT_THROW(masked_squared_error(e, Image::gray(5, 5)), Error);
+}

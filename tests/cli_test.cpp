@@ -17,6 +17,7 @@
 #include <map>
 #include <random>
 #include <set>
+#include <sstream>
 #include <nlohmann/json.hpp>
 #include <thread>
 
@@ -236,6 +237,35 @@ TEST(Cli, BenchVariantsTabulatesEveryFilterVariant) {
   }
   EXPECT_EQ(lines(csv), rows.size() + 2);  // the header and the unfiltered row
   EXPECT_TRUE(fs::exists(out + "/variants.svg"));
+}
+
+// The sampler-error bench: a row per sampler and spp, and where the squared error sits (shares of the
+// unfiltered image's: LV's, of which the emitter pixels', HV's, of which its worst 1 % of pixels').
+TEST(Cli, BenchSamplerErrorSaysWhereTheErrorSits) {
+  const std::string out = temp_dir("sampler_error");
+  const Result r = run("bench --pathtracer --sampler-error --size 24x24 --seeds 2 --spp 2,4 --reference-spp 32 "
+                       "--rounds 1 --out " + out);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("where the squared error sits"), std::string::npos) << r.out;
+  std::istringstream csv(slurp(out + "/sampler_error_cornell.csv"));
+  std::string line;
+  std::getline(csv, line);
+  EXPECT_EQ(line.substr(line.rfind(',') + 1), "hv_worst1_share");
+  int rows = 0;
+  while (std::getline(csv, line)) {
+    std::vector<double> v;
+    std::istringstream fields(line.substr(line.find(',', line.find(',') + 1) + 1));  // after scene, sampler
+    for (std::string f; std::getline(fields, f, ',');) v.push_back(std::stod(f));
+    ASSERT_EQ(v.size(), 9u) << line;  // spp, seeds, 3 NRMSE, 4 shares
+    const double lv = v[5], lv_emitters = v[6], hv = v[7], hv_worst = v[8];
+    EXPECT_GT(lv_emitters, 0.0) << line;  // the ceiling light is in view, its edges are noisy
+    EXPECT_LE(lv_emitters, lv + 1e-12) << line;
+    EXPECT_GT(hv_worst, 0.0) << line;
+    EXPECT_LE(hv_worst, hv + 1e-12) << line;
+    EXPECT_LT(lv + hv, 1.5) << line;  // LV's and HV's error share the image's, up to their cross term
+    ++rows;
+  }
+  EXPECT_EQ(rows, 4);  // two samplers at two sample counts
 }
 
 TEST(Cli, RenderWithTimeStopsByItselfAndFinishes) {
