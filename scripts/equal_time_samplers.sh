@@ -7,7 +7,11 @@
 # the Sobol / independent ratios of the medians.
 # Usage: scripts/equal_time_samplers.sh REFERENCE_DIR [SECONDS] [ROUNDS] [SCENES...]
 #   REFERENCE_DIR holds reference_<scene>_384x216_2048spp.exr for every scene (as `pxf bench
-#   --scene S --size 384x216 --reference-spp 2048 --out DIR` writes it: another seed, unfiltered).
+#   --scene S --size 384x216 --reference-spp 2048 --out DIR` writes it: another seed, unfiltered),
+#   or <scene>/buffers.exr, a reference render's output (`pxf render --scene S --size 384x216
+#   --spp 2048 --seed 7 --filter none --out DIR/S`). With the buffers, each filtered job is also
+#   blended again with a perfect filter (`pxf diff --perfect-filter`: L_f = the reference's HV),
+#   the least error any filter could leave under the blend.
 #   Defaults: 2 s, 3 rounds, cornell atrium kitchen envmap.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -23,7 +27,8 @@ trap 'rm -rf "$tmp"' EXIT
 echo "scene round sampler filter spp hdr_nrmse display_nrmse" | tee "$tmp/runs"
 for scene in "${scenes[@]}"; do
   ref="$refs/reference_${scene}_384x216_2048spp.exr"
-  [ -f "$ref" ] || { echo "missing $ref" >&2; exit 2; }
+  [ -f "$refs/$scene/buffers.exr" ] && ref="$refs/$scene/buffers.exr"
+  [ -f "$ref" ] || { echo "missing $ref (or $refs/$scene/buffers.exr)" >&2; exit 2; }
   for round in $(seq "$rounds"); do
     # Alternate which sampler goes first: on a shared machine the first jobs of a round can run
     # at another speed than the last ones.
@@ -39,6 +44,12 @@ for scene in "${scenes[@]}"; do
         hdr=$(sed -E 's/.*HDR NRMSE ([0-9.]+).*/\1/' <<<"$line")
         display=$(sed -E 's/.*display NRMSE ([0-9.]+).*/\1/' <<<"$line")
         echo "$scene $round $sampler $filter $spp $hdr $display" | tee -a "$tmp/runs"
+        if [ "$filter" = grid ] && [ "${ref##*/}" = buffers.exr ]; then
+          line=$("$pxf" diff "$out/buffers.exr" "$ref" --perfect-filter | grep '^blend with a perfect filter')
+          hdr=$(sed -E 's/.*HDR NRMSE ([0-9.]+).*/\1/' <<<"$line")
+          display=$(sed -E 's/.*display NRMSE ([0-9.]+).*/\1/' <<<"$line")
+          echo "$scene $round $sampler perfect $spp $hdr $display" | tee -a "$tmp/runs"
+        fi
       done
     done
   done
@@ -54,15 +65,16 @@ for scene, rnd, sampler, filt, spp, hdr, disp in rows:
 med = {k: [statistics.median(v[i] for v in vals) for i in range(3)] for k, vals in runs.items()}
 print("\nmedians over rounds; ratio = sobol / independent of the medians")
 print("%-10s %-8s %16s %22s %22s" % ("scene", "filter", "spp sobol/indep", "HDR % (ratio)", "display % (ratio)"))
+filters = [f for f in ("none", "grid", "perfect") if any(r[3] == f for r in rows)]
 for scene in dict.fromkeys(r[0] for r in rows):
-    for filt in ("none", "grid"):
+    for filt in filters:
         s, i = med[(scene, "sobol", filt)], med[(scene, "independent", filt)]
         print("%-10s %-8s %7.0f / %-7.0f %7.2f/%-6.2f (%.2f) %7.2f/%-6.2f (%.2f)" %
               (scene, filt, s[0], i[0], s[1], i[1], s[1] / i[1], s[2], i[2], s[2] / i[2]))
 # The same rounds paired (one seed, both samplers back to back): how far single rounds spread.
 print("\nper-round ratios sobol / independent: median [min - max]")
 for scene in dict.fromkeys(r[0] for r in rows):
-    for filt in ("none", "grid"):
+    for filt in filters:
         pairs = [v for (sc, f, _), v in paired.items() if sc == scene and f == filt and len(v) == 2]
         cells = []
         for k, name in ((0, "HDR"), (1, "display")):
