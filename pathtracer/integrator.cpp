@@ -115,12 +115,14 @@ struct PathTracer::ShadowQueue {
     glm::vec3 contribution;  // added when the shadow ray reaches the light
     bool lv;
   };
-  ShadowRay rays[kBatchPaths];
-  Pending pending[kBatchPaths];
-  bool occluded[kBatchPaths];
+  // Per path and vertex: the chosen light's shadow ray and one per sun.
+  static constexpr size_t kCapacity = kBatchPaths * (1 + LightSampler::kMaxSuns);
+  ShadowRay rays[kCapacity];
+  Pending pending[kCapacity];
+  bool occluded[kCapacity];
   // Firefly attribution only (trace_pixels_classified): each pending contribution's sample and class.
-  HvSampleClass* class_out[kBatchPaths];
-  HvClass classes[kBatchPaths];
+  HvSampleClass* class_out[kCapacity];
+  HvClass classes[kCapacity];
   int count = 0;
 
   void push(const ShadowRay& ray, const Pending& contribution) {
@@ -396,25 +398,27 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
   // Next event estimation (the light vertex is vertex + 1 <= max_vertices).
   const PathSampler::LightNumbers u_light = numbers ? numbers->light : sampler.light_numbers(vertex, bsdf.has_nondelta());
   if (bsdf.has_nondelta()) {
-    LightSample ls;
-    if (u_light.shared ? lights_.sample(sp.position, u_light.point, &ls)
-                       : lights_.sample(sp.position, u_light.select, u_light.point, &ls)) {
+    // The light sample: the chosen light, then every sun (LightSampler::kMaxSuns).
+    const auto queue_light = [&](const LightSample& ls) {
       float bsdf_pdf;
       glm::vec3 f = bsdf.eval(ls.wi, &bsdf_pdf);
-      if (max_component(f) > 0.0f && max_component(ls.radiance) > 0.0f) {
-        ShadowRay ray = std::isinf(ls.distance)
-                            ? ShadowRay{offset_ray_origin(sp.position, sp.geometric_normal, ls.wi), ls.wi, ls.distance}
-                            : shadow_ray_between(sp.position, sp.geometric_normal, ls.point, ls.normal);
-        ++out.rays;
-        float w = ls.delta ? 1.0f : power_heuristic(ls.pdf, bsdf_pdf);
-        if constexpr (kClassify) {
-          shadows.class_out[shadows.count] = cls->out;
-          shadows.classes[shadows.count] = cls->classify(s.nonspecular, false);
-        }
-        shadows.push(ray,
-                     {&out, s.throughput * f * ls.radiance * (w / ls.pdf), s.nonspecular == 0});
+      if (!(max_component(f) > 0.0f && max_component(ls.radiance) > 0.0f)) return;
+      ShadowRay ray = std::isinf(ls.distance)
+                          ? ShadowRay{offset_ray_origin(sp.position, sp.geometric_normal, ls.wi), ls.wi, ls.distance}
+                          : shadow_ray_between(sp.position, sp.geometric_normal, ls.point, ls.normal);
+      ++out.rays;
+      float w = ls.delta ? 1.0f : power_heuristic(ls.pdf, bsdf_pdf);
+      if constexpr (kClassify) {
+        shadows.class_out[shadows.count] = cls->out;
+        shadows.classes[shadows.count] = cls->classify(s.nonspecular, false);
       }
-    }
+      shadows.push(ray, {&out, s.throughput * f * ls.radiance * (w / ls.pdf), s.nonspecular == 0});
+    };
+    LightSample ls;
+    if (u_light.shared ? lights_.sample(sp.position, u_light.point, &ls)
+                       : lights_.sample(sp.position, u_light.select, u_light.point, &ls))
+      queue_light(ls);
+    for (size_t sun = 0; sun < lights_.sun_count(); ++sun) queue_light(lights_.sun_sample(sun));
   }
 
   // Specular sampling: light through a specular chain, which NEE cannot reach (HV: D S+ L).

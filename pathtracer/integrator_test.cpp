@@ -278,39 +278,49 @@ PixelStats sample_pixels(const PathTracer& tracer, const Camera& camera, int siz
 }
 
 TEST(Integrator, PowerBasedLightSelectionKeepsTheExpectation) {
-  // A diffuse plane under a uniform sky (L = 1) and a sun straight down (E = 2): the lights get
-  // unequal shares (sky 4 pi : sun 2), and the radiance stays albedo / pi x (pi L + E). Z-test on
-  // the image mean; the per-frame variance overestimates the Sobol mean's, so |z| < 4 is safe.
-  Scene scene;
-  scene.materials = {make_diffuse(glm::vec3(0.6f))};
-  scene.meshes.push_back(make_quad(glm::vec3(-50, 0, 50), glm::vec3(100, 0, 0), glm::vec3(0, 0, -100), 0));
-  scene.environment = uniform_environment(1.0f);
-  PunctualLight sun;
-  sun.type = PunctualLight::Type::Directional;
-  sun.direction = glm::vec3(0, -1, 0);
-  sun.intensity = 2.0f;
-  scene.lights.push_back(sun);
-  scene.camera = look_at_camera(glm::vec3(0, 2, 0.01f), glm::vec3(0, 0, 0), glm::vec3(0, 0, -1), 0.8f);
-  PathTracer tracer(scene);
-  // 1e-2: the 8 x 4 sky's power is a midpoint sum over 4 rows.
-  ASSERT_NEAR(tracer.lights().environment_probability(), 4 * kPi / (4 * kPi + 2), 1e-2);
-  const double expected = 0.6 * (1.0 + 2.0 / kPi);
-  for (SamplerType sampler : {SamplerType::Sobol, SamplerType::Independent}) {
-    TraceParams params = furnace_params();
-    params.sampler = sampler;
-    double lv_total;
-    const int size = 8, spp = 64;
-    PixelStats st = sample_pixels(tracer, scene.camera, size, spp, params, &lv_total);
-    double sum = 0, var_sum = 0;
-    for (int p = 0; p < size * size; ++p) {
-      const double m = st.sum[p] / spp;
-      sum += m;
-      var_sum += (st.sum2[p] / spp - m * m) / (spp - 1);  // Var of the pixel mean
+  // A diffuse plane under a uniform sky (L = 1) and suns straight down (E = 2 in all): the radiance
+  // is albedo / pi x (pi L + E) however the light is sampled. One sun or two: each sampled at every
+  // vertex beside the chosen light (a sun counted twice would add 0.6 x 2 / pi); five, above
+  // kMaxSuns: chosen among the lights by power (sky 4 pi : suns 2). Z-test on the image mean; the
+  // per-frame variance overestimates the Sobol mean's, so |z| < 4 is safe.
+  for (int suns : {1, 2, 5}) {
+    Scene scene;
+    scene.materials = {make_diffuse(glm::vec3(0.6f))};
+    scene.meshes.push_back(make_quad(glm::vec3(-50, 0, 50), glm::vec3(100, 0, 0), glm::vec3(0, 0, -100), 0));
+    scene.environment = uniform_environment(1.0f);
+    PunctualLight sun;
+    sun.type = PunctualLight::Type::Directional;
+    sun.direction = glm::vec3(0, -1, 0);
+    sun.intensity = 2.0f / static_cast<float>(suns);
+    for (int k = 0; k < suns; ++k) scene.lights.push_back(sun);
+    scene.camera = look_at_camera(glm::vec3(0, 2, 0.01f), glm::vec3(0, 0, 0), glm::vec3(0, 0, -1), 0.8f);
+    PathTracer tracer(scene);
+    if (suns <= static_cast<int>(LightSampler::kMaxSuns)) {
+      ASSERT_EQ(tracer.lights().sun_count(), static_cast<size_t>(suns));
+      ASSERT_EQ(tracer.lights().environment_probability(), 1.0f);
+    } else {
+      ASSERT_EQ(tracer.lights().sun_count(), 0u);
+      // 1e-2: the 8 x 4 sky's power is a midpoint sum over 4 rows.
+      ASSERT_NEAR(tracer.lights().environment_probability(), 4 * kPi / (4 * kPi + 2), 1e-2);
     }
-    const double mean = sum / (size * size), se = std::sqrt(var_sum) / (size * size);
-    const double z = (mean - expected) / se;
-    EXPECT_LT(std::abs(z), 4.0) << "mean " << mean << " expected " << expected << " se " << se;
-    std::printf("sampler %d: mean %.5f expected %.5f z %.2f\n", int(sampler), mean, expected, z);
+    const double expected = 0.6 * (1.0 + 2.0 / kPi);
+    for (SamplerType sampler : {SamplerType::Sobol, SamplerType::Independent}) {
+      TraceParams params = furnace_params();
+      params.sampler = sampler;
+      double lv_total;
+      const int size = 8, spp = 64;
+      PixelStats st = sample_pixels(tracer, scene.camera, size, spp, params, &lv_total);
+      double sum = 0, var_sum = 0;
+      for (int p = 0; p < size * size; ++p) {
+        const double m = st.sum[p] / spp;
+        sum += m;
+        var_sum += (st.sum2[p] / spp - m * m) / (spp - 1);  // Var of the pixel mean
+      }
+      const double mean = sum / (size * size), se = std::sqrt(var_sum) / (size * size);
+      const double z = (mean - expected) / se;
+      EXPECT_LT(std::abs(z), 4.0) << suns << " suns, mean " << mean << " expected " << expected << " se " << se;
+      std::printf("%d suns, sampler %d: mean %.5f expected %.5f z %.2f\n", suns, int(sampler), mean, expected, z);
+    }
   }
 }
 

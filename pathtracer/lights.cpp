@@ -137,7 +137,11 @@ LightSampler::LightSampler(const Scene& scene) : scene_(scene) {
   }
   for (const PunctualLight& light : scene.lights)
     if (light.intensity > 0.0f && std::isfinite(light.intensity) && max_component(light.color) > 0.0f)
-      punctual_.push_back(&light);
+      (light.type == PunctualLight::Type::Directional ? suns_ : punctual_).push_back(&light);
+  if (suns_.size() > kMaxSuns) {  // many directional lights: chosen among the punctual ones, as any other
+    punctual_.insert(punctual_.end(), suns_.begin(), suns_.end());
+    suns_.clear();
+  }
 
   bool has_tri = triangle_dist_.valid(), has_env = env_ != nullptr, has_punctual = !punctual_.empty();
   category_count_ = int(has_tri) + int(has_env) + int(has_punctual);
@@ -490,6 +494,17 @@ float LightSampler::pdf_environment(glm::vec3 direction) const {
 glm::vec3 LightSampler::environment_radiance(glm::vec3 direction) const {
   if (!env_) return glm::vec3(0.0f);
   return glm::vec3(sample_texture(env_->image, equirect_uv(direction))) * env_->strength;
+}
+
+LightSample LightSampler::sun_sample(size_t index) const {
+  const PunctualLight& sun = *suns_[index];
+  LightSample out;
+  out.wi = -glm::normalize(sun.direction);
+  out.distance = kInf;
+  out.radiance = sun.color * sun.intensity;
+  out.pdf = 1.0f;
+  out.delta = true;
+  return out;
 }
 
 bool LightSampler::sample_punctual(glm::vec3 position, float u_select, LightSample* out) const {

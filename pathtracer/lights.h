@@ -3,6 +3,8 @@
 // (luminance x sin(theta) importance sampling on the equirect image) and KHR punctual lights
 // (delta lights, NEE only). One light sample per call: a category
 // (triangles / environment / punctual) is picked first, in proportion to its estimated power.
+// Directional lights (suns; at most kMaxSuns) are not in that choice: every vertex samples each of
+// them besides (sun_sample), one shadow ray each and no random number (docs/sampling.md).
 #pragma once
 #include <limits>
 #include <vector>
@@ -29,7 +31,7 @@ class LightSampler {
  public:
   explicit LightSampler(const Scene& scene);
 
-  bool empty() const { return category_count_ == 0; }  // nothing emits: the image is black
+  bool empty() const { return category_count_ == 0 && suns_.empty(); }  // nothing emits: the image is black
   bool has_environment() const { return env_ != nullptr; }
 
   bool sample(glm::vec3 position, float u_select, glm::vec2 u, LightSample* out) const;
@@ -123,6 +125,14 @@ class LightSampler {
   }
   const Parallelogram& parallelogram(size_t index) const { return parallelograms_[index]; }
 
+  // Directional lights sampled at every vertex, outside the category choice: with up to this many
+  // the scene is lit by a sun or two (the case measured), and a sun costs one shadow ray and no
+  // random number. More keep their place in the punctual category.
+  static constexpr size_t kMaxSuns = 4;
+  size_t sun_count() const { return suns_.size(); }
+  // Sun `index`'s sample: its direction, radiance (E), pdf 1 (always taken), delta.
+  LightSample sun_sample(size_t index) const;
+
   // Category selection probabilities and the power estimates they come from.
   float triangles_probability() const { return p_triangles_; }
   float environment_probability() const { return p_environment_; }
@@ -179,6 +189,7 @@ class LightSampler {
   const Environment* env_ = nullptr;
   Distribution2D env_dist_;
   std::vector<const PunctualLight*> punctual_;
+  std::vector<const PunctualLight*> suns_;  // sampled at every vertex (kMaxSuns)
   // Category selection: [0, p_tri) triangles, [p_tri, p_tri + p_env) environment, rest punctual.
   float p_triangles_ = 0.0f, p_environment_ = 0.0f, p_punctual_ = 0.0f;
   double power_triangles_ = 0.0, power_environment_ = 0.0, power_punctual_ = 0.0;
