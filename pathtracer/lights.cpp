@@ -496,29 +496,33 @@ glm::vec3 LightSampler::environment_radiance(glm::vec3 direction) const {
   return glm::vec3(sample_texture(env_->image, equirect_uv(direction))) * env_->strength;
 }
 
-LightSample LightSampler::sun_sample(size_t index) const {
-  const PunctualLight& sun = *suns_[index];
+namespace {
+// A directional light's sample, the same from every point: towards where its light comes from, at
+// infinity, irradiance E x colour; `pdf` the probability it was taken with.
+LightSample directional_sample(const PunctualLight& light, float pdf) {
   LightSample out;
-  out.wi = -glm::normalize(sun.direction);
+  out.wi = -glm::normalize(light.direction);
   out.distance = kInf;
-  out.radiance = sun.color * sun.intensity;
-  out.pdf = 1.0f;
+  out.radiance = light.color * light.intensity;
+  out.pdf = pdf;
   out.delta = true;
   return out;
 }
+}  // namespace
+
+LightSample LightSampler::sun_sample(size_t index) const { return directional_sample(*suns_[index], 1.0f); }
 
 bool LightSampler::sample_punctual(glm::vec3 position, float u_select, LightSample* out) const {
   size_t index = std::min(static_cast<size_t>(u_select * punctual_.size()), punctual_.size() - 1);
   const PunctualLight& light = *punctual_[index];
-  glm::vec3 power = light.color * light.intensity;
-  out->delta = true;
-  out->pdf = p_punctual_ / static_cast<float>(punctual_.size());
+  const float pdf = p_punctual_ / static_cast<float>(punctual_.size());
   if (light.type == PunctualLight::Type::Directional) {
-    out->wi = -glm::normalize(light.direction);
-    out->distance = kInf;
-    out->radiance = power;
+    *out = directional_sample(light, pdf);
     return true;
   }
+  glm::vec3 power = light.color * light.intensity;
+  out->delta = true;
+  out->pdf = pdf;
   glm::vec3 d = light.position - position;
   float dist2 = glm::dot(d, d);
   if (!(dist2 > 0.0f)) return false;
