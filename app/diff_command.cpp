@@ -100,11 +100,6 @@ const Image& layer_of(const std::vector<Layer>& layers, const std::string& name,
   }
 }
 
-Image plus(Image a, const Image& b) {
-  for (size_t i = 0; i < a.pixels.size(); ++i) a.pixels[i] += b.pixels[i];
-  return a;
-}
-
 void print_error_line(const char* label, const Image& test, const Image& reference, const DisplayMetricOptions& o) {
   const DisplayMetrics m = compare_display(test, reference, nullptr, o);
   std::printf("%s: HDR NRMSE %.4f %%  display NRMSE %.4f %%\n", label, m.hdr.nrmse_percent, m.display_nrmse_percent);
@@ -138,8 +133,8 @@ void print_perfect_filter(const std::string& test_path, const std::string& refer
   std::printf("perfect filter: t %g (%g at %.0f spp), sigma_c %g, sigma_d %g from %s\n", settings.threshold, t, spp,
               settings.filter.sigma_c, settings.filter.sigma_d, settings.source.c_str());
   print_error_line("blend with a perfect filter", blended.final_rgb, ref_final, display);
-  print_error_line("unfiltered (lv + hv)", plus(lv, hv), ref_final, display);
-  print_error_line("lv + reference hv", plus(lv, ref_hv), ref_final, display);
+  print_error_line("unfiltered (lv + hv)", sum_of(lv, hv), ref_final, display);
+  print_error_line("lv + reference hv", sum_of(lv, ref_hv), ref_final, display);
 }
 
 void print_display(const char* label, const DisplayMetrics& m, const OutlierMetrics& o) {

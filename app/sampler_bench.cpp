@@ -32,13 +32,13 @@ TraceParams with_sampler(TraceParams params, SamplerType type, uint64_t seed) {
 // emitter), HV's (and on each image's worst 1 % of pixels, where fireflies sit).
 struct ErrorSums {
   double all = 0, lv = 0, lv_emitters = 0, hv = 0, hv_worst = 0;
-  void add(const ProgressiveRenderer& r, const Image& reference_all, const Image& reference_lv,
-           const Image& reference_hv, const Image& emitters) {
-    all += total_squared_error(pixel_squared_errors(r.unfiltered_image(), reference_all));
-    const std::vector<double> lv_errors = pixel_squared_errors(r.lv_image(), reference_lv);
+  // The images (unfiltered, LV, HV) and their references, in that order.
+  void add(const Image (&test)[3], const Image (&reference)[3], const Image& emitters) {
+    all += total_squared_error(pixel_squared_errors(test[0], reference[0]));
+    const std::vector<double> lv_errors = pixel_squared_errors(test[1], reference[1]);
     lv += total_squared_error(lv_errors);
     lv_emitters += masked_squared_error(lv_errors, emitters);
-    const std::vector<double> hv_errors = pixel_squared_errors(r.hv_image(), reference_hv);
+    const std::vector<double> hv_errors = pixel_squared_errors(test[2], reference[2]);
     const double hv_total = total_squared_error(hv_errors);
     hv += hv_total;
     hv_worst += hv_total * worst_pixels_share(hv_errors, 0.01);
@@ -63,8 +63,9 @@ void run_sampler_error_bench(const SamplerBenchSetup& b, int reference_spp, cons
   for (int i = 0; i < reference_spp; ++i) reference.add_frame();
   std::printf("%s %dx%d: reference %d spp in %.1f s\n", b.scene_name.c_str(), b.width, b.height, reference_spp,
               elapsed_ms(start) / 1000);
-  const Image reference_all = reference.unfiltered_image(), reference_lv = reference.lv_image(),
-              reference_hv = reference.hv_image(), emitters = reference.emitter_coverage_image();
+  // Unfiltered, LV, HV.
+  const Image references[3] = {reference.unfiltered_image(), reference.lv_image(), reference.hv_image()};
+  const Image emitters = reference.emitter_coverage_image();
   const int max_spp = *std::max_element(spps.begin(), spps.end());
 
   // One seed's NRMSE is dominated by the few fireflies it happens to catch: the figures are the
@@ -86,11 +87,12 @@ void run_sampler_error_bench(const SamplerBenchSetup& b, int reference_spp, cons
         const auto it = std::find(spps.begin(), spps.end(), frame);
         if (it == spps.end() || it - spps.begin() >= static_cast<long>(kMaxSpps)) continue;
         const size_t k = static_cast<size_t>(it - spps.begin());
-        const double e[3] = {compare_images(renderer.unfiltered_image(), reference_all).nrmse_percent,
-                             compare_images(renderer.lv_image(), reference_lv).nrmse_percent,
-                             compare_images(renderer.hv_image(), reference_hv).nrmse_percent};
-        for (int c = 0; c < 3; ++c) square[s][c][k] += e[c] * e[c];
-        sums[s][k].add(renderer, reference_all, reference_lv, reference_hv, emitters);
+        const Image images[3] = {renderer.unfiltered_image(), renderer.lv_image(), renderer.hv_image()};
+        for (int c = 0; c < 3; ++c) {
+          const double e = compare_images(images[c], references[c]).nrmse_percent;
+          square[s][c][k] += e * e;
+        }
+        sums[s][k].add(images, references, emitters);
       }
     }
   }

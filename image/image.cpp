@@ -27,6 +27,13 @@ int Image::channel_index(const std::string& name) const {
   return it == channels.end() ? -1 : static_cast<int>(it - channels.begin());
 }
 
+Image sum_of(Image a, const Image& b) {
+  if (a.width != b.width || a.height != b.height || a.channels != b.channels)
+    throw Error("sum_of: the images differ in size or channels");
+  for (size_t i = 0; i < a.pixels.size(); ++i) a.pixels[i] += b.pixels[i];
+  return a;
+}
+
 Image Image::select(const std::vector<std::string>& names) const {
   std::vector<int> source;
   for (const auto& name : names) {

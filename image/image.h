@@ -32,6 +32,10 @@ struct Image {
   Image select(const std::vector<std::string>& names) const;
 };
 
+// a + b, sample by sample (LV + HV = the unfiltered image); throws pxf::Error unless both have the
+// same size and channels.
+Image sum_of(Image a, const Image& b);
+
 // A named layer of a multi-layer EXR; channels are stored as "<layer>.<channel>" ("" = no prefix).
 struct Layer {
   std::string name;

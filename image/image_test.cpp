@@ -321,3 +321,14 @@ TEST(ImageMetrics, IgnoresAlphaAndRejectsMismatches) {
   EXPECT_THROW(compare_images(Image::rgb(2, 1), Image::rgb(1, 1)), Error);
   EXPECT_THROW(compare_images(Image::gray(1, 1, "Z"), Image::rgb(1, 1)), Error);
 }
+
+TEST(Image, SumOfAddsSampleBySampleAndChecksTheShape) {
+  Image a = Image::rgb(2, 1, 1.0f), b = Image::rgb(2, 1, 0.5f);
+  b.at(1, 0, 2) = 3.0f;
+  const Image s = sum_of(a, b);
+  EXPECT_EQ(s.channels, a.channels);
+  EXPECT_EQ(s.at(0, 0, 0), 1.5f);
+  EXPECT_EQ(s.at(1, 0, 2), 4.0f);
+  EXPECT_THROW(sum_of(a, Image::rgb(1, 2)), Error);
+  EXPECT_THROW(sum_of(a, Image::gray(2, 1)), Error);
+}

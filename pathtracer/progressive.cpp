@@ -177,12 +177,7 @@ Image ProgressiveRenderer::variance_image() const {
   return image;
 }
 
-Image ProgressiveRenderer::unfiltered_image() const {
-  Image sum = lv_image();
-  const Image hv = hv_image();
-  for (size_t i = 0; i < sum.pixels.size(); ++i) sum.pixels[i] += hv.pixels[i];
-  return sum;
-}
+Image ProgressiveRenderer::unfiltered_image() const { return sum_of(lv_image(), hv_image()); }
 
 Image ProgressiveRenderer::samples_image() const {
   Image image = Image::gray(impl_->width, impl_->height);

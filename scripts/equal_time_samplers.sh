@@ -22,6 +22,8 @@ shift $(($# < 3 ? $# : 3))
 scenes=("$@")
 [ ${#scenes[@]} -gt 0 ] || scenes=(cornell atrium kitchen envmap)
 pxf=build/app/pxf
+# "HDR DISPLAY" from a `pxf diff` line "...: HDR NRMSE x %  display NRMSE y % ...".
+nrmse_pair() { sed -E 's/.*HDR NRMSE ([0-9.]+) %  display NRMSE ([0-9.]+).*/\1 \2/' <<<"$1"; }
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 echo "scene round sampler filter spp hdr_nrmse display_nrmse" | tee "$tmp/runs"
@@ -40,15 +42,11 @@ for scene in "${scenes[@]}"; do
         "$pxf" render --scene "$scene" --size 384x216 --time "$seconds" --sampler "$sampler" --filter "$filter" \
           --seed $((100 + round)) --out "$out" >/dev/null 2>&1
         spp=$(python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['time_budget']['spp_reached'])" "$out/stats.json")
-        line=$("$pxf" diff "$out/final.exr" "$ref" | grep '^all pixels')
-        hdr=$(sed -E 's/.*HDR NRMSE ([0-9.]+).*/\1/' <<<"$line")
-        display=$(sed -E 's/.*display NRMSE ([0-9.]+).*/\1/' <<<"$line")
-        echo "$scene $round $sampler $filter $spp $hdr $display" | tee -a "$tmp/runs"
+        errors=$(nrmse_pair "$("$pxf" diff "$out/final.exr" "$ref" | grep '^all pixels')")
+        echo "$scene $round $sampler $filter $spp $errors" | tee -a "$tmp/runs"
         if [ "$filter" = grid ] && [ "${ref##*/}" = buffers.exr ]; then
-          line=$("$pxf" diff "$out/buffers.exr" "$ref" --perfect-filter | grep '^blend with a perfect filter')
-          hdr=$(sed -E 's/.*HDR NRMSE ([0-9.]+).*/\1/' <<<"$line")
-          display=$(sed -E 's/.*display NRMSE ([0-9.]+).*/\1/' <<<"$line")
-          echo "$scene $round $sampler perfect $spp $hdr $display" | tee -a "$tmp/runs"
+          errors=$(nrmse_pair "$("$pxf" diff "$out/buffers.exr" "$ref" --perfect-filter | grep '^blend with a perfect filter')")
+          echo "$scene $round $sampler perfect $spp $errors" | tee -a "$tmp/runs"
         fi
       done
     done
