@@ -13,6 +13,7 @@
 #   blended again with a perfect filter (`pxf diff --perfect-filter`: L_f = the reference's HV),
 #   the least error any filter could leave under the blend.
 #   Defaults: 2 s, 3 rounds, cornell atrium kitchen envmap.
+#   FILTER_FLAGS="--sigma-s 2" (say) adds render flags to the filtered jobs only.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 refs=${1:?usage: scripts/equal_time_samplers.sh REFERENCE_DIR [SECONDS] [ROUNDS] [SCENES...]}
@@ -39,8 +40,10 @@ for scene in "${scenes[@]}"; do
     for sampler in "${order[@]}"; do
       for filter in none grid; do
         out="$tmp/$scene-$round-$sampler-$filter"
+        flags=()
+        [ "$filter" = grid ] && read -r -a flags <<<"${FILTER_FLAGS:-}"
         "$pxf" render --scene "$scene" --size 384x216 --time "$seconds" --sampler "$sampler" --filter "$filter" \
-          --seed $((100 + round)) --out "$out" >/dev/null 2>&1
+          --seed $((100 + round)) "${flags[@]}" --out "$out" >/dev/null 2>&1
         spp=$(python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['time_budget']['spp_reached'])" "$out/stats.json")
         errors=$(nrmse_pair "$("$pxf" diff "$out/final.exr" "$ref" | grep '^all pixels')")
         echo "$scene $round $sampler $filter $spp $errors" | tee -a "$tmp/runs"
