@@ -449,6 +449,7 @@ class Explorer {
     changed |= ImGui::SliderInt("path length", &s.trace.max_vertices, 2, 32);
     changed |= ImGui::Checkbox("all HV", &s.trace.all_hv);
     changed |= ImGui::Checkbox("specular sampling", &s.trace.specular_sampling);
+    changed |= ImGui::Checkbox("near specular sampling", &s.trace.near_specular_sampling);
     changed |= ImGui::SliderFloat("exposure key", &s.tonemap.key, 0.01f, 2.0f, "%.3f", ImGuiSliderFlags_Logarithmic);
     ImGui::Checkbox("pause", &paused_);
     ImGui::SameLine();

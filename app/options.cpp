@@ -54,6 +54,10 @@ void add_preview_options(CommandLine& cli, PreviewSettings& s) {
   cli.flag("--specular-sampling", &s.trace.specular_sampling,
            "also sample the cones of mirror and glass objects at diffuse vertices, MIS-combined with BSDF\n"
            "sampling: unbiased, fewer caustic fireflies, more rays (docs/sampling.md#fireflies)");
+  cli.choice("--near-specular", &s.trace.near_specular_sampling, {"off", "on"},
+             "the same at the first diffuse vertex only, toward mirror and glass objects that fill at least pi sr\n"
+             "of its view: the focus a glass object throws on the floor it stands on (default on;\n"
+             "docs/sampling.md#near-specular-sampling)");
   cli.flag("--all-hv", &s.trace.all_hv, "put every contribution into the HV buffer but what the camera sees directly or through\nmirrors and glass (environment-lit scenes)");
   cli.option("--key", &s.tonemap.key, "Reinhard key a (default 0.18)", 1e-4f, 100.0f);
   cli.option("--white", &s.tonemap.white, "Reinhard white point (0 = none)", 0.0f, 1e9f);

@@ -12,7 +12,8 @@ namespace {
 // Every TraceParams field: a change of any of them makes the accumulated samples another render's.
 bool same_trace_params(const TraceParams& a, const TraceParams& b) {
   return a.max_vertices == b.max_vertices && a.rr_start_vertex == b.rr_start_vertex && a.all_hv == b.all_hv &&
-         a.specular_sampling == b.specular_sampling && a.seed == b.seed && a.threads == b.threads &&
+         a.specular_sampling == b.specular_sampling && a.near_specular_sampling == b.near_specular_sampling &&
+         a.seed == b.seed && a.threads == b.threads &&
          a.sampler == b.sampler && a.replicates == b.replicates;
 }
 

@@ -56,6 +56,7 @@ nlohmann::json stats_json(Preview& preview, const RenderReport& r) {
                    {"rr_start_vertex", s.trace.rr_start_vertex},
                    {"all_hv", s.trace.all_hv},
                    {"specular_sampling", s.trace.specular_sampling},
+                   {"near_specular_sampling", s.trace.near_specular_sampling},
                    {"key", s.tonemap.key},
                    {"gl", r.gl_backend},
                    {"stage_timing", gl_timing_names()[static_cast<int>(gl_timing())]},

@@ -117,7 +117,7 @@ SampleSettings get_settings(Reader& r) {
   s.sampler = r.get<uint32_t>("header");
   s.replicates = r.get<uint32_t>("header");
   s.specular_sampling = r.get<uint32_t>("header");
-  if (s.all_hv > 1 || s.specular_sampling > 1 || s.sampler > 1)
+  if (s.all_hv > 1 || s.specular_sampling > 2 || s.sampler > 1)
     throw Error("state file has an invalid setting flag (all-hv, sampler or specular sampling)");
   if (s.replicates < 1 || s.replicates > kMaxReplicates)
     throw Error("state file has an invalid replicate count " + std::to_string(s.replicates));
@@ -239,7 +239,7 @@ SampleSettings sample_settings(uint64_t scene_hash, int width, int height, const
   s.all_hv = params.all_hv ? 1u : 0u;
   s.sampler = static_cast<uint32_t>(params.sampler);
   s.replicates = static_cast<uint32_t>(std::max(params.replicates, 1));
-  s.specular_sampling = params.specular_sampling ? 1u : 0u;
+  s.specular_sampling = params.specular_sampling ? 1u : params.near_specular_sampling ? 2u : 0u;
   return s;
 }
 

@@ -31,7 +31,7 @@ struct SampleSettings {
   uint32_t all_hv = 0;
   uint32_t sampler = 0;            // SamplerType: 0 sobol, 1 independent
   uint32_t replicates = 1;         // TraceParams::replicates (which scrambled sequence frame k uses)
-  uint32_t specular_sampling = 0;  // 0/1
+  uint32_t specular_sampling = 0;  // 0 none, 1 at every diffuse vertex, 2 near only (the default)
   bool operator==(const SampleSettings& o) const;
   // "" when equal, else one phrase naming the first difference ("seed 1 vs 2").
   std::string difference(const SampleSettings& o) const;

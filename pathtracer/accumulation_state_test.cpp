@@ -154,7 +154,7 @@ TEST(AccumulationState, OverlapAndMismatchAreRefused) {
   EXPECT_THROW(merge_states({render_frames({0, 10}), other_scene}), Error);
 }
 
-// Sampler, replicates and specular sampling decide the samples too: they round-trip, a state of
+// Sampler, replicates and specular sampling (none, everywhere, near) decide the samples too: they round-trip, a state of
 // another value is refused by name, and a corrupt value is a clear error.
 TEST(AccumulationState, SamplerSettingsRoundTripAndAreChecked) {
   TraceParams params;
@@ -175,9 +175,16 @@ TEST(AccumulationState, SamplerSettingsRoundTripAndAreChecked) {
   a = plain;
   a.replicates = 4;
   EXPECT_EQ(a.difference(plain), "replicates 4 vs 1");
+  // The default is near specular sampling (2); without it 0; --specular-sampling wins over it (1).
+  EXPECT_EQ(plain.specular_sampling, 2u);
+  TraceParams none;
+  none.near_specular_sampling = false;
+  EXPECT_EQ(sample_settings(0x1234, kW, kH, none).specular_sampling, 0u);
   a = plain;
   a.specular_sampling = 1;
-  EXPECT_EQ(a.difference(plain), "specular sampling 1 vs 0");
+  EXPECT_EQ(a.difference(plain), "specular sampling 1 vs 2");
+  a.specular_sampling = 0;
+  EXPECT_EQ(a.difference(plain), "specular sampling 0 vs 2");
   // A corrupt flag with a valid checksum: the header check names it.
   AccumulationState bad = render_frames({0, 1});
   bad.settings.specular_sampling = 7;

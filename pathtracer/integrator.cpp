@@ -167,6 +167,7 @@ PathTracer::PathTracer(const Scene& scene) : geometry_(scene), lights_(scene) {
       target.center = 0.5f * (lo + hi);
       for (const glm::vec3& p : mesh.positions) target.radius = std::max(target.radius, glm::length(p - target.center));
       target.radius *= 1.0001f;
+      target.near_distance2 = target.radius * target.radius * kNearSpecularDistance2PerRadius2;
       if (std::isfinite(target.radius) && target.radius > 0.0f) specular_targets_.push_back(target);
     }
 }
@@ -193,35 +194,59 @@ bool target_cone(glm::vec3 center, float radius, glm::vec3 p, glm::vec3* axis, f
 }
 }  // namespace
 
-float PathTracer::specular_pdf(glm::vec3 p, glm::vec3 wi) const {
+bool PathTracer::SpecularTarget::near(glm::vec3 p) const {
+  const glm::vec3 d = center - p;
+  const float d2 = glm::dot(d, d);
+  return d2 <= near_distance2 && d2 > radius * radius;
+}
+
+int PathTracer::chain_target_count(glm::vec3 p, bool near_only) const {
+  if (!near_only) return static_cast<int>(specular_targets_.size());
+  int n = 0;
+  for (const SpecularTarget& t : specular_targets_) n += t.near(p);
+  return n;
+}
+
+float PathTracer::specular_pdf(glm::vec3 p, glm::vec3 wi, bool near_only) const {
   float sum = 0.0f;
+  int candidates = 0;
   for (const SpecularTarget& t : specular_targets_) {
+    if (near_only && !t.near(p)) continue;
+    ++candidates;
     glm::vec3 axis;
     float cos_max;
     if (target_cone(t.center, t.radius, p, &axis, &cos_max) && glm::dot(wi, axis) >= cos_max)
       sum += 1.0f / (2.0f * kPi * (1.0f - cos_max));
   }
-  return sum / static_cast<float>(specular_targets_.size());
+  return candidates > 0 ? sum / static_cast<float>(candidates) : 0.0f;
 }
 
 glm::vec3 PathTracer::specular_chain_light(const SurfacePoint& sp, const Bsdf& bsdf, glm::vec3 throughput, int vertex,
-                                           PathSampler& sampler, const TraceParams& params, uint32_t* rays,
-                                           bool* through_glass) const {
+                                           bool near_only, PathSampler& sampler, const TraceParams& params,
+                                           uint32_t* rays, bool* through_glass) const {
   const Scene& scene = geometry_.scene();
   const PathSampler::SpecularNumbers numbers = sampler.specular_numbers(vertex);
   const float u_select = numbers.select;
   const glm::vec2 u = numbers.direction;
-  const size_t n = specular_targets_.size();
-  const SpecularTarget& target = specular_targets_[std::min(n - 1, static_cast<size_t>(u_select * static_cast<float>(n)))];
+  // The target: candidate number k (every specular object, or the near ones), chosen uniformly.
+  const int n = chain_target_count(sp.position, near_only);
+  if (n == 0) return glm::vec3(0.0f);
+  int k = std::min(n - 1, static_cast<int>(u_select * static_cast<float>(n)));
+  const SpecularTarget* target = nullptr;
+  for (const SpecularTarget& t : specular_targets_)
+    if ((!near_only || t.near(sp.position)) && k-- == 0) {
+      target = &t;
+      break;
+    }
   glm::vec3 axis;
   float cos_max;
-  if (!target_cone(target.center, target.radius, sp.position, &axis, &cos_max)) return glm::vec3(0.0f);
+  if (!target_cone(target->center, target->radius, sp.position, &axis, &cos_max)) return glm::vec3(0.0f);
   const float cos_t = 1.0f - u.x * (1.0f - cos_max), sin_t = std::sqrt(std::max(0.0f, 1.0f - cos_t * cos_t));
   const float phi = 2.0f * kPi * u.y;
   const glm::vec3 wi = glm::normalize(Frame::from_normal(axis).to_world(glm::vec3(std::cos(phi) * sin_t, std::sin(phi) * sin_t, cos_t)));
   float bsdf_pdf;
   const glm::vec3 f = bsdf.eval(wi, &bsdf_pdf);
-  const float pdf = specular_pdf(sp.position, wi);
+  const float pdf = specular_pdf(sp.position, wi, near_only);
   if (!(max_component(f) > 0.0f) || !(pdf > 0.0f)) return glm::vec3(0.0f);
   glm::vec3 t = throughput * f / pdf;
   const float w = power_heuristic(pdf, bsdf_pdf);
@@ -421,13 +446,18 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
     for (size_t sun = 0; sun < lights_.sun_count(); ++sun) queue_light(lights_.sun_sample(sun));
   }
 
-  // Specular sampling: light through a specular chain, which NEE cannot reach (HV: D S+ L).
-  const bool specular_sampling = params.specular_sampling && !specular_targets_.empty() && bsdf.has_nondelta() &&
-                                 vertex + 2 <= params.max_vertices;
+  // Specular sampling: light through a specular chain, which NEE cannot reach (HV: D S+ L). At every
+  // diffuse vertex toward every specular object (params.specular_sampling), else at the first one
+  // toward the specular objects that fill much of its view (params.near_specular_sampling).
+  const bool room = !specular_targets_.empty() && bsdf.has_nondelta() && vertex + 2 <= params.max_vertices;
+  const bool near_only = !params.specular_sampling;
+  const bool specular_sampling =
+      room && (params.specular_sampling || (params.near_specular_sampling && s.nonspecular == 0 &&
+                                            chain_target_count(sp.position, true) > 0));
   if (specular_sampling) {
     bool through_glass = false;
-    const glm::vec3 light =
-        specular_chain_light(sp, bsdf, s.throughput, vertex, sampler, params, &out.rays, &through_glass);
+    const glm::vec3 light = specular_chain_light(sp, bsdf, s.throughput, vertex, near_only, sampler, params,
+                                                 &out.rays, &through_glass);
     if (max_component(light) > 0.0f) {
       out.hv += light;
       if constexpr (kClassify) {
@@ -456,7 +486,7 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
   }
   s.throughput *= bs.weight;
   if (!bs.delta)
-    s.chain_mis = specular_sampling ? power_heuristic(bs.pdf, specular_pdf(sp.position, bs.wi)) : 1.0f;
+    s.chain_mis = specular_sampling ? power_heuristic(bs.pdf, specular_pdf(sp.position, bs.wi, near_only)) : 1.0f;
   else if (!material_is_perfect_specular(material))
     s.chain_mis = 1.0f;  // a delta lobe of a surface the specular chains stop at
   if (!bs.delta) ++s.nonspecular;

@@ -97,16 +97,21 @@ class PathTracer {
   bool shade_vertex(Path& path, const Hit& hit, int vertex, const TraceParams& params, ShadowQueue& shadows,
                     const PathSampler::VertexNumbers* numbers, ClassState* cls) const;
 
-  // Specular sampling (TraceParams::specular_sampling): the bounding spheres of the perfectly
-  // specular meshes, the solid-angle pdf of a direction from p under it, and the light one sampled
-  // direction from a diffuse vertex reaches through a specular chain (already MIS-weighted).
+  // Specular sampling (TraceParams::specular_sampling, near_specular_sampling): the bounding spheres
+  // of the perfectly specular meshes; the candidates a chain from p aims at (every target, or with
+  // near_only those whose sphere subtends at least kNearSpecularSolidAngle from p), one chosen
+  // uniformly; the solid-angle pdf of a direction from p under that choice; and the light one
+  // sampled direction reaches through a specular chain (already MIS-weighted).
   struct SpecularTarget {
     glm::vec3 center{0.0f};
     float radius = 0.0f;
+    float near_distance2 = 0.0f;  // squared distance from the center within which p is near
+    bool near(glm::vec3 p) const;  // outside the sphere, and it subtends >= kNearSpecularSolidAngle
   };
-  float specular_pdf(glm::vec3 p, glm::vec3 wi) const;
+  int chain_target_count(glm::vec3 p, bool near_only) const;
+  float specular_pdf(glm::vec3 p, glm::vec3 wi, bool near_only) const;
   glm::vec3 specular_chain_light(const SurfacePoint& sp, const Bsdf& bsdf, glm::vec3 throughput, int vertex,
-                                 PathSampler& sampler, const TraceParams& params, uint32_t* rays,
+                                 bool near_only, PathSampler& sampler, const TraceParams& params, uint32_t* rays,
                                  bool* through_glass) const;
 
   // The BsdfMaterial at sp: the one precomputed for its material when eval_material() reads no

@@ -860,31 +860,48 @@ TEST(FireflyFigures, DISABLED_Cornell) {
 }  // namespace
 }  // namespace pxf
 
-// Specular sampling (TraceParams::specular_sampling) must not change the expected image.
+// Specular sampling (TraceParams::specular_sampling, near_specular_sampling) must not change the
+// expected image.
 namespace pxf {
 namespace {
+
+enum class ChainMode { Off, Near, All };
+TraceParams with_chains(TraceParams params, ChainMode mode) {
+  params.specular_sampling = mode == ChainMode::All;
+  params.near_specular_sampling = mode == ChainMode::Near;
+  return params;
+}
+
+// Near means that the bounding sphere subtends at least kNearSpecularSolidAngle: 2 pi (1 - cos a)
+// with sin^2 a = r^2 / d^2 at the squared distance d^2 the tracer compares against.
+TEST(SpecularSampling, NearDistanceIsWhereTheSphereSubtendsTheNearSolidAngle) {
+  const double sin2 = 1.0 / kNearSpecularDistance2PerRadius2;
+  EXPECT_NEAR(2.0 * 3.14159265358979 * (1.0 - std::sqrt(1.0 - sin2)), kNearSpecularSolidAngle, 1e-5);
+}
 
 // A white furnace with a mirror: a white Lambertian sphere beside a perfect mirror sphere in a
 // uniform sky of radiance 1. Every path ends in the sky with throughput 1, so every pixel is 1
 // exactly; the diffuse sphere sees much of the sky through the mirror (D S L), the light specular
 // sampling finds, so MIS weights that did not sum to 1 would show.
+// The spheres are 0.02 apart, so the diffuse sphere's points nearest the mirror are near it (near
+// specular sampling chains from them) and the rest are not.
 TEST(SpecularSampling, WhiteFurnaceWithAMirrorStaysOne) {
   Scene scene;
   scene.materials = {make_diffuse(glm::vec3(1.0f)), make_mirror(glm::vec3(1.0f))};
-  scene.meshes.push_back(make_sphere(glm::vec3(-0.55f, 0, 0), 0.5f, 0, 64, 32));
-  scene.meshes.push_back(make_sphere(glm::vec3(0.55f, 0, 0), 0.5f, 1, 64, 32));
+  scene.meshes.push_back(make_sphere(glm::vec3(-0.51f, 0, 0), 0.5f, 0, 64, 32));
+  scene.meshes.push_back(make_sphere(glm::vec3(0.51f, 0, 0), 0.5f, 1, 64, 32));
   scene.environment = uniform_environment(1.0f);
   scene.camera = look_at_camera(glm::vec3(0, 0, 3.0f), glm::vec3(0), glm::vec3(0, 1, 0), 0.75f);
-  TraceParams params = furnace_params();
-  double means[2];
-  for (bool on : {false, true}) {
-    params.specular_sampling = on;
+  double means[3];
+  for (ChainMode mode : {ChainMode::Off, ChainMode::Near, ChainMode::All}) {
+    const int m = static_cast<int>(mode);
     double worst = 0;
-    means[on] = render_mean(scene, params, 32, 512, &worst, 1.0);
-    EXPECT_NEAR(means[on], 1.0, 1e-3) << on;  // double-counted D S L light would add about 0.05
-    EXPECT_LT(worst, 0.04) << on;             // the tessellated spheres' shading normals: about 0.02 either way
+    means[m] = render_mean(scene, with_chains(furnace_params(), mode), 32, 512, &worst, 1.0);
+    EXPECT_NEAR(means[m], 1.0, 1e-3) << m;  // double-counted D S L light would add about 0.05
+    EXPECT_LT(worst, 0.04) << m;            // the tessellated spheres' shading normals: about 0.02 either way
   }
   EXPECT_NEAR(means[1], means[0], 5e-4);
+  EXPECT_NEAR(means[2], means[0], 5e-4);
 }
 
 struct ChainPixelStats {
@@ -910,20 +927,32 @@ ChainPixelStats chain_pixel_stats(const Scene& scene, const TraceParams& params,
   return r;
 }
 
+void expect_block_means_agree(const ChainPixelStats& off, const ChainPixelStats& on, int size, int frames,
+                              const char* what);
+
 // The Cornell box with the mirror and glass spheres, independent samples: the mean of every 4x4
-// block with and without specular sampling agree; the sum of the 16 blocks' squared z-scores is
-// chi-square with 16 degrees of freedom, below 39.25 with probability 0.999. Specular sampling
-// traces more rays (its chains) and lowers the variance of the caustic-lit pixels.
+// block with and without specular sampling (near, or at every vertex) agree; the sum of the 16
+// blocks' squared z-scores is chi-square with 16 degrees of freedom, below 39.25 with probability
+// 0.999. Specular sampling traces more rays (its chains), near specular sampling fewer than it.
 TEST(SpecularSampling, CornellMeansAgreeWithoutIt) {
   const Scene scene = make_cornell_box(true);
   TraceParams params;
   params.sampler = SamplerType::Independent;
-  const int size = 16, frames = 4096, block = 4;
-  const ChainPixelStats off = chain_pixel_stats(scene, params, size, frames);
-  params.specular_sampling = true;
+  const int size = 16, frames = 4096;
+  const ChainPixelStats off = chain_pixel_stats(scene, with_chains(params, ChainMode::Off), size, frames);
   params.seed = 2;
-  const ChainPixelStats on = chain_pixel_stats(scene, params, size, frames);
-  EXPECT_GT(on.rays, off.rays);
+  const ChainPixelStats on = chain_pixel_stats(scene, with_chains(params, ChainMode::All), size, frames);
+  params.seed = 3;
+  const ChainPixelStats near = chain_pixel_stats(scene, with_chains(params, ChainMode::Near), size, frames);
+  EXPECT_GT(on.rays, near.rays);
+  EXPECT_GT(near.rays, off.rays);
+  expect_block_means_agree(off, on, size, frames, "all");
+  expect_block_means_agree(off, near, size, frames, "near");
+}
+
+void expect_block_means_agree(const ChainPixelStats& off, const ChainPixelStats& on, int size, int frames,
+                              const char* what) {
+  const int block = 4;
   double chi2 = 0, var_off_total = 0, var_on_total = 0;
   for (int by = 0; by < size; by += block)
     for (int bx = 0; bx < size; bx += block) {
@@ -942,9 +971,9 @@ TEST(SpecularSampling, CornellMeansAgreeWithoutIt) {
       var_off_total += v[0];
       var_on_total += v[1];
     }
-  EXPECT_LT(chi2, 39.25);
-  std::printf("chi2 %.2f (16 dof); summed variance of the block means: off %.3g, on %.3g\n", chi2, var_off_total,
-              var_on_total);
+  EXPECT_LT(chi2, 39.25) << what;
+  std::printf("%s: chi2 %.2f (16 dof); summed variance of the block means: off %.3g, on %.3g\n", what, chi2,
+              var_off_total, var_on_total);
 }
 
 }  // namespace

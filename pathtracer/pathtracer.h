@@ -33,7 +33,19 @@ struct TraceParams {
   // caustics that NEE cannot see), combined with BSDF sampling by the power heuristic
   // (docs/sampling.md#fireflies). Off by default.
   bool specular_sampling = false;
+  // Near specular sampling, the default: the same chains at the first diffuse vertex only, toward the
+  // specular objects whose bounding sphere subtends at least kNearSpecularSolidAngle from it. That
+  // is where a glass object focuses the light onto the floor it stands on, a caustic that BSDF
+  // sampling finds in a few % of its samples; there a chain costs little (few first vertices are
+  // that near) and halves the error (docs/sampling.md#near-specular-sampling). Ignored with
+  // specular_sampling, which does this and more.
+  bool near_specular_sampling = true;
 };
+
+// A sphere subtends solid angle 2 pi (1 - cos a) from a point at distance d from its center, with
+// sin a = r / d. Near: at least pi sr (a >= 60 degrees), i.e. d^2 <= r^2 / sin^2(60 deg) = 4/3 r^2.
+constexpr float kNearSpecularSolidAngle = 3.14159265358979323846f;
+constexpr float kNearSpecularDistance2PerRadius2 = 4.0f / 3.0f;
 
 // The replicates an accumulation keeps sums for: only the Sobol sampler has any (independent
 // samples are their own replicates). The renderer and the state files both go by this.

@@ -214,10 +214,15 @@ TEST(Cli, RenderWritesEveryOutput) {
   ASSERT_EQ(run("render --size 32x24 --spp 2 --demodulate on --quiet --out " + out).code, 0);
   EXPECT_EQ(nlohmann::json::parse(slurp(out + "/stats.json"))["settings"]["demodulate"], true);
   EXPECT_EQ(run("render --size 32x24 --spp 2 --demodulate maybe --quiet --out " + out).code, 2);
-  // Specular sampling is off unless asked for, and stats.json says which.
+  // Specular sampling is off unless asked for, near specular sampling on unless turned off, and
+  // stats.json says which.
   EXPECT_EQ(stats2["settings"]["specular_sampling"], false);
-  ASSERT_EQ(run("render --size 32x24 --spp 2 --specular-sampling --quiet --out " + out).code, 0);
-  EXPECT_EQ(nlohmann::json::parse(slurp(out + "/stats.json"))["settings"]["specular_sampling"], true);
+  EXPECT_EQ(stats2["settings"]["near_specular_sampling"], true);
+  ASSERT_EQ(run("render --size 32x24 --spp 2 --specular-sampling --near-specular off --quiet --out " + out).code, 0);
+  const auto stats3 = nlohmann::json::parse(slurp(out + "/stats.json"));
+  EXPECT_EQ(stats3["settings"]["specular_sampling"], true);
+  EXPECT_EQ(stats3["settings"]["near_specular_sampling"], false);
+  EXPECT_EQ(run("render --size 32x24 --spp 2 --near-specular maybe --quiet --out " + out).code, 2);
   EXPECT_GT(stats2["unfiltered_vs_reference"]["nrmse_percent"].get<double>(), 0.0);
 }
 
