@@ -46,6 +46,9 @@ struct TraceParams {
 // sin a = r / d. Near: at least pi sr (a >= 60 degrees), i.e. d^2 <= r^2 / sin^2(60 deg) = 4/3 r^2.
 constexpr float kNearSpecularSolidAngle = 3.14159265358979323846f;
 constexpr float kNearSpecularDistance2PerRadius2 = 4.0f / 3.0f;
+// ... and only toward a mesh whose area is at least this share of its bounding sphere's (on average
+// it then covers at least this share of the cone the chain samples).
+constexpr double kNearSpecularMinFill = 0.5;
 
 // The replicates an accumulation keeps sums for: only the Sobol sampler has any (independent
 // samples are their own replicates). The renderer and the state files both go by this.
