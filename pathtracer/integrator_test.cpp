@@ -927,6 +927,38 @@ ChainPixelStats chain_pixel_stats(const Scene& scene, const TraceParams& params,
   return r;
 }
 
+// Near chains go only toward a mesh that fills its bounding sphere (kNearSpecularMinFill): the
+// mirror sphere beside the white one draws them; six small mirror spheres in one mesh with the same
+// bounding sphere (on its surface, one 0.02 from the white sphere), which fill it to 0.06, do not.
+TEST(SpecularSampling, NearChainsOnlyTowardMeshesThatFillTheirBoundingSphere) {
+  Scene scene;
+  scene.materials = {make_diffuse(glm::vec3(0.8f)), make_mirror(glm::vec3(1.0f))};
+  const glm::vec3 center(0.51f, 0, 0);
+  scene.meshes.push_back(make_sphere(glm::vec3(-0.51f, 0, 0), 0.5f, 0, 32, 16));
+  scene.meshes.push_back(make_sphere(center, 0.5f, 1, 32, 16));
+  scene.environment = uniform_environment(1.0f);
+  scene.camera = look_at_camera(glm::vec3(0, 0, 3.0f), glm::vec3(0), glm::vec3(0, 1, 0), 0.75f);
+  const auto rays = [](const Scene& sc, ChainMode mode) {
+    return chain_pixel_stats(sc, with_chains(TraceParams{}, mode), 16, 8).rays;
+  };
+  EXPECT_GT(rays(scene, ChainMode::Near), rays(scene, ChainMode::Off));
+  Mesh spread;
+  spread.material = 1;
+  for (int axis = 0; axis < 3; ++axis)
+    for (float sign : {-1.0f, 1.0f}) {
+      glm::vec3 c = center;
+      c[axis] += sign * 0.45f;
+      const Mesh small = make_sphere(c, 0.05f, 1, 8, 4);
+      const uint32_t base = static_cast<uint32_t>(spread.positions.size());
+      spread.positions.insert(spread.positions.end(), small.positions.begin(), small.positions.end());
+      spread.normals.insert(spread.normals.end(), small.normals.begin(), small.normals.end());
+      spread.uv0.insert(spread.uv0.end(), small.uv0.begin(), small.uv0.end());
+      for (const glm::uvec3& t : small.triangles) spread.triangles.push_back(t + glm::uvec3(base));
+    }
+  scene.meshes[1] = spread;
+  EXPECT_EQ(rays(scene, ChainMode::Near), rays(scene, ChainMode::Off));
+}
+
 void expect_block_means_agree(const ChainPixelStats& off, const ChainPixelStats& on, int size, int frames,
                               const char* what);
 
