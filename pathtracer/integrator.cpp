@@ -155,7 +155,8 @@ PathTracer::PathTracer(const Scene& scene) : geometry_(scene), lights_(scene) {
           bsdf_material(eval_material(scene, material, glm::vec2(0.0f), glm::vec2(0.0f), glm::vec4(1.0f)));
     precomputed_materials_.push_back(precomputed);
   }
-  for (const Mesh& mesh : scene.meshes)
+  for (unsigned mesh_index = 0; mesh_index < scene.meshes.size(); ++mesh_index) {
+    const Mesh& mesh = scene.meshes[mesh_index];
     if (!mesh.triangles.empty() && material_is_perfect_specular(scene.materials[mesh.material])) {
       has_perfect_specular_ = true;
       glm::vec3 lo(INFINITY), hi(-INFINITY);
@@ -172,14 +173,16 @@ PathTracer::PathTracer(const Scene& scene) : geometry_(scene), lights_(scene) {
       // mean share of the cone it covers (a sphere 1, a cube 0.64; three jars merged into one mesh,
       // as on the kitchen's shelf, 0.2: chains toward them mostly miss the glass).
       double area = 0.0;
-      for (const glm::uvec3& tri : mesh.triangles)
-        area += 0.5 * glm::length(glm::cross(mesh.positions[tri.y] - mesh.positions[tri.x],
-                                             mesh.positions[tri.z] - mesh.positions[tri.x]));
+      for (unsigned prim = 0; prim < mesh.triangles.size(); ++prim) area += geometry_.triangle_area(mesh_index, prim);
       const double sphere_area = 4.0 * kPi * double(target.radius) * double(target.radius);
       if (area >= kNearSpecularMinFill * sphere_area)
         target.near_distance2 = target.radius * target.radius * kNearSpecularDistance2PerRadius2;
-      if (std::isfinite(target.radius) && target.radius > 0.0f) specular_targets_.push_back(target);
+      if (std::isfinite(target.radius) && target.radius > 0.0f) {
+        specular_targets_.push_back(target);
+        has_near_targets_ |= target.near_distance2 > 0.0f;
+      }
     }
+  }
 }
 
 const BsdfMaterial& PathTracer::bsdf_material_at(const SurfacePoint& sp, BsdfMaterial* scratch) const {
@@ -462,8 +465,8 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
   const bool room = !specular_targets_.empty() && bsdf.has_nondelta() && vertex + 2 <= params.max_vertices;
   const bool near_only = !params.specular_sampling;
   const bool specular_sampling =
-      room && (params.specular_sampling || (params.near_specular_sampling && s.nonspecular == 0 &&
-                                            chain_target_count(sp.position, true) > 0));
+      room && (params.specular_sampling || (params.near_specular_sampling && has_near_targets_ &&
+                                            s.nonspecular == 0 && chain_target_count(sp.position, true) > 0));
   if (specular_sampling) {
     bool through_glass = false;
     const glm::vec3 light = specular_chain_light(sp, bsdf, s.throughput, vertex, near_only, sampler, params,

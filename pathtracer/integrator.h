@@ -128,6 +128,7 @@ class PathTracer {
   std::vector<PrecomputedBsdfMaterial> precomputed_materials_;  // per scene material
   std::vector<SpecularTarget> specular_targets_;
   bool has_perfect_specular_ = false;
+  bool has_near_targets_ = false;  // a target that fills its bounding sphere enough for near chains
 };
 
 // Adds one accepted sample to pixel `pixel`: running means of LV/HV RGB and Welford (double) of

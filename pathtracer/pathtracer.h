@@ -43,9 +43,10 @@ struct TraceParams {
 };
 
 // A sphere subtends solid angle 2 pi (1 - cos a) from a point at distance d from its center, with
-// sin a = r / d. Near: at least pi sr (a >= 60 degrees), i.e. d^2 <= r^2 / sin^2(60 deg) = 4/3 r^2.
+// sin a = r / d. Near: at least pi sr (a >= 60 degrees), i.e. d^2 <= r^2 / sin^2 a = r^2 / (1 - cos^2 a).
 constexpr float kNearSpecularSolidAngle = 3.14159265358979323846f;
-constexpr float kNearSpecularDistance2PerRadius2 = 4.0f / 3.0f;
+constexpr float kNearSpecularCosHalfAngle = 1.0f - kNearSpecularSolidAngle / (2.0f * 3.14159265358979323846f);
+constexpr float kNearSpecularDistance2PerRadius2 = 1.0f / (1.0f - kNearSpecularCosHalfAngle * kNearSpecularCosHalfAngle);
 // ... and only toward a mesh whose area is at least this share of its bounding sphere's (on average
 // it then covers at least this share of the cone the chain samples).
 constexpr double kNearSpecularMinFill = 0.5;
