@@ -37,7 +37,7 @@ struct TraceParams {
   // specular objects whose bounding sphere subtends at least kNearSpecularSolidAngle from it. That
   // is where a glass object focuses the light onto the floor it stands on, a caustic that BSDF
   // sampling finds in a few % of its samples; there a chain costs little (few first vertices are
-  // that near) and halves the error (docs/sampling.md#near-specular-sampling). Ignored with
+  // that near) and about halves the variance there (docs/sampling.md#near-specular-sampling). Ignored with
   // specular_sampling, which does this and more.
   bool near_specular_sampling = true;
 };

@@ -17,7 +17,8 @@
 //                       rescaled, is the point's first coordinate; dimension 2 is unused)
 //   vertex v, bsdf    : 0,1 BSDF direction (2D) | 2 BSDF lobe | 3 Russian roulette
 //   vertex v, specular: 0,1 direction in the chosen object's cone (2D) | 2 object selection
-//   (only with TraceParams::specular_sampling; the chain's delta choices: one group per bounce b)
+//   (with TraceParams::specular_sampling, or near_specular_sampling at the first diffuse vertex;
+//   the chain's delta choices: one group per bounce b)
 // Group ids: camera = 0, light of vertex v = 2v, bsdf of vertex v = 2v + 1 (v >= 2); specular
 // sampling of vertex v = 4096 + v, its chain bounce b = 8192 + 1024 v + b (v, b < 1024: --max-vertices caps both).
 // Only the coordinates a vertex uses are computed (no lobe with one lobe, no roulette before
