@@ -37,23 +37,21 @@ struct Texel8Tables {
     }
   }
 };
-const Texel8Tables& texel8_tables() {
-  static const Texel8Tables tables;
-  return tables;
-}
+// Built at static initialization, not on first use: a function-local static is a guarded load
+// at each of the four texels of every bilinear lookup. Nothing samples a texture before main().
+const Texel8Tables kTexel8Tables;
 
 }  // namespace
 
 float texel8_to_linear(unsigned char k, bool srgb) {
-  return srgb ? texel8_tables().srgb[k] : texel8_tables().linear[k];
+  return srgb ? kTexel8Tables.srgb[k] : kTexel8Tables.linear[k];
 }
 
 glm::vec4 Texture::texel(size_t i) const {
   if (!is_8bit()) return texels[i];
-  const Texel8Tables& tables = texel8_tables();
-  const float* rgb = srgb ? tables.srgb.data() : tables.linear.data();
+  const float* rgb = srgb ? kTexel8Tables.srgb.data() : kTexel8Tables.linear.data();
   const unsigned char* p = texels8->data() + 4 * i;
-  return glm::vec4(rgb[p[0]], rgb[p[1]], rgb[p[2]], tables.linear[p[3]]);
+  return glm::vec4(rgb[p[0]], rgb[p[1]], rgb[p[2]], kTexel8Tables.linear[p[3]]);
 }
 
 namespace {
@@ -66,29 +64,63 @@ float sanitize_coordinate(float x) {
   return x;
 }
 
-glm::vec4 texel(const Texture& t, int x, int y) {
-  x = wrap_texel_index(x, t.width, t.wrap_s);
-  y = wrap_texel_index(y, t.height, t.wrap_t);
-  return t.texel(static_cast<size_t>(y) * t.width + x);
+// Texel i and its right neighbour, read from the storage directly: a bilinear lookup reads two rows
+// of two texels, so the storage kind and decode table are chosen once, not per texel.
+struct TexelReader {
+  const glm::vec4* floats = nullptr;
+  const unsigned char* codes = nullptr;
+  const float* rgb = nullptr;
+  explicit TexelReader(const Texture& t) {
+    if (t.is_8bit()) {
+      codes = t.texels8->data();
+      rgb = t.srgb ? kTexel8Tables.srgb.data() : kTexel8Tables.linear.data();
+    } else {
+      floats = t.texels.data();
+    }
+  }
+  glm::vec4 operator()(size_t i) const {
+    if (floats) return floats[i];
+    const unsigned char* p = codes + 4 * i;
+    return glm::vec4(rgb[p[0]], rgb[p[1]], rgb[p[2]], kTexel8Tables.linear[p[3]]);
+  }
+};
+
+// wrap_texel_index(i) and wrap_texel_index(i + 1), with no division when i is already inside
+// [0, size) under Repeat (the common case: uvs in [0, 1)).
+void wrap_texel_pair(int i, int size, Wrap wrap, int* first, int* second) {
+  if (wrap == Wrap::Repeat && size > 1) {
+    const int m = (i >= 0 && i < size) ? i : wrap_texel_index(i, size, wrap);
+    *first = m;
+    *second = m + 1 == size ? 0 : m + 1;
+    return;
+  }
+  *first = wrap_texel_index(i, size, wrap);
+  *second = wrap_texel_index(i + 1, size, wrap);
 }
 
 }  // namespace
 
 glm::vec4 sample_texture(const Texture& texture, glm::vec2 uv) {
   if (!texture.valid()) return glm::vec4(1.0f);
+  const TexelReader read(texture);
   // Continuous texel coordinates; texel centers sit at integer + 0.5.
   float x = sanitize_coordinate(uv.x) * texture.width;
   float y = sanitize_coordinate(uv.y) * texture.height;
   if (texture.nearest) {
-    return texel(texture, static_cast<int>(std::floor(x)), static_cast<int>(std::floor(y)));
+    const int xi = wrap_texel_index(static_cast<int>(std::floor(x)), texture.width, texture.wrap_s);
+    const int yi = wrap_texel_index(static_cast<int>(std::floor(y)), texture.height, texture.wrap_t);
+    return read(static_cast<size_t>(yi) * texture.width + xi);
   }
   x -= 0.5f;
   y -= 0.5f;
   float fx = std::floor(x), fy = std::floor(y);
-  int x0 = static_cast<int>(fx), y0 = static_cast<int>(fy);
   float tx = x - fx, ty = y - fy;
-  glm::vec4 top = glm::mix(texel(texture, x0, y0), texel(texture, x0 + 1, y0), tx);
-  glm::vec4 bottom = glm::mix(texel(texture, x0, y0 + 1), texel(texture, x0 + 1, y0 + 1), tx);
+  int x0, x1, y0, y1;
+  wrap_texel_pair(static_cast<int>(fx), texture.width, texture.wrap_s, &x0, &x1);
+  wrap_texel_pair(static_cast<int>(fy), texture.height, texture.wrap_t, &y0, &y1);
+  const size_t row0 = static_cast<size_t>(y0) * texture.width, row1 = static_cast<size_t>(y1) * texture.width;
+  glm::vec4 top = glm::mix(read(row0 + x0), read(row0 + x1), tx);
+  glm::vec4 bottom = glm::mix(read(row1 + x0), read(row1 + x1), tx);
   return glm::mix(top, bottom, ty);
 }
 

@@ -5,6 +5,8 @@
 
 #include <cmath>
 #include <limits>
+#include <memory>
+#include <vector>
 
 namespace pxf {
 namespace {
@@ -92,6 +94,54 @@ TEST(TextureSample, NonPowerOfTwoSize) {
   t.wrap_s = t.wrap_t = Wrap::ClampToEdge;
   EXPECT_NEAR(sample_texture(t, {0.5f, 0.5f}).x, 3.0f, 1e-5f);  // center of the middle texel
   EXPECT_NEAR(sample_texture(t, {1.0f / 3.0f, 0.5f}).x, 1.5f, 1e-5f);
+}
+
+// The bilinear lookup written out from its definition: the four texels around the coordinate,
+// each wrapped on its own, read through Texture::texel. sample_texture's shared wrapping and
+// direct storage reads must give the same floats, for both storages and every wrap mode.
+glm::vec4 bilinear_by_definition(const Texture& t, glm::vec2 uv) {
+  const float x = uv.x * t.width - 0.5f, y = uv.y * t.height - 0.5f;
+  const float fx = std::floor(x), fy = std::floor(y);
+  auto at = [&](int i, int j) {
+    const int xi = wrap_texel_index(i, t.width, t.wrap_s), yi = wrap_texel_index(j, t.height, t.wrap_t);
+    return t.texel(static_cast<size_t>(yi) * t.width + xi);
+  };
+  const int x0 = static_cast<int>(fx), y0 = static_cast<int>(fy);
+  const glm::vec4 top = glm::mix(at(x0, y0), at(x0 + 1, y0), x - fx);
+  const glm::vec4 bottom = glm::mix(at(x0, y0 + 1), at(x0 + 1, y0 + 1), x - fx);
+  return glm::mix(top, bottom, y - fy);
+}
+
+TEST(TextureSample, BilinearMatchesTheDefinitionForEveryStorageAndWrap) {
+  const int width = 5, height = 3;  // not powers of two; odd, so the seams fall between texels
+  std::vector<unsigned char> codes(4 * width * height);
+  for (size_t k = 0; k < codes.size(); ++k) codes[k] = static_cast<unsigned char>((k * 97 + 13) % 256);
+  for (int storage = 0; storage < 3; ++storage) {  // float, 8-bit linear, 8-bit sRGB
+    Texture t;
+    t.width = width;
+    t.height = height;
+    if (storage == 0) {
+      for (size_t k = 0; k < codes.size(); k += 4)
+        t.texels.push_back(glm::vec4(codes[k], codes[k + 1], codes[k + 2], codes[k + 3]) / 255.0f);
+    } else {
+      t.texels8 = std::make_shared<const std::vector<unsigned char>>(codes);
+      t.srgb = storage == 2;
+    }
+    for (Wrap wrap : {Wrap::Repeat, Wrap::ClampToEdge, Wrap::MirroredRepeat}) {
+      t.wrap_s = wrap;
+      t.wrap_t = wrap == Wrap::ClampToEdge ? Wrap::Repeat : wrap;  // mixed modes too
+      // A grid across [-2.3, 2.3)^2 whose points land on, between and just beside texel centres
+      // and the seams of the repeats.
+      for (int i = 0; i < 47; ++i)
+        for (int j = 0; j < 29; ++j) {
+          const glm::vec2 uv(-2.3f + 0.1f * i, -2.3f + 0.16f * j);
+          const glm::vec4 got = sample_texture(t, uv), want = bilinear_by_definition(t, uv);
+          for (int c = 0; c < 4; ++c)
+            ASSERT_EQ(got[c], want[c]) << "storage " << storage << " wrap " << static_cast<int>(wrap) << " uv "
+                                       << uv.x << ", " << uv.y << " channel " << c;
+        }
+    }
+  }
 }
 
 TEST(TextureTransform, MatrixFollowsKhrTextureTransform) {
