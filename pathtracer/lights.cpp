@@ -91,6 +91,65 @@ glm::vec3 equirect_direction(glm::vec2 uv) {
   return glm::vec3(s * std::sin(phi), std::cos(theta), -s * std::cos(phi));
 }
 
+namespace {
+
+struct ImportanceMap {
+  std::vector<float> weights;
+  int width = 0, height = 0;
+};
+
+// The environment's importance map: luminance x sin(theta) per texel, or summed over square
+// blocks of texels so that the map is about LightSampler::kEnvironmentImportanceWidth cells wide.
+// Every environment sample reads a random row of the map, and a full-resolution one (16 MB at
+// 2048 x 1024) misses the cache at each read; a coarse one stays in it (8-14 % more paths/s on
+// envmap and atrium). Within a block the coarse map is uniform, so it is kept only where that
+// costs little variance: sampling a function proportional to the texel weights w_t with the
+// coarse pmf q_t instead of p_t = w_t / W multiplies its variance by sum p_t^2 / q_t (1 when
+// every block is uniform), which must stay within kEnvironmentCoarseVarianceFactor. A sun drawn
+// into the map (a few bright texels in a block) fails that and keeps the full map. The pdf is
+// the sampled map's in either case, so the estimate stays unbiased.
+ImportanceMap environment_importance(const Texture& image) {
+  ImportanceMap fine{std::vector<float>(static_cast<size_t>(image.width) * image.height), image.width, image.height};
+  for (int y = 0; y < image.height; ++y) {
+    const float sin_theta = std::sin(kPi * (y + 0.5f) / image.height);
+    for (int x = 0; x < image.width; ++x) {
+      const size_t i = static_cast<size_t>(y) * image.width + x;
+      const float w = luminance(glm::vec3(image.texels[i])) * sin_theta;
+      fine.weights[i] = std::isfinite(w) && w > 0.0f ? w : 0.0f;
+    }
+  }
+  const int block = (image.width + LightSampler::kEnvironmentImportanceWidth - 1) / LightSampler::kEnvironmentImportanceWidth;
+  if (block <= 1) return fine;
+  ImportanceMap coarse{{}, (image.width + block - 1) / block, (image.height + block - 1) / block};
+  coarse.weights.assign(static_cast<size_t>(coarse.width) * coarse.height, 0.0f);
+  std::vector<double> sums(coarse.weights.size(), 0.0);
+  std::vector<int> texels(coarse.weights.size(), 0);
+  std::vector<size_t> cell_of(fine.weights.size());
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) {
+      // The cell holding the texel's centre (x / block where the block divides the width).
+      const size_t cx = (2 * static_cast<size_t>(x) + 1) * coarse.width / (2 * static_cast<size_t>(image.width));
+      const size_t cy = (2 * static_cast<size_t>(y) + 1) * coarse.height / (2 * static_cast<size_t>(image.height));
+      const size_t i = static_cast<size_t>(y) * image.width + x, c = cy * coarse.width + cx;
+      cell_of[i] = c;
+      sums[c] += fine.weights[i];
+      ++texels[c];
+    }
+  double total = 0.0;
+  for (double w : sums) total += w;
+  if (!(total > 0.0) || !std::isfinite(total)) return fine;
+  double factor = 0.0;  // sum over texels of p_t^2 / q_t, q_t = (W_cell / W) / texels in the cell
+  for (size_t i = 0; i < fine.weights.size(); ++i) {
+    const double w = fine.weights[i];
+    if (w > 0.0) factor += w * w * texels[cell_of[i]] / (total * sums[cell_of[i]]);
+  }
+  if (!(factor <= LightSampler::kEnvironmentCoarseVarianceFactor)) return fine;
+  for (size_t c = 0; c < sums.size(); ++c) coarse.weights[c] = static_cast<float>(sums[c]);
+  return coarse;
+}
+
+}  // namespace
+
 LightSampler::LightSampler(const Scene& scene) : scene_(scene) {
   std::vector<float> powers;
   mesh_light_offset_.assign(scene.meshes.size(), -1);
@@ -123,16 +182,8 @@ LightSampler::LightSampler(const Scene& scene) : scene_(scene) {
   build_near_field_clusters(powers);
 
   if (scene.environment && scene.environment->strength > 0.0f && !scene.environment->image.texels.empty()) {
-    const Texture& image = scene.environment->image;
-    std::vector<float> weights(static_cast<size_t>(image.width) * image.height);
-    for (int y = 0; y < image.height; ++y) {
-      float sin_theta = std::sin(kPi * (y + 0.5f) / image.height);
-      for (int x = 0; x < image.width; ++x) {
-        size_t i = static_cast<size_t>(y) * image.width + x;
-        weights[i] = luminance(glm::vec3(image.texels[i])) * sin_theta;
-      }
-    }
-    env_dist_ = Distribution2D(weights, image.width, image.height);
+    const ImportanceMap map = environment_importance(scene.environment->image);
+    env_dist_ = Distribution2D(map.weights, map.width, map.height);
     if (env_dist_.valid()) env_ = &*scene.environment;
   }
   for (const PunctualLight& light : scene.lights)

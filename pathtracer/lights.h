@@ -73,6 +73,11 @@ class LightSampler {
   // in the solid angle it subtends where its diagonal is at least its distance (this factor on
   // the squares), else uniformly in area (docs/sampling.md: measured choice).
   static constexpr float kSolidAngleNearness = 1.0f;
+  // The environment's importance map: at most about this many cells wide where the coarser map
+  // multiplies the variance of sampling the map's own luminance by at most the factor below,
+  // else one cell per texel (environment_importance in lights.cpp; docs/sampling.md).
+  static constexpr int kEnvironmentImportanceWidth = 256;
+  static constexpr double kEnvironmentCoarseVarianceFactor = 1.1;
   bool near_field_selection() const { return !clusters_.empty(); }
   glm::vec3 sample_environment_direction(glm::vec2 u, float* pdf) const;  // pdf without selection
   float environment_direction_pdf(glm::vec3 direction) const;             // pdf without selection

@@ -16,8 +16,8 @@
 namespace pxf {
 namespace {
 
-// Bonferroni over the twelve chi-square tests here (6 near-field, 2 double-sided quad, 2 environment,
-// 2 light types), with one to spare.
+// Bonferroni over the thirteen chi-square tests here (6 near-field, 2 double-sided quad, 3
+// environment, 2 light types).
 constexpr double kAlpha = 0.01 / 13;
 
 Scene three_emitters() {
@@ -310,19 +310,15 @@ Scene random_environment(int width, int height, uint64_t seed) {
   return scene;
 }
 
-TEST(Lights, EnvironmentSamplingMatchesItsPdf) {
-  // Directly, and through the whole light choice from one 2D number (a quad emitter beside the
-  // environment, so u.x must be rescaled into the environment's share before it picks the column).
-  for (bool shared : {false, true}) {
-    SCOPED_TRACE(shared ? "through sample(position, u)" : "sample_environment_direction");
-    Scene scene = random_environment(16, 8, 21);
-    if (shared) {
-      scene.materials.push_back(make_emitter(glm::vec3(3.0f)));
-      scene.meshes.push_back(make_quad(glm::vec3(0, 2, 0), glm::vec3(1, 0, 0), glm::vec3(0, 0, 1), 1));
-    }
+// Environment directions drawn (directly, or through the whole light choice when `shared`) land
+// in bu x bv bins of (u, v) as often as their claimed pdf integrates to (sub x sub points per bin:
+// exact where the bins hold whole cells of the importance map), and the pdf a sample claims is the
+// one environment_direction_pdf gives for its direction.
+void expect_environment_sampling_matches_its_pdf(const Scene& scene, bool shared, int bu, int bv, int sub) {
+  {
     LightSampler lights(scene);
     ASSERT_TRUE(lights.has_environment());
-    const int bu = 48, bv = 24, sub = 6, n = 300000;
+    const int n = 300000;
     std::vector<double> observed(bu * bv, 0.0);
     Rng rng(4, 0, 0);
     int pdf_mismatches = 0, drawn = 0;
@@ -347,7 +343,7 @@ TEST(Lights, EnvironmentSamplingMatchesItsPdf) {
     if (shared) {
       EXPECT_GT(drawn, n / 4);
     }
-    // Bins finer than the texels, in (u, v); expected counts integrate pdf(direction) over each bin.
+    // Expected counts integrate pdf(direction) over each bin.
     std::vector<double> expected(bu * bv, 0.0);
     for (int y = 0; y < bv * sub; ++y) {
       for (int x = 0; x < bu * sub; ++x) {
@@ -362,6 +358,81 @@ TEST(Lights, EnvironmentSamplingMatchesItsPdf) {
     stat::ChiSquareResult r = stat::chi_square(observed, expected);
     EXPECT_TRUE(r.problem.empty()) << r.problem;
     EXPECT_GT(r.p_value, kAlpha) << "chi2 " << r.statistic << " dof " << r.dof;
+  }
+}
+
+TEST(Lights, EnvironmentSamplingMatchesItsPdf) {
+  // Directly, and through the whole light choice from one 2D number (a quad emitter beside the
+  // environment, so u.x must be rescaled into the environment's share before it picks the column).
+  for (bool shared : {false, true}) {
+    SCOPED_TRACE(shared ? "through sample(position, u)" : "sample_environment_direction");
+    Scene scene = random_environment(16, 8, 21);
+    if (shared) {
+      scene.materials.push_back(make_emitter(glm::vec3(3.0f)));
+      scene.meshes.push_back(make_quad(glm::vec3(0, 2, 0), glm::vec3(1, 0, 0), glm::vec3(0, 0, 1), 1));
+    }
+    expect_environment_sampling_matches_its_pdf(scene, shared, 48, 24, 6);  // bins finer than the texels
+  }
+}
+
+// A smooth sky, wider than LightSampler::kEnvironmentImportanceWidth and not a multiple of the
+// block in either direction, with a black band and, optionally, a sun of 2 x 2 texels.
+Scene smooth_sky(bool with_sun) {
+  Scene scene;
+  scene.materials = {make_diffuse(glm::vec3(0.5f))};
+  Environment env;
+  env.image.width = 1030;
+  env.image.height = 517;
+  env.image.wrap_t = Wrap::ClampToEdge;
+  for (int y = 0; y < env.image.height; ++y)
+    for (int x = 0; x < env.image.width; ++x) {
+      float v = 1.0f + 0.5f * std::sin(6.2831853f * x / env.image.width) + 2.0f * y / env.image.height;
+      if (y >= 300 && y < 340) v = 0.0f;  // the black band: its edges cut blocks
+      if (with_sun && x >= 600 && x < 602 && y >= 100 && y < 102) v = 1.0e5f;
+      env.image.texels.push_back(glm::vec4(v, 0.8f * v, 0.6f * v, 1.0f));
+    }
+  scene.environment = env;
+  return scene;
+}
+
+// The pdf over (u, v) at texel (x, y)'s centre.
+float texel_pdf_uv(const LightSampler& lights, const Texture& image, int x, int y) {
+  const glm::vec2 uv((x + 0.5f) / image.width, (y + 0.5f) / image.height);
+  return lights.environment_direction_pdf(equirect_direction(uv)) * 2.0f * kPi * kPi * std::sin(kPi * uv.y);
+}
+
+TEST(Lights, EnvironmentImportanceMapIsCoarseOnlyWhereThatCostsLittleVariance) {
+  {
+    SCOPED_TRACE("smooth sky: blocks of 5 x 5 texels, uniform inside");
+    const Scene scene = smooth_sky(false);
+    const LightSampler lights(scene);
+    const Texture& image = scene.environment->image;
+    // Texels 0-4 of row 0-4 share a block (1030 / 256 rounds up to 5); texel 5 starts the next.
+    const float first = texel_pdf_uv(lights, image, 0, 2);
+    EXPECT_NEAR(texel_pdf_uv(lights, image, 4, 2), first, 1e-3f * first);
+    EXPECT_NEAR(texel_pdf_uv(lights, image, 2, 0), first, 1e-3f * first);
+    EXPECT_NE(texel_pdf_uv(lights, image, 5, 2), first);
+    // Every texel with light keeps a positive pdf, and black blocks none.
+    for (int y = 0; y < image.height; ++y)
+      for (int x = 0; x < image.width; x += 7) {
+        const bool lit = image.texels[static_cast<size_t>(y) * image.width + x].x > 0.0f;
+        if (lit) {
+          ASSERT_GT(texel_pdf_uv(lights, image, x, y), 0.0f) << x << ", " << y;
+        }
+        if (y >= 305 && y < 335) {
+          ASSERT_EQ(texel_pdf_uv(lights, image, x, y), 0.0f) << x << ", " << y;
+        }
+      }
+    expect_environment_sampling_matches_its_pdf(scene, false, 103, 52, 4);  // bins of 2 x 2 cells (206 x 104)
+  }
+  {
+    SCOPED_TRACE("the same sky with a sun of 2 x 2 texels: one cell per texel");
+    const Scene scene = smooth_sky(true);
+    const LightSampler lights(scene);
+    const Texture& image = scene.environment->image;
+    // The sun's texels against the sky texel beside them in the same block: the full map's
+    // ratio of weights (1e5 against about 1.4), where a block sum would give 1.
+    EXPECT_GT(texel_pdf_uv(lights, image, 600, 100) / texel_pdf_uv(lights, image, 603, 100), 1.0e4f);
   }
 }
 
