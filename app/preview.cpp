@@ -9,10 +9,11 @@ namespace pxf {
 
 namespace {
 
-// Every TraceParams field: a change of any of them makes the accumulated samples another render's.
+// Every TraceParams field that changes the samples: a change of any of them makes the accumulated
+// samples another render's. Near specular sampling under full specular sampling changes nothing.
 bool same_trace_params(const TraceParams& a, const TraceParams& b) {
   return a.max_vertices == b.max_vertices && a.rr_start_vertex == b.rr_start_vertex && a.all_hv == b.all_hv &&
-         a.specular_sampling == b.specular_sampling && a.near_specular_sampling == b.near_specular_sampling &&
+         specular_sampling_mode(a) == specular_sampling_mode(b) &&
          a.seed == b.seed && a.threads == b.threads &&
          a.sampler == b.sampler && a.replicates == b.replicates;
 }

@@ -239,7 +239,7 @@ SampleSettings sample_settings(uint64_t scene_hash, int width, int height, const
   s.all_hv = params.all_hv ? 1u : 0u;
   s.sampler = static_cast<uint32_t>(params.sampler);
   s.replicates = static_cast<uint32_t>(std::max(params.replicates, 1));
-  s.specular_sampling = params.specular_sampling ? 1u : params.near_specular_sampling ? 2u : 0u;
+  s.specular_sampling = static_cast<uint32_t>(specular_sampling_mode(params));
   return s;
 }
 

@@ -51,6 +51,16 @@ constexpr float kNearSpecularDistance2PerRadius2 = 1.0f / (1.0f - kNearSpecularC
 // it then covers at least this share of the cone the chain samples).
 constexpr double kNearSpecularMinFill = 0.5;
 
+// The specular sampling a TraceParams asks for, as the state files number it: near sampling means
+// nothing while full specular sampling is on, so two params that differ only there trace the same
+// samples.
+enum class SpecularSamplingMode : uint32_t { None = 0, All = 1, Near = 2 };
+inline SpecularSamplingMode specular_sampling_mode(const TraceParams& p) {
+  return p.specular_sampling         ? SpecularSamplingMode::All
+         : p.near_specular_sampling ? SpecularSamplingMode::Near
+                                    : SpecularSamplingMode::None;
+}
+
 // The replicates an accumulation keeps sums for: only the Sobol sampler has any (independent
 // samples are their own replicates). The renderer and the state files both go by this.
 inline int accumulated_replicates(SamplerType sampler, int replicates) {
