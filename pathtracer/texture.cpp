@@ -41,31 +41,8 @@ struct Texel8Tables {
 // at each of the four texels of every bilinear lookup. Nothing samples a texture before main().
 const Texel8Tables kTexel8Tables;
 
-}  // namespace
-
-float texel8_to_linear(unsigned char k, bool srgb) {
-  return srgb ? kTexel8Tables.srgb[k] : kTexel8Tables.linear[k];
-}
-
-glm::vec4 Texture::texel(size_t i) const {
-  if (!is_8bit()) return texels[i];
-  const float* rgb = srgb ? kTexel8Tables.srgb.data() : kTexel8Tables.linear.data();
-  const unsigned char* p = texels8->data() + 4 * i;
-  return glm::vec4(rgb[p[0]], rgb[p[1]], rgb[p[2]], kTexel8Tables.linear[p[3]]);
-}
-
-namespace {
-
-// Keeps huge or non-finite coordinates from overflowing the integer texel arithmetic.
-float sanitize_coordinate(float x) {
-  if (!std::isfinite(x)) return 0.0f;
-  const float limit = 1.0e6f;
-  if (x > limit || x < -limit) x = std::fmod(x, limit);
-  return x;
-}
-
-// Texel i and its right neighbour, read from the storage directly: a bilinear lookup reads two rows
-// of two texels, so the storage kind and decode table are chosen once, not per texel.
+// Reads texels as linear RGBA from either storage. A bilinear look-up reads four, so the storage
+// kind and the decode table are chosen once, when the reader is made, not per texel.
 struct TexelReader {
   const glm::vec4* floats = nullptr;
   const unsigned char* codes = nullptr;
@@ -84,6 +61,24 @@ struct TexelReader {
     return glm::vec4(rgb[p[0]], rgb[p[1]], rgb[p[2]], kTexel8Tables.linear[p[3]]);
   }
 };
+
+}  // namespace
+
+float texel8_to_linear(unsigned char k, bool srgb) {
+  return srgb ? kTexel8Tables.srgb[k] : kTexel8Tables.linear[k];
+}
+
+glm::vec4 Texture::texel(size_t i) const { return TexelReader(*this)(i); }
+
+namespace {
+
+// Keeps huge or non-finite coordinates from overflowing the integer texel arithmetic.
+float sanitize_coordinate(float x) {
+  if (!std::isfinite(x)) return 0.0f;
+  const float limit = 1.0e6f;
+  if (x > limit || x < -limit) x = std::fmod(x, limit);
+  return x;
+}
 
 // wrap_texel_index(i) and wrap_texel_index(i + 1), with no division when i is already inside
 // [0, size) under Repeat (the common case: uvs in [0, 1)).
