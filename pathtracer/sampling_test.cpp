@@ -1,6 +1,8 @@
 #include "pathtracer/sampling.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -68,6 +70,26 @@ TEST(Distribution1D, UOnABoundaryPicksTheBinThatStartsThere) {
   EXPECT_EQ(remapped, 0.0f);
   EXPECT_EQ(dist.sample(0x1.fffffep-1f, &remapped), 3u);
   EXPECT_LT(remapped, 1.0f);
+}
+
+TEST(SortedUpperBound, MatchesStdUpperBound) {
+  // Sorted arrays of every length up to 70 and a long one, with runs of equal entries (empty bins)
+  // and both search paths (counted, halved); u on every entry, just beside it, between entries,
+  // outside [0, 1] and NaN.
+  for (size_t n : {0, 1, 2, 3, 5, 8, 9, 10, 11, 16, 17, 31, 33, 64, 70, 1025}) {
+    std::vector<float> sorted(n);
+    for (size_t i = 0; i < n; ++i) sorted[i] = static_cast<float>((i / 3) * 3) / static_cast<float>(n + 1);
+    std::vector<float> us = {std::nanf(""), -1.0f, 0.0f, 1.0f, 2.0f, std::numeric_limits<float>::infinity()};
+    for (float c : sorted)
+      for (float u : {c, std::nextafter(c, -1.0f), std::nextafter(c, 2.0f), c + 0.5f / static_cast<float>(n + 1)})
+        us.push_back(u);
+    for (size_t count_up_to : {size_t{0}, size_t{9}})
+      for (float u : us) {
+        const size_t want = static_cast<size_t>(std::upper_bound(sorted.begin(), sorted.end(), u) - sorted.begin());
+        ASSERT_EQ(sorted_upper_bound(sorted.data(), n, u, count_up_to), want)
+            << "n " << n << " u " << u << " count_up_to " << count_up_to;
+      }
+  }
 }
 
 TEST(Distribution1D, NonFiniteUStillPicksABin) {
