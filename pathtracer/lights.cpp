@@ -124,25 +124,28 @@ ImportanceMap environment_importance(const Texture& image) {
   coarse.weights.assign(static_cast<size_t>(coarse.width) * coarse.height, 0.0f);
   std::vector<double> sums(coarse.weights.size(), 0.0);
   std::vector<int> texels(coarse.weights.size(), 0);
-  std::vector<size_t> cell_of(fine.weights.size());
+  // The cell holding texel (x, y)'s centre (x / block where the block divides the width).
+  const auto cell_of = [&](int x, int y) {
+    const size_t cx = (2 * static_cast<size_t>(x) + 1) * coarse.width / (2 * static_cast<size_t>(image.width));
+    const size_t cy = (2 * static_cast<size_t>(y) + 1) * coarse.height / (2 * static_cast<size_t>(image.height));
+    return cy * coarse.width + cx;
+  };
   for (int y = 0; y < image.height; ++y)
     for (int x = 0; x < image.width; ++x) {
-      // The cell holding the texel's centre (x / block where the block divides the width).
-      const size_t cx = (2 * static_cast<size_t>(x) + 1) * coarse.width / (2 * static_cast<size_t>(image.width));
-      const size_t cy = (2 * static_cast<size_t>(y) + 1) * coarse.height / (2 * static_cast<size_t>(image.height));
-      const size_t i = static_cast<size_t>(y) * image.width + x, c = cy * coarse.width + cx;
-      cell_of[i] = c;
-      sums[c] += fine.weights[i];
+      const size_t c = cell_of(x, y);
+      sums[c] += fine.weights[static_cast<size_t>(y) * image.width + x];
       ++texels[c];
     }
   double total = 0.0;
   for (double w : sums) total += w;
   if (!(total > 0.0) || !std::isfinite(total)) return fine;
   double factor = 0.0;  // sum over texels of p_t^2 / q_t, q_t = (W_cell / W) / texels in the cell
-  for (size_t i = 0; i < fine.weights.size(); ++i) {
-    const double w = fine.weights[i];
-    if (w > 0.0) factor += w * w * texels[cell_of[i]] / (total * sums[cell_of[i]]);
-  }
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) {
+      const double w = fine.weights[static_cast<size_t>(y) * image.width + x];
+      const size_t c = cell_of(x, y);
+      if (w > 0.0) factor += w * w * texels[c] / (total * sums[c]);
+    }
   if (!(factor <= LightSampler::kEnvironmentCoarseVarianceFactor)) return fine;
   for (size_t c = 0; c < sums.size(); ++c) coarse.weights[c] = static_cast<float>(sums[c]);
   return coarse;
