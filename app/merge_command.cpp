@@ -25,8 +25,9 @@ void take_settings_from_state(const SampleSettings& s, SceneOptions& scene, Prev
   preview.trace.all_hv = s.all_hv != 0;
   preview.trace.sampler = static_cast<SamplerType>(s.sampler);
   preview.trace.replicates = static_cast<int>(s.replicates);
-  preview.trace.specular_sampling = s.specular_sampling == 1;
-  preview.trace.near_specular_sampling = s.specular_sampling == 2;
+  const auto mode = static_cast<SpecularSamplingMode>(s.specular_sampling);
+  preview.trace.specular_sampling = mode == SpecularSamplingMode::All;
+  preview.trace.near_specular_sampling = mode == SpecularSamplingMode::Near;
 }
 
 }  // namespace

@@ -117,7 +117,7 @@ SampleSettings get_settings(Reader& r) {
   s.sampler = r.get<uint32_t>("header");
   s.replicates = r.get<uint32_t>("header");
   s.specular_sampling = r.get<uint32_t>("header");
-  if (s.all_hv > 1 || s.specular_sampling > 2 || s.sampler > 1)
+  if (s.all_hv > 1 || s.specular_sampling > static_cast<uint32_t>(SpecularSamplingMode::Near) || s.sampler > 1)
     throw Error("state file has an invalid setting flag (all-hv, sampler or specular sampling)");
   if (s.replicates < 1 || s.replicates > kMaxReplicates)
     throw Error("state file has an invalid replicate count " + std::to_string(s.replicates));

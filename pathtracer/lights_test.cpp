@@ -315,50 +315,48 @@ Scene random_environment(int width, int height, uint64_t seed) {
 // exact where the bins hold whole cells of the importance map), and the pdf a sample claims is the
 // one environment_direction_pdf gives for its direction.
 void expect_environment_sampling_matches_its_pdf(const Scene& scene, bool shared, int bu, int bv, int sub) {
-  {
-    LightSampler lights(scene);
-    ASSERT_TRUE(lights.has_environment());
-    const int n = 300000;
-    std::vector<double> observed(bu * bv, 0.0);
-    Rng rng(4, 0, 0);
-    int pdf_mismatches = 0, drawn = 0;
-    for (int k = 0; k < n; ++k) {
-      float pdf;
-      glm::vec3 d;
-      if (shared) {
-        LightSample ls;
-        if (!lights.sample(glm::vec3(0.0f), rng.next_2d(), &ls) || !std::isinf(ls.distance)) continue;
-        d = ls.wi;
-        pdf = ls.pdf / lights.environment_probability();
-      } else {
-        d = lights.sample_environment_direction(rng.next_2d(), &pdf);
-      }
-      glm::vec2 uv = equirect_uv(d);
-      int x = std::min(bu - 1, static_cast<int>(uv.x * bu)), y = std::min(bv - 1, static_cast<int>(uv.y * bv));
-      observed[y * bu + x] += 1.0;
-      ++drawn;
-      float again = lights.environment_direction_pdf(d);
-      if (std::abs(again - pdf) > 2e-3f * pdf) ++pdf_mismatches;
-    }
+  LightSampler lights(scene);
+  ASSERT_TRUE(lights.has_environment());
+  const int n = 300000;
+  std::vector<double> observed(bu * bv, 0.0);
+  Rng rng(4, 0, 0);
+  int pdf_mismatches = 0, drawn = 0;
+  for (int k = 0; k < n; ++k) {
+    float pdf;
+    glm::vec3 d;
     if (shared) {
-      EXPECT_GT(drawn, n / 4);
+      LightSample ls;
+      if (!lights.sample(glm::vec3(0.0f), rng.next_2d(), &ls) || !std::isinf(ls.distance)) continue;
+      d = ls.wi;
+      pdf = ls.pdf / lights.environment_probability();
+    } else {
+      d = lights.sample_environment_direction(rng.next_2d(), &pdf);
     }
-    // Expected counts integrate pdf(direction) over each bin.
-    std::vector<double> expected(bu * bv, 0.0);
-    for (int y = 0; y < bv * sub; ++y) {
-      for (int x = 0; x < bu * sub; ++x) {
-        glm::vec2 uv((x + 0.5f) / (bu * sub), (y + 0.5f) / (bv * sub));
-        glm::vec3 d = equirect_direction(uv);
-        double jacobian = 2.0 * M_PI * M_PI * std::sin(M_PI * uv.y);  // dω = 2 pi^2 sin(theta) du dv
-        expected[(y / sub) * bu + x / sub] +=
-            drawn * lights.environment_direction_pdf(d) * jacobian / (double(bu * sub) * double(bv * sub));
-      }
-    }
-    EXPECT_LE(pdf_mismatches, n / 10000);  // texel-boundary round-off only
-    stat::ChiSquareResult r = stat::chi_square(observed, expected);
-    EXPECT_TRUE(r.problem.empty()) << r.problem;
-    EXPECT_GT(r.p_value, kAlpha) << "chi2 " << r.statistic << " dof " << r.dof;
+    glm::vec2 uv = equirect_uv(d);
+    int x = std::min(bu - 1, static_cast<int>(uv.x * bu)), y = std::min(bv - 1, static_cast<int>(uv.y * bv));
+    observed[y * bu + x] += 1.0;
+    ++drawn;
+    float again = lights.environment_direction_pdf(d);
+    if (std::abs(again - pdf) > 2e-3f * pdf) ++pdf_mismatches;
   }
+  if (shared) {
+    EXPECT_GT(drawn, n / 4);
+  }
+  // Expected counts integrate pdf(direction) over each bin.
+  std::vector<double> expected(bu * bv, 0.0);
+  for (int y = 0; y < bv * sub; ++y) {
+    for (int x = 0; x < bu * sub; ++x) {
+      glm::vec2 uv((x + 0.5f) / (bu * sub), (y + 0.5f) / (bv * sub));
+      glm::vec3 d = equirect_direction(uv);
+      double jacobian = 2.0 * M_PI * M_PI * std::sin(M_PI * uv.y);  // dω = 2 pi^2 sin(theta) du dv
+      expected[(y / sub) * bu + x / sub] +=
+          drawn * lights.environment_direction_pdf(d) * jacobian / (double(bu * sub) * double(bv * sub));
+    }
+  }
+  EXPECT_LE(pdf_mismatches, n / 10000);  // texel-boundary round-off only
+  stat::ChiSquareResult r = stat::chi_square(observed, expected);
+  EXPECT_TRUE(r.problem.empty()) << r.problem;
+  EXPECT_GT(r.p_value, kAlpha) << "chi2 " << r.statistic << " dof " << r.dof;
 }
 
 TEST(Lights, EnvironmentSamplingMatchesItsPdf) {

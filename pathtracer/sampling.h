@@ -134,9 +134,6 @@ inline float max_component(glm::vec3 v) { return std::max(v.x, std::max(v.y, v.z
 inline float luminance(glm::vec3 c) { return 0.2126f * c.r + 0.7152f * c.g + 0.0722f * c.b; }
 inline bool is_finite(glm::vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
-// Piecewise-constant distribution over n bins from non-negative weights (non-finite or negative
-// weights count as 0). Sampling is a binary search in the CDF (a linear count for up to 8 bins);
-// O(log n), no allocation.
 // std::upper_bound's index in sorted[0, n) (how many entries are not above u; n for a NaN u, as
 // std::upper_bound gives), without branches on the comparisons: where a random u falls is a coin
 // flip per sample, and a branch on it is mispredicted half the time. Up to `count_up_to` entries
@@ -158,6 +155,9 @@ inline size_t sorted_upper_bound(const float* sorted, size_t n, float u, size_t 
   return first + !(u < sorted[first]);
 }
 
+// Piecewise-constant distribution over n bins from non-negative weights (non-finite or negative
+// weights count as 0). Sampling is a binary search in the CDF (a linear count for up to 8 bins);
+// O(log n), no allocation.
 class Distribution1D {
  public:
   Distribution1D() = default;
