@@ -235,15 +235,14 @@ float PathTracer::specular_pdf(glm::vec3 p, glm::vec3 wi, bool near_only) const 
 }
 
 glm::vec3 PathTracer::specular_chain_light(const SurfacePoint& sp, const Bsdf& bsdf, glm::vec3 throughput, int vertex,
-                                           bool near_only, PathSampler& sampler, const TraceParams& params,
-                                           uint32_t* rays, bool* through_glass) const {
+                                           bool near_only, int candidates, PathSampler& sampler,
+                                           const TraceParams& params, uint32_t* rays, bool* through_glass) const {
   const Scene& scene = geometry_.scene();
   const PathSampler::SpecularNumbers numbers = sampler.specular_numbers(vertex);
   const float u_select = numbers.select;
   const glm::vec2 u = numbers.direction;
   // The target: candidate number k (every specular object, or the near ones), chosen uniformly.
-  const int n = chain_target_count(sp.position, near_only);
-  if (n == 0) return glm::vec3(0.0f);
+  const int n = candidates;
   int k = std::min(n - 1, static_cast<int>(u_select * static_cast<float>(n)));
   const SpecularTarget* target = nullptr;
   for (const SpecularTarget& t : specular_targets_)
@@ -464,13 +463,15 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
   // toward the specular objects that fill much of its view (params.near_specular_sampling).
   const bool room = !specular_targets_.empty() && bsdf.has_nondelta() && vertex + 2 <= params.max_vertices;
   const bool near_only = !params.specular_sampling;
-  const bool specular_sampling =
-      room && (params.specular_sampling || (params.near_specular_sampling && has_near_targets_ &&
-                                            s.nonspecular == 0 && chain_target_count(sp.position, true) > 0));
+  const int candidates =
+      room && (params.specular_sampling || (params.near_specular_sampling && has_near_targets_ && s.nonspecular == 0))
+          ? chain_target_count(sp.position, near_only)
+          : 0;
+  const bool specular_sampling = candidates > 0;
   if (specular_sampling) {
     bool through_glass = false;
-    const glm::vec3 light = specular_chain_light(sp, bsdf, s.throughput, vertex, near_only, sampler, params,
-                                                 &out.rays, &through_glass);
+    const glm::vec3 light = specular_chain_light(sp, bsdf, s.throughput, vertex, near_only, candidates, sampler,
+                                                 params, &out.rays, &through_glass);
     if (max_component(light) > 0.0f) {
       out.hv += light;
       if constexpr (kClassify) {

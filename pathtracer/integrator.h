@@ -110,9 +110,10 @@ class PathTracer {
   };
   int chain_target_count(glm::vec3 p, bool near_only) const;
   float specular_pdf(glm::vec3 p, glm::vec3 wi, bool near_only) const;
+  // `candidates`: chain_target_count(sp.position, near_only), at least 1.
   glm::vec3 specular_chain_light(const SurfacePoint& sp, const Bsdf& bsdf, glm::vec3 throughput, int vertex,
-                                 bool near_only, PathSampler& sampler, const TraceParams& params, uint32_t* rays,
-                                 bool* through_glass) const;
+                                 bool near_only, int candidates, PathSampler& sampler, const TraceParams& params,
+                                 uint32_t* rays, bool* through_glass) const;
 
   // The BsdfMaterial at sp: the one precomputed for its material when eval_material() reads no
   // texture of it and the vertex color is white (base color x 1 is exact, so the values are the
