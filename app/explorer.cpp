@@ -445,6 +445,7 @@ class Explorer {
     changed |= ImGui::SliderFloat("sigma d", &s.filter.sigma_d, 1e-3f, 1e3f, "%.3g", ImGuiSliderFlags_Logarithmic);
     changed |= enum_combo("filter", filter_option_names(), &s.filter.kind);
     changed |= ImGui::Checkbox("albedo demodulation", &s.demodulate);
+    changed |= ImGui::Checkbox("bias guard", &s.bias_guard);
     changed |= enum_combo("schedule", filter_schedule_names(), &s.schedule);
     changed |= ImGui::SliderInt("path length", &s.trace.max_vertices, 2, 32);
     changed |= ImGui::Checkbox("all HV", &s.trace.all_hv);

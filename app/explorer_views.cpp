@@ -40,6 +40,7 @@ const std::array<CaseStyle, kBlendCaseCount> kCaseStyles = {{
     case_style("2  unfiltered (s = 1)", kCaseUnfiltered),
     case_style("3  mixed (0 < s < 1)", kCaseMixed),
     case_style("4  n < 2 (s = 0)", kCaseUnknownVar),
+    case_style("5  bias guard (s raised)", kCaseBiasGuard),
 }};
 
 constexpr int kLegendWidth = 256;

@@ -132,7 +132,7 @@ void run_threshold_fidelity_bench(const FidelityBenchSetup& b, const std::vector
         for (const auto& c : s.blend_case) ++count[std::min<int>(c[p], kBlendCaseCount - 1)];
         majority[p] = static_cast<int>(std::max_element(count, count + kBlendCaseCount) - count);
       }
-      for (int want : {kCaseUnfiltered, kCaseMixed}) {
+      for (int want : {kCaseUnfiltered, kCaseMixed, kCaseBiasGuard}) {
         const Summary r = summarize(s, thresholds[ti], want, majority);
         const double fraction = r.pixels ? static_cast<double>(r.at_most_t) / r.pixels : 0;
         std::printf("%6d %7g %6d %8zu %11.1f%% %13.3f +- %.3f\n", spps[k], thresholds[ti], want, r.pixels,

@@ -253,7 +253,7 @@ void Preview::blend_and_tonemap() {
   // The filter's centre weight is that of the demodulated run too: with a grey factor a,
   // Cov[L_u, a L_f'] = a w Var[L_u] / a = w Var[L_u], the blend's covariance term is unchanged.
   blend_.run(inputs_, have_filtered_ ? &filtered_output() : nullptr, &range_.guide(), threshold_now(),
-             BlendParams{range_weights(settings_.filter)},
+             BlendParams{range_weights(settings_.filter), settings_.bias_guard},
              have_filtered_ ? filter_.centre_weight() : nullptr);
   last_.blend += blend_.last_ms();
   tonemap_.run(blend_.output(), settings_.tonemap);

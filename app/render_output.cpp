@@ -46,6 +46,7 @@ nlohmann::json stats_json(Preview& preview, const RenderReport& r) {
                    {"threshold", s.threshold},
                    {"filter", filter_kind_name(s.filter.kind)},
                    {"demodulate", s.demodulate},
+                   {"bias_guard", s.bias_guard},
                    {"schedule", filter_schedule_names()[static_cast<int>(s.schedule)]},
                    {"sigma_s", s.filter.sigma_s},
                    {"sigma_c", s.filter.sigma_c},
@@ -80,7 +81,7 @@ nlohmann::json stats_json(Preview& preview, const RenderReport& r) {
   const auto& counts = preview.case_counts();
   j["blend_case_pixels"] = {{"no_filtered", counts[kCaseNoFiltered]}, {"case1", counts[kCaseFilteredOnly]},
                             {"case2", counts[kCaseUnfiltered]},       {"case3", counts[kCaseMixed]},
-                            {"unknown_variance", counts[kCaseUnknownVar]}};
+                            {"unknown_variance", counts[kCaseUnknownVar]}, {"bias_guard", counts[kCaseBiasGuard]}};
   if (r.final_vs_reference) j["final_vs_reference"] = metrics_json(*r.final_vs_reference);
   if (r.unfiltered_vs_reference) j["unfiltered_vs_reference"] = metrics_json(*r.unfiltered_vs_reference);
   return j;

@@ -140,6 +140,54 @@ TEST(BlendFactorCpu, CovarianceTermHitsTheThreshold) {
   EXPECT_GT(mixed, 1000);
 }
 
+// The bias guard's factor (shaders/pass_formulas.h): the s in [0, 1] of least expected squared
+// error (1-s)^2 (b2 + f) + s^2 u + 2 s (1-s) c, found here by a fine search, but never below the
+// blend's own s; the case becomes kCaseBiasGuard only where it raised s, and no bias changes nothing.
+double expected_squared_error(double s, double u, double f, double w, double b2) {
+  return (1 - s) * (1 - s) * b2 + blend_variance(s, u, f, w);
+}
+
+TEST(BlendFactorCpu, BiasGuardRaisesSToTheLeastErrorAndNeverLowersIt) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> e(-6.0f, 1.0f), unit(0.0f, 1.0f);
+  int raised = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const float u = std::pow(10.0f, e(rng)), w = unit(rng), s0 = unit(rng);
+    const float f = w * w * u + std::pow(10.0f, e(rng)), b2 = std::pow(10.0f, e(rng));
+    SCOPED_TRACE(testing::Message() << "u=" << u << " f=" << f << " w=" << w << " b2=" << b2 << " s0=" << s0);
+    int blend_case = kCaseMixed;
+    const float s = shared::bias_guard_factor(s0, u, f, w, b2, blend_case);
+    ASSERT_GE(s, s0);
+    ASSERT_LE(s, 1.0f);
+    double best_s = 0, best = expected_squared_error(0, u, f, w, b2);
+    for (int k = 1; k <= 10000; ++k) {
+      const double e_k = expected_squared_error(k / 10000.0, u, f, w, b2);
+      if (e_k < best) best = e_k, best_s = k / 10000.0;
+    }
+    if (best_s > s0 + 1e-3) {
+      ASSERT_EQ(blend_case, kCaseBiasGuard);
+      ASSERT_NEAR(s, best_s, 2e-4);
+      ++raised;
+    } else if (best_s < s0 - 1e-3) {
+      ASSERT_EQ(s, s0);
+      ASSERT_EQ(blend_case, kCaseMixed);
+    }
+    int unchanged = kCaseFilteredOnly;
+    ASSERT_EQ(shared::bias_guard_factor(s0, u, f, w, 0.0f, unchanged), s0);
+    ASSERT_EQ(unchanged, kCaseFilteredOnly);
+  }
+  EXPECT_GT(raised, 2000);
+  // By hand: u = 0.04, f = 0, w = 0, b2 = 0.01: s = 0.01 / 0.05 = 0.2 (from the blend's 0.1).
+  int c = kCaseMixed;
+  EXPECT_NEAR(shared::bias_guard_factor(0.1f, 0.04f, 0.0f, 0.0f, 0.01f, c), 0.2f, 1e-6f);
+  EXPECT_EQ(c, kCaseBiasGuard);
+  // Non-finite variances: s unchanged.
+  c = kCaseMixed;
+  EXPECT_EQ(shared::bias_guard_factor(0.3f, kInf, 0.0f, 0.0f, 0.01f, c), 0.3f);
+  EXPECT_EQ(shared::bias_guard_factor(0.3f, 0.1f, kNaN, 0.0f, 0.01f, c), 0.3f);
+  EXPECT_EQ(c, kCaseMixed);
+}
+
 // s from the shader for (u, f) pairs: L_lv = 0, L_f = (1,1,1) so L_b = 1, Var[L_u] = u, Var[L_f] = f.
 TEST(BlendFactorShader, MatchesCpuOnGridAndBoundaries) {
   test::osmesa_context();

@@ -32,6 +32,7 @@ void BlendPass::run(const PreviewInputs& inputs, const Texture2D* filtered, cons
   program_.set("k_c", params.range.k_c);
   program_.set("k_d", params.range.k_d);
   program_.set("t", t);
+  program_.set("bias_guard", params.bias_guard ? 1 : 0);
   const std::array<uint32_t, kBlendCaseCount> zeros{};
   counts_.upload(zeros.data(), sizeof zeros);
   counts_.bind_storage(shared::kBufferCounts);

@@ -32,7 +32,7 @@ class BlendPass {
 
   const Texture2D& output() const { return output_; }       // rgb L, a s
   const Texture2D& case_texture() const { return case_; }   // r: case code (kCase* in shaders/pass_formulas.h)
-  // Pixels per case of the last run (a 20-byte read-back).
+  // Pixels per case of the last run (a 24-byte read-back).
   std::array<uint32_t, kBlendCaseCount> case_counts() const;
   double last_ms() const { return timer_.last_ms(); }
 

@@ -235,7 +235,17 @@ BlendOutput cpu_blend(const Image& lv, const Image& hv, const Image& var_u, cons
           if (pool) vu = pooled_var_u(var_u, *range_color, *depth, x, y, params.range);
           float u = vu > 0.0f ? relative_variance(vu, lb) : zero_variance_u(lum(lf.c), lb);
           const float w_centre = filtered->centre_weight.pixels.empty() ? 0.0f : filtered->centre_weight.at(x, y, 0);
-          d = blend_decision(u, relative_variance(vf, lb), t, w_centre);
+          const float f = relative_variance(vf, lb);
+          d = blend_decision(u, f, t, w_centre);
+          if (params.bias_guard && (d.blend_case == kCaseMixed || d.blend_case == kCaseFilteredOnly)) {
+            const TexelView hv_view{&hv, &var_u}, filtered_view{&filtered->filtered, &filtered->variance};
+            const float b2 = shared::filter_bias_squared(hv_view, filtered_view, glm::ivec2(x, y));
+            if (b2 > 0.0f) {
+              const float u_guard =
+                  std::max(u, relative_variance(shared::broad_var_u(hv_view, filtered_view, glm::ivec2(x, y)), lb));
+              d.s = shared::bias_guard_factor(d.s, u_guard, f, w_centre, relative_variance(b2, lb), d.blend_case);
+            }
+          }
         }
       }
       for (int c = 0; c < 3; ++c)

@@ -22,6 +22,7 @@ using shared::kCaseMixed;
 using shared::kCaseNoFiltered;
 using shared::kCaseUnfiltered;
 using shared::kCaseUnknownVar;
+using shared::kCaseBiasGuard;
 using shared::kMaxInput;
 using shared::kVarSkipped;
 using shared::kVarSkippedBelow;
@@ -117,6 +118,10 @@ float effective_threshold(float t, uint64_t samples);
 struct BlendParams {
   // Weights of the 3x3 variance pooling (pooled_var_u in shaders/pass_formulas.h): the filter's.
   RangeWeights range = range_weights(FilterParams{});
+  // Raise s where L_f is measurably biased (bias_guard_factor in shaders/pass_formulas.h, case
+  // kCaseBiasGuard). Off here, the method's blend as published; the preview's
+  // default turns it on (PreviewSettings).
+  bool bias_guard = false;
 };
 
 // TonemapParams: image/tonemap.h (the tone map formula lives there).

@@ -459,10 +459,11 @@ TEST(BlendVsCpu, MatchesReferenceWithFilteredInput) {
     Texture2D filtered(W, H, TextureFormat::RGBA32F);
     filtered.upload(packed);
     for (float t : {0.0f, 0.001f, 0.02f, 0.2f})
-      for (bool pool : {false, true}) {
-      SCOPED_TRACE(testing::Message() << "t=" << t << " pool=" << pool << " skip=" << skip);
+      for (bool pool : {false, true})
+        for (bool guard : {false, true}) {
+      SCOPED_TRACE(testing::Message() << "t=" << t << " pool=" << pool << " skip=" << skip << " guard=" << guard);
       BlendPass blend(W, H);
-      const BlendParams bp{range_weights(fp)};
+      const BlendParams bp{range_weights(fp), guard};
       blend.run(gpu.inputs, &filtered, pool ? &gpu.guide : nullptr, t, bp);
       BlendOutput ref = cpu_blend(s.lv, s.hv, s.var, &ref_f, t, bp, pool ? &s.range : nullptr, pool ? &s.depth : nullptr);
       expect_close(blend.final_image(), ref.final_rgb, 1e-4f, 1e-6f, "final");
@@ -477,8 +478,93 @@ TEST(BlendVsCpu, MatchesReferenceWithFilteredInput) {
         total += counts[c];
       }
       EXPECT_EQ(total, uint32_t(W * H));
+      // Where the blend mixes, this filter's L_f is biased enough somewhere (the scenario's HV
+      // steps at its region borders) for the guard to act.
+      if (guard && t > 0.0f && t < 0.2f) {
+        EXPECT_GT(counts[kCaseBiasGuard], 0u);
+      }
+      if (!guard) {
+        EXPECT_EQ(counts[kCaseBiasGuard], 0u);
+      }
     }
   }
+}
+
+// The bias guard on a flat surface: L_u = m + Gaussian noise of the variance Var[L_u] says, L_f = m + b with Var[L_f] = 0.
+// Unbiased (b = 0) the 3x3 mean of d = L_f - L_u is N(0, Var[L_u] / 9), and the 2-sigma test
+// fires in P(|Z| > 2) = 4.6 % of the pixels; with b = 2 sigma of a single pixel (z = 6 for the
+// mean) it fires in nearly all of them, and s becomes the least-error blend factor for the
+// measured bias: about (b^2 + f) / (b^2 + f + u), here b^2 = 4 u, f = 0: 0.8.
+TEST(BlendVsCpu, BiasGuardFiresWhereLfIsBiasedAndRarelyWhereItIsNot) {
+  constexpr int kSize = 64;
+  const float sigma = 0.1f, m = 1.0f, t = 1e-4f;  // u = sigma^2 / m^2 = 0.01 > t: the blend mixes
+  std::mt19937 rng(5);
+  std::normal_distribution<float> noise(0.0f, sigma);
+  Image lv = Image::rgb(kSize, kSize), hv = Image::rgb(kSize, kSize), var = Image::gray(kSize, kSize);
+  Image range = Image::rgb(kSize, kSize), depth = Image::gray(kSize, kSize);
+  for (int y = 0; y < kSize; ++y)
+    for (int x = 0; x < kSize; ++x) {
+      const float v = m + noise(rng);
+      for (int c = 0; c < 3; ++c) {
+        hv.at(x, y, c) = v;
+        range.at(x, y, c) = 0.5f;
+      }
+      var.at(x, y, 0) = sigma * sigma;
+      depth.at(x, y, 0) = 2.0f;
+    }
+  BlendParams guarded{range_weights(FilterParams{}), true};
+  for (float bias : {0.0f, 2.0f * sigma}) {
+    SCOPED_TRACE(testing::Message() << "bias=" << bias);
+    FilterOutput f;
+    f.filtered = Image::rgb(kSize, kSize);
+    f.variance = Image::gray(kSize, kSize);
+    for (float& c : f.filtered.pixels) c = m + bias;
+    const BlendOutput out = cpu_blend(lv, hv, var, &f, t, guarded, &range, &depth);
+    size_t fired = 0, judged = 0;
+    double s_sum = 0;
+    for (int y = 1; y < kSize - 1; ++y)
+      for (int x = 1; x < kSize - 1; ++x) {
+        ++judged;
+        const bool raised = out.blend_case.at(x, y, 0) == float(kCaseBiasGuard);
+        fired += raised;
+        if (raised) s_sum += out.s.at(x, y, 0);
+      }
+    const double share = double(fired) / judged;
+    std::printf("bias %g: the guard fired in %.1f %% of the pixels, mean s there %.3f\n", bias, 100 * share,
+                fired ? s_sum / fired : 0.0);
+    if (bias == 0.0f) {
+      EXPECT_GT(share, 0.02);
+      EXPECT_LT(share, 0.08);
+    } else {
+      EXPECT_GT(share, 0.99);
+      // s from the measured bias (b + noise of the mean)^2 averages near 0.8 (with b^2 = 4 u).
+      EXPECT_NEAR(s_sum / fired, 0.8, 0.03);
+    }
+  }
+  // The noise the guard trades against is the 5x5 neighbourhood's, whatever its range colour: rows
+  // of two range colours, the even rows reporting Var[L_u] = sigma^2 / 100 (as a pixel that missed
+  // the rare bright paths does), the odd ones sigma^2. The blend's own u of an even-row pixel pools
+  // its own colour only (sigma^2 / 100); the guard's is the 5x5 mean, 3 even rows and 2 odd:
+  // 0.406 sigma^2. L_u = m, L_f = m + 2 sigma exactly: s = 4 / (4 + 0.406) = 0.908, where the
+  // blend's u would give 4 / 4.01 = 0.998.
+  for (int y = 0; y < kSize; ++y)
+    for (int x = 0; x < kSize; ++x) {
+      for (int c = 0; c < 3; ++c) {
+        hv.at(x, y, c) = m;
+        range.at(x, y, c) = y % 2 ? 0.9f : 0.1f;
+      }
+      var.at(x, y, 0) = y % 2 ? sigma * sigma : sigma * sigma / 100;
+    }
+  FilterOutput f;
+  f.filtered = Image::rgb(kSize, kSize);
+  f.variance = Image::gray(kSize, kSize);
+  for (float& c : f.filtered.pixels) c = m + 2 * sigma;
+  const BlendOutput out = cpu_blend(lv, hv, var, &f, t / 100, guarded, &range, &depth);  // u > t in every row
+  for (int y = 2; y < kSize - 2; y += 2)
+    for (int x = 2; x < kSize - 2; ++x) {
+      ASSERT_EQ(out.blend_case.at(x, y, 0), float(kCaseBiasGuard)) << x << "," << y;
+      ASSERT_NEAR(out.s.at(x, y, 0), 4.0 / 4.406, 1e-4) << x << "," << y;
+    }
 }
 
 // The full bilateral's centre weight feeds the blend's covariance term: GPU against CPU, and the
@@ -495,7 +581,7 @@ TEST(BlendVsCpu, CovarianceTermFromTheFiltersCentreWeight) {
   FilterOutput ref_f = cpu_filter(s.hv, s.var, s.lv, s.range, s.depth, fp, test::kTestThreshold);
   FilterOutput ref_plain = ref_f;
   ref_plain.centre_weight = Image();
-  size_t changed = 0;
+  size_t changed = 0, guarded_pixels = 0;
   for (float t : {0.001f, 0.02f, 0.2f}) {
     SCOPED_TRACE(testing::Message() << "t=" << t);
     filter.run(gpu.inputs, gpu.guide, fp, t);
@@ -513,8 +599,16 @@ TEST(BlendVsCpu, CovarianceTermFromTheFiltersCentreWeight) {
       EXPECT_LE(ref.s.pixels[i], plain.s.pixels[i] + 1e-6f) << i;
       changed += ref.s.pixels[i] < plain.s.pixels[i] - 1e-3f;
     }
+    // The bias guard takes the same covariance into its least-error s.
+    const BlendParams guarded{range_weights(fp), true};
+    blend.run(gpu.inputs, &filter, gpu.guide, t, guarded);
+    BlendOutput ref_guarded = cpu_blend(s.lv, s.hv, s.var, &ref_f, t, guarded, &s.range, &s.depth);
+    expect_close(blend.s_image(), ref_guarded.s, 1e-4f, 1e-4f, "s, guarded");
+    expect_close(blend.case_image(), ref_guarded.blend_case, 0.0f, 0.0f, "case, guarded");
+    guarded_pixels += blend.case_counts()[kCaseBiasGuard];
   }
   EXPECT_GT(changed, 0u);
+  EXPECT_GT(guarded_pixels, 0u);
 }
 
 TEST(BlendVsCpu, BackgroundPixelsWithoutHvTakeNoFilteredLight) {

@@ -13,6 +13,7 @@ uniform int has_guide;  // 0: u from the pixel's own variance only
 uniform float k_c;      // range weights of the variance pooling (the filter's)
 uniform float k_d;
 uniform float t;
+uniform int bias_guard;  // 1: raise s where L_f is measurably biased (bias_guard_factor)
 
 layout(std430, binding = kBufferCounts) buffer CaseCounts { uint case_counts[kBlendCaseCount]; };
 layout(location = 0) out vec4 out_final;  // rgb L, a s
@@ -45,7 +46,15 @@ void main() {
       if (has_guide != 0) vu = pooled_var_u(hv_tex, guide_tex, p, k_c, k_d);
       float u = vu > 0.0 ? relative_variance(vu, lb) : zero_variance_u(luminance(lf), lb);
       float w = has_centre_weight != 0 ? texelFetch(centre_weight_tex, p, 0).r : 0.0;
-      s = blend_factor_covariance(u, relative_variance(vf, lb), t, w, blend_case);
+      float f = relative_variance(vf, lb);
+      s = blend_factor_covariance(u, f, t, w, blend_case);
+      if (bias_guard != 0 && (blend_case == kCaseMixed || blend_case == kCaseFilteredOnly)) {
+        float b2 = filter_bias_squared(hv_tex, filtered_tex, p);
+        if (b2 > 0.0) {
+          float u_guard = max(u, relative_variance(broad_var_u(hv_tex, filtered_tex, p), lb));
+          s = bias_guard_factor(s, u_guard, f, w, relative_variance(b2, lb), blend_case);
+        }
+      }
     }
   }
   atomicAdd(case_counts[blend_case], 1u);

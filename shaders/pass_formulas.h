@@ -23,7 +23,8 @@ PXF_CONST int kCaseFilteredOnly = 1;  // D < 0: s = 0
 PXF_CONST int kCaseUnfiltered = 2;    // u <= t (or the filter skipped the pixel): s = 1
 PXF_CONST int kCaseMixed = 3;         // s = (f + sqrt(D)) / (u + f)
 PXF_CONST int kCaseUnknownVar = 4;    // n < 2, variance unknown: s = 0 (filtered value only)
-PXF_CONST int kBlendCaseCount = 5;
+PXF_CONST int kCaseBiasGuard = 5;     // case 1 or 3 whose L_f is measurably biased: s raised to the least-error s
+PXF_CONST int kBlendCaseCount = 6;
 // The color of each case in the explorer's case view and its legend; yellow for any other code.
 PXF_INLINE vec3 case_color(int code) {
   if (code == kCaseNoFiltered) return vec3(0.35f, 0.35f, 0.35f);
@@ -31,6 +32,7 @@ PXF_INLINE vec3 case_color(int code) {
   if (code == kCaseUnfiltered) return vec3(0.20f, 0.75f, 0.25f);
   if (code == kCaseMixed) return vec3(0.20f, 0.45f, 0.95f);
   if (code == kCaseUnknownVar) return vec3(0.85f, 0.30f, 0.85f);
+  if (code == kCaseBiasGuard) return vec3(0.10f, 0.85f, 0.85f);
   return vec3(1.0f, 1.0f, 0.0f);
 }
 
@@ -273,6 +275,89 @@ PXF_INLINE float blend_factor_covariance(float u, float f, float t, float w, PXF
   if (th < (s_min >= 0.0f ? g_min : fh)) return 0.0f;
   blend_case = kCaseMixed;
   return float(clamp(s_min + sqrt((th - g_min) / a), wide_float(0.0f), wide_float(1.0f)));
+}
+
+// ---- Bias guard (docs/method.md section 3.7) ----
+
+// The blend picks s from variances alone, as if L_f were unbiased. Where the filter averages light
+// across a change the range buffer does not show (a contact shadow, a caustic, the corner of a
+// room), E[L_f] differs from E[L_u] and the blended pixel keeps (1 - s) times that bias: an error
+// that does not fall with the noise. The guard measures it. d = Y(L_f) - Y(L_u) has mean b (the
+// bias) and, where L_f is unbiased, mean 0; its mean over the pixel's 3x3 neighbourhood has
+// variance about sum (Var[L_u] + Var[L_f]) / 9^2 (the covariance of L_u and L_f left out: the test
+// reads high, so it errs towards finding no bias). All nine count alike, whatever their range
+// colour: a bias is a property of the filter around the pixel, and weighting by the range buffer
+// left fewer pixels to the test, which then missed bias it finds otherwise (atrium 32 spp, display
+// NRMSE 9.15 % with the range weights against 8.68 % without). A variance of 0 (all samples equal)
+// counts as Y(L_f)^2, as in zero_variance_u. Returns the squared mean where it exceeds
+// kBiasGuardZ^2 times that variance, else 0.
+PXF_CONST float kBiasGuardZ = 2.0f;
+PXF_SAMPLER_FN float filter_bias_squared(sampler2D hv, sampler2D filtered, ivec2 p) {
+  ivec2 size = textureSize(hv, 0);
+  wide_float sum_d = 0.0f, sum_var = 0.0f;
+  int count = 0;
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx) {
+      ivec2 q = p + ivec2(dx, dy);
+      if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) continue;
+      vec4 u_q = texelFetch(hv, q, 0), f_q = texelFetch(filtered, q, 0);
+      if (f_q.a < kVarSkippedBelow) continue;  // skipped by the filter: L_f is L_u there
+      float vu = clean_var(u_q.a);
+      if (vu < 0.0f) continue;  // n < 2: no variance to judge d against
+      float y_f = luminance(clean(vec3(f_q)));
+      if (vu == 0.0f) vu = y_f * y_f;  // all samples equal: no evidence of low variance
+      sum_d += wide_float(y_f - luminance(clean(vec3(u_q))));
+      sum_var += wide_float(vu + max(clean_var(f_q.a), 0.0f));
+      count += 1;
+    }
+  if (count == 0) return 0.0f;
+  wide_float n = wide_float(count);
+  wide_float mean = sum_d / n, var_mean = sum_var / (n * n);
+  wide_float b2 = mean * mean;
+  return b2 > wide_float(kBiasGuardZ * kBiasGuardZ) * var_mean ? float(min(b2, wide_float(kMaxInput))) : 0.0f;
+}
+
+// The Var[L_u] the guard trades bias against: the mean of the known variances over the 5x5
+// neighbours, whatever their range colour, where that is larger than the pixel's own (the blend's
+// u). The guard adds noise where it raises s, so it must not take that noise for less than it is;
+// a variance estimated from few heavy-tailed samples is low far more often than high, the more so
+// the fewer pixels it pools (with the blend's u alone the guard cost atrium 13-23 % of its display
+// error at 4-32 spp; docs/method.md section 3.7). A variance of 0 (all samples equal) counts as
+// Y(L_f)^2, as in zero_variance_u.
+PXF_SAMPLER_FN float broad_var_u(sampler2D hv, sampler2D filtered, ivec2 p) {
+  ivec2 size = textureSize(hv, 0);
+  wide_float sum = 0.0f;
+  int count = 0;
+  for (int dy = -2; dy <= 2; ++dy)
+    for (int dx = -2; dx <= 2; ++dx) {
+      ivec2 q = p + ivec2(dx, dy);
+      if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) continue;
+      float v = clean_var(texelFetch(hv, q, 0).a);
+      if (v < 0.0f) continue;  // n < 2
+      if (v == 0.0f) {
+        float y_f = luminance(clean(vec3(texelFetch(filtered, q, 0))));
+        v = y_f * y_f;
+      }
+      sum += wide_float(v);
+      count += 1;
+    }
+  return count > 0 ? float(min(sum / wide_float(count), wide_float(kMaxInput))) : 0.0f;
+}
+
+// The blend factor of least expected squared error with L_f biased by b (b2 = b^2 / L_b^2, relative
+// like u and f; c = w u the covariance): E[(L - E L_u)^2] / L_b^2 = (1-s)^2 (b2 + f) + s^2 u
+// + 2 s (1-s) c is least at s = (b2 + f - c) / (b2 + f + u - 2c). The guard never lowers s: it
+// returns max(s, that), and the case kCaseBiasGuard where it raised it. b2 = 0 (no bias measured):
+// s and the case unchanged.
+PXF_INLINE float bias_guard_factor(float s, float u, float f, float w, float b2, PXF_INOUT(int) blend_case) {
+  if (!(b2 > 0.0f) || isinf(u) || isnan(u) || isinf(f) || isnan(f)) return s;
+  wide_float uu = wide_float(max(u, 0.0f)), ff = wide_float(max(f, 0.0f)), bb = wide_float(b2);
+  wide_float c = min(wide_float(clamp(w, 0.0f, 1.0f)) * uu, sqrt(uu * ff));
+  wide_float den = bb + ff + uu - 2.0f * c;  // >= b2 > 0 (u + f - 2c >= 0 by Cauchy-Schwarz)
+  float best = float(clamp((bb + ff - c) / den, wide_float(0.0f), wide_float(1.0f)));
+  if (!(best > s)) return s;
+  blend_case = kCaseBiasGuard;
+  return best;
 }
 
 // ---- Albedo demodulation ----

@@ -196,6 +196,8 @@ TEST(Cli, RenderWritesEveryOutput) {
   EXPECT_EQ(stats["settings"]["spp"], 4);
   EXPECT_EQ(stats["filter_runs"], 3);  // 1, 2, 4
   EXPECT_EQ(stats["settings"]["demodulate"], false);
+  EXPECT_EQ(stats["settings"]["bias_guard"], true);
+  EXPECT_TRUE(stats["blend_case_pixels"].contains("bias_guard"));
   EXPECT_EQ(stats["filter_runs_skipped_low_hv"], 0);
   EXPECT_GT(stats["hv_energy_share"].get<double>(), 0.01);
   for (const char* stage : {"path_tracing", "upload", "range", "filter", "blend", "tonemap"})
@@ -214,6 +216,10 @@ TEST(Cli, RenderWritesEveryOutput) {
   ASSERT_EQ(run("render --size 32x24 --spp 2 --demodulate on --quiet --out " + out).code, 0);
   EXPECT_EQ(nlohmann::json::parse(slurp(out + "/stats.json"))["settings"]["demodulate"], true);
   EXPECT_EQ(run("render --size 32x24 --spp 2 --demodulate maybe --quiet --out " + out).code, 2);
+  // So is --bias-guard off.
+  ASSERT_EQ(run("render --size 32x24 --spp 2 --bias-guard off --quiet --out " + out).code, 0);
+  EXPECT_EQ(nlohmann::json::parse(slurp(out + "/stats.json"))["settings"]["bias_guard"], false);
+  EXPECT_EQ(run("render --size 32x24 --spp 2 --bias-guard maybe --quiet --out " + out).code, 2);
   // Specular sampling is off unless asked for, near specular sampling on unless turned off, and
   // stats.json says which.
   EXPECT_EQ(stats2["settings"]["specular_sampling"], false);
