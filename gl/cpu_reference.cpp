@@ -237,15 +237,9 @@ BlendOutput cpu_blend(const Image& lv, const Image& hv, const Image& var_u, cons
           const float w_centre = filtered->centre_weight.pixels.empty() ? 0.0f : filtered->centre_weight.at(x, y, 0);
           const float f = relative_variance(vf, lb);
           d = blend_decision(u, f, t, w_centre);
-          if (params.bias_guard && (d.blend_case == kCaseMixed || d.blend_case == kCaseFilteredOnly)) {
-            const TexelView hv_view{&hv, &var_u}, filtered_view{&filtered->filtered, &filtered->variance};
-            const float b2 = shared::filter_bias_squared(hv_view, filtered_view, glm::ivec2(x, y));
-            if (b2 > 0.0f) {
-              const float u_guard =
-                  std::max(u, relative_variance(shared::broad_var_u(hv_view, filtered_view, glm::ivec2(x, y)), lb));
-              d.s = shared::bias_guard_factor(d.s, u_guard, f, w_centre, relative_variance(b2, lb), d.blend_case);
-            }
-          }
+          if (params.bias_guard)
+            d.s = shared::guarded_blend_factor(TexelView{&hv, &var_u}, TexelView{&filtered->filtered, &filtered->variance},
+                                               glm::ivec2(x, y), d.s, u, f, w_centre, lb, d.blend_case);
         }
       }
       for (int c = 0; c < 3; ++c)

@@ -48,13 +48,7 @@ void main() {
       float w = has_centre_weight != 0 ? texelFetch(centre_weight_tex, p, 0).r : 0.0;
       float f = relative_variance(vf, lb);
       s = blend_factor_covariance(u, f, t, w, blend_case);
-      if (bias_guard != 0 && (blend_case == kCaseMixed || blend_case == kCaseFilteredOnly)) {
-        float b2 = filter_bias_squared(hv_tex, filtered_tex, p);
-        if (b2 > 0.0) {
-          float u_guard = max(u, relative_variance(broad_var_u(hv_tex, filtered_tex, p), lb));
-          s = bias_guard_factor(s, u_guard, f, w, relative_variance(b2, lb), blend_case);
-        }
-      }
+      if (bias_guard != 0) s = guarded_blend_factor(hv_tex, filtered_tex, p, s, u, f, w, lb, blend_case);
     }
   }
   atomicAdd(case_counts[blend_case], 1u);

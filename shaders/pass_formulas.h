@@ -360,6 +360,18 @@ PXF_INLINE float bias_guard_factor(float s, float u, float f, float w, float b2,
   return best;
 }
 
+// The guard as the blend applies it (blend.frag, cpu_blend): in cases 1 and 3 only, s and the
+// case from bias_guard_factor where filter_bias_squared finds a bias, traded against the larger of
+// the blend's u and broad_var_u's. lb: the blend's L_b; w: the filter's centre weight (0 if none).
+PXF_SAMPLER_FN float guarded_blend_factor(sampler2D hv, sampler2D filtered, ivec2 p, float s, float u, float f,
+                                          float w, float lb, PXF_INOUT(int) blend_case) {
+  if (blend_case != kCaseMixed && blend_case != kCaseFilteredOnly) return s;
+  float b2 = filter_bias_squared(hv, filtered, p);
+  if (!(b2 > 0.0f)) return s;
+  float u_guard = max(u, relative_variance(broad_var_u(hv, filtered, p), lb));
+  return bias_guard_factor(s, u_guard, f, w, relative_variance(b2, lb), blend_case);
+}
+
 // ---- Albedo demodulation ----
 
 // The factor HV is divided by before the filter and L_f multiplied by after it (gl/demodulation.h):
