@@ -109,7 +109,8 @@ void print_error_line(const char* label, const Image& test, const Image& referen
 // with a perfect filter, L_f = REFERENCE's HV and Var[L_f] = 0, at TEST's threshold and sample
 // count: what remains is the noise the blend keeps at t and LV's error, the least any filter could
 // leave under this blend. Beside it TEST unfiltered (lv + hv) and TEST's LV with REFERENCE's HV
-// (LV's error alone), all against REFERENCE's final.
+// (LV's error alone), all against REFERENCE's final. Without the bias guard (BlendParams'
+// default): a perfect L_f has no bias for it to find, only L_u's noise to mistake for one.
 void print_perfect_filter(const std::string& test_path, const std::string& reference_path,
                           const DisplayMetricOptions& display) {
   const std::vector<Layer> test = read_exr_layers(test_path), reference = read_exr_layers(reference_path);

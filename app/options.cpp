@@ -45,7 +45,7 @@ void add_preview_options(CommandLine& cli, PreviewSettings& s) {
              "sharp (default off: docs/measurements.md, \"Albedo demodulation\")");
   cli.choice("--bias-guard", &s.bias_guard, {"off", "on"},
              "the blend's bias guard: where the filtered light measurably differs from the unfiltered\n"
-             "(3x3 neighbours, 2 standard deviations), s is raised to the least-error blend factor (default on;\n"
+             "(5x5 neighbours, 2 standard deviations), s is raised to the least-error blend factor (default on;\n"
              "off: the published blend, noise held at t everywhere; docs/method.md section 3.7)");
   cli.option("--seed", &s.trace.seed, "random seed", 0, 2147483647);
   cli.choice("--sampler", &s.trace.sampler, sampler_type_names(),

@@ -283,21 +283,25 @@ PXF_INLINE float blend_factor_covariance(float u, float f, float t, float w, PXF
 // across a change the range buffer does not show (a contact shadow, a caustic, the corner of a
 // room), E[L_f] differs from E[L_u] and the blended pixel keeps (1 - s) times that bias: an error
 // that does not fall with the noise. The guard measures it. d = Y(L_f) - Y(L_u) has mean b (the
-// bias) and, where L_f is unbiased, mean 0; its mean over the pixel's 3x3 neighbourhood has
-// variance about sum (Var[L_u] + Var[L_f]) / 9^2 (the covariance of L_u and L_f left out: the test
-// reads high, so it errs towards finding no bias). All nine count alike, whatever their range
-// colour: a bias is a property of the filter around the pixel, and weighting by the range buffer
-// left fewer pixels to the test, which then missed bias it finds otherwise (atrium 32 spp, display
-// NRMSE 9.15 % with the range weights against 8.68 % without). A variance of 0 (all samples equal)
-// counts as Y(L_f)^2, as in zero_variance_u. Returns the squared mean where it exceeds
-// kBiasGuardZ^2 times that variance, else 0.
+// bias) and, where L_f is unbiased, mean 0; its mean over the pixel's 5x5 neighbourhood
+// (kBiasGuardRadius) has variance about sum (Var[L_u] + Var[L_f]) / 25^2 (the covariance of L_u
+// and L_f left out: the test reads high, so it errs towards finding no bias). All 25 count alike,
+// whatever their range colour: a bias is a property of the filter around the pixel, and weighting
+// by the range buffer left fewer pixels to the test, which then missed bias it finds otherwise
+// (3x3, atrium 32 spp: display NRMSE 9.15 % with the range weights against 8.68 % without). 5x5
+// rather than 3x3: a steadier decision. With 3x3 a pixel was raised in some seeds and not in
+// others, which added variance to the pixels the blend holds at t (cornell 128², 16 spp,
+// t = 0.001: case-3 median 1.056 t against 0.924 t with 5x5; docs/measurements.md, "Bias guard").
+// A variance of 0 (all samples equal) counts as Y(L_f)^2, as in zero_variance_u. Returns the
+// squared mean where it exceeds kBiasGuardZ^2 times that variance, else 0.
 PXF_CONST float kBiasGuardZ = 2.0f;
+PXF_CONST int kBiasGuardRadius = 2;
 PXF_SAMPLER_FN float filter_bias_squared(sampler2D hv, sampler2D filtered, ivec2 p) {
   ivec2 size = textureSize(hv, 0);
   wide_float sum_d = 0.0f, sum_var = 0.0f;
   int count = 0;
-  for (int dy = -1; dy <= 1; ++dy)
-    for (int dx = -1; dx <= 1; ++dx) {
+  for (int dy = -kBiasGuardRadius; dy <= kBiasGuardRadius; ++dy)
+    for (int dx = -kBiasGuardRadius; dx <= kBiasGuardRadius; ++dx) {
       ivec2 q = p + ivec2(dx, dy);
       if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) continue;
       vec4 u_q = texelFetch(hv, q, 0), f_q = texelFetch(filtered, q, 0);
