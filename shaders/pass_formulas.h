@@ -292,31 +292,56 @@ PXF_INLINE float blend_factor_covariance(float u, float f, float t, float w, PXF
 // rather than 3x3: a steadier decision. With 3x3 a pixel was raised in some seeds and not in
 // others, which added variance to the pixels the blend holds at t (cornell 128², 16 spp,
 // t = 0.001: case-3 median 1.056 t against 0.924 t with 5x5; docs/measurements.md, "Bias guard").
-// A variance of 0 (all samples equal) counts as Y(L_f)^2, as in zero_variance_u. Returns the
-// squared mean where it exceeds kBiasGuardZ^2 times that variance, else 0.
+// The test: the squared mean of d counts as the bias where it exceeds kBiasGuardZ^2 times that
+// variance, else no bias (filter_bias_squared).
 PXF_CONST float kBiasGuardZ = 2.0f;
 PXF_CONST int kBiasGuardRadius = 2;
-PXF_SAMPLER_FN float filter_bias_squared(sampler2D hv, sampler2D filtered, ivec2 p) {
+
+// What the guard reads from the 5x5 neighbourhood, in one pass over it (two texel reads a
+// neighbour: the blend runs on every displayed frame, and on llvmpipe each read counts).
+struct BiasGuardSums {
+  wide_float d, var_d;  // sum of d and of Var[L_u] + Var[L_f], over the judged neighbours
+  int judged;           // neighbours with n >= 2 that the filter did not skip
+  wide_float var_u;     // sum of Var[L_u] over the neighbours with n >= 2
+  int known;            // their count
+};
+
+// Returns the 5x5 sums. The bias test leaves out neighbours with n < 2 (no variance to judge d
+// against) and those the filter skipped (L_f is L_u there); the variance mean only the first. A
+// variance of 0 (all samples equal) counts as Y(L_f)^2 in both, as in zero_variance_u.
+PXF_SAMPLER_FN BiasGuardSums bias_guard_sums(sampler2D hv, sampler2D filtered, ivec2 p) {
   ivec2 size = textureSize(hv, 0);
-  wide_float sum_d = 0.0f, sum_var = 0.0f;
-  int count = 0;
+  BiasGuardSums sums;
+  sums.d = 0.0f;
+  sums.var_d = 0.0f;
+  sums.judged = 0;
+  sums.var_u = 0.0f;
+  sums.known = 0;
   for (int dy = -kBiasGuardRadius; dy <= kBiasGuardRadius; ++dy)
     for (int dx = -kBiasGuardRadius; dx <= kBiasGuardRadius; ++dx) {
       ivec2 q = p + ivec2(dx, dy);
       if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) continue;
-      vec4 u_q = texelFetch(hv, q, 0), f_q = texelFetch(filtered, q, 0);
-      if (f_q.a < kVarSkippedBelow) continue;  // skipped by the filter: L_f is L_u there
+      vec4 u_q = texelFetch(hv, q, 0);
       float vu = clean_var(u_q.a);
-      if (vu < 0.0f) continue;  // n < 2: no variance to judge d against
+      if (vu < 0.0f) continue;  // n < 2
+      vec4 f_q = texelFetch(filtered, q, 0);
       float y_f = luminance(clean(vec3(f_q)));
       if (vu == 0.0f) vu = y_f * y_f;  // all samples equal: no evidence of low variance
-      sum_d += wide_float(y_f - luminance(clean(vec3(u_q))));
-      sum_var += wide_float(vu + max(clean_var(f_q.a), 0.0f));
-      count += 1;
+      sums.var_u += wide_float(vu);
+      sums.known += 1;
+      if (f_q.a < kVarSkippedBelow) continue;  // skipped by the filter: L_f is L_u there
+      sums.d += wide_float(y_f - luminance(clean(vec3(u_q))));
+      sums.var_d += wide_float(vu + max(clean_var(f_q.a), 0.0f));
+      sums.judged += 1;
     }
-  if (count == 0) return 0.0f;
-  wide_float n = wide_float(count);
-  wide_float mean = sum_d / n, var_mean = sum_var / (n * n);
+  return sums;
+}
+
+// The squared mean of d where it exceeds kBiasGuardZ^2 times its variance, else 0.
+PXF_INLINE float filter_bias_squared(BiasGuardSums sums) {
+  if (sums.judged == 0) return 0.0f;
+  wide_float n = wide_float(sums.judged);
+  wide_float mean = sums.d / n, var_mean = sums.var_d / (n * n);
   wide_float b2 = mean * mean;
   return b2 > wide_float(kBiasGuardZ * kBiasGuardZ) * var_mean ? float(min(b2, wide_float(kMaxInput))) : 0.0f;
 }
@@ -326,26 +351,9 @@ PXF_SAMPLER_FN float filter_bias_squared(sampler2D hv, sampler2D filtered, ivec2
 // u). The guard adds noise where it raises s, so it must not take that noise for less than it is;
 // a variance estimated from few heavy-tailed samples is low far more often than high, the more so
 // the fewer pixels it pools (with the blend's u alone the guard cost atrium 13-23 % of its display
-// error at 4-32 spp; docs/method.md section 3.7). A variance of 0 (all samples equal) counts as
-// Y(L_f)^2, as in zero_variance_u.
-PXF_SAMPLER_FN float broad_var_u(sampler2D hv, sampler2D filtered, ivec2 p) {
-  ivec2 size = textureSize(hv, 0);
-  wide_float sum = 0.0f;
-  int count = 0;
-  for (int dy = -2; dy <= 2; ++dy)
-    for (int dx = -2; dx <= 2; ++dx) {
-      ivec2 q = p + ivec2(dx, dy);
-      if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) continue;
-      float v = clean_var(texelFetch(hv, q, 0).a);
-      if (v < 0.0f) continue;  // n < 2
-      if (v == 0.0f) {
-        float y_f = luminance(clean(vec3(texelFetch(filtered, q, 0))));
-        v = y_f * y_f;
-      }
-      sum += wide_float(v);
-      count += 1;
-    }
-  return count > 0 ? float(min(sum / wide_float(count), wide_float(kMaxInput))) : 0.0f;
+// error at 4-32 spp; docs/method.md section 3.7).
+PXF_INLINE float broad_var_u(BiasGuardSums sums) {
+  return sums.known > 0 ? float(min(sums.var_u / wide_float(sums.known), wide_float(kMaxInput))) : 0.0f;
 }
 
 // The blend factor of least expected squared error with L_f biased by b (b2 = b^2 / L_b^2, relative
@@ -370,9 +378,10 @@ PXF_INLINE float bias_guard_factor(float s, float u, float f, float w, float b2,
 PXF_SAMPLER_FN float guarded_blend_factor(sampler2D hv, sampler2D filtered, ivec2 p, float s, float u, float f,
                                           float w, float lb, PXF_INOUT(int) blend_case) {
   if (blend_case != kCaseMixed && blend_case != kCaseFilteredOnly) return s;
-  float b2 = filter_bias_squared(hv, filtered, p);
+  BiasGuardSums sums = bias_guard_sums(hv, filtered, p);
+  float b2 = filter_bias_squared(sums);
   if (!(b2 > 0.0f)) return s;
-  float u_guard = max(u, relative_variance(broad_var_u(hv, filtered, p), lb));
+  float u_guard = max(u, relative_variance(broad_var_u(sums), lb));
   return bias_guard_factor(s, u_guard, f, w, relative_variance(b2, lb), blend_case);
 }
 
