@@ -41,10 +41,16 @@ class BlendPass {
   Image case_image() const;   // "Y"
 
  private:
+  // The bias guard's 5x5 sums (bias_guard_texel in shaders/pass_formulas.h) into guard_sums_: a row
+  // pass and a column pass of 5 reads each.
+  void sum_bias_guard(const PreviewInputs& inputs, const Texture2D& filtered);
+
   int width_, height_;
   Program program_;
+  Program guard_rows_program_, guard_columns_program_;
   Texture2D output_, case_;
-  Framebuffer fbo_;
+  Texture2D guard_rows_, guard_sums_;
+  Framebuffer fbo_, guard_rows_fbo_, guard_sums_fbo_;
   Buffer counts_;
   FullscreenPass quad_;
   StageTimer timer_;

@@ -238,8 +238,10 @@ BlendOutput cpu_blend(const Image& lv, const Image& hv, const Image& var_u, cons
           const float f = relative_variance(vf, lb);
           d = blend_decision(u, f, t, w_centre);
           if (params.bias_guard)
-            d.s = shared::guarded_blend_factor(TexelView{&hv, &var_u}, TexelView{&filtered->filtered, &filtered->variance},
-                                               glm::ivec2(x, y), d.s, u, f, w_centre, lb, d.blend_case);
+            d.s = shared::guarded_blend_factor(
+                shared::bias_guard_sums(TexelView{&hv, &var_u}, TexelView{&filtered->filtered, &filtered->variance},
+                                        glm::ivec2(x, y)),
+                d.s, u, f, w_centre, lb, d.blend_case);
         }
       }
       for (int c = 0; c < 3; ++c)

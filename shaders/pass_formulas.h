@@ -57,6 +57,7 @@ PXF_CONST int kUnitSignal = 3;        // what a filter pass filters: L_u, or the
 PXF_CONST int kUnitFiltered = 4;      // rgb L_f, a Var[L_f] or a sentinel
 PXF_CONST int kUnitCentreWeight = 5;  // r: the filter's centre weight
 PXF_CONST int kUnitAlbedo = 6;        // rgb mean first non-specular albedo
+PXF_CONST int kUnitGuardSums = 7;     // the bias guard's 5x5 sums (bias_guard_texel), or their row sums
 
 // Shader storage buffer bindings of the pass shaders.
 PXF_CONST int kBufferCounts = 0;      // the filters' filtered-pixel counter, the blend's case counts
@@ -297,8 +298,8 @@ PXF_INLINE float blend_factor_covariance(float u, float f, float t, float w, PXF
 PXF_CONST float kBiasGuardZ = 2.0f;
 PXF_CONST int kBiasGuardRadius = 2;
 
-// What the guard reads from the 5x5 neighbourhood, in one pass over it (two texel reads a
-// neighbour: the blend runs on every displayed frame, and on llvmpipe each read counts).
+// What the guard reads from the 5x5 neighbourhood: sums over the neighbours of what each
+// contributes (bias_guard_texel).
 struct BiasGuardSums {
   wide_float d, var_d;  // sum of d and of Var[L_u] + Var[L_f], over the judged neighbours
   int judged;           // neighbours with n >= 2 that the filter did not skip
@@ -306,35 +307,51 @@ struct BiasGuardSums {
   int known;            // their count
 };
 
-// Returns the 5x5 sums. The bias test leaves out neighbours with n < 2 (no variance to judge d
-// against) and those the filter skipped (L_f is L_u there); the variance mean only the first. A
-// variance of 0 (all samples equal) counts as Y(L_f)^2 in both, as in zero_variance_u.
+// One neighbour's part of the sums, packed so that the sums of 5x5 texels are texels too (the blend
+// pass adds them up in a row pass and a column pass of 5 reads each, instead of 25 reads of two
+// textures per pixel: on llvmpipe the blend runs on the CPU cores the path tracer needs):
+// (d, Var[L_u] + Var[L_f], Var[L_u], judged + 32 known). The bias test leaves out neighbours with
+// n < 2 (no variance to judge d against) and those the filter skipped (L_f is L_u there); the
+// variance mean only the first. A variance of 0 (all samples equal) counts as Y(L_f)^2 in both,
+// as in zero_variance_u.
+PXF_CONST float kBiasGuardKnownUnit = 32.0f;  // more than the 25 neighbours: the two counts stay apart
+PXF_SAMPLER_FN vec4 bias_guard_texel(sampler2D hv, sampler2D filtered, ivec2 q) {
+  vec4 u_q = texelFetch(hv, q, 0);
+  float vu = clean_var(u_q.a);
+  if (vu < 0.0f) return vec4(0.0f);  // n < 2
+  vec4 f_q = texelFetch(filtered, q, 0);
+  float y_f = luminance(clean(vec3(f_q)));
+  if (vu == 0.0f) vu = y_f * y_f;  // all samples equal: no evidence of low variance
+  if (f_q.a < kVarSkippedBelow) return vec4(0.0f, 0.0f, vu, kBiasGuardKnownUnit);  // skipped by the filter
+  return vec4(y_f - luminance(clean(vec3(u_q))), vu + max(clean_var(f_q.a), 0.0f), vu, kBiasGuardKnownUnit + 1.0f);
+}
+
+// Unpacks summed bias_guard_texel values.
+PXF_INLINE BiasGuardSums bias_guard_sums_of(vec4 sum) {
+  BiasGuardSums sums;
+  sums.d = wide_float(sum.x);
+  sums.var_d = wide_float(sum.y);
+  sums.var_u = wide_float(sum.z);
+  sums.known = int(floor(sum.w / kBiasGuardKnownUnit + 0.5f / kBiasGuardKnownUnit));
+  sums.judged = int(sum.w - kBiasGuardKnownUnit * float(sums.known) + 0.5f);
+  return sums;
+}
+
+// The 5x5 sums by their definition (the CPU reference; the GPU adds the same texels in two passes).
 PXF_SAMPLER_FN BiasGuardSums bias_guard_sums(sampler2D hv, sampler2D filtered, ivec2 p) {
   ivec2 size = textureSize(hv, 0);
-  BiasGuardSums sums;
-  sums.d = 0.0f;
-  sums.var_d = 0.0f;
-  sums.judged = 0;
-  sums.var_u = 0.0f;
-  sums.known = 0;
+  wide_float d = 0.0f, var_d = 0.0f, var_u = 0.0f, counts = 0.0f;
   for (int dy = -kBiasGuardRadius; dy <= kBiasGuardRadius; ++dy)
     for (int dx = -kBiasGuardRadius; dx <= kBiasGuardRadius; ++dx) {
       ivec2 q = p + ivec2(dx, dy);
       if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) continue;
-      vec4 u_q = texelFetch(hv, q, 0);
-      float vu = clean_var(u_q.a);
-      if (vu < 0.0f) continue;  // n < 2
-      vec4 f_q = texelFetch(filtered, q, 0);
-      float y_f = luminance(clean(vec3(f_q)));
-      if (vu == 0.0f) vu = y_f * y_f;  // all samples equal: no evidence of low variance
-      sums.var_u += wide_float(vu);
-      sums.known += 1;
-      if (f_q.a < kVarSkippedBelow) continue;  // skipped by the filter: L_f is L_u there
-      sums.d += wide_float(y_f - luminance(clean(vec3(u_q))));
-      sums.var_d += wide_float(vu + max(clean_var(f_q.a), 0.0f));
-      sums.judged += 1;
+      vec4 c = bias_guard_texel(hv, filtered, q);
+      d += wide_float(c.x);
+      var_d += wide_float(c.y);
+      var_u += wide_float(c.z);
+      counts += wide_float(c.w);
     }
-  return sums;
+  return bias_guard_sums_of(vec4(float(d), float(var_d), float(var_u), float(counts)));
 }
 
 // The squared mean of d where it exceeds kBiasGuardZ^2 times its variance, else 0.
@@ -373,12 +390,12 @@ PXF_INLINE float bias_guard_factor(float s, float u, float f, float w, float b2,
 }
 
 // The guard as the blend applies it (blend.frag, cpu_blend): in cases 1 and 3 only, s and the
-// case from bias_guard_factor where filter_bias_squared finds a bias, traded against the larger of
-// the blend's u and broad_var_u's. lb: the blend's L_b; w: the filter's centre weight (0 if none).
-PXF_SAMPLER_FN float guarded_blend_factor(sampler2D hv, sampler2D filtered, ivec2 p, float s, float u, float f,
-                                          float w, float lb, PXF_INOUT(int) blend_case) {
+// case from bias_guard_factor where filter_bias_squared finds a bias in the 5x5 sums, traded
+// against the larger of the blend's u and broad_var_u's. lb: the blend's L_b; w: the filter's
+// centre weight (0 if none).
+PXF_INLINE float guarded_blend_factor(BiasGuardSums sums, float s, float u, float f, float w, float lb,
+                                      PXF_INOUT(int) blend_case) {
   if (blend_case != kCaseMixed && blend_case != kCaseFilteredOnly) return s;
-  BiasGuardSums sums = bias_guard_sums(hv, filtered, p);
   float b2 = filter_bias_squared(sums);
   if (!(b2 > 0.0f)) return s;
   float u_guard = max(u, relative_variance(broad_var_u(sums), lb));
