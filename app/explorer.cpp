@@ -337,9 +337,13 @@ class Explorer {
     ImGui::Text("    blend %.2f  tone map %.2f   filter runs %d%s", stage_ms_.blend, stage_ms_.tonemap,
                 preview_->filter_runs(), preview_->filter_stopped() ? " (stopped: all case 2)" : "");
     const auto& counts = preview_->case_counts();
-    ImGui::Text("cases  0: %.1f%%  1: %.1f%%  2: %.1f%%  3: %.1f%%  4: %.1f%%", 100.0 * counts[0] / pixels,
-                100.0 * counts[1] / pixels, 100.0 * counts[2] / pixels, 100.0 * counts[3] / pixels,
-                100.0 * counts[4] / pixels);
+    std::string cases = "cases";  // every case code, so a new case cannot be left out of the line
+    for (int c = 0; c < kBlendCaseCount; ++c) {
+      char part[32];
+      std::snprintf(part, sizeof part, "  %d: %.1f%%", c, 100.0 * counts[c] / pixels);
+      cases += part;
+    }
+    ImGui::TextUnformatted(cases.c_str());
     const std::vector<float> plot(history_.begin(), history_.end());
     char overlay[64];
     std::snprintf(overlay, sizeof(overlay), "pixels at s = 1: %.1f%%", plot.empty() ? 0.0 : 100.0 * plot.back());
