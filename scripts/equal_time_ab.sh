@@ -23,14 +23,12 @@ read -r -a flags_b <<<"$label_b"
 shift 5
 scenes=("$@")
 [ ${#scenes[@]} -gt 0 ] || scenes=(cornell atrium kitchen envmap)
-pxf=build/app/pxf
+source scripts/equal_time_common.sh
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 echo "scene round variant spp hdr_nrmse display_nrmse" | tee "$tmp/runs"
 for scene in "${scenes[@]}"; do
-  ref="$refs/reference_${scene}_384x216_2048spp.exr"
-  [ -f "$refs/$scene/buffers.exr" ] && ref="$refs/$scene/buffers.exr"
-  [ -f "$ref" ] || { echo "missing $ref (or $refs/$scene/buffers.exr)" >&2; exit 2; }
+  ref=$(reference_of "$refs" "$scene")
   for round in $(seq "$rounds"); do
     order=(A B)
     [ $((round % 2)) -eq 0 ] && order=(B A)
@@ -39,9 +37,8 @@ for scene in "${scenes[@]}"; do
       if [ "$variant" = A ]; then flags=("${flags_a[@]}"); else flags=("${flags_b[@]}"); fi
       "$pxf" render --scene "$scene" --size 384x216 --time "$seconds" --seed $((100 + round)) "${flags[@]}" \
         --out "$out" >/dev/null 2>&1
-      spp=$(python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['time_budget']['spp_reached'])" "$out/stats.json")
-      errors=$("$pxf" diff "$out/final.exr" "$ref" | grep '^all pixels' |
-               sed -E 's/.*HDR NRMSE ([0-9.]+) %  display NRMSE ([0-9.]+).*/\1 \2/')
+      spp=$(spp_of "$out")
+      errors=$(nrmse_pair 'all pixels' "$out/final.exr" "$ref")
       echo "$scene $round $variant $spp $errors" | tee -a "$tmp/runs"
     done
   done

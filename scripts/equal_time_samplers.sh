@@ -22,16 +22,12 @@ rounds=${3:-3}
 shift $(($# < 3 ? $# : 3))
 scenes=("$@")
 [ ${#scenes[@]} -gt 0 ] || scenes=(cornell atrium kitchen envmap)
-pxf=build/app/pxf
-# "HDR DISPLAY" from a `pxf diff` line "...: HDR NRMSE x %  display NRMSE y % ...".
-nrmse_pair() { sed -E 's/.*HDR NRMSE ([0-9.]+) %  display NRMSE ([0-9.]+).*/\1 \2/' <<<"$1"; }
+source scripts/equal_time_common.sh
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 echo "scene round sampler filter spp hdr_nrmse display_nrmse" | tee "$tmp/runs"
 for scene in "${scenes[@]}"; do
-  ref="$refs/reference_${scene}_384x216_2048spp.exr"
-  [ -f "$refs/$scene/buffers.exr" ] && ref="$refs/$scene/buffers.exr"
-  [ -f "$ref" ] || { echo "missing $ref (or $refs/$scene/buffers.exr)" >&2; exit 2; }
+  ref=$(reference_of "$refs" "$scene")
   for round in $(seq "$rounds"); do
     # Alternate which sampler goes first: on a shared machine the first jobs of a round can run
     # at another speed than the last ones.
@@ -44,11 +40,11 @@ for scene in "${scenes[@]}"; do
         [ "$filter" = grid ] && read -r -a flags <<<"${FILTER_FLAGS:-}"
         "$pxf" render --scene "$scene" --size 384x216 --time "$seconds" --sampler "$sampler" --filter "$filter" \
           --seed $((100 + round)) "${flags[@]}" --out "$out" >/dev/null 2>&1
-        spp=$(python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['time_budget']['spp_reached'])" "$out/stats.json")
-        errors=$(nrmse_pair "$("$pxf" diff "$out/final.exr" "$ref" | grep '^all pixels')")
+        spp=$(spp_of "$out")
+        errors=$(nrmse_pair 'all pixels' "$out/final.exr" "$ref")
         echo "$scene $round $sampler $filter $spp $errors" | tee -a "$tmp/runs"
         if [ "$filter" = grid ] && [ "${ref##*/}" = buffers.exr ]; then
-          errors=$(nrmse_pair "$("$pxf" diff "$out/buffers.exr" "$ref" --perfect-filter | grep '^blend with a perfect filter')")
+          errors=$(nrmse_pair 'blend with a perfect filter' "$out/buffers.exr" "$ref" --perfect-filter)
           echo "$scene $round $sampler perfect $spp $errors" | tee -a "$tmp/runs"
         fi
       done
