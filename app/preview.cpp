@@ -252,9 +252,11 @@ void Preview::blend_and_tonemap() {
   upload();
   // The filter's centre weight is that of the demodulated run too: with a grey factor a,
   // Cov[L_u, a L_f'] = a w Var[L_u] / a = w Var[L_u], the blend's covariance term is unchanged.
+  // Once a filter run skipped every pixel, its L_f marks every pixel case 2 and the guard, which
+  // acts in cases 1 and 3 only, would change nothing: its passes are left out (the same image).
+  const bool guard = settings_.bias_guard && !schedule_.all_pixels_case2;
   blend_.run(inputs_, have_filtered_ ? &filtered_output() : nullptr, &range_.guide(), threshold_now(),
-             BlendParams{range_weights(settings_.filter), settings_.bias_guard},
-             have_filtered_ ? filter_.centre_weight() : nullptr);
+             BlendParams{range_weights(settings_.filter), guard}, have_filtered_ ? filter_.centre_weight() : nullptr);
   last_.blend += blend_.last_ms();
   tonemap_.run(blend_.output(), settings_.tonemap);
   last_.tonemap += tonemap_.last_ms();

@@ -74,10 +74,11 @@ constexpr double kMinHvShare = 0.01;
 
 // Memory a Preview of width x height needs, checked before it allocates anything: the peak memory
 // of `pxf render` grows by about this much per pixel (cornell at 256x256 and 1024x1024, 2 spp: 130
-// and 615 MiB, before the bias guard's two sums textures added 32 B: 647 MiB at 1024x1024): the
-// accumulation (means, variances in double, albedo, replicates), the GL textures of every pass,
-// and the read-backs written to buffers.exr.
-constexpr uint64_t kPreviewBytesPerPixel = 552;
+// and 615 MiB, before the bias guard's two sums textures added 32 B: 647 MiB at 1024x1024, and its
+// half windows' two more row textures another 37 B: 683 MiB): the accumulation (means, variances in
+// double, albedo, replicates), the GL textures of every pass, and the read-backs written to
+// buffers.exr.
+constexpr uint64_t kPreviewBytesPerPixel = 590;
 uint64_t preview_bytes(int width, int height);
 // Throws pxf::Error, one line naming the size and both figures, when preview_bytes exceeds
 // `available_bytes` (available_memory_bytes() in the constructor).

@@ -9,25 +9,31 @@ BlendPass::BlendPass(int width, int height)
       guard_rows_program_(Program::from_embedded("fullscreen.vert", "bias_guard_rows.frag")),
       guard_columns_program_(Program::from_embedded("fullscreen.vert", "bias_guard_columns.frag")),
       output_(width, height, TextureFormat::RGBA32F), case_(width, height, TextureFormat::R32F),
-      guard_rows_(width, height, TextureFormat::RGBA32F), guard_sums_(width, height, TextureFormat::RGBA32F),
+      guard_rows_(width, height, TextureFormat::RGBA32F), guard_rows_low_x_(width, height, TextureFormat::RGBA32F),
+      guard_rows_high_x_(width, height, TextureFormat::RGBA32F), guard_(width, height, TextureFormat::RG32F),
       counts_(sizeof(uint32_t) * kBlendCaseCount) {
   fbo_.attach(0, output_);
   fbo_.attach(1, case_);
   fbo_.check("blend pass");
   guard_rows_fbo_.attach(0, guard_rows_);
+  guard_rows_fbo_.attach(1, guard_rows_low_x_);
+  guard_rows_fbo_.attach(2, guard_rows_high_x_);
   guard_rows_fbo_.check("blend pass, bias guard rows");
-  guard_sums_fbo_.attach(0, guard_sums_);
-  guard_sums_fbo_.check("blend pass, bias guard sums");
+  guard_fbo_.attach(0, guard_);
+  guard_fbo_.check("blend pass, bias guard");
 }
 
-void BlendPass::sum_bias_guard(const PreviewInputs& inputs, const Texture2D& filtered) {
+void BlendPass::run_bias_guard(const PreviewInputs& inputs, const Texture2D& filtered) {
+  ++guard_runs_;
   inputs.hv().bind(shared::kUnitHv);
   filtered.bind(shared::kUnitFiltered);
   guard_rows_program_.use();
   quad_.draw(guard_rows_fbo_, width_, height_);
   guard_rows_.bind(shared::kUnitGuardSums);
+  guard_rows_low_x_.bind(shared::kUnitGuardRowsLowX);
+  guard_rows_high_x_.bind(shared::kUnitGuardRowsHighX);
   guard_columns_program_.use();
-  quad_.draw(guard_sums_fbo_, width_, height_);
+  quad_.draw(guard_fbo_, width_, height_);
 }
 
 void BlendPass::run(const PreviewInputs& inputs, const FilterPass* filtered, const Texture2D& guide, float t,
@@ -44,7 +50,7 @@ void BlendPass::run(const PreviewInputs& inputs, const Texture2D* filtered, cons
     throw Error("blend pass: input size differs from the pass size");
   timer_.begin();
   const bool guard = params.bias_guard && filtered;
-  if (guard) sum_bias_guard(inputs, *filtered);
+  if (guard) run_bias_guard(inputs, *filtered);
   program_.set("has_filtered", filtered ? 1 : 0);
   program_.set("has_guide", guide ? 1 : 0);
   program_.set("has_centre_weight", filtered && centre_weight ? 1 : 0);
@@ -61,7 +67,7 @@ void BlendPass::run(const PreviewInputs& inputs, const Texture2D* filtered, cons
   (filtered ? *filtered : inputs.hv()).bind(shared::kUnitFiltered);
   (guide ? *guide : inputs.hv()).bind(shared::kUnitGuide);
   (centre_weight ? *centre_weight : inputs.hv()).bind(shared::kUnitCentreWeight);
-  guard_sums_.bind(shared::kUnitGuardSums);
+  guard_.bind(shared::kUnitGuardSums);
   program_.use();
   quad_.draw(fbo_, width_, height_);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);

@@ -35,25 +35,28 @@ class BlendPass {
   // Pixels per case of the last run (a 24-byte read-back).
   std::array<uint32_t, kBlendCaseCount> case_counts() const;
   double last_ms() const { return timer_.last_ms(); }
+  int guard_runs() const { return guard_runs_; }  // runs that ran the bias guard's passes
 
   Image final_image() const;  // "R,G,B"
   Image s_image() const;      // "Y"
   Image case_image() const;   // "Y"
 
  private:
-  // The bias guard's 5x5 sums (bias_guard_texel in shaders/pass_formulas.h) into guard_sums_: a row
-  // pass and a column pass of 5 reads each.
-  void sum_bias_guard(const PreviewInputs& inputs, const Texture2D& filtered);
+  // The bias guard's finding (bias_guard_estimate in shaders/pass_formulas.h) into guard_: a row
+  // pass of 5 reads writes the row sums of three x ranges, a column pass of 5 reads of each adds
+  // them into the 5x5 window and its four halves and judges them.
+  void run_bias_guard(const PreviewInputs& inputs, const Texture2D& filtered);
 
   int width_, height_;
   Program program_;
   Program guard_rows_program_, guard_columns_program_;
   Texture2D output_, case_;
-  Texture2D guard_rows_, guard_sums_;
-  Framebuffer fbo_, guard_rows_fbo_, guard_sums_fbo_;
+  Texture2D guard_rows_, guard_rows_low_x_, guard_rows_high_x_, guard_;
+  Framebuffer fbo_, guard_rows_fbo_, guard_fbo_;
   Buffer counts_;
   FullscreenPass quad_;
   StageTimer timer_;
+  int guard_runs_ = 0;
 };
 
 }  // namespace pxf

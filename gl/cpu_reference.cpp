@@ -239,8 +239,8 @@ BlendOutput cpu_blend(const Image& lv, const Image& hv, const Image& var_u, cons
           d = blend_decision(u, f, t, w_centre);
           if (params.bias_guard)
             d.s = shared::guarded_blend_factor(
-                shared::bias_guard_sums(TexelView{&hv, &var_u}, TexelView{&filtered->filtered, &filtered->variance},
-                                        glm::ivec2(x, y)),
+                shared::bias_guard_estimate_at(TexelView{&hv, &var_u},
+                                               TexelView{&filtered->filtered, &filtered->variance}, glm::ivec2(x, y)),
                 d.s, u, f, w_centre, lb, d.blend_case);
         }
       }

@@ -541,12 +541,13 @@ TEST(BlendVsCpu, BiasGuardFiresWhereLfIsBiasedAndRarelyWhereItIsNot) {
       EXPECT_NEAR(s_sum / fired, 0.8, 0.03);
     }
   }
-  // The noise the guard trades against is the 5x5 neighbourhood's, whatever its range colour: rows
-  // of two range colours, the even rows reporting Var[L_u] = sigma^2 / 100 (as a pixel that missed
-  // the rare bright paths does), the odd ones sigma^2. The blend's own u of an even-row pixel pools
-  // its own colour only (sigma^2 / 100); the guard's is the 5x5 mean, 3 even rows and 2 odd:
-  // 0.406 sigma^2. L_u = m, L_f = m + 2 sigma exactly: s = 4 / (4 + 0.406) = 0.908, where the
-  // blend's u would give 4 / 4.01 = 0.998.
+  // The noise the guard trades against is its window's, whatever its range colour: rows of two
+  // range colours, the even rows reporting Var[L_u] = sigma^2 / 100 (as a pixel that missed the
+  // rare bright paths does), the odd ones sigma^2. The blend's own u of an even-row pixel pools its
+  // own colour only (sigma^2 / 100). Every window finds the bias (L_u = m, L_f = m + 2 sigma
+  // exactly), and the guard takes the one asking for the largest s: a half window of 3 rows (2 even,
+  // 1 odd), mean 0.34 sigma^2 (the 5x5 window's is 0.406 sigma^2, 3 even rows and 2 odd):
+  // s = 4 / (4 + 0.34) = 0.922, where the blend's u would give 4 / 4.01 = 0.998.
   for (int y = 0; y < kSize; ++y)
     for (int x = 0; x < kSize; ++x) {
       for (int c = 0; c < 3; ++c) {
@@ -563,8 +564,82 @@ TEST(BlendVsCpu, BiasGuardFiresWhereLfIsBiasedAndRarelyWhereItIsNot) {
   for (int y = 2; y < kSize - 2; y += 2)
     for (int x = 2; x < kSize - 2; ++x) {
       ASSERT_EQ(out.blend_case.at(x, y, 0), float(kCaseBiasGuard)) << x << "," << y;
-      ASSERT_NEAR(out.s.at(x, y, 0), 4.0 / 4.406, 1e-4) << x << "," << y;
+      ASSERT_NEAR(out.s.at(x, y, 0), 4.0 / 4.34, 1e-4) << x << "," << y;
     }
+}
+
+// A bias on one side of a sharp change the guide does not show, as where a focused caustic meets the
+// contact shadow under a glass sphere: one range colour; on the "caustic" side L_u = 1 with a large
+// Var[L_u] (0.25), on the "shadow" side L_u = 0.01 with a small one (1e-4); the filter has moved
+// light across the change, L_f = 0.7 in the caustic's two rows next to it and 0.3 in the shadow's
+// two. There the 5x5 window holds about as much d < 0 as d > 0 and the caustic's variance, so its
+// test finds nothing; the half window on the shadow side holds the bias alone, with the shadow's
+// variance. In all four orientations (each half window), CPU and GPU.
+TEST(BlendVsCpu, BiasGuardFindsABiasOnOneSideOfASharpChange) {
+  test::osmesa_context();
+  const float v_caustic = 0.25f, v_shadow = 1e-4f, t = 1e-5f;
+  for (int orientation = 0; orientation < 4; ++orientation) {
+    SCOPED_TRACE(testing::Message() << "orientation " << orientation);
+    // k: the distance into the shadow side (k >= 0), across the change.
+    auto k_of = [&](int x, int y) {
+      switch (orientation) {
+        case 0: return y - H / 2;
+        case 1: return H / 2 - y;
+        case 2: return x - W / 2;
+        default: return W / 2 - x;
+      }
+    };
+    Scenario s;
+    FilterOutput f{Image::rgb(W, H), Image::gray(W, H), Image()};
+    for (int y = 0; y < H; ++y)
+      for (int x = 0; x < W; ++x) {
+        const int k = k_of(x, y);
+        const float lu = k >= 0 ? 0.01f : 1.0f;
+        const float lf = (k == 0 || k == 1) ? 0.3f : (k == -1 || k == -2) ? 0.7f : lu;
+        for (int c = 0; c < 3; ++c) {
+          s.hv.at(x, y, c) = lu;
+          s.range.at(x, y, c) = 0.5f;
+          f.filtered.at(x, y, c) = lf;
+        }
+        s.var.at(x, y, 0) = k >= 0 ? v_shadow : v_caustic;
+        s.depth.at(x, y, 0) = 2.0f;
+        f.variance.at(x, y, 0) = 1e-6f;
+      }
+    const BlendParams guarded{range_weights(FilterParams{}), true};
+    const BlendOutput out = cpu_blend(s.lv, s.hv, s.var, &f, t, guarded, &s.range, &s.depth);
+    size_t checked = 0;
+    for (int y = 2; y < H - 2; ++y)
+      for (int x = 2; x < W - 2; ++x) {
+        const int k = k_of(x, y);
+        if (k != 0 && k != 1) continue;
+        // The 5x5 window's own test (kBiasGuardZ) finds nothing here.
+        double d_sum = 0, var_sum = 0;
+        for (int dy = -2; dy <= 2; ++dy)
+          for (int dx = -2; dx <= 2; ++dx) {
+            d_sum += f.filtered.at(x + dx, y + dy, 1) - s.hv.at(x + dx, y + dy, 1);
+            var_sum += s.var.at(x + dx, y + dy, 0) + f.variance.at(x + dx, y + dy, 0);
+          }
+        ASSERT_LT(std::abs(d_sum / 25), shared::kBiasGuardZ * std::sqrt(var_sum) / 25) << x << "," << y;
+        ASSERT_EQ(out.blend_case.at(x, y, 0), float(kCaseBiasGuard)) << x << "," << y;
+        // Next to the change the blend's u pools the caustic's variance, which keeps s low; one
+        // pixel further in, the shadow's own noise is all the guard trades against.
+        ASSERT_GT(out.s.at(x, y, 0), k == 0 ? 0.2f : 0.95f) << x << "," << y;
+        ++checked;
+      }
+    EXPECT_GE(checked, 50u);  // 2 rows or columns of 25 or more
+    GpuFixture gpu(s);
+    Image packed = Image::rgba(W, H);
+    for (size_t i = 0; i < packed.pixel_count(); ++i) {
+      for (int c = 0; c < 3; ++c) packed.pixels[4 * i + c] = f.filtered.pixels[3 * i + c];
+      packed.pixels[4 * i + 3] = f.variance.pixels[i];
+    }
+    Texture2D filtered(W, H, TextureFormat::RGBA32F);
+    filtered.upload(packed);
+    BlendPass blend(W, H);
+    blend.run(gpu.inputs, &filtered, &gpu.guide, t, guarded);
+    expect_close(blend.s_image(), out.s, 1e-4f, 1e-5f, "s");
+    expect_close(blend.case_image(), out.blend_case, 0.0f, 0.0f, "case");
+  }
 }
 
 // The full bilateral's centre weight feeds the blend's covariance term: GPU against CPU, and the

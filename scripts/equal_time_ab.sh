@@ -10,6 +10,8 @@
 #   <scene>/buffers.exr (`pxf render --scene S --size 384x216 --spp 2048 --seed 7 --filter none
 #   --out DIR/S`). Default scenes: cornell atrium kitchen envmap.
 # Example: scripts/equal_time_ab.sh REF 2 6 "--bias-guard off" "--bias-guard on"
+# Two builds: PXF_A and PXF_B name the binaries of A and B (default build/app/pxf), e.g.
+#   PXF_A=OLD/app/pxf scripts/equal_time_ab.sh REF 2 6 --quiet --quiet (the flags may not be empty)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 usage="usage: scripts/equal_time_ab.sh REFERENCE_DIR SECONDS ROUNDS FLAGS_A FLAGS_B [SCENES...]"
@@ -24,6 +26,8 @@ shift 5
 scenes=("$@")
 [ ${#scenes[@]} -gt 0 ] || scenes=(cornell atrium kitchen envmap)
 source scripts/equal_time_common.sh
+pxf_a=${PXF_A:-$pxf}
+pxf_b=${PXF_B:-$pxf}
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 echo "scene round variant spp hdr_nrmse display_nrmse" | tee "$tmp/runs"
@@ -34,8 +38,8 @@ for scene in "${scenes[@]}"; do
     [ $((round % 2)) -eq 0 ] && order=(B A)
     for variant in "${order[@]}"; do
       out="$tmp/$scene-$round-$variant"
-      if [ "$variant" = A ]; then flags=("${flags_a[@]}"); else flags=("${flags_b[@]}"); fi
-      "$pxf" render --scene "$scene" --size 384x216 --time "$seconds" --seed $((100 + round)) "${flags[@]}" \
+      if [ "$variant" = A ]; then flags=("${flags_a[@]}") bin=$pxf_a; else flags=("${flags_b[@]}") bin=$pxf_b; fi
+      "$bin" render --scene "$scene" --size 384x216 --time "$seconds" --seed $((100 + round)) "${flags[@]}" \
         --out "$out" >/dev/null 2>&1
       spp=$(spp_of "$out")
       errors=$(nrmse_pair 'all pixels' "$out/final.exr" "$ref")
@@ -43,7 +47,7 @@ for scene in "${scenes[@]}"; do
     done
   done
 done
-python3 - "$tmp/runs" "$label_a" "$label_b" <<'PY'
+python3 - "$tmp/runs" "$label_a [$pxf_a]" "$label_b [$pxf_b]" <<'PY'
 import collections, statistics, sys
 rows = [l.split() for l in open(sys.argv[1]).read().splitlines()[1:]]
 runs = collections.defaultdict(list)   # (scene, variant) -> [(spp, hdr, display)]

@@ -1,18 +1,29 @@
 #version 450 core
-// The bias guard's sums, second pass: per pixel, the sum of the row sums (bias_guard_rows.frag) of
-// the 5 pixels of its column window, the 5x5 sums the blend reads (bias_guard_sums_of).
+// The bias guard's second pass: per pixel, the row sums (bias_guard_rows.frag) added along its
+// column into the 5x5 window's sums and its four half windows' (y from -r to 0 and from 0 to r,
+// x from -r to 0 and from 0 to r), and the guard's finding from them (bias_guard_estimate): the
+// squared bias and the variance it is traded against, which the blend reads.
 #include "pass_formulas.h"
 
-layout(binding = kUnitGuardSums) uniform sampler2D rows_tex;
-layout(location = 0) out vec4 out_sums;
+layout(binding = kUnitGuardSums) uniform sampler2D rows_tex;          // row sums, x in [-r, r]
+layout(binding = kUnitGuardRowsLowX) uniform sampler2D low_x_tex;     // x in [-r, 0]
+layout(binding = kUnitGuardRowsHighX) uniform sampler2D high_x_tex;   // x in [0, r]
+layout(location = 0) out vec2 out_estimate;  // (b2, var_u) of BiasGuardEstimate
 
 void main() {
   ivec2 p = ivec2(gl_FragCoord.xy);
   int height = textureSize(rows_tex, 0).y;
-  vec4 sum = vec4(0.0);
+  vec4 low_y = vec4(0.0), high_y = vec4(0.0), centre = vec4(0.0), low_x = vec4(0.0), high_x = vec4(0.0);
   for (int dy = -kBiasGuardRadius; dy <= kBiasGuardRadius; ++dy) {
     ivec2 q = p + ivec2(0, dy);
-    if (q.y >= 0 && q.y < height) sum += texelFetch(rows_tex, q, 0);
+    if (q.y < 0 || q.y >= height) continue;
+    vec4 row = texelFetch(rows_tex, q, 0);
+    if (dy < 0) low_y += row;
+    if (dy > 0) high_y += row;
+    if (dy == 0) centre = row;
+    low_x += texelFetch(low_x_tex, q, 0);
+    high_x += texelFetch(high_x_tex, q, 0);
   }
-  out_sums = sum;
+  BiasGuardEstimate e = bias_guard_estimate(low_y + centre + high_y, low_y + centre, centre + high_y, low_x, high_x);
+  out_estimate = vec2(e.b2, e.var_u);
 }

@@ -7,7 +7,7 @@ layout(binding = kUnitLv) uniform sampler2D lv_tex;        // rgb L_lv
 layout(binding = kUnitFiltered) uniform sampler2D filtered_tex;  // rgb L_f, a Var[L_f] (or a sentinel)
 layout(binding = kUnitGuide) uniform sampler2D guide_tex;   // rgb range color, a distance (pooling)
 layout(binding = kUnitCentreWeight) uniform sampler2D centre_weight_tex;  // r: the filter's centre weight w
-layout(binding = kUnitGuardSums) uniform sampler2D guard_sums_tex;  // the bias guard's 5x5 sums (bias_guard: 1)
+layout(binding = kUnitGuardSums) uniform sampler2D guard_tex;  // rg: the bias guard's finding, b2 and var_u (bias_guard: 1)
 uniform int has_filtered;
 uniform int has_centre_weight;  // 0: Cov[L_u, L_f] not known, left out (w = 0)
 uniform int has_guide;  // 0: u from the pixel's own variance only
@@ -49,8 +49,13 @@ void main() {
       float w = has_centre_weight != 0 ? texelFetch(centre_weight_tex, p, 0).r : 0.0;
       float f = relative_variance(vf, lb);
       s = blend_factor_covariance(u, f, t, w, blend_case);
-      if (bias_guard != 0)
-        s = guarded_blend_factor(bias_guard_sums_of(texelFetch(guard_sums_tex, p, 0)), s, u, f, w, lb, blend_case);
+      if (bias_guard != 0) {
+        vec2 g = texelFetch(guard_tex, p, 0).rg;
+        BiasGuardEstimate e;
+        e.b2 = g.x;
+        e.var_u = g.y;
+        s = guarded_blend_factor(e, s, u, f, w, lb, blend_case);
+      }
     }
   }
   atomicAdd(case_counts[blend_case], 1u);

@@ -57,7 +57,9 @@ PXF_CONST int kUnitSignal = 3;        // what a filter pass filters: L_u, or the
 PXF_CONST int kUnitFiltered = 4;      // rgb L_f, a Var[L_f] or a sentinel
 PXF_CONST int kUnitCentreWeight = 5;  // r: the filter's centre weight
 PXF_CONST int kUnitAlbedo = 6;        // rgb mean first non-specular albedo
-PXF_CONST int kUnitGuardSums = 7;     // the bias guard's 5x5 sums (bias_guard_texel), or their row sums
+PXF_CONST int kUnitGuardSums = 7;     // the bias guard's finding (b2, var_u), or the row sums over x in [-r, r]
+PXF_CONST int kUnitGuardRowsLowX = 8;   // the bias guard's row sums over x in [-r, 0]
+PXF_CONST int kUnitGuardRowsHighX = 9;  // and over x in [0, r]
 
 // Shader storage buffer bindings of the pass shaders.
 PXF_CONST int kBufferCounts = 0;      // the filters' filtered-pixel counter, the blend's case counts
@@ -294,12 +296,22 @@ PXF_INLINE float blend_factor_covariance(float u, float f, float t, float w, PXF
 // others, which added variance to the pixels the blend holds at t (cornell 128², 16 spp,
 // t = 0.001: case-3 median 1.056 t against 0.924 t with 5x5; docs/measurements.md, "Bias guard").
 // The test: the squared mean of d counts as the bias where it exceeds kBiasGuardZ^2 times that
-// variance, else no bias (filter_bias_squared).
+// variance, else no bias (window_bias_squared).
+//
+// The 5x5 mean misses a bias on one side of a sharp change the filter blurs: next to a focused
+// caustic, the contact shadow under the glass sphere takes the caustic's light in L_f (d > 0) while
+// the caustic loses it (d < 0), and the two cancel in the mean (cornell, 2 s: those 0.1 % of the
+// pixels held 40 % of the filtered image's squared display error, 30-70x too bright in every seed).
+// So the guard also judges the four half windows that contain the pixel (5 wide and 3 tall below
+// and above it, 3 wide and 5 tall left and right of it) at kBiasGuardHalfZ, stricter against the
+// more tests, each with its own mean Var[L_u] (the shadow side's variance, not the caustic's), and
+// keeps the window that asks for the largest s (consider_window).
 PXF_CONST float kBiasGuardZ = 2.0f;
+PXF_CONST float kBiasGuardHalfZ = 4.0f;
 PXF_CONST int kBiasGuardRadius = 2;
 
-// What the guard reads from the 5x5 neighbourhood: sums over the neighbours of what each
-// contributes (bias_guard_texel).
+// What the guard reads from a window (the 5x5 neighbourhood or one of its halves): sums over its
+// pixels of what each contributes (bias_guard_texel).
 struct BiasGuardSums {
   wide_float d, var_d;  // sum of d and of Var[L_u] + Var[L_f], over the judged neighbours
   int judged;           // neighbours with n >= 2 that the filter did not skip
@@ -307,8 +319,8 @@ struct BiasGuardSums {
   int known;            // their count
 };
 
-// One neighbour's part of the sums, packed so that the sums of 5x5 texels are texels too (the blend
-// pass adds them up in a row pass and a column pass of 5 reads each, instead of 25 reads of two
+// One neighbour's part of the sums, packed so that the sums of a window's texels are texels too (the
+// blend pass adds them up in a row pass and a column pass of 5 reads each, instead of 25 reads of two
 // textures per pixel: on llvmpipe the blend runs on the CPU cores the path tracer needs):
 // (d, Var[L_u] + Var[L_f], Var[L_u], judged + 32 known). The bias test leaves out neighbours with
 // n < 2 (no variance to judge d against) and those the filter skipped (L_f is L_u there); the
@@ -337,12 +349,14 @@ PXF_INLINE BiasGuardSums bias_guard_sums_of(vec4 sum) {
   return sums;
 }
 
-// The 5x5 sums by their definition (the CPU reference; the GPU adds the same texels in two passes).
-PXF_SAMPLER_FN BiasGuardSums bias_guard_sums(sampler2D hv, sampler2D filtered, ivec2 p) {
+// The packed sums of bias_guard_texel over the pixels p + (dx, dy), lo <= (dx, dy) <= hi, inside
+// the image, by their definition (the CPU reference; the GPU adds the same texels in a row pass and
+// a column pass).
+PXF_SAMPLER_FN vec4 bias_guard_window_sums(sampler2D hv, sampler2D filtered, ivec2 p, ivec2 lo, ivec2 hi) {
   ivec2 size = textureSize(hv, 0);
   wide_float d = 0.0f, var_d = 0.0f, var_u = 0.0f, counts = 0.0f;
-  for (int dy = -kBiasGuardRadius; dy <= kBiasGuardRadius; ++dy)
-    for (int dx = -kBiasGuardRadius; dx <= kBiasGuardRadius; ++dx) {
+  for (int dy = lo.y; dy <= hi.y; ++dy)
+    for (int dx = lo.x; dx <= hi.x; ++dx) {
       ivec2 q = p + ivec2(dx, dy);
       if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) continue;
       vec4 c = bias_guard_texel(hv, filtered, q);
@@ -351,24 +365,24 @@ PXF_SAMPLER_FN BiasGuardSums bias_guard_sums(sampler2D hv, sampler2D filtered, i
       var_u += wide_float(c.z);
       counts += wide_float(c.w);
     }
-  return bias_guard_sums_of(vec4(float(d), float(var_d), float(var_u), float(counts)));
+  return vec4(float(d), float(var_d), float(var_u), float(counts));
 }
 
-// The squared mean of d where it exceeds kBiasGuardZ^2 times its variance, else 0.
-PXF_INLINE float filter_bias_squared(BiasGuardSums sums) {
+// The squared mean of d over a window where it exceeds z^2 times its variance, else 0.
+PXF_INLINE float window_bias_squared(BiasGuardSums sums, float z) {
   if (sums.judged == 0) return 0.0f;
   wide_float n = wide_float(sums.judged);
   wide_float mean = sums.d / n, var_mean = sums.var_d / (n * n);
   wide_float b2 = mean * mean;
-  return b2 > wide_float(kBiasGuardZ * kBiasGuardZ) * var_mean ? float(min(b2, wide_float(kMaxInput))) : 0.0f;
+  return b2 > wide_float(z * z) * var_mean ? float(min(b2, wide_float(kMaxInput))) : 0.0f;
 }
 
-// The Var[L_u] the guard trades bias against: the mean of the known variances over the 5x5
-// neighbours, whatever their range colour, where that is larger than the pixel's own (the blend's
-// u). The guard adds noise where it raises s, so it must not take that noise for less than it is;
-// a variance estimated from few heavy-tailed samples is low far more often than high, the more so
-// the fewer pixels it pools (with the blend's u alone the guard cost atrium 13-23 % of its display
-// error at 4-32 spp; docs/method.md section 3.7).
+// The Var[L_u] the guard trades bias against: the mean of the known variances over the window's
+// pixels (for the 5x5 window, all 25 neighbours), whatever their range colour, where that is
+// larger than the pixel's own (the blend's u). The guard adds noise where it raises s, so it must
+// not take that noise for less than it is; a variance estimated from few heavy-tailed samples is
+// low far more often than high, the more so the fewer pixels it pools (with the blend's u alone the
+// guard cost atrium 13-23 % of its display error at 4-32 spp; docs/method.md section 3.7).
 PXF_INLINE float broad_var_u(BiasGuardSums sums) {
   return sums.known > 0 ? float(min(sums.var_u / wide_float(sums.known), wide_float(kMaxInput))) : 0.0f;
 }
@@ -389,17 +403,60 @@ PXF_INLINE float bias_guard_factor(float s, float u, float f, float w, float b2,
   return best;
 }
 
+// What the guard found around a pixel: the squared bias b2 it measured (0: none) and the mean
+// Var[L_u] of the window it measured it in, which the bias is traded against (absolute values).
+struct BiasGuardEstimate {
+  float b2;
+  float var_u;
+};
+
+// Takes a window's finding where it asks for a larger s than the best so far: for the least-error
+// factor b2 / (b2 + u) (f and c aside) that is the larger b2 / var_u, compared crosswise so that a
+// window without known variances (var_u 0) wins over any with them.
+PXF_INLINE void consider_window(BiasGuardSums sums, float z, PXF_INOUT(BiasGuardEstimate) best) {
+  float b2 = window_bias_squared(sums, z);
+  if (!(b2 > 0.0f)) return;
+  float var_u = broad_var_u(sums);
+  if (best.b2 > 0.0f && !(wide_float(b2) * wide_float(best.var_u) > wide_float(best.b2) * wide_float(var_u))) return;
+  best.b2 = b2;
+  best.var_u = var_u;
+}
+
+// The guard's finding from the packed sums (bias_guard_window_sums) of the 5x5 window at
+// kBiasGuardZ and of its four half windows at kBiasGuardHalfZ: y from -r to 0 and from 0 to r (all
+// five columns), x from -r to 0 and from 0 to r (all five rows).
+PXF_INLINE BiasGuardEstimate bias_guard_estimate(vec4 full, vec4 low_y, vec4 high_y, vec4 low_x, vec4 high_x) {
+  BiasGuardEstimate best;
+  best.b2 = 0.0f;
+  best.var_u = 0.0f;
+  consider_window(bias_guard_sums_of(full), kBiasGuardZ, best);
+  consider_window(bias_guard_sums_of(low_y), kBiasGuardHalfZ, best);
+  consider_window(bias_guard_sums_of(high_y), kBiasGuardHalfZ, best);
+  consider_window(bias_guard_sums_of(low_x), kBiasGuardHalfZ, best);
+  consider_window(bias_guard_sums_of(high_x), kBiasGuardHalfZ, best);
+  return best;
+}
+
+// The guard's finding at pixel p by the definition of its windows (the CPU reference).
+PXF_SAMPLER_FN BiasGuardEstimate bias_guard_estimate_at(sampler2D hv, sampler2D filtered, ivec2 p) {
+  const int r = kBiasGuardRadius;
+  return bias_guard_estimate(bias_guard_window_sums(hv, filtered, p, ivec2(-r, -r), ivec2(r, r)),
+                             bias_guard_window_sums(hv, filtered, p, ivec2(-r, -r), ivec2(r, 0)),
+                             bias_guard_window_sums(hv, filtered, p, ivec2(-r, 0), ivec2(r, r)),
+                             bias_guard_window_sums(hv, filtered, p, ivec2(-r, -r), ivec2(0, r)),
+                             bias_guard_window_sums(hv, filtered, p, ivec2(0, -r), ivec2(r, r)));
+}
+
 // The guard as the blend applies it (blend.frag, cpu_blend): in cases 1 and 3 only, s and the
-// case from bias_guard_factor where filter_bias_squared finds a bias in the 5x5 sums, traded
-// against the larger of the blend's u and broad_var_u's. lb: the blend's L_b; w: the filter's
-// centre weight (0 if none).
-PXF_INLINE float guarded_blend_factor(BiasGuardSums sums, float s, float u, float f, float w, float lb,
+// case from bias_guard_factor where the estimate holds a bias, traded against the larger of the
+// blend's u and the window's mean variance. lb: the blend's L_b; w: the filter's centre weight (0 if
+// none).
+PXF_INLINE float guarded_blend_factor(BiasGuardEstimate e, float s, float u, float f, float w, float lb,
                                       PXF_INOUT(int) blend_case) {
   if (blend_case != kCaseMixed && blend_case != kCaseFilteredOnly) return s;
-  float b2 = filter_bias_squared(sums);
-  if (!(b2 > 0.0f)) return s;
-  float u_guard = max(u, relative_variance(broad_var_u(sums), lb));
-  return bias_guard_factor(s, u_guard, f, w, relative_variance(b2, lb), blend_case);
+  if (!(e.b2 > 0.0f)) return s;
+  float u_guard = max(u, relative_variance(e.var_u, lb));
+  return bias_guard_factor(s, u_guard, f, w, relative_variance(e.b2, lb), blend_case);
 }
 
 // ---- Albedo demodulation ----
