@@ -1,6 +1,7 @@
 #include "app/explorer.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -138,6 +139,9 @@ class Explorer {
       const auto frame_start = Clock::now();
       glfwPollEvents();
       load_dropped_scenes();
+      // Tracing and its passes before the panel is built: the status line and the case legend
+      // then count the blend the views below show, not the one before it.
+      trace();
       ImGui_ImplOpenGL3_NewFrame();
       ImGui_ImplGlfw_NewFrame();
       ImGui::NewFrame();
@@ -145,7 +149,6 @@ class Explorer {
       panel();
       handle_keys();
       apply_changes();
-      trace();
       render_views();
       ImGui::Render();
       draw_to_window();
@@ -337,6 +340,7 @@ class Explorer {
     ImGui::Text("    blend %.2f  tone map %.2f   filter runs %d%s", stage_ms_.blend, stage_ms_.tonemap,
                 preview_->filter_runs(), preview_->filter_stopped() ? " (stopped: all case 2)" : "");
     const auto& counts = preview_->case_counts();
+    shown_case_counts_ = counts;
     std::string cases = "cases";  // every case code, so a new case cannot be left out of the line
     for (int c = 0; c < kBlendCaseCount; ++c) {
       char part[32];
@@ -691,7 +695,10 @@ class Explorer {
     if (options_.capture_on_exit) capture();
     if (!options_.screenshot.empty()) {
       write_png(options_.screenshot, read_window(window_width_, window_height_));
-      std::fprintf(stderr, "pxf explore: wrote %s\n", options_.screenshot.c_str());
+      std::string cases;
+      for (uint32_t n : shown_case_counts_) cases += " " + std::to_string(n);
+      std::fprintf(stderr, "pxf explore: wrote %s (its status line counts the blend cases%s)\n",
+                   options_.screenshot.c_str(), cases.c_str());
     }
   }
 
@@ -703,6 +710,7 @@ class Explorer {
   std::unique_ptr<Preview> preview_;
   std::unique_ptr<CameraController> controller_;
   std::unique_ptr<ViewRenderer> views_;
+  std::array<uint32_t, kBlendCaseCount> shown_case_counts_{};  // the status line's, last built
   int width_ = 0, height_ = 0, window_width_ = 0, window_height_ = 0;
   float scale_ = 1.0f;
   BufferView view_ = BufferView::Final, split_left_ = BufferView::Final, split_right_ = BufferView::Unfiltered;
