@@ -301,7 +301,7 @@ PXF_INLINE float blend_factor_covariance(float u, float f, float t, float w, PXF
 // The 5x5 mean misses a bias on one side of a sharp change the filter blurs: next to a focused
 // caustic, the contact shadow under the glass sphere takes the caustic's light in L_f (d > 0) while
 // the caustic loses it (d < 0), and the two cancel in the mean (cornell, 2 s: those 0.1 % of the
-// pixels held 40 % of the filtered image's squared display error, 30-70x too bright in every seed).
+// pixels held 40 % of the filtered image's squared display error, 30-70x too bright, seed after seed).
 // So the guard also judges the four half windows that contain the pixel (5 wide and 3 tall below
 // and above it, 3 wide and 5 tall left and right of it) at kBiasGuardHalfZ, stricter against the
 // more tests, each with its own mean Var[L_u] (the shadow side's variance, not the caustic's), and
