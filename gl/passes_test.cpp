@@ -83,6 +83,18 @@ struct GpuFixture {
   }
 };
 
+// A CPU filter output as the texture the blend reads: rgb L_f, a Var[L_f] (or a sentinel).
+Texture2D filtered_texture(const FilterOutput& f) {
+  Image packed = Image::rgba(f.filtered.width, f.filtered.height);
+  for (size_t i = 0; i < packed.pixel_count(); ++i) {
+    for (int c = 0; c < 3; ++c) packed.pixels[4 * i + c] = f.filtered.pixels[3 * i + c];
+    packed.pixels[4 * i + 3] = f.variance.pixels[i];
+  }
+  Texture2D texture(packed.width, packed.height, TextureFormat::RGBA32F);
+  texture.upload(packed);
+  return texture;
+}
+
 class FilterVsCpu : public ::testing::TestWithParam<std::tuple<FilterKind, bool, float>> {};
 
 TEST_P(FilterVsCpu, MatchesReference) {
@@ -451,13 +463,7 @@ TEST(BlendVsCpu, MatchesReferenceWithFilteredInput) {
     const float filter_t = 0.02f;
     FilterOutput ref_f = cpu_filter(s.hv, s.var, s.lv, s.range, s.depth, fp, filter_t);
     ref_f.centre_weight = Image();  // the blend below gets L_f as a plain texture, without a centre weight
-    Image packed = Image::rgba(W, H);
-    for (size_t i = 0; i < packed.pixel_count(); ++i) {
-      for (int c = 0; c < 3; ++c) packed.pixels[4 * i + c] = ref_f.filtered.pixels[3 * i + c];
-      packed.pixels[4 * i + 3] = ref_f.variance.pixels[i];
-    }
-    Texture2D filtered(W, H, TextureFormat::RGBA32F);
-    filtered.upload(packed);
+    const Texture2D filtered = filtered_texture(ref_f);
     for (float t : {0.0f, 0.001f, 0.02f, 0.2f})
       for (bool pool : {false, true})
         for (bool guard : {false, true}) {
@@ -628,13 +634,7 @@ TEST(BlendVsCpu, BiasGuardFindsABiasOnOneSideOfASharpChange) {
       }
     EXPECT_GE(checked, 50u);  // 2 rows or columns of 25 or more
     GpuFixture gpu(s);
-    Image packed = Image::rgba(W, H);
-    for (size_t i = 0; i < packed.pixel_count(); ++i) {
-      for (int c = 0; c < 3; ++c) packed.pixels[4 * i + c] = f.filtered.pixels[3 * i + c];
-      packed.pixels[4 * i + 3] = f.variance.pixels[i];
-    }
-    Texture2D filtered(W, H, TextureFormat::RGBA32F);
-    filtered.upload(packed);
+    const Texture2D filtered = filtered_texture(f);
     BlendPass blend(W, H);
     blend.run(gpu.inputs, &filtered, &gpu.guide, t, guarded);
     expect_close(blend.s_image(), out.s, 1e-4f, 1e-5f, "s");
