@@ -138,6 +138,54 @@ void print_perfect_filter(const std::string& test_path, const std::string& refer
   print_error_line("lv + reference hv", sum_of(lv, ref_hv), ref_final, display);
 }
 
+// --second-reference: the correction holds only for a second reference rendered like the first with
+// independent noise. Where both have a stats.json beside them, a second reference of the same seed
+// (the same noise), of another sample count (another noise level) or of another scene or size is
+// an error; without them nothing can be checked, which is said.
+void check_second_reference(const std::string& reference_path, const std::string& second_path) {
+  auto settings_of = [](const std::string& path) -> std::optional<nlohmann::json> {
+    std::ifstream in(std::filesystem::path(path).parent_path() / "stats.json");
+    if (!in) return std::nullopt;
+    const nlohmann::json json = nlohmann::json::parse(in, nullptr, false);
+    if (json.is_discarded() || !json.contains("settings")) return std::nullopt;
+    nlohmann::json s = json["settings"];
+    if (json.contains("time_budget")) s["spp"] = json["time_budget"].value("spp_reached", s.value("spp", 0));
+    return s;
+  };
+  const std::optional<nlohmann::json> first = settings_of(reference_path), second = settings_of(second_path);
+  if (!first || !second) {
+    std::printf("second reference: no stats.json beside both references; they must be renders of the same\n"
+                "  scene with the same sample count and different seeds, which cannot be checked here\n");
+    return;
+  }
+  for (const char* key : {"scene", "width", "height", "spp", "sampler", "max_vertices"})
+    if (first->value(key, nlohmann::json()) != second->value(key, nlohmann::json()))
+      throw Error(second_path + ": its " + key + " (" + second->value(key, nlohmann::json()).dump() +
+                  ") differs from the reference's (" + first->value(key, nlohmann::json()).dump() +
+                  "); --second-reference needs a render like the reference's with another seed");
+  if (first->value("seed", -1) == second->value("seed", -1))
+    throw Error(second_path + ": the same seed as the reference, so the same noise; --second-reference needs "
+                "another seed");
+}
+
+// The error against the truth from two references (correct_for_reference_noise), on all pixels.
+void print_noise_corrected(const Image& test, const Image& reference, const Image& second,
+                           const DisplayMetricOptions& o) {
+  const DisplayMetrics raw = compare_display(test, reference, nullptr, o);
+  const DisplayMetrics references = compare_display(second, reference, nullptr, o);
+  const ReferenceNoiseCorrection hdr =
+      correct_for_reference_noise(raw.hdr.nrmse_percent, references.hdr.nrmse_percent);
+  const ReferenceNoiseCorrection display =
+      correct_for_reference_noise(raw.display_nrmse_percent, references.display_nrmse_percent);
+  std::printf("reference noise: HDR NRMSE %.4f %%  display NRMSE %.4f %%\n", hdr.reference_noise_percent,
+              display.reference_noise_percent);
+  std::printf("noise-corrected: HDR NRMSE %.4f %%  display NRMSE %.4f %%%s\n", hdr.corrected_percent,
+              display.corrected_percent,
+              hdr.within_reference_noise || display.within_reference_noise
+                  ? "  (0: within the reference's noise, no error can be told)"
+                  : "");
+}
+
 void print_display(const char* label, const DisplayMetrics& m, const OutlierMetrics& o) {
   std::printf("%s: HDR NRMSE %.4f %%  display NRMSE %.4f %%  FLIP %.6f  outliers (Y > 5x reference) %zu (%.4f %%)\n",
               label, m.hdr.nrmse_percent, m.display_nrmse_percent, m.flip_mean, o.outliers, 100.0 * o.fraction);
@@ -145,7 +193,7 @@ void print_display(const char* label, const DisplayMetrics& m, const OutlierMetr
 }  // namespace
 
 int run_diff(const Args& args) {
-  std::string test_path, reference_path, layer, reference_layer, mask_path, images_dir;
+  std::string test_path, reference_path, second_path, layer, reference_layer, mask_path, images_dir;
   double max_nrmse = -1, max_flip = -1;
   bool perfect_filter = false;
   DisplayMetricOptions display;
@@ -172,6 +220,10 @@ int run_diff(const Args& args) {
            "TEST and REFERENCE are a render's and a reference render's buffers.exr: also the error of\n"
            "TEST blended again with a perfect filter (L_f = REFERENCE's hv, Var[L_f] = 0; t and sigmas\n"
            "from TEST's stats.json), of TEST unfiltered, and of TEST's lv with REFERENCE's hv");
+  cli.option("--second-reference", &second_path, "FILE.exr",
+             "a second reference, rendered like REFERENCE with another seed: also REFERENCE's own noise\n"
+             "(their NRMSE / sqrt 2) and TEST's error against the truth with that noise taken out,\n"
+             "NRMSE^2(TEST, REFERENCE) - NRMSE^2(SECOND, REFERENCE) / 2 (HDR and display, all pixels)");
   if (!cli.parse(args)) return 0;
   if (!cli.given("--reference-layer")) reference_layer = layer;
 
@@ -203,6 +255,12 @@ int run_diff(const Args& args) {
     }
   } else {
     std::printf("display metrics: skipped, the images have no R,G,B channels\n");
+  }
+  if (!second_path.empty()) {
+    if (!has_rgb(test) || !has_rgb(reference)) throw Error("--second-reference needs R,G,B images");
+    check_second_reference(reference_path, second_path);
+    const Image second = read_exr(second_path, reference_layer);
+    print_noise_corrected(test, reference, second, display);
   }
   if (perfect_filter) print_perfect_filter(test_path, reference_path, display);
   if (max_nrmse >= 0 && m.nrmse_percent > max_nrmse) {

@@ -52,6 +52,7 @@ nlohmann::json stats_json(Preview& preview, const RenderReport& r) {
                    {"sigma_c", s.filter.sigma_c},
                    {"sigma_d", s.filter.sigma_d},
                    {"seed", s.trace.seed},
+                   {"sampler", sampler_type_names()[static_cast<int>(s.trace.sampler)]},
                    {"threads", s.trace.threads},
                    {"max_vertices", s.trace.max_vertices},
                    {"rr_start_vertex", s.trace.rr_start_vertex},

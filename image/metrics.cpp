@@ -195,4 +195,14 @@ DisplayMetrics compare_display(const Image& test, const Image& reference, const 
   return m;
 }
 
+ReferenceNoiseCorrection correct_for_reference_noise(double test_nrmse_percent, double references_nrmse_percent) {
+  ReferenceNoiseCorrection c;
+  const double noise_squared = 0.5 * references_nrmse_percent * references_nrmse_percent;
+  const double excess = test_nrmse_percent * test_nrmse_percent - noise_squared;
+  c.reference_noise_percent = std::sqrt(noise_squared);
+  c.within_reference_noise = !(excess > 0);
+  c.corrected_percent = c.within_reference_noise ? 0.0 : std::sqrt(excess);
+  return c;
+}
+
 }  // namespace pxf

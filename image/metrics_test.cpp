@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 
 #include "image/flip.h"
 #include "image/metrics.h"
@@ -151,4 +152,43 @@ TEST(ErrorConcentration, WorstPixelsAndMaskShares) {
   mask.at(0, 0, 0) = 1.0f;
   EXPECT_NEAR(masked_squared_error(e, mask), 9.02, 1e-5);
   EXPECT_THROW(masked_squared_error(e, Image::gray(5, 5)), Error);
+}
+
+// Two noisy references of one truth recover the test's error against the truth: the raw NRMSE
+// against one reference carries that reference's noise too (here 40 % more than the true error),
+// the corrected one does not, in HDR and (to first order) in display values.
+TEST(ReferenceNoise, TwoReferencesRecoverTheErrorAgainstTheTruth) {
+  const Image truth = gradient(96, 64, 1.0f);
+  std::mt19937 rng(7);
+  std::normal_distribution<float> normal(0.0f, 1.0f);
+  auto noisy = [&](float relative_sd, float gain) {
+    Image im = truth;
+    for (float& v : im.pixels) v = gain * v * (1.0f + relative_sd * normal(rng));
+    return im;
+  };
+  const Image reference = noisy(0.05f, 1.0f), second = noisy(0.05f, 1.0f), test = noisy(0.04f, 1.02f);
+  const DisplayMetrics raw = compare_display(test, reference), references = compare_display(second, reference);
+  const DisplayMetrics exact = compare_display(test, truth);
+  const ReferenceNoiseCorrection hdr =
+      correct_for_reference_noise(raw.hdr.nrmse_percent, references.hdr.nrmse_percent);
+  const ReferenceNoiseCorrection display =
+      correct_for_reference_noise(raw.display_nrmse_percent, references.display_nrmse_percent);
+  EXPECT_GT(raw.hdr.nrmse_percent, 1.3 * exact.hdr.nrmse_percent);
+  EXPECT_NEAR(hdr.corrected_percent, exact.hdr.nrmse_percent, 0.04 * exact.hdr.nrmse_percent);
+  EXPECT_NEAR(hdr.reference_noise_percent, compare_images(reference, truth).nrmse_percent,
+              0.04 * hdr.reference_noise_percent);
+  EXPECT_GT(raw.display_nrmse_percent, 1.3 * exact.display_nrmse_percent);
+  EXPECT_NEAR(display.corrected_percent, exact.display_nrmse_percent, 0.06 * exact.display_nrmse_percent);
+  EXPECT_FALSE(hdr.within_reference_noise);
+}
+
+// An error the reference's noise explains is reported as such, never as a NaN.
+TEST(ReferenceNoise, WithinTheNoiseIsZero) {
+  const ReferenceNoiseCorrection c = correct_for_reference_noise(1.0, 2.0);  // 1 < 2^2 / 2
+  EXPECT_TRUE(c.within_reference_noise);
+  EXPECT_EQ(c.corrected_percent, 0.0);
+  EXPECT_NEAR(c.reference_noise_percent, std::sqrt(2.0), 1e-12);
+  const ReferenceNoiseCorrection exact = correct_for_reference_noise(5.0, std::sqrt(2.0) * 3.0);
+  EXPECT_NEAR(exact.corrected_percent, 4.0, 1e-12);
+  EXPECT_FALSE(exact.within_reference_noise);
 }

@@ -10,6 +10,9 @@
 #   <scene>/buffers.exr (`pxf render --scene S --size 384x216 --spp 2048 --seed 7 --filter none
 #   --out DIR/S`). Default scenes: cornell atrium kitchen envmap.
 # Example: scripts/equal_time_ab.sh REF 2 6 "--bias-guard off" "--bias-guard on"
+# SECOND_REFS=DIR2 (references like REFERENCE_DIR's, rendered with another seed) judges every job by
+#   its noise-corrected error (`pxf diff --second-reference`, docs/metrics.md) instead of its raw
+#   error against REFERENCE_DIR; the perfect-filter rows stay raw (they use the reference's HV).
 # Two builds: PXF_A and PXF_B name the binaries of A and B (default build/app/pxf), e.g.
 #   PXF_A=OLD/app/pxf scripts/equal_time_ab.sh REF 2 6 --quiet --quiet (the flags may not be empty)
 set -euo pipefail
@@ -42,7 +45,7 @@ for scene in "${scenes[@]}"; do
       "$bin" render --scene "$scene" --size 384x216 --time "$seconds" --seed $((100 + round)) "${flags[@]}" \
         --out "$out" >/dev/null 2>&1
       spp=$(spp_of "$out")
-      errors=$(nrmse_pair 'all pixels' "$out/final.exr" "$ref")
+      errors=$(judge "$out/final.exr" "$refs" "$scene")
       echo "$scene $round $variant $spp $errors" | tee -a "$tmp/runs"
     done
   done

@@ -23,3 +23,17 @@ nrmse_pair() {
   shift
   "$pxf" diff "$@" | grep "^$label" | sed -E 's/.*HDR NRMSE ([0-9.]+) %  display NRMSE ([0-9.]+).*/\1 \2/'
 }
+
+# "HDR DISPLAY" NRMSE of TEST against the reference of SCENE in REFERENCE_DIR. With SECOND_REFS=DIR
+# (a second reference per scene, found the same way, rendered like the first with another seed),
+# the noise-corrected error instead (`pxf diff --second-reference`): the reference's own noise
+# taken out, which otherwise adds to every job's error alike and pulls every ratio toward 1.
+judge() {
+  local test=$1 refs=$2 scene=$3
+  if [ -n "${SECOND_REFS:-}" ]; then
+    nrmse_pair 'noise-corrected' "$test" "$(reference_of "$refs" "$scene")" \
+      --second-reference "$(reference_of "$SECOND_REFS" "$scene")"
+  else
+    nrmse_pair 'all pixels' "$test" "$(reference_of "$refs" "$scene")"
+  fi
+}

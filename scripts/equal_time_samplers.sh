@@ -13,6 +13,9 @@
 #   blended again with a perfect filter (`pxf diff --perfect-filter`: L_f = the reference's HV),
 #   the least error any filter could leave under the blend.
 #   Defaults: 2 s, 3 rounds, cornell atrium kitchen envmap.
+#   SECOND_REFS=DIR2 (references like REFERENCE_DIR's, rendered with another seed) judges every job by
+#   its noise-corrected error (`pxf diff --second-reference`, docs/metrics.md) instead of its raw
+#   error against REFERENCE_DIR; the perfect-filter rows stay raw (they use the reference's HV).
 #   FILTER_FLAGS="--sigma-s 2" (say) adds render flags to the filtered jobs only.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -41,7 +44,7 @@ for scene in "${scenes[@]}"; do
         "$pxf" render --scene "$scene" --size 384x216 --time "$seconds" --sampler "$sampler" --filter "$filter" \
           --seed $((100 + round)) "${flags[@]}" --out "$out" >/dev/null 2>&1
         spp=$(spp_of "$out")
-        errors=$(nrmse_pair 'all pixels' "$out/final.exr" "$ref")
+        errors=$(judge "$out/final.exr" "$refs" "$scene")
         echo "$scene $round $sampler $filter $spp $errors" | tee -a "$tmp/runs"
         if [ "$filter" = grid ] && [ "${ref##*/}" = buffers.exr ]; then
           errors=$(nrmse_pair 'blend with a perfect filter' "$out/buffers.exr" "$ref" --perfect-filter)

@@ -197,6 +197,7 @@ TEST(Cli, RenderWritesEveryOutput) {
   EXPECT_EQ(stats["filter_runs"], 3);  // 1, 2, 4
   EXPECT_EQ(stats["settings"]["demodulate"], false);
   EXPECT_EQ(stats["settings"]["bias_guard"], true);
+  EXPECT_EQ(stats["settings"]["sampler"], "sobol");
   EXPECT_TRUE(stats["blend_case_pixels"].contains("bias_guard"));
   EXPECT_EQ(stats["filter_runs_skipped_low_hv"], 0);
   EXPECT_GT(stats["hv_energy_share"].get<double>(), 0.01);
@@ -457,6 +458,35 @@ TEST(Cli, DiffPerfectFilterBlendsTheTestBuffersWithTheReferenceHv) {
   const Result bad = run("diff " + keep + "/final.exr " + ref + "/buffers.exr --perfect-filter");
   EXPECT_EQ(bad.code, 1);
   EXPECT_NE(bad.err.find(keep + "/final.exr: no 'lv' layer"), std::string::npos) << bad.err;
+}
+
+// --second-reference takes the reference's own noise out. TEST here is a render like the two
+// references (unfiltered, unbiased, the same spp, a third seed), so its error against the truth is
+// the references' noise itself: the corrected NRMSE is about the raw one / sqrt 2 and about the
+// reference noise printed beside it. A second reference that cannot be independent is refused.
+TEST(Cli, DiffSecondReferenceTakesOutTheReferencesNoise) {
+  const std::string a = temp_dir("noise_a"), b = temp_dir("noise_b"), test = temp_dir("noise_test"),
+                    other = temp_dir("noise_other");
+  for (const auto& [dir, seed] : {std::pair{a, 9}, {b, 10}, {test, 11}})
+    ASSERT_EQ(run("render --size 40x40 --spp 16 --filter none --quiet --seed " + std::to_string(seed) + " --out " + dir)
+                  .code,
+              0);
+  const Result r = run("diff " + test + "/final.exr " + a + "/final.exr --second-reference " + b + "/final.exr");
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const char* value : {"HDR NRMSE ", "display NRMSE "}) {
+    const double raw = number_after(r.out, "all pixels:", value);
+    const double corrected = number_after(r.out, "noise-corrected:", value);
+    const double noise = number_after(r.out, "reference noise:", value);
+    EXPECT_NEAR(corrected, raw / std::sqrt(2.0), 0.2 * raw) << value << r.out;
+    EXPECT_NEAR(corrected, noise, 0.25 * noise) << value << r.out;
+  }
+  const Result same_seed = run("diff " + test + "/final.exr " + a + "/final.exr --second-reference " + a + "/final.exr");
+  EXPECT_EQ(same_seed.code, 1);
+  EXPECT_NE(same_seed.err.find("seed"), std::string::npos) << same_seed.err;
+  ASSERT_EQ(run("render --size 40x40 --spp 8 --filter none --quiet --seed 12 --out " + other).code, 0);
+  const Result other_spp = run("diff " + test + "/final.exr " + a + "/final.exr --second-reference " + other + "/final.exr");
+  EXPECT_EQ(other_spp.code, 1);
+  EXPECT_NE(other_spp.err.find("spp"), std::string::npos) << other_spp.err;
 }
 
 // ---------------------------------------------------------------------------------------------
