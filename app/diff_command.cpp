@@ -141,7 +141,8 @@ void print_perfect_filter(const std::string& test_path, const std::string& refer
 // --second-reference: the correction holds only for a second reference rendered like the first with
 // independent noise. Where both have a stats.json beside them, a second reference of the same seed
 // (the same noise), of another sample count (another noise level) or of another scene or size is
-// an error; without them nothing can be checked, which is said.
+// an error (a setting only one of them records, like the sampler before stats.json had it, is not
+// compared); without them nothing can be checked, which is said.
 void check_second_reference(const std::string& reference_path, const std::string& second_path) {
   auto settings_of = [](const std::string& path) -> std::optional<nlohmann::json> {
     std::ifstream in(std::filesystem::path(path).parent_path() / "stats.json");
@@ -159,7 +160,7 @@ void check_second_reference(const std::string& reference_path, const std::string
     return;
   }
   for (const char* key : {"scene", "width", "height", "spp", "sampler", "max_vertices"})
-    if (first->value(key, nlohmann::json()) != second->value(key, nlohmann::json()))
+    if (first->contains(key) && second->contains(key) && (*first)[key] != (*second)[key])
       throw Error(second_path + ": its " + key + " (" + second->value(key, nlohmann::json()).dump() +
                   ") differs from the reference's (" + first->value(key, nlohmann::json()).dump() +
                   "); --second-reference needs a render like the reference's with another seed");

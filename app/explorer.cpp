@@ -337,8 +337,9 @@ class Explorer {
     ImGui::Text("ms: trace %.1f/frame  range %.1f  filter %.1f", stage_ms_.path_tracing, stage_ms_.range,
                 preview_->filter().last_ms());
     ImGui::Text("    longest display frame %.0f ms (budget %.0f; tracing on a worker)", longest_frame_ms_, kUiBudgetMs);
-    ImGui::Text("    blend %.2f  tone map %.2f   filter runs %d%s", stage_ms_.blend, stage_ms_.tonemap,
-                preview_->filter_runs(), preview_->filter_stopped() ? " (stopped: all case 2)" : "");
+    ImGui::Text("    blend %.2f  tone map %.2f   filter runs %d (sigma s %.2f)%s", stage_ms_.blend, stage_ms_.tonemap,
+                preview_->filter_runs(), preview_->last_sigma_s(),
+                preview_->filter_stopped() ? " (stopped: all case 2)" : "");
     const auto& counts = preview_->case_counts();
     shown_case_counts_ = counts;
     std::string cases = "cases";  // every case code, so a new case cannot be left out of the line
@@ -449,6 +450,7 @@ class Explorer {
     bool changed = false;
     changed |= ImGui::SliderFloat("threshold t", &s.threshold, 1e-5f, 1.0f, "%.2e", ImGuiSliderFlags_Logarithmic);
     changed |= ImGui::SliderFloat("sigma s (px)", &s.filter.sigma_s, 0.5f, kMaxFilterRadius / 3.0f, "%.2f");
+    changed |= ImGui::Checkbox("shrink sigma s with spp", &s.shrink_sigma);
     changed |= ImGui::SliderFloat("sigma c", &s.filter.sigma_c, 1e-4f, 10.0f, "%.3g", ImGuiSliderFlags_Logarithmic);
     changed |= ImGui::SliderFloat("sigma d", &s.filter.sigma_d, 1e-3f, 1e3f, "%.3g", ImGuiSliderFlags_Logarithmic);
     changed |= enum_combo("filter", filter_option_names(), &s.filter.kind);

@@ -22,7 +22,7 @@ bool same_filter_params(const PreviewSettings& a, const PreviewSettings& b) {
   return a.filter.kind == b.filter.kind && a.filter.sigma_s == b.filter.sigma_s &&
          a.filter.sigma_c == b.filter.sigma_c && a.filter.sigma_d == b.filter.sigma_d &&
          a.filter.skip_case2 == b.filter.skip_case2 && a.filter.subsampled_taps == b.filter.subsampled_taps &&
-         a.threshold == b.threshold && a.demodulate == b.demodulate;
+         a.threshold == b.threshold && a.demodulate == b.demodulate && a.shrink_sigma == b.shrink_sigma;
 }
 }  // namespace
 
@@ -192,8 +192,15 @@ void Preview::advance_range_buffer() {
   schedule_.pass_ms += last_.range - before;
 }
 
+FilterParams Preview::filter_params_now() const {
+  FilterParams p = settings_.filter;
+  if (settings_.shrink_sigma) p.sigma_s = shrunk_sigma_s(p.sigma_s, static_cast<uint64_t>(samples()));
+  return p;
+}
+
 void Preview::run_filter() {
   const double range_before = last_.range;
+  const FilterParams params = filter_params_now();
   if (range_.frames() == 0) step_range_buffer();
   upload();
   double filter_ms = 0;
@@ -202,18 +209,19 @@ void Preview::run_filter() {
     const auto start = BenchClock::now();
     if (!demod_) demod_ = std::make_unique<Demodulation>(width_, height_);
     inputs_.upload_albedo(&renderer_->accumulation().albedo_mean[0].x);
-    demod_->demodulate(inputs_, range_.guide(), settings_.filter, threshold_now());
-    filter_.run(demod_->filter_inputs(), range_.guide(), settings_.filter, threshold_now());
+    demod_->demodulate(inputs_, range_.guide(), params, threshold_now());
+    filter_.run(demod_->filter_inputs(), range_.guide(), params, threshold_now());
     demod_->remodulate(filter_.output(), inputs_);
     filter_ms = elapsed_ms(start);
   } else {
-    filter_.run(inputs_, range_.guide(), settings_.filter, threshold_now());
+    filter_.run(inputs_, range_.guide(), params, threshold_now());
     filter_ms = filter_.last_ms();
   }
   last_.filter += filter_ms;
   schedule_.last_run_ms = filter_ms + (last_.range - range_before);
   schedule_.pass_ms += schedule_.last_run_ms;
   ++filter_runs_;
+  last_sigma_s_ = params.sigma_s;
   filtered_samples_ = samples();
   have_filtered_ = true;
   // Every pixel skipped = every pixel already in case 2: the filter is not needed any more.

@@ -43,6 +43,11 @@ struct PreviewSettings {
   // L_f measurably differs from L_u. On: at equal time it lowered the filtered image's error on all
   // four built-in scenes (docs/measurements.md, "Bias guard"); off is the method's blend as published.
   bool bias_guard = true;
+  // Shrink the filter's sigma_s as samples accumulate (shrunk_sigma_s in gl/pass_params.h,
+  // docs/method.md 2.5): filter.sigma_s up to 4 spp, then sigma_s sqrt(4 / n), at least 2 px. On:
+  // at equal time it lowered the filtered error from about 30 spp on (docs/measurements.md,
+  // "Shrinking sigma_s"); off keeps filter.sigma_s for every run, the method as published.
+  bool shrink_sigma = true;
   FilterSchedule schedule = FilterSchedule::Budget;
   TonemapParams tonemap;
   RangeSettings range;
@@ -134,6 +139,11 @@ class Preview {
   const StageTimes& last_times() const { return last_; }
   const StageTimes& total_times() const { return total_; }
   int filter_runs() const { return filter_runs_; }
+  // The filter's parameters for a run now: settings().filter with sigma_s shrunk for the sample
+  // count when settings().shrink_sigma.
+  FilterParams filter_params_now() const;
+  // The sigma_s of the last filter run (0 before the first).
+  float last_sigma_s() const { return last_sigma_s_; }
   // The `--time` prediction for one more frame: its tracing, the passes it makes due, and the
   // finish after it (last filter run if due, upload, blend, tone map), from measured costs.
   TimeBudget predict_next_frame(double budget_ms, double elapsed_ms) const;
@@ -190,6 +200,7 @@ class Preview {
   bool have_filtered_ = false;
   bool uploaded_ = false;  // inputs hold the current samples
   int filter_runs_ = 0;
+  float last_sigma_s_ = 0.0f;
   int low_hv_skips_ = 0;
   int filtered_samples_ = -1;  // sample count of the newest L_f
   StageTimes last_, total_;

@@ -49,6 +49,7 @@ nlohmann::json stats_json(Preview& preview, const RenderReport& r) {
                    {"bias_guard", s.bias_guard},
                    {"schedule", filter_schedule_names()[static_cast<int>(s.schedule)]},
                    {"sigma_s", s.filter.sigma_s},
+                   {"sigma_shrink", s.shrink_sigma},
                    {"sigma_c", s.filter.sigma_c},
                    {"sigma_d", s.filter.sigma_d},
                    {"seed", s.trace.seed},
@@ -74,6 +75,7 @@ nlohmann::json stats_json(Preview& preview, const RenderReport& r) {
   j["paths_per_second"] = total.path_tracing > 0 ? trace.paths / (total.path_tracing / 1000.0) : 0.0;
   j["rays"] = trace.rays;
   j["filter_runs"] = preview.filter_runs();
+  j["filter_last_sigma_s"] = preview.last_sigma_s();
   j["filter_stopped_all_case2"] = preview.filter_stopped();
   j["filter_runs_skipped_low_hv"] = preview.filter_runs_skipped_low_hv();
   j["hv_energy_share"] = hv_energy_share(preview.renderer().accumulation());

@@ -35,6 +35,12 @@ float effective_threshold(float t, uint64_t samples) {
   return static_cast<float>(t * ((n - 3.0) / (n - 1.0)));
 }
 
+float shrunk_sigma_s(float sigma_s, uint64_t samples) {
+  if (samples <= kSigmaShrinkFromSpp || !(sigma_s > kSigmaShrinkMin)) return sigma_s;
+  const double shrunk = sigma_s * std::sqrt(double(kSigmaShrinkFromSpp) / double(samples));
+  return static_cast<float>(std::max(shrunk, double(kSigmaShrinkMin)));
+}
+
 // Pass i of the à-trous filter convolves with the B3 spline at hole spacing 2^i, whose variance is
 // 4^i px^2 per axis (the taps 1/16 [1 4 6 4 1] have variance 1 at spacing 1), and the variances
 // of successive convolutions add: k passes have (4^k - 1) / 3. Passes are added while that is

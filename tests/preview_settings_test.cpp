@@ -42,3 +42,35 @@ TEST(PreviewSettings, TraceChangesRestartAndPassChangesKeepTheSamples) {
 }
 
 }  // namespace
+
+namespace {
+// The sigma_s of the filter's last run after `frames` frames, every frame filtered.
+float sigma_after(const Scene& scene, int frames, bool shrink) {
+  PreviewSettings settings;
+  settings.schedule = FilterSchedule::EveryFrame;
+  settings.shrink_sigma = shrink;
+  Preview preview(scene, settings, 24, 16);
+  for (int i = 0; i < frames; ++i) preview.add_frame(i + 1 == frames);
+  EXPECT_EQ(preview.filter_params_now().sigma_s, preview.last_sigma_s());
+  return preview.last_sigma_s();
+}
+}  // namespace
+
+// The preview's filter runs with sigma_s shrunk for the sample count (shrunk_sigma_s), or with
+// --sigma-s itself when shrinking is off; turning it off or on filters again without restarting.
+TEST(PreviewSettings, FilterSigmaShrinksWithTheSampleCount) {
+  test_support::headless_context();
+  const Scene scene = load_scene("cornell");
+  EXPECT_EQ(sigma_after(scene, 4, true), 8.0f);
+  EXPECT_FLOAT_EQ(sigma_after(scene, 16, true), 4.0f);
+  EXPECT_FLOAT_EQ(sigma_after(scene, 16, false), 8.0f);
+  PreviewSettings settings;
+  Preview preview(scene, settings, 16, 16);
+  for (int i = 0; i < 16; ++i) preview.add_frame();
+  const int runs = preview.filter_runs();
+  settings.shrink_sigma = false;
+  preview.set_settings(settings);
+  EXPECT_EQ(preview.samples(), 16);
+  EXPECT_EQ(preview.filter_runs(), runs + 1);
+  EXPECT_EQ(preview.last_sigma_s(), 8.0f);
+}
