@@ -49,7 +49,8 @@ void add_preview_options(CommandLine& cli, PreviewSettings& s) {
              "off: the published blend, noise held at t everywhere; docs/method.md section 3.7)");
   cli.choice("--sigma-shrink", &s.shrink_sigma, {"off", "on"},
              "shrink the filter's sigma_s as samples accumulate: --sigma-s up to 4 spp, then\n"
-             "sigma_s sqrt(4 / spp), at least 2 px (default on; off: --sigma-s for every filter run)");
+             "sigma_s sqrt(4 / spp), at least 2 px (default off: --sigma-s for every filter run; on lowers\n"
+             "the error but mixed pixels keep more noise than t, docs/method.md 2.5)");
   cli.option("--seed", &s.trace.seed, "random seed", 0, 2147483647);
   cli.choice("--sampler", &s.trace.sampler, sampler_type_names(),
              "random numbers of the path tracer: Owen-scrambled Sobol (default) or independent PCG32");

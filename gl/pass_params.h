@@ -114,7 +114,7 @@ float atrous_variance_correction(int pass);
 float effective_threshold(float t, uint64_t samples);
 
 // The spatial sigma of a filter run after `samples` samples per pixel, when the preview shrinks it
-// (PreviewSettings::shrink_sigma, on by default; docs/method.md 2.5): sigma_s up to
+// (PreviewSettings::shrink_sigma, off by default; docs/method.md 2.5): sigma_s up to
 // kSigmaShrinkFromSpp samples, then sigma_s sqrt(kSigmaShrinkFromSpp / samples), never below
 // kSigmaShrinkMin (a sigma_s already below it is kept). Why 1 / sqrt(n): the filter has to bring a
 // pixel's perceived variance u down to about t, i.e. average about u / t pixels; u falls as 1 / n,

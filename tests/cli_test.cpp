@@ -221,16 +221,16 @@ TEST(Cli, RenderWritesEveryOutput) {
   ASSERT_EQ(run("render --size 32x24 --spp 2 --bias-guard off --quiet --out " + out).code, 0);
   EXPECT_EQ(nlohmann::json::parse(slurp(out + "/stats.json"))["settings"]["bias_guard"], false);
   EXPECT_EQ(run("render --size 32x24 --spp 2 --bias-guard maybe --quiet --out " + out).code, 2);
-  // The filter's sigma_s shrinks with the sample count unless --sigma-shrink off; stats.json records
-  // the setting and the last run's sigma_s (8 px up to 4 spp, 8 sqrt(4 / 16) = 4 px at 16).
-  EXPECT_EQ(stats["settings"]["sigma_shrink"], true);
+  // The filter's sigma_s shrinks with the sample count with --sigma-shrink on (off by default);
+  // stats.json records the setting and the last run's sigma_s (8 sqrt(4 / 16) = 4 px at 16 spp).
+  EXPECT_EQ(stats["settings"]["sigma_shrink"], false);
   EXPECT_EQ(stats["filter_last_sigma_s"].get<double>(), 8.0);
   ASSERT_EQ(run("render --size 32x24 --spp 16 --quiet --out " + out).code, 0);
-  EXPECT_FLOAT_EQ(nlohmann::json::parse(slurp(out + "/stats.json"))["filter_last_sigma_s"].get<float>(), 4.0f);
-  ASSERT_EQ(run("render --size 32x24 --spp 16 --sigma-shrink off --quiet --out " + out).code, 0);
-  const auto unshrunk = nlohmann::json::parse(slurp(out + "/stats.json"));
-  EXPECT_EQ(unshrunk["settings"]["sigma_shrink"], false);
-  EXPECT_EQ(unshrunk["filter_last_sigma_s"].get<double>(), 8.0);
+  EXPECT_EQ(nlohmann::json::parse(slurp(out + "/stats.json"))["filter_last_sigma_s"].get<double>(), 8.0);
+  ASSERT_EQ(run("render --size 32x24 --spp 16 --sigma-shrink on --quiet --out " + out).code, 0);
+  const auto shrunk = nlohmann::json::parse(slurp(out + "/stats.json"));
+  EXPECT_EQ(shrunk["settings"]["sigma_shrink"], true);
+  EXPECT_FLOAT_EQ(shrunk["filter_last_sigma_s"].get<float>(), 4.0f);
   EXPECT_EQ(run("render --size 32x24 --spp 2 --sigma-shrink maybe --quiet --out " + out).code, 2);
   // Specular sampling is off unless asked for, near specular sampling on unless turned off, and
   // stats.json says which.

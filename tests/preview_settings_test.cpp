@@ -65,6 +65,7 @@ TEST(PreviewSettings, FilterSigmaShrinksWithTheSampleCount) {
   EXPECT_FLOAT_EQ(sigma_after(scene, 16, true), 4.0f);
   EXPECT_FLOAT_EQ(sigma_after(scene, 16, false), 8.0f);
   PreviewSettings settings;
+  settings.shrink_sigma = true;
   Preview preview(scene, settings, 16, 16);
   for (int i = 0; i < 16; ++i) preview.add_frame();
   const int runs = preview.filter_runs();
