@@ -375,24 +375,24 @@ TEST(EffectiveThreshold, RealizedPerceivedVarianceMatchesTOnAverage) {
   }
 }
 
-}  // namespace
-}  // namespace pxf
-
 // shrunk_sigma_s: sigma_s up to 4 spp, then sigma_s sqrt(4 / n) down to 2 px; a sigma_s below 2
 // is kept, never widened.
 TEST(SigmaShrink, FallsAsOneOverRootNDownToTwoPixels) {
-  for (uint64_t n : {0, 1, 2, 3, 4}) EXPECT_EQ(pxf::shrunk_sigma_s(8.0f, n), 8.0f);
-  EXPECT_FLOAT_EQ(pxf::shrunk_sigma_s(8.0f, 16), 4.0f);
-  EXPECT_FLOAT_EQ(pxf::shrunk_sigma_s(8.0f, 64), 2.0f);
-  EXPECT_FLOAT_EQ(pxf::shrunk_sigma_s(8.0f, 100000), 2.0f);
-  EXPECT_FLOAT_EQ(pxf::shrunk_sigma_s(12.0f, 9), 8.0f);
-  EXPECT_FLOAT_EQ(pxf::shrunk_sigma_s(1.5f, 1000), 1.5f);
-  EXPECT_FLOAT_EQ(pxf::shrunk_sigma_s(3.0f, 16), 2.0f);
+  for (uint64_t n : {0, 1, 2, 3, 4}) EXPECT_EQ(shrunk_sigma_s(8.0f, n), 8.0f);
+  EXPECT_FLOAT_EQ(shrunk_sigma_s(8.0f, 16), 4.0f);
+  EXPECT_FLOAT_EQ(shrunk_sigma_s(8.0f, 64), 2.0f);
+  EXPECT_FLOAT_EQ(shrunk_sigma_s(8.0f, 100000), 2.0f);
+  EXPECT_FLOAT_EQ(shrunk_sigma_s(12.0f, 9), 8.0f);
+  EXPECT_FLOAT_EQ(shrunk_sigma_s(1.5f, 1000), 1.5f);
+  EXPECT_FLOAT_EQ(shrunk_sigma_s(3.0f, 16), 2.0f);
   float previous = 8.0f;
   for (uint64_t n = 1; n < 5000; n = n * 3 / 2 + 1) {
-    const float s = pxf::shrunk_sigma_s(8.0f, n);
+    const float s = shrunk_sigma_s(8.0f, n);
     EXPECT_LE(s, previous);
-    EXPECT_GE(s, pxf::kSigmaShrinkMin);
+    EXPECT_GE(s, kSigmaShrinkMin);
     previous = s;
   }
 }
+
+}  // namespace
+}  // namespace pxf

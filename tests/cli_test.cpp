@@ -498,6 +498,19 @@ TEST(Cli, DiffSecondReferenceTakesOutTheReferencesNoise) {
   const Result other_spp = run("diff " + test + "/final.exr " + a + "/final.exr --second-reference " + other + "/final.exr");
   EXPECT_EQ(other_spp.code, 1);
   EXPECT_NE(other_spp.err.find("spp"), std::string::npos) << other_spp.err;
+  // A setting only one of them records (the sampler, in a stats.json written before it was) is not
+  // compared; the settings both record still are.
+  for (const std::string& dir : {b, other}) {
+    auto stats = nlohmann::json::parse(slurp(dir + "/stats.json"));
+    stats["settings"].erase("sampler");
+    std::ofstream(dir + "/stats.json") << stats.dump();
+  }
+  const Result older = run("diff " + test + "/final.exr " + a + "/final.exr --second-reference " + b + "/final.exr");
+  EXPECT_EQ(older.code, 0) << older.err;
+  const Result older_other_spp =
+      run("diff " + test + "/final.exr " + a + "/final.exr --second-reference " + other + "/final.exr");
+  EXPECT_EQ(older_other_spp.code, 1);
+  EXPECT_NE(older_other_spp.err.find("spp"), std::string::npos) << older_other_spp.err;
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -41,9 +41,6 @@ TEST(PreviewSettings, TraceChangesRestartAndPassChangesKeepTheSamples) {
   EXPECT_EQ(samples_after_change(scene, [](PreviewSettings& s) { s.filter.sigma_s = 4.0f; }), 2);
 }
 
-}  // namespace
-
-namespace {
 // The sigma_s of the filter's last run after `frames` frames, every frame filtered.
 float sigma_after(const Scene& scene, int frames, bool shrink) {
   PreviewSettings settings;
@@ -54,7 +51,6 @@ float sigma_after(const Scene& scene, int frames, bool shrink) {
   EXPECT_EQ(preview.filter_params_now().sigma_s, preview.last_sigma_s());
   return preview.last_sigma_s();
 }
-}  // namespace
 
 // The preview's filter runs with sigma_s shrunk for the sample count (shrunk_sigma_s), or with
 // --sigma-s itself when shrinking is off; turning it off or on filters again without restarting.
@@ -75,3 +71,5 @@ TEST(PreviewSettings, FilterSigmaShrinksWithTheSampleCount) {
   EXPECT_EQ(preview.filter_runs(), runs + 1);
   EXPECT_EQ(preview.last_sigma_s(), 8.0f);
 }
+
+}  // namespace
