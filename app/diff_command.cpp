@@ -4,7 +4,6 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <optional>
 
 #include <nlohmann/json.hpp>
@@ -13,6 +12,7 @@
 #include "app/commands.h"
 #include "gl/cpu_reference.h"
 #include "image/image.h"
+#include "image/input_file.h"
 #include "image/metrics.h"
 
 namespace pxf {
@@ -28,6 +28,23 @@ bool has_layer(const std::vector<Layer>& layers, const std::string& name) {
   for (const Layer& l : layers)
     if (l.name == name) return true;
   return false;
+}
+
+// The stats.json a render wrote beside `image_path`; nullopt where there is none or it is not JSON.
+// Read like every named input (a FIFO there is refused, not waited on), up to 16 MiB: pxf writes a
+// few KB.
+constexpr uint64_t kMaxStatsJsonBytes = uint64_t{16} << 20;
+std::string stats_path_beside(const std::string& image_path) {
+  return (std::filesystem::path(image_path).parent_path() / "stats.json").string();
+}
+std::optional<nlohmann::json> stats_beside(const std::string& image_path) {
+  const std::string path = stats_path_beside(image_path);
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) return std::nullopt;
+  const std::vector<unsigned char> bytes = read_input_file(path, kMaxStatsJsonBytes);
+  nlohmann::json json = nlohmann::json::parse(bytes.begin(), bytes.end(), nullptr, false);
+  if (json.is_discarded()) return std::nullopt;
+  return json;
 }
 
 // The emitter mask: --mask FILE's "emitter" layer, else the reference's own when it is a
@@ -79,16 +96,13 @@ struct BlendSettings {
 };
 BlendSettings blend_settings_of(const std::string& buffers_path) {
   BlendSettings b;
-  const std::filesystem::path stats = std::filesystem::path(buffers_path).parent_path() / "stats.json";
-  std::ifstream in(stats);
-  if (!in) return b;
-  const nlohmann::json json = nlohmann::json::parse(in, nullptr, false);
-  if (json.is_discarded() || !json.contains("settings")) return b;
-  const nlohmann::json& s = json["settings"];
+  const std::optional<nlohmann::json> json = stats_beside(buffers_path);
+  if (!json || !json->contains("settings")) return b;
+  const nlohmann::json& s = (*json)["settings"];
   b.threshold = s.value("threshold", b.threshold);
   b.filter.sigma_c = s.value("sigma_c", b.filter.sigma_c);
   b.filter.sigma_d = s.value("sigma_d", b.filter.sigma_d);
-  b.source = stats.string();
+  b.source = stats_path_beside(buffers_path);
   return b;
 }
 
@@ -145,12 +159,10 @@ void print_perfect_filter(const std::string& test_path, const std::string& refer
 // compared); without them nothing can be checked, which is said.
 void check_second_reference(const std::string& reference_path, const std::string& second_path) {
   auto settings_of = [](const std::string& path) -> std::optional<nlohmann::json> {
-    std::ifstream in(std::filesystem::path(path).parent_path() / "stats.json");
-    if (!in) return std::nullopt;
-    const nlohmann::json json = nlohmann::json::parse(in, nullptr, false);
-    if (json.is_discarded() || !json.contains("settings")) return std::nullopt;
-    nlohmann::json s = json["settings"];
-    if (json.contains("time_budget")) s["spp"] = json["time_budget"].value("spp_reached", s.value("spp", 0));
+    const std::optional<nlohmann::json> json = stats_beside(path);
+    if (!json || !json->contains("settings")) return std::nullopt;
+    nlohmann::json s = (*json)["settings"];
+    if (json->contains("time_budget")) s["spp"] = (*json)["time_budget"].value("spp_reached", s.value("spp", 0));
     return s;
   };
   const std::optional<nlohmann::json> first = settings_of(reference_path), second = settings_of(second_path);

@@ -2,6 +2,7 @@
 // Float pixels with named, interleaved channels ("R","G","B","A", or "Y", ...), top row first.
 #pragma once
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
@@ -55,6 +56,13 @@ void sync_folder(const std::string& folder);
 // The readers refuse images of more float samples (width x height x channels) than this: 8 GiB of
 // pixels, from a header that is corrupt far more often than it is real.
 constexpr size_t kMaxImageSamples = size_t{1} << 31;
+// The image files the readers open (image/input_file.h checks the size before a byte is read).
+// stb takes the length of its input as an int: 2 GiB - 1. An EXR at the sample cap, stored raw at
+// 4 bytes a sample (FLOAT or UINT; the compressors store a chunk raw rather than let it grow), is
+// 8 GiB of pixels; the same again leaves room for the header, the offset tables and the chunk
+// framing, so the bound is 16 GiB.
+constexpr uint64_t kMaxStbImageFileBytes = 0x7fffffff;
+constexpr uint64_t kMaxExrFileBytes = 2 * 4 * uint64_t{kMaxImageSamples};
 
 // ZIP-compressed. Samples are stored as 32-bit floats, or with `half_float` as 16-bit half floats (about
 // 3 decimal digits; magnitudes beyond 65504 become infinite, so a caller clamps first where that matters).

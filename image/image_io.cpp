@@ -16,12 +16,11 @@
 #include <cstring>
 #include <cmath>
 #include <cstdint>
-#include <fstream>
-#include <iterator>
 #include <map>
 #include <memory>
 
 #include "image/image.h"
+#include "image/input_file.h"
 
 namespace pxf {
 
@@ -87,14 +86,6 @@ void check_sample_count(const std::string& path, int64_t width, int64_t height, 
     throw Error(path + ": " + std::to_string(width) + "x" + std::to_string(height) + " pixels with " +
                 std::to_string(channels) + " channels exceed the readable " + std::to_string(max_samples) +
                 " samples (a corrupt header, or an image too large to load)");
-}
-
-std::vector<unsigned char> read_file_bytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(path + ": cannot open file");
-  std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) throw Error(path + ": cannot read file");
-  return bytes;
 }
 
 void check_layers(const std::string& path, const std::vector<Layer>& layers) {
@@ -322,7 +313,7 @@ void write_exr(const std::string& path, const std::vector<Layer>& layers, bool h
 }
 
 std::vector<Layer> read_exr_layers(const std::string& path) {
-  const std::vector<unsigned char> bytes = read_file_bytes(path);
+  const std::vector<unsigned char> bytes = read_input_file(path, kMaxExrFileBytes);
   return read_exr_layers_from_memory(bytes.data(), bytes.size(), path);
 }
 
@@ -415,7 +406,7 @@ void write_png(const std::string& path, const Image& display) {
 }
 
 Image read_ldr_or_hdr(const std::string& path) {
-  const std::vector<unsigned char> bytes = read_file_bytes(path);
+  const std::vector<unsigned char> bytes = read_input_file(path, kMaxStbImageFileBytes);
   return read_ldr_or_hdr_from_memory(bytes.data(), bytes.size(), path);
 }
 

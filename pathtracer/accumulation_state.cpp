@@ -10,6 +10,8 @@
 #include <sstream>
 #include <unistd.h>
 
+#include "image/input_file.h"
+
 namespace pxf {
 
 static_assert(sizeof(glm::vec3) == 3 * sizeof(float), "glm::vec3 must be three packed floats");
@@ -253,10 +255,9 @@ uint64_t fnv1a64(const void* data, size_t size, uint64_t hash) {
 }
 
 namespace {
-uint64_t hash_file(const std::string& path, uint64_t hash) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(path + ": cannot read file to hash the scene");
-  std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+// `max_bytes`: the bound of the reader that loads the file.
+uint64_t hash_file(const std::string& path, uint64_t max_bytes, uint64_t hash) {
+  const std::vector<unsigned char> bytes = read_input_file(path, max_bytes);
   return fnv1a64(bytes.data(), bytes.size(), hash);
 }
 }  // namespace
@@ -265,8 +266,8 @@ uint64_t scene_content_hash(const std::string& scene, const std::string& env_pat
   std::string path = scene;
   for (const BuiltinScene& b : builtin_scenes())
     if (b.name == scene) path = b.path;
-  uint64_t hash = hash_file(path, fnv1a64(nullptr, 0));
-  if (!env_path.empty()) hash = hash_file(env_path, hash);
+  uint64_t hash = hash_file(path, kMaxGltfFileBytes, fnv1a64(nullptr, 0));
+  if (!env_path.empty()) hash = hash_file(env_path, std::max(kMaxExrFileBytes, kMaxStbImageFileBytes), hash);
   return fnv1a64(&env_strength, sizeof(env_strength), hash);
 }
 
@@ -352,15 +353,29 @@ void write_state_file(const std::string& path, const AccumulationState& state) {
   });
 }
 
+namespace {
+// The largest file decode_state can accept, every count at its bound: the header, kMaxFrameRanges
+// frame ranges, kMaxSide^2 pixels with kMaxReplicates replicate slots each, the checksum. About
+// 824 GiB: no practical size, but a bound on what is read, derived from the format itself.
+uint64_t max_state_file_bytes() {
+  Writer header;
+  header.put_bytes(kMagic, sizeof(kMagic));
+  header.put(kStateFormatVersion);
+  put_settings(header, SampleSettings{});
+  header.put(uint32_t{0});  // the range count
+  Accumulation pixel;
+  pixel.replicates = kMaxReplicates;
+  uint64_t per_pixel = 0;
+  visit_arrays(pixel, [&](const auto& array, size_t slots) {
+    per_pixel += slots * sizeof(typename std::decay_t<decltype(array)>::value_type);
+  });
+  return header.bytes.size() + uint64_t{kMaxFrameRanges} * 2 * sizeof(uint32_t) +
+         uint64_t{kMaxSide} * kMaxSide * per_pixel + sizeof(uint64_t);
+}
+}  // namespace
+
 AccumulationState read_state_file(const std::string& path) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) throw Error(path + ": not a state file (no such regular file)");
-  std::ifstream in(path, std::ios::binary | std::ios::ate);
-  if (!in) throw Error(path + ": cannot open state file");
-  std::vector<uint8_t> bytes(static_cast<size_t>(std::max<std::streamoff>(0, in.tellg())));
-  in.seekg(0);
-  if (!in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(bytes.size())))
-    throw Error(path + ": cannot read state file");
+  const std::vector<unsigned char> bytes = read_input_file(path, max_state_file_bytes());
   try {
     return decode_state(bytes.data(), bytes.size());
   } catch (const Error& e) {

@@ -91,6 +91,10 @@ struct LoadEstimate {
   uint64_t bytes() const;
 };
 
+// The glTF/GLB file and the files its uris name (buffers, images) are read up to 4 GiB - 1: tinygltf
+// takes a file's length as an unsigned int, and a GLB stores its lengths in 32 bits.
+constexpr uint64_t kMaxGltfFileBytes = 0xffffffff;
+
 // Loads a glTF/GLB file or a built-in scene name ("cornell", ...); throws pxf::Error naming the
 // file and the problem. `env_path` (optional) replaces the environment with an equirectangular
 // EXR or Radiance .hdr (checked before the scene loads). A scene without any light gets the

@@ -23,6 +23,7 @@
 #include <tbb/parallel_for.h>
 
 #include "image/image.h"
+#include "image/input_file.h"
 #include "pathtracer/auto_camera.h"
 #include "pathtracer/default_light.h"
 #include "pathtracer/gltf_accessor.h"
@@ -231,12 +232,7 @@ class GltfLoader {
   void warn(const std::string& message) { scene_.warnings.push_back(file_ + ": " + message); }
 
   void read_model() {
-    std::error_code ec;
-    if (!fs::is_regular_file(file_, ec)) fail("no such file");
-    std::ifstream in(file_, std::ios::binary);
-    if (!in) fail("cannot open file");
-    std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    if (in.bad()) fail("cannot read file");
+    const std::vector<unsigned char> bytes = read_input_file(file_, kMaxGltfFileBytes);
     parse_model(bytes.data(), bytes.size(), fs::path(file_).parent_path().string());
   }
 
@@ -249,12 +245,25 @@ class GltfLoader {
     return (fs::path(*static_cast<const std::string*>(base_dir)) / path).string();
   }
 
+  // tinygltf's own callbacks open a uri's file to see whether it exists and then read it with a
+  // stream: a FIFO blocks both, a directory reads as a huge length (std::bad_alloc). A uri that
+  // names nothing stays tinygltf's "not found" (a missing texture is a warning); anything else
+  // goes through read_input_file, whose error (a pxf::Error, through tinygltf) fails the load.
+  static bool uri_exists(const std::string& path, void*) {
+    std::error_code ec;
+    return fs::exists(path, ec);
+  }
+  static bool read_uri(std::vector<unsigned char>* out, std::string*, const std::string& path, void*) {
+    *out = read_input_file(path, kMaxGltfFileBytes);
+    return true;
+  }
+
   void parse_model(const unsigned char* data, size_t size, const std::string& base_dir) {
     base_dir_ = base_dir;
     if (size > std::numeric_limits<unsigned int>::max()) fail("file larger than 4 GiB");
     const bool binary = size >= 4 && std::memcmp(data, "glTF", 4) == 0;
     tinygltf::TinyGLTF loader;
-    loader.SetFsCallbacks({&tinygltf::FileExists, &GltfLoader::resolve_uri, &tinygltf::ReadWholeFile,
+    loader.SetFsCallbacks({&GltfLoader::uri_exists, &GltfLoader::resolve_uri, &GltfLoader::read_uri,
                            &tinygltf::WriteWholeFile, &base_dir_});
     images_.install(loader);
     std::string err, warn_text;
@@ -263,6 +272,8 @@ class GltfLoader {
       ok = binary ? loader.LoadBinaryFromMemory(&model_, &err, &warn_text, data, static_cast<unsigned int>(size), "")
                   : loader.LoadASCIIFromString(&model_, &err, &warn_text, reinterpret_cast<const char*>(data),
                                                static_cast<unsigned int>(size), "");
+    } catch (const Error& e) {
+      fail(e.what());  // a uri's file (read_uri)
     } catch (const std::exception& e) {
       fail(std::string("invalid glTF: ") + e.what());
     }
@@ -1121,12 +1132,10 @@ enum class FileKind { Exr, RadianceHdr, Gltf, Glb, Other };
 
 // The format by its first bytes, not its name: a renamed or mislabelled file still gets the
 // right reader or a clear error.
-FileKind sniff_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(path + ": cannot open file");
-  char head[10] = {};
-  in.read(head, sizeof head);
-  std::string bytes(head, static_cast<size_t>(in.gcount()));
+// `max_bytes`: the bound of the readers the file may go to.
+FileKind sniff_file(const std::string& path, uint64_t max_bytes) {
+  const std::vector<unsigned char> head = read_input_file_head(path, max_bytes, 10);
+  const std::string bytes(head.begin(), head.end());
   if (bytes.compare(0, 4, "\x76\x2f\x31\x01") == 0) return FileKind::Exr;
   if (bytes.compare(0, 2, "#?") == 0) return FileKind::RadianceHdr;
   if (bytes.compare(0, 4, "glTF") == 0) return FileKind::Glb;
@@ -1137,7 +1146,7 @@ FileKind sniff_file(const std::string& path) {
 
 // The environment image as linear float RGB(A)/Y channels, by format.
 Image read_environment_image(const std::string& path) {
-  switch (sniff_file(path)) {
+  switch (sniff_file(path, std::max(kMaxExrFileBytes, kMaxStbImageFileBytes))) {
     case FileKind::Exr: return read_exr(path);
     case FileKind::RadianceHdr: return read_ldr_or_hdr(path);
     default: throw Error(path + ": not a supported environment map (supported: OpenEXR .exr, Radiance .hdr)");
@@ -1188,9 +1197,7 @@ Environment load_environment(const std::string& path, float strength, std::vecto
 
 // An image passed as the scene gets told so, rather than reaching the JSON parser.
 void check_scene_file(const std::string& path) {
-  std::error_code ec;
-  if (!fs::is_regular_file(path, ec)) return;  // the glTF loader names the missing file
-  FileKind kind = sniff_file(path);
+  FileKind kind = sniff_file(path, kMaxGltfFileBytes);
   if (kind == FileKind::Exr || kind == FileKind::RadianceHdr)
     throw Error(path + ": is an environment image, not a scene (--scene takes a .gltf/.glb file or a built-in name; "
                 "pass environment maps with --env)");
