@@ -311,6 +311,25 @@ def gltf_seeds():
     ortho["cameras"] = [{"type": "orthographic", "orthographic": {"xmag": 2, "ymag": 2, "znear": 0.1, "zfar": 10}}]
     ortho["nodes"][0]["scale"] = [1e-10, 1e-10, 1e-10]
     put("gltf_scene", "ortho_tiny.gltf", gltf(ortho, [quad_buffer()]))
+    # Issue 38: a camera node scaled by 2e19 (its frame's length overflowed float: NaN rays, an Embree
+    # abort), an orthographic camera of xmag/ymag 1e19 (ray origins past Embree's bound), "extras"
+    # nested 20,000 deep at the top level and in a node (a stack overflow in the JSON conversion),
+    # and a texture transform of 3e38 (an infinite range buffer).
+    scaled = json.loads(json.dumps(base))
+    scaled["nodes"][1]["scale"] = [2e19, 2e19, 2e19]
+    put("gltf_scene", "camera_scale_2e19.gltf", gltf(scaled, [quad_buffer()]))
+    wide = json.loads(json.dumps(base))
+    wide["cameras"] = [{"type": "orthographic", "orthographic": {"xmag": 1e19, "ymag": 1e19, "znear": 0.01, "zfar": 100}}]
+    put("gltf_scene", "ortho_mag_1e19.gltf", gltf(wide, [quad_buffer()]))
+    deep_json = "[" * 20000 + "]" * 20000
+    for name, holder in (("deep_extras_top.gltf", None), ("deep_extras_node.gltf", 0)):
+        doc = json.loads(json.dumps(base))
+        (doc if holder is None else doc["nodes"][holder])["extras"] = "DEEP"
+        put("gltf_scene", name, gltf(doc, [quad_buffer()]).replace('"DEEP"', deep_json))
+    huge_transform = json.loads(json.dumps(tex))
+    huge_transform["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["extensions"]["KHR_texture_transform"] = {
+        "offset": [3e38, 3e38], "scale": [3e38, 3e38]}
+    put("gltf_scene", "texture_transform_3e38.glb", glb(huge_transform, buf + tiny_png))
     nan = quad_buffer()
     nan = struct.pack("<3f", float("nan"), float("inf"), 3e38) + nan[12:]
     put("gltf_scene", "nan_positions.gltf", gltf(json.loads(json.dumps(base)), [nan]))

@@ -3,6 +3,7 @@
 // This header has no Embree, GL or tinygltf dependency.
 #pragma once
 #include <glm/glm.hpp>
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
@@ -159,6 +160,7 @@ struct Scene {
   SceneDefaults defaults;
   std::vector<std::string> warnings;  // what the loader skipped or substituted, one line each
   std::vector<std::string> notes;     // what the loader added that a user should know (the default light)
+  uint64_t estimated_load_bytes = 0;  // the loader's memory estimate (LoadEstimate), 0 for a scene not loaded from a file
 
   size_t triangle_count() const;
 };

@@ -11,7 +11,9 @@
 #include <fstream>
 #include <limits>
 
+#include "core/json_depth.h"
 #include "image/image.h"
+#include "pathtracer/camera.h"
 #include "pathtracer/pathtracer.h"
 #include "pathtracer/texture.h"
 
@@ -1562,6 +1564,180 @@ TEST(SceneLoadLimits, InstancedTrianglesOverTheCapAreAClearError) {
   const std::string deep = d.write_gltf(dir + "/doubling.gltf");
   msg = error_of([&] { load_scene(deep); });
   EXPECT_NE(msg.find("the scene instances more than 1.8e19 triangles, over the limit of 100000000"), std::string::npos) << msg;
+}
+
+
+// ----------------------------------------------------------------------------------------------
+// Issue 38: camera-derived ray origins, JSON depth, texture transforms, the whole memory estimate
+
+// A quad seen by a camera node with `camera_node`'s transform (a perspective camera unless `camera` says).
+std::string write_camera_scene(const std::string& path, const json& camera_node, const json& camera = nullptr) {
+  GltfBuilder b;
+  b.doc["cameras"] = json::array({camera.is_null() ? json{{"type", "perspective"}, {"perspective", {{"yfov", 0.8}, {"znear", 0.01}}}}
+                                                   : camera});
+  json node = camera_node;
+  node["camera"] = 0;
+  b.scene({b.node({{"mesh", b.mesh(b.quad_primitive())}}), b.node(node)});
+  return b.write_gltf(path);
+}
+
+TEST(SceneLoadLimits, CameraScaledBeyondFloatLengthsKeepsAUnitFrame) {
+  const std::string dir = temp_dir();
+  // |column|^2 = 4e38 overflows float: normalizing by it gave a zero basis (NaN rays, an Embree abort).
+  const Scene scene = load_scene(write_camera_scene(dir + "/scaled.gltf", {{"translation", {0, 0, 3}}, {"scale", {2e19, 2e19, 2e19}}}));
+  const glm::mat3 basis(scene.camera.camera_to_world);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(glm::length(basis[c]), 1.0f, 1e-5f) << "column " << c;
+  expect_vec3_near(glm::vec3(scene.camera.camera_to_world[3]), glm::vec3(0, 0, 3));
+  const Ray ray = camera_ray(scene.camera, 16, 16, 3.0f, 5.0f);
+  EXPECT_TRUE(std::isfinite(ray.direction.x) && std::isfinite(ray.direction.y) && std::isfinite(ray.direction.z));
+  // A camera placed far out is the coordinate bound's.
+  const std::string msg = error_of([&] { load_scene(write_camera_scene(dir + "/far.gltf", {{"translation", {0, 0, 3e12}}})); });
+  EXPECT_NE(msg.find("camera 0 has a world-space coordinate of 3e+12, beyond the supported 1e+12"), std::string::npos) << msg;
+}
+
+TEST(SceneLoadLimits, OrthographicExtentBeyondTheCoordinateBoundIsRefused) {
+  const std::string dir = temp_dir();
+  auto ortho = [](double xmag, double ymag) {
+    return json{{"type", "orthographic"}, {"orthographic", {{"xmag", xmag}, {"ymag", ymag}, {"znear", 0.01}, {"zfar", 100}}}};
+  };
+  const json at = {{"translation", {0, 0, 3}}};
+  std::string msg = error_of([&] { load_scene(write_camera_scene(dir + "/y.gltf", at, ortho(1, 1e19))); });
+  EXPECT_NE(msg.find("y.gltf: orthographic camera 0 ymag is 1e+19, beyond the supported 1e+12"), std::string::npos) << msg;
+  msg = error_of([&] { load_scene(write_camera_scene(dir + "/x.gltf", at, ortho(1e19, 1))); });
+  EXPECT_NE(msg.find("orthographic camera 0 xmag is 1e+19"), std::string::npos) << msg;
+  EXPECT_FLOAT_EQ(load_scene(write_camera_scene(dir + "/ok.gltf", at, ortho(1e6, 1e6))).camera.ymag, 1e6f);
+}
+
+std::string nested_arrays(size_t depth) { return std::string(depth, '[') + std::string(depth, ']'); }
+
+// `doc` written as .gltf or .glb with its "extras" (a placeholder string) replaced by arrays nested
+// `depth` deep. The placeholder has the nesting's length, so the GLB's chunk lengths stay right.
+std::string write_with_deep_extras(GltfBuilder& b, const std::string& path, size_t depth, bool binary) {
+  const std::string placeholder(2 * depth - 2, 'x');
+  b.doc["extras"] = placeholder;
+  binary ? b.write_glb(path) : b.write_gltf(path);
+  std::ifstream in(path, std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  bytes.replace(bytes.find("\"" + placeholder + "\""), 2 * depth, nested_arrays(depth));
+  std::ofstream(path, std::ios::binary) << bytes;
+  return path;
+}
+
+TEST(SceneLoadLimits, JsonNestedDeeperThanTheLimitIsRefusedBeforeParsing) {
+  const std::string simple = R"({"a":[[1],{"b":2}]})";
+  EXPECT_EQ(json_nesting_depth(simple.data(), simple.size()), 3u);
+  const std::string quoted = R"({"s":"[[[{{\"[[[["})";  // brackets in a string, an escaped quote
+  EXPECT_EQ(json_nesting_depth(quoted.data(), quoted.size()), 1u);
+  const std::string dir = temp_dir();
+  // 20,000 deep (a 40 KB file): tinygltf's recursive conversion of "extras" overflowed the stack.
+  GltfBuilder top;
+  top.add_quad_scene();
+  const std::string gltf = write_with_deep_extras(top, dir + "/top.gltf", 20000, false);
+  EXPECT_EQ(error_of([&] { load_scene(gltf); }),
+            gltf + ": JSON nested deeper than 256 levels (arrays and objects), which pxf does not read");
+  const std::string glb = write_with_deep_extras(top, dir + "/top.glb", 20000, true);
+  EXPECT_NE(error_of([&] { load_scene(glb); }).find("top.glb: JSON nested deeper than 256 levels"), std::string::npos);
+  // In a node, as the fuzzer's harness reads it (from memory).
+  GltfBuilder in_node;
+  in_node.scene({in_node.node({{"mesh", in_node.mesh(in_node.quad_primitive())}, {"extras", "deep"}})});
+  in_node.write_gltf(dir + "/node.gltf");
+  std::ifstream in(dir + "/node.gltf");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  text.replace(text.find("\"deep\""), 6, nested_arrays(20000));
+  const std::vector<unsigned char> bytes(text.begin(), text.end());
+  EXPECT_NE(error_of([&] { load_scene_from_memory(bytes, "node.gltf", dir); }).find("nested deeper than 256"), std::string::npos);
+  // At the limit it loads.
+  EXPECT_NO_THROW(load_scene(write_with_deep_extras(top, dir + "/ok.glb", 255, true)));
+}
+
+TEST(SceneLoadLimits, TextureTransformAndAttributesOfAnyFiniteSizeStayFinite) {
+  const std::string dir = temp_dir();
+  GltfBuilder b;
+  const int texture = b.texture(b.image(encode_png(2, 2, 3, 8, std::vector<uint32_t>(12, 200))));
+  const json transform = {{"offset", {3e38, -3e38}}, {"scale", {3e38, 3e38}}, {"rotation", 0.3}};
+  const int material = b.material({{"pbrMetallicRoughness",
+                                    {{"baseColorTexture", {{"index", texture}, {"extensions", {{"KHR_texture_transform", transform}}}}}}}});
+  json quad = b.quad_primitive(material);
+  quad["attributes"]["TEXCOORD_0"] = b.floats({3e38f, -3e38f, 1, 1, 1, 0, 0, 0}, "VEC2");
+  quad["attributes"]["COLOR_0"] = b.floats({3e38f, 2, 0.5f, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1}, "VEC4");
+  b.scene({b.node({{"mesh", b.mesh(quad)}})});
+  b.doc["extensionsUsed"] = {"KHR_texture_transform"};
+  const Scene scene = load_scene(b.write_gltf(dir + "/transform.gltf"));
+  EXPECT_TRUE(any_warning_contains(scene, "base color texture transform has an offset or scale beyond +-1.68e+07; clamped to it"))
+      << warnings_of(scene);
+  const TextureRef& ref = scene.materials[0].base_color_texture;
+  ASSERT_TRUE(ref.valid());
+  // What the raster pass computes: the transform of every UV, times the base color, texel and vertex color.
+  for (const glm::vec2& uv : scene.meshes[0].uv0) {
+    const glm::vec3 mapped = ref.transform * glm::vec3(uv, 1.0f);
+    EXPECT_TRUE(std::isfinite(mapped.x) && std::isfinite(mapped.y)) << uv.x << ", " << uv.y;
+  }
+  for (const glm::vec4& c : scene.meshes[0].colors)
+    EXPECT_TRUE(glm::all(glm::lessThanEqual(c, glm::vec4(1.0f))) && glm::all(glm::greaterThanEqual(c, glm::vec4(0.0f))));
+  EXPECT_EQ(scene.meshes[0].colors[0], glm::vec4(1.0f, 1.0f, 0.5f, 1.0f));
+}
+
+// Nodes that instance `leaf` 10^levels times (each level references the next ten times).
+int instancing_tree(GltfBuilder& b, const json& leaf, int levels) {
+  int next = b.node(leaf);
+  for (int level = 0; level < levels; ++level) next = b.node({{"children", std::vector<int>(10, next)}});
+  return next;
+}
+
+TEST(SceneLoadLimits, InstancedLightsAndPrimitivesAreInTheEstimate) {
+  const std::string dir = temp_dir();
+  LoadLimits limits;
+  limits.available_memory = 100ull << 20;
+  // 10^6 instanced point lights, a 1 KB file: 305 MiB at 320 B a light. They were not counted.
+  GltfBuilder lights;
+  lights.doc["extensionsUsed"] = {"KHR_lights_punctual"};
+  lights.doc["extensions"]["KHR_lights_punctual"]["lights"] = json::array({{{"type", "point"}, {"intensity", 1}}});
+  lights.scene({lights.node({{"mesh", lights.mesh(lights.quad_primitive())}}),
+                instancing_tree(lights, {{"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}}, 6)});
+  const std::string lights_path = lights.write_gltf(dir + "/lights.gltf");
+  std::string msg = error_of([&] { load_scene(lights_path, "", 1.0f, DefaultLight::None, limits); });
+  EXPECT_NE(msg.find("loading needs an estimated 305 MiB (2 triangles, 1000000 lights, 0 MiB of textures)"), std::string::npos) << msg;
+  // 10^4 instances of a quad: 8 KB each for its Mesh, BVH geometry and draw (measured 6.5-7 KB),
+  // where the estimate had only the vertices and triangles (10 MiB).
+  GltfBuilder quads;
+  quads.scene({instancing_tree(quads, {{"mesh", quads.mesh(quads.quad_primitive())}}, 4)});
+  const std::string quads_path = quads.write_gltf(dir + "/quads.gltf");
+  limits.available_memory = 50ull << 20;
+  msg = error_of([&] { load_scene(quads_path, "", 1.0f, DefaultLight::None, limits); });
+  EXPECT_NE(msg.find("loading needs an estimated 88.3 MiB (20000 triangles"), std::string::npos) << msg;
+  limits.available_memory = 100ull << 20;
+  EXPECT_EQ(load_scene(quads_path, "", 1.0f, DefaultLight::None, limits).estimated_load_bytes,
+            10000u * (4 * 200 + 2 * 136 + 8192));
+  LoadEstimate e;
+  e.meshes = 3;
+  e.lights = 5;
+  e.environment_texels = 7;
+  EXPECT_EQ(e.bytes(), 3u * 8192 + 5u * 320 + 7u * 40);
+}
+
+TEST(SceneLoadLimits, EnvironmentMapIsUnderTheTextureSizeCapAndInTheEstimate) {
+  const std::string dir = temp_dir();
+  GltfBuilder b;
+  b.add_quad_scene();
+  const std::string scene = b.write_gltf(dir + "/quad.gltf");
+  const std::string env = dir + "/env.exr";
+  write_exr(env, Image::rgb(64, 32, 1.0f));
+  LoadLimits limits;
+  limits.max_texture_size = 16;
+  EXPECT_EQ(error_of([&] { load_scene(scene, env, 1.0f, DefaultLight::None, limits); }),
+            env + ": environment map is 64x32, over the texture size limit of 16 (raise it with --max-texture-size)");
+  limits.max_texture_size = 64;
+  limits.available_memory = 64 * 32 * 40 - 1;  // the environment alone, before it is decoded
+  EXPECT_NE(error_of([&] { load_scene(scene, env, 1.0f, DefaultLight::None, limits); })
+                .find(env + ": loading needs an estimated 0.0781 MiB (0 triangles, 0 MiB of textures, an environment map of 2048 texels)"),
+            std::string::npos);
+  limits.available_memory = 64 * 32 * 40 + 4096;  // with the scene's quad
+  EXPECT_NE(error_of([&] { load_scene(scene, env, 1.0f, DefaultLight::None, limits); }).find("quad.gltf: loading needs an estimated"),
+            std::string::npos);
+  limits.available_memory = 1ull << 30;
+  const Scene loaded = load_scene(scene, env, 1.0f, DefaultLight::None, limits);
+  ASSERT_TRUE(loaded.environment.has_value());
+  EXPECT_EQ(loaded.estimated_load_bytes, 64u * 32 * 40 + 4 * 200 + 2 * 136 + 8192);
 }
 
 }  // namespace
