@@ -1,4 +1,5 @@
 // pxf: pixel filtering for progressive path tracing. One core, four front ends.
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <exception>
@@ -32,6 +33,9 @@ void print_usage(FILE* out) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Progress and reports on stdout and stderr are best effort: a reader that went away (`pxf render
+  // 2>&1 | head -1`) must not kill a render, whose results go to files.
+  std::signal(SIGPIPE, SIG_IGN);
   if (argc < 2) {
     print_usage(stderr);
     return 2;

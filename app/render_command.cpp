@@ -3,6 +3,7 @@
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <iterator>
 #include <unistd.h>
 
 #include "app/checkpoint.h"
@@ -17,30 +18,39 @@ namespace pxf {
 
 namespace {
 
-std::atomic<bool> g_interrupted{false};
+// The stop signal that arrived (SIGINT, SIGTERM or SIGHUP), or 0. The render then finishes its
+// frame and writes every output; the exit status is 128 + that signal, as a shell reports it.
+std::atomic<int> g_stop_signal{0};
+const int kStopSignals[] = {SIGINT, SIGTERM, SIGHUP};
 
-extern "C" void on_interrupt(int) {
-  g_interrupted = true;
-  std::signal(SIGINT, SIG_DFL);  // a second Ctrl-C stops at once (after the writes: they block it)
+extern "C" void on_stop_signal(int signal_number) {
+  g_stop_signal = signal_number;
+  // A second stop signal ends the process at once; the output set stays whole (output_set.h).
+  for (int s : kStopSignals) std::signal(s, SIG_DFL);
 }
 
-// Installs on_interrupt unless SIGINT is ignored (a background job of a shell script must stay
-// immune to the terminal's Ctrl-C); the previous disposition comes back at scope exit.
-class InterruptHandler {
+// Installs on_stop_signal for each stop signal that is not ignored (a background job of a shell
+// script must stay immune to the terminal's Ctrl-C, a nohup'ed one to SIGHUP); the previous
+// dispositions come back at scope exit. A process-directed signal may reach any thread (TBB's,
+// llvmpipe's): the handler only sets a flag, so whichever runs it is fine.
+class StopSignalHandlers {
  public:
-  InterruptHandler() {
-    struct sigaction current {};
-    sigaction(SIGINT, nullptr, &current);
-    ignored_ = current.sa_handler == SIG_IGN;
-    if (!ignored_) previous_ = std::signal(SIGINT, on_interrupt);
+  StopSignalHandlers() {
+    for (size_t i = 0; i < std::size(kStopSignals); ++i) {
+      struct sigaction current {};
+      sigaction(kStopSignals[i], nullptr, &current);
+      ignored_[i] = current.sa_handler == SIG_IGN;
+      if (!ignored_[i]) previous_[i] = std::signal(kStopSignals[i], on_stop_signal);
+    }
   }
-  ~InterruptHandler() {
-    if (!ignored_) std::signal(SIGINT, previous_);
+  ~StopSignalHandlers() {
+    for (size_t i = 0; i < std::size(kStopSignals); ++i)
+      if (!ignored_[i]) std::signal(kStopSignals[i], previous_[i]);
   }
 
  private:
-  bool ignored_ = false;
-  void (*previous_)(int) = SIG_DFL;
+  bool ignored_[std::size(kStopSignals)] = {};
+  void (*previous_[std::size(kStopSignals)])(int) = {};
 };
 
 // "[#######.....]  12/64 spp  1.2 s elapsed  ETA 5.1 s" on stderr, at most ~10 times a second.
@@ -82,8 +92,9 @@ int run_render(const Args& args) {
   CommandLine cli("render", "[options]",
                   "Renders a scene progressively with pixel filtering, headless, and writes DIR/final.png\n"
                   "(tone-mapped), DIR/final.exr, DIR/buffers.exr (final, lv, hv, hv_filtered, var_u, var_f,\n"
-                  "blend, case, range_color, depth, samples) and DIR/stats.json. Ctrl-C finishes the current\n"
-                  "frame and writes everything. A reference: --filter none --spp 4096.");
+                  "blend, case, range_color, depth, samples) and DIR/stats.json, replaced as one set. Ctrl-C,\n"
+                  "SIGTERM or SIGHUP finishes the current frame and writes everything (exit 128 + the signal).\n"
+                  "A reference: --filter none --spp 4096.");
   add_scene_options(cli, scene_options, /*headless=*/true);
   cli.option("--spp", &spp, "samples (path-traced frames) per pixel (default 64; unbounded with --time alone)", 1,
              1 << 24);
@@ -116,12 +127,12 @@ int run_render(const Args& args) {
                             frames);
   checkpointer.start(preview);
 
-  g_interrupted = false;
-  const InterruptHandler interrupt_handler;  // kept through the writes: Ctrl-C then still gives 130
+  g_stop_signal = 0;
+  const StopSignalHandlers stop_handlers;  // kept through the writes: a stop then still gives 128 + signal
   const int total = static_cast<int>(frames.count());
   ProgressBar progress(total);
   const int first = preview.samples();  // > 0 after --resume
-  for (int i = first; i < total && !g_interrupted; ++i) {
+  for (int i = first; i < total && !g_stop_signal; ++i) {
     // The first frame always traces; the next ones only while they and the finish fit the budget.
     if (i > first && !next_frame_fits(preview.predict_next_frame(budget_ms, elapsed_ms(start)))) break;
     // With a budget the first frame is displayed: that measures the finish's blend and tone map.
@@ -136,7 +147,7 @@ int run_render(const Args& args) {
 
   RenderReport report;
   report.scene = &scene_options;
-  report.interrupted = g_interrupted;
+  report.interrupted = g_stop_signal != 0;
   report.gl_backend = context->backend_name();
   report.gl_renderer = context->gl_renderer();
   report.reference_path = reference;
@@ -162,7 +173,7 @@ int run_render(const Args& args) {
               out.c_str(), out.c_str());
   if (checkpointer.enabled())
     std::printf("wrote %s (state writes %.0f ms in all)\n", state_path(out).c_str(), checkpointer.write_ms());
-  return report.interrupted || g_interrupted ? 130 : 0;
+  return g_stop_signal ? 128 + g_stop_signal : 0;
 }
 
 }  // namespace pxf

@@ -1,15 +1,11 @@
 #include "app/render_output.h"
 #include "core/timing.h"
 
-#include <pthread.h>
-#include <signal.h>
-#include <unistd.h>
-
-#include <cerrno>
 #include <filesystem>
-#include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "app/checkpoint.h"
+#include "app/output_set.h"
 #include "gl/context.h"
 
 namespace pxf {
@@ -94,45 +90,7 @@ nlohmann::json stats_json(Preview& preview, const RenderReport& r) {
 
 namespace {
 
-namespace fs = std::filesystem;
-
-const char* const kOutputNames[] = {"final.png", "final.exr", "buffers.exr", "stats.json"};
-const std::string kStagingPrefix = ".pxf-staging-";
-
-// The pid in "NAME.tmp-PID" or ".pxf-staging-PID", or 0.
-pid_t pid_suffix(const std::string& name) {
-  size_t at = std::string::npos;
-  if (name.rfind(kStagingPrefix, 0) == 0) at = kStagingPrefix.size();
-  else if (const size_t tmp = name.rfind(".tmp-"); tmp != std::string::npos) at = tmp + 5;
-  if (at == std::string::npos || at >= name.size() || name.find_first_not_of("0123456789", at) != std::string::npos)
-    return 0;
-  return static_cast<pid_t>(std::stol(name.substr(at)));
-}
-
-bool process_is_gone(pid_t pid) { return pid > 0 && pid != ::getpid() && ::kill(pid, 0) != 0 && errno == ESRCH; }
-
-// Staging folders and temporary files that a killed pxf (SIGKILL, power loss) left behind.
-void remove_stale_temporaries(const std::string& dir) {
-  std::error_code ec;
-  for (const auto& entry : fs::directory_iterator(dir, ec))
-    if (process_is_gone(pid_suffix(entry.path().filename().string()))) fs::remove_all(entry.path(), ec);
-}
-
-// Blocks the stop signals while the output set is replaced, so that a Ctrl-C or SIGTERM arriving
-// then takes effect only once every file is in place (the handlers stay as they are).
-class StopSignalsBlocked {
- public:
-  StopSignalsBlocked() {
-    sigset_t stop;
-    sigemptyset(&stop);
-    for (int s : {SIGINT, SIGTERM, SIGHUP, SIGQUIT}) sigaddset(&stop, s);
-    pthread_sigmask(SIG_BLOCK, &stop, &previous_);
-  }
-  ~StopSignalsBlocked() { pthread_sigmask(SIG_SETMASK, &previous_, nullptr); }
-
- private:
-  sigset_t previous_;
-};
+const std::vector<std::string> kOutputNames = {"final.png", "final.exr", "buffers.exr", "stats.json"};
 
 void write_outputs_into(const std::string& staging, Preview& preview, RenderReport& report,
                         const std::vector<Layer>& buffers) {
@@ -141,22 +99,6 @@ void write_outputs_into(const std::string& staging, Preview& preview, RenderRepo
   write_exr(staging + "/buffers.exr", buffers);
   const std::string text = stats_json(preview, report).dump(2) + "\n";
   write_file_completely(staging + "/stats.json", text.data(), text.size());
-}
-
-// The new set replaces the old one only once it is complete. The old files go first, so that a
-// kill in between leaves part of one run's set, never a mix of two runs.
-void replace_output_set(const std::string& staging, const std::string& dir) {
-  std::error_code ec;
-  for (const char* name : kOutputNames) {
-    fs::remove(dir + "/" + name, ec);
-    if (ec) throw Error(dir + "/" + name + ": cannot replace: " + ec.message());
-  }
-  sync_folder(dir);
-  for (const char* name : kOutputNames) {
-    fs::rename(staging + "/" + name, dir + "/" + name, ec);
-    if (ec) throw Error(dir + "/" + name + ": cannot move into place: " + ec.message());
-  }
-  sync_folder(dir);
 }
 
 }  // namespace
@@ -169,10 +111,6 @@ void check_reference(const std::string& path, int width, int height) {
 }
 
 void write_render_outputs(const std::string& dir, Preview& preview, RenderReport& report) {
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (ec) throw Error(dir + ": cannot create output folder: " + ec.message());
-  remove_stale_temporaries(dir);
   const std::vector<Layer> buffers = preview.buffers();
   for (const Layer& l : buffers)
     if (count_nonfinite(l.image) > 0)
@@ -183,19 +121,12 @@ void write_render_outputs(const std::string& dir, Preview& preview, RenderReport
     report.final_vs_reference = compare_images(layer_image(buffers, "final"), reference);
     report.unfiltered_vs_reference = compare_images(unfiltered_image(buffers), reference);
   }
-  const StopSignalsBlocked blocked;
-  const std::string staging = dir + "/" + kStagingPrefix + std::to_string(::getpid());
-  fs::remove_all(staging, ec);
-  fs::create_directory(staging, ec);
-  if (ec) throw Error(staging + ": cannot create: " + ec.message());
-  try {
-    write_outputs_into(staging, preview, report, buffers);
-    replace_output_set(staging, dir);
-  } catch (...) {
-    fs::remove_all(staging, ec);
-    throw;
-  }
-  fs::remove_all(staging, ec);
+  OutputSetWriter writer(dir, kOutputNames);
+  write_outputs_into(writer.staging(), preview, report, buffers);
+  writer.commit();
+  // The checkpoint's state file is no part of the set, but a killed write of it leaves its
+  // temporary in the same folder.
+  remove_stale_temporaries(dir, {std::filesystem::path(state_path(dir)).filename().string()});
 }
 
 }  // namespace pxf

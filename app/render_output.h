@@ -1,6 +1,6 @@
 // What `pxf render` (and the explorer's capture) writes: final.png, final.exr, buffers.exr and
-// stats.json in an output folder. The set is written into a staging folder inside the output
-// folder and moved into place only once every file is complete (see write_render_outputs).
+// stats.json in an output folder, replaced as one unit (app/output_set.h): after any kill the
+// folder shows the whole previous set or the whole new one.
 #pragma once
 #include <optional>
 #include <string>

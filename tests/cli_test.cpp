@@ -21,6 +21,7 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
+#include "app/output_set.h"
 #include "gl/pass_params.h"
 #include "image/image.h"
 #include "tests/test_support.h"
@@ -619,11 +620,16 @@ std::string file_bytes(const std::string& path) {
   return std::string(std::istreambuf_iterator<char>(in), {});
 }
 
+// pxf's temporaries left in `dir`: anything of its own names but the current set and its link.
 std::vector<std::string> leftovers(const std::string& dir) {
+  const std::string current = fs::is_symlink(dir + "/" + kCurrentSetLink)
+                                  ? fs::read_symlink(dir + "/" + kCurrentSetLink).string() : "";
   std::vector<std::string> names;
   for (const auto& entry : fs::directory_iterator(dir)) {
     const std::string name = entry.path().filename().string();
-    if (name.find(".tmp-") != std::string::npos || name.rfind(".pxf-staging-", 0) == 0) names.push_back(name);
+    if ((name.find(".tmp-") != std::string::npos || name.rfind(".pxf-", 0) == 0) && name != kCurrentSetLink &&
+        name != current)
+      names.push_back(name);
   }
   return names;
 }
@@ -654,8 +660,11 @@ TEST(Cli, FullDiskKeepsThePreviousOutputSetAndNamesTheFile) {
 
 TEST(Cli, StaleTemporariesOfDeadProcessesAreRemoved) {
   const std::string out = temp_dir("stale");
-  fs::create_directories(out + "/.pxf-staging-999999999");
+  fs::create_directories(out + "/.pxf-staging-999999999");  // an earlier pxf's staging folder
   std::ofstream(out + "/final.png.tmp-999999999") << "partial";
+  fs::create_directories(out + "/" + set_folder_name(999999999, 0));
+  std::ofstream(out + "/" + set_folder_name(999999999, 0) + "/final.exr") << "partial";
+  std::ofstream(out + "/state.pxfs.tmp-999999999") << "partial";
   std::ofstream(out + "/notes.txt") << "kept";
   ASSERT_EQ(run("render --size 16x16 --spp 2 --quiet --out " + out).code, 0);
   EXPECT_TRUE(leftovers(out).empty());
