@@ -68,6 +68,8 @@ nlohmann::json stats_json(Preview& preview, const RenderReport& r) {
   j["filter_range_share_of_tracing"] = pass_share_of_tracing(total);
   j["load_ms"] = r.load_ms;
   j["peak_memory_mib"] = peak_memory_mib();
+  // The loader's estimate (docs/robustness.md), beside the peak it bounds: 0 for a built-in scene.
+  j["estimated_load_mib"] = preview.renderer().scene().estimated_load_bytes / (1024.0 * 1024.0);
   j["paths_per_second"] = total.path_tracing > 0 ? trace.paths / (total.path_tracing / 1000.0) : 0.0;
   j["rays"] = trace.rays;
   j["filter_runs"] = preview.filter_runs();

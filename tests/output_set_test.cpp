@@ -220,3 +220,20 @@ TEST(OutputSet, AClosedProgressPipeDoesNotStopTheRender) {
   EXPECT_EQ(WEXITSTATUS(status), 0) << "141 is death by SIGPIPE";
   EXPECT_EQ(check_set(out).problem, "");
 }
+
+// Where the file system has no symbolic links, each output is renamed over its name: the outputs are
+// plain, complete files of the latest run, and the folder holds nothing else of pxf's.
+TEST(OutputSet, WithoutSymlinksEachFileIsReplacedWhole) {
+  const std::string out = test_support::temp_dir("output_set", "no_symlinks");
+  for (const int width : {16, 20}) {
+    const std::string command = "LD_PRELOAD=" + std::string(PXF_NO_SYMLINKS_SHIM) + " " + PXF_EXECUTABLE +
+                                " render --size " + std::to_string(width) + "x16 --spp 1 --quiet --out " + out +
+                                " >/dev/null 2>&1";
+    const int status = std::system(command.c_str());
+    ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << command;
+    for (const char* name : kOutputs) EXPECT_FALSE(fs::is_symlink(out + "/" + name)) << name;
+    EXPECT_EQ(check_set(out).width, width) << check_set(out).problem;
+    for (const auto& entry : fs::directory_iterator(out))
+      EXPECT_NE(entry.path().filename().string().rfind(".pxf-", 0), 0u) << entry.path();
+  }
+}
