@@ -38,6 +38,9 @@ FrameRange render_frame_range(const CheckpointOptions& o, int spp) {
   if (!o.frames.empty()) {
     if (!parse_pair(o.frames, ':', range.begin, range.end) || range.begin >= range.end)
       throw UsageError("--frames wants A:B with A < B, got '" + o.frames + "'");
+    if (range.count() > kMaxRenderFrames)
+      throw UsageError("--frames " + o.frames + " is " + std::to_string(range.count()) + " frames; one render traces at most " +
+                       std::to_string(kMaxRenderFrames) + " (like --spp; split it into shards)");
   } else if (!o.shard.empty()) {
     uint32_t i = 0, n = 0;
     if (!parse_pair(o.shard, '/', i, n) || n == 0 || i >= n)
@@ -88,7 +91,16 @@ AccumulationState Checkpointer::state_of(const Preview& preview) const {
 void Checkpointer::maybe_write(const Preview& preview) {
   if (options_.interval_s <= 0) return;
   const auto now = std::chrono::steady_clock::now();
-  if (std::chrono::duration<double>(now - last_write_).count() >= options_.interval_s) write(preview);
+  if (std::chrono::duration<double>(now - last_write_).count() < options_.interval_s) return;
+  // A failed periodic write (a full disk) loses nothing: the atomic write leaves the previous
+  // state in place, and the final write tries again. So the render goes on, with one warning.
+  try {
+    write(preview);
+  } catch (const Error& e) {
+    last_write_ = std::chrono::steady_clock::now();  // the next try after another interval
+    if (!warned_) std::fprintf(stderr, "pxf: warning: periodic state not saved, rendering on: %s\n", e.what());
+    warned_ = true;
+  }
 }
 
 void Checkpointer::write(const Preview& preview) {
@@ -96,9 +108,20 @@ void Checkpointer::write(const Preview& preview) {
   const auto start = std::chrono::steady_clock::now();
   std::error_code ignored;  // a folder that cannot be made fails the write below with its name
   std::filesystem::create_directories(std::filesystem::path(path_).parent_path(), ignored);
+  written_ = false;  // until this write succeeds, the file on disk is not the state of these samples
   write_state_file(path_, state_of(preview));
+  written_ = true;
   last_write_ = std::chrono::steady_clock::now();
   write_ms_ += std::chrono::duration<double, std::milli>(last_write_ - start).count();
+}
+
+std::string Checkpointer::write_final(const Preview& preview) {
+  try {
+    write(preview);
+    return "";
+  } catch (const Error& e) {
+    return e.what();
+  }
 }
 
 }  // namespace pxf

@@ -38,9 +38,16 @@ class Checkpointer {
   // otherwise starts the preview at the range's first frame. Throws pxf::Error before anything is
   // written when the state does not fit.
   void start(Preview& preview) const;
-  // Writes the state when the interval has passed since the last write.
+  // Writes the state when the interval has passed since the last write. A failed write warns once
+  // on stderr and is retried after the next interval; the render goes on (the previous state stays).
   void maybe_write(const Preview& preview);
+  // Writes the state now (nothing without samples); throws pxf::Error naming the file on failure.
   void write(const Preview& preview);
+  // The final write: its one-line error, or "" (written, or nothing to write). Returned, not
+  // thrown, so that the render's outputs are still written; the caller then exits 1.
+  std::string write_final(const Preview& preview);
+  // Whether the state file holds the current samples (the last write succeeded).
+  bool written() const { return written_; }
   double write_ms() const { return write_ms_; }  // total time spent writing states
 
  private:
@@ -53,6 +60,8 @@ class Checkpointer {
   bool enabled_;
   std::chrono::steady_clock::time_point last_write_;
   double write_ms_ = 0;
+  bool written_ = false;
+  bool warned_ = false;  // a periodic write failed and was reported
 };
 
 }  // namespace pxf

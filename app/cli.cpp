@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <limits>
 #include <sstream>
+#include <type_traits>
 
 namespace pxf {
 
@@ -37,20 +38,31 @@ std::string readable_number(double v) {
   return buffer;
 }
 
+// Whether `value` converts to T without overflow. An integer type's max (2^63 - 1, 2^64 - 1) rounds
+// up to 2^63, 2^64 in double, where the conversion is undefined: its bound is that power, exclusive.
+template <typename T>
+bool representable(double value) {
+  if (value < static_cast<double>(std::numeric_limits<T>::lowest())) return false;
+  if (std::is_integral<T>::value) return value < std::ldexp(1.0, std::numeric_limits<T>::digits);
+  return value <= static_cast<double>(std::numeric_limits<T>::max());
+}
+
 template <typename T>
 std::function<void(const std::string&)> number_setter(const std::string& name, T* target, double min, double max,
                                                       bool integer) {
+  // The bounds in the target's type; a bound that double cannot carry back (UINT64_MAX) is the type's own.
+  const T lo = representable<T>(min) ? static_cast<T>(min) : std::numeric_limits<T>::lowest();
+  const T hi = representable<T>(max) ? static_cast<T>(max) : std::numeric_limits<T>::max();
   return [=](const std::string& text) {
     const double value = parse_number(name, text);
     if (integer && value != std::floor(value)) throw UsageError(name + ": '" + text + "' is not an integer");
     // Compared in the target's type: a float limit such as 0.1f is not 0.1 in double, so "0.1"
     // would be out of a range that prints as starting at 0.1.
-    const bool representable = value >= static_cast<double>(std::numeric_limits<T>::lowest()) &&
-                               value <= static_cast<double>(std::numeric_limits<T>::max());
-    const T typed = representable ? static_cast<T>(value) : T{};
-    if (!representable || typed < static_cast<T>(min) || typed > static_cast<T>(max))
-      throw UsageError(name + ": " + text + " is out of range [" + readable_number(static_cast<T>(min)) + ", " +
-                       readable_number(static_cast<T>(max)) + "]");
+    const bool fits = representable<T>(value);
+    const T typed = fits ? static_cast<T>(value) : T{};
+    if (!fits || typed < lo || typed > hi)
+      throw UsageError(name + ": " + text + " is out of range [" + readable_number(static_cast<double>(lo)) + ", " +
+                       readable_number(static_cast<double>(hi)) + "]");
     *target = typed;
   };
 }

@@ -8,6 +8,7 @@
 
 #include "app/checkpoint.h"
 #include "app/commands.h"
+#include "app/first_frame.h"
 #include "app/options.h"
 #include "app/preview.h"
 #include "app/render_output.h"
@@ -97,7 +98,7 @@ int run_render(const Args& args) {
                   "A reference: --filter none --spp 4096.");
   add_scene_options(cli, scene_options, /*headless=*/true);
   cli.option("--spp", &spp, "samples (path-traced frames) per pixel (default 64; unbounded with --time alone)", 1,
-             1 << 24);
+             static_cast<int>(kMaxRenderFrames));
   cli.option("--time", &time_s,
              "wall-clock budget in seconds of the whole job (load, trace, passes, finish); with --spp: first wins",
              0.001, 1e7);
@@ -111,7 +112,7 @@ int run_render(const Args& args) {
   if (print_scene_list_if_asked(scene_options)) return 0;
   const double budget_ms = time_s * 1000.0;
   if (budget_ms > 0 && !cli.given("--spp")) {
-    spp = 1 << 24;
+    spp = static_cast<int>(kMaxRenderFrames);
     quiet = true;  // no total to show progress against
   }
 
@@ -121,6 +122,9 @@ int run_render(const Args& args) {
   if (!reference.empty()) check_reference(reference, scene_options.width, scene_options.height);  // before tracing
   set_gl_timing(scene_options.stage_timing);
   auto context = create_gl_context(parse_gl_backend(scene_options.gl));
+  // The first frame traces whatever the budget: refused up front when even it cannot fit.
+  check_first_frame_fits(scene, preview_settings, scene_options.width, scene_options.height, budget_ms,
+                         elapsed_ms(start));
   Preview preview(scene, preview_settings, scene_options.width, scene_options.height);
   const FrameRange frames = render_frame_range(checkpoint_options, spp);
   Checkpointer checkpointer(checkpoint_options, out, render_sample_settings(scene_options, preview_settings),
@@ -142,7 +146,7 @@ int run_render(const Args& args) {
   }
   preview.finish();
   const double used_ms = elapsed_ms(start);
-  checkpointer.write(preview);
+  const std::string state_error = checkpointer.write_final(preview);  // reported after the outputs
   if (!quiet) progress.finish();
 
   RenderReport report;
@@ -171,8 +175,12 @@ int run_render(const Args& args) {
                 report.unfiltered_vs_reference->nrmse_percent);
   std::printf("wrote %s/final.png, %s/final.exr, %s/buffers.exr, %s/stats.json\n", out.c_str(), out.c_str(),
               out.c_str(), out.c_str());
-  if (checkpointer.enabled())
+  if (checkpointer.written())
     std::printf("wrote %s (state writes %.0f ms in all)\n", state_path(out).c_str(), checkpointer.write_ms());
+  if (!state_error.empty()) {
+    std::fprintf(stderr, "pxf render: %s\n", state_error.c_str());
+    return 1;
+  }
   return g_stop_signal ? 128 + g_stop_signal : 0;
 }
 

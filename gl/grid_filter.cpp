@@ -1,5 +1,6 @@
 #include "gl/grid_filter.h"
 
+#include "gl/dispatch.h"
 #include "gl/gl.h"
 
 namespace pxf {
@@ -28,7 +29,7 @@ void GridFilter::run(const FilterParams& p, float t, const Framebuffer& target) 
 
   bounds_.use();
   const int strips = (width_ + 63) / 64 * height_;  // 64-pixel row strips (grid_bounds.comp)
-  glDispatchCompute((strips + 63) / 64, 1, 1);
+  dispatch_compute_1d("grid filter bounds", (strips + 63) / 64);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
 
   step_ms_[0] = step_timer_.end();
@@ -39,7 +40,7 @@ void GridFilter::run(const FilterParams& p, float t, const Framebuffer& target) 
   splat_.set("min_cell_z", grid_min_cell_z(p.sigma_c));
   splat_.use();
   grid_[0].bind_storage(shared::kBufferGrid);
-  glDispatchCompute((layout_.nx + 7) / 8, (layout_.ny + 7) / 8, 1);
+  dispatch_compute("grid filter splat", (layout_.nx + 7) / 8, (layout_.ny + 7) / 8);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
 
   step_ms_[1] = step_timer_.end();
@@ -47,12 +48,12 @@ void GridFilter::run(const FilterParams& p, float t, const Framebuffer& target) 
   blur_.set("grid_xy", grid_xy);
   blur_.set("grid_z_cells", layout_.nz);
   blur_.use();
-  const GLuint groups = static_cast<GLuint>((layout_.cells() + 63) / 64);
+  const uint64_t groups = (layout_.cells() + 63) / 64;
   for (int axis = 0; axis < 2; ++axis) {  // z was blurred in the splat
     blur_.set("axis", axis);
     grid_[axis % 2].bind_storage(shared::kBufferGrid);
     grid_[1 - axis % 2].bind_storage(shared::kBufferGridTarget);
-    glDispatchCompute(groups, 1, 1);
+    dispatch_compute_1d("grid filter blur", groups);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
   }
 

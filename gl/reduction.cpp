@@ -1,5 +1,6 @@
 #include "gl/reduction.h"
 
+#include "gl/dispatch.h"
 #include "gl/gl.h"
 
 namespace pxf {
@@ -19,7 +20,7 @@ void GpuReduction::run(const Texture2D& source, int mode, float delta) {
   result_.bind_storage(2);
   program_.use();
   program_.set("stage", 0);
-  glDispatchCompute(gx, gy, 1);
+  dispatch_compute("reduction", gx, gy);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
   program_.set("stage", 1);
   glDispatchCompute(1, 1, 1);

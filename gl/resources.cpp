@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cstdio>
 #include <glm/gtc/type_ptr.hpp>
+#include "gl/dispatch.h"
 #include "gl/gl.h"
 
 namespace pxf {
@@ -141,6 +142,7 @@ int texture_format_channels(TextureFormat format) { return info(format).channels
 Texture2D::Texture2D(int width, int height, TextureFormat format, int levels)
     : width_(width), height_(height), format_(format) {
   if (width <= 0 || height <= 0) throw Error("texture: invalid size " + std::to_string(width) + "x" + std::to_string(height));
+  check_texture_size("texture", width, height, query_gl_limits());  // a one-line error, not a GL error later
   glCreateTextures(GL_TEXTURE_2D, 1, &name_.id);
   glTextureStorage2D(name_.id, levels, info(format).internal, width, height);
   set_filter(false);

@@ -128,6 +128,20 @@ SampleSettings get_settings(Reader& r) {
   return s;
 }
 
+// The frames of the ranges in all, in 64 bits: no sum of uint32 counts can wrap.
+uint64_t total_frames(const std::vector<FrameRange>& ranges) {
+  uint64_t n = 0;
+  for (const FrameRange& r : ranges) n += r.count();
+  return n;
+}
+
+// Refuses a frame total beyond kMaxStateFrames; `what` begins the message ("state file has").
+void check_frame_total(uint64_t frames, const std::string& what) {
+  if (frames > kMaxStateFrames)
+    throw Error(what + " " + std::to_string(frames) + " frames, more than the " + std::to_string(kMaxStateFrames) +
+                " a state can hold");
+}
+
 void check_frame_ranges(const std::vector<FrameRange>& ranges) {
   for (size_t i = 0; i < ranges.size(); ++i) {
     if (ranges[i].begin >= ranges[i].end) throw Error("state file has an empty or reversed frame range");
@@ -136,6 +150,7 @@ void check_frame_ranges(const std::vector<FrameRange>& ranges) {
     if (i > 0 && ranges[i].begin <= ranges[i - 1].end)
       throw Error("state file has unsorted, overlapping or unjoined adjacent frame ranges");
   }
+  check_frame_total(total_frames(ranges), "state file has");
 }
 
 void check_pixels(const AccumulationState& state) {
@@ -225,9 +240,7 @@ std::string SampleSettings::difference(const SampleSettings& o) const {
 }
 
 uint32_t AccumulationState::frame_count() const {
-  uint64_t n = 0;
-  for (const FrameRange& r : frames) n += r.count();
-  return static_cast<uint32_t>(std::min<uint64_t>(n, UINT32_MAX));
+  return static_cast<uint32_t>(std::min<uint64_t>(total_frames(frames), UINT32_MAX));
 }
 
 SampleSettings sample_settings(uint64_t scene_hash, int width, int height, const TraceParams& params) {
@@ -385,6 +398,9 @@ AccumulationState read_state_file(const std::string& path) {
 
 AccumulationState merge_states(const std::vector<AccumulationState>& states) {
   if (states.empty()) throw Error("no state to merge");
+  uint64_t frames = 0;  // checked before any pixel is combined: per-pixel counts stay below it
+  for (const AccumulationState& state : states) frames += total_frames(state.frames);
+  check_frame_total(frames, "the states to merge hold");
   AccumulationState merged = states.front();
   for (size_t i = 1; i < states.size(); ++i) {
     const std::string diff = states[i].settings.difference(merged.settings);

@@ -13,6 +13,12 @@ namespace pxf {
 
 constexpr uint32_t kStateFormatVersion = 4;  // 2: the albedo mean; 3: sampler, replicates, specular sampling; 4: replicate sums
 
+// Frame counts: one render traces at most kMaxRenderFrames frames (--spp, --frames, --shard); a
+// state, also a merge of many shards, holds at most kMaxStateFrames in all, the most the preview's
+// int sample count holds. Every count is checked against these before it is used.
+constexpr uint32_t kMaxRenderFrames = 1u << 24;
+constexpr uint32_t kMaxStateFrames = 0x7fffffffu;
+
 // The frames [begin, end) of the counter-based sample sequence.
 struct FrameRange {
   uint32_t begin = 0, end = 0;
@@ -62,8 +68,8 @@ void write_state_file(const std::string& path, const AccumulationState& state);
 AccumulationState read_state_file(const std::string& path);
 
 // Combines states of disjoint frame ranges with equal sample settings: sample-count weighted means
-// and Chan's parallel combination of the Welford M2. Throws pxf::Error when settings differ or the
-// frame ranges overlap.
+// and Chan's parallel combination of the Welford M2. Throws pxf::Error when settings differ, the
+// frame ranges overlap or together hold more than kMaxStateFrames frames.
 AccumulationState merge_states(const std::vector<AccumulationState>& states);
 
 // "0:16,32:48"

@@ -6,6 +6,7 @@
 #include "pass_formulas.h"
 #include "grid_common.glsl"
 layout(local_size_x = 64) in;
+#include "flat_dispatch.glsl"
 
 layout(std430, binding = kBufferGrid) readonly buffer Source { vec4 src[]; };
 layout(std430, binding = kBufferGridTarget) writeonly buffer Target { vec4 dst[]; };
@@ -14,7 +15,7 @@ uniform int grid_z_cells;
 uniform int axis;       // 0: x, 1: y, 2: z
 
 void main() {
-  int cell = int(gl_GlobalInvocationID.x);
+  int cell = flat_invocation();
   int plane = grid_xy.x * grid_xy.y;
   if (cell >= plane * grid_z_cells) return;
   ivec3 c = ivec3(cell % grid_xy.x, (cell / grid_xy.x) % grid_xy.y, cell / plane);

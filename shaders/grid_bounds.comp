@@ -5,6 +5,7 @@
 #include "pass_formulas.h"
 #include "grid_common.glsl"
 layout(local_size_x = 64) in;
+#include "flat_dispatch.glsl"
 
 layout(binding = kUnitGuide) uniform sampler2D guide_tex;
 const int kStrip = 64;
@@ -12,7 +13,7 @@ const int kStrip = 64;
 void main() {
   ivec2 size = textureSize(guide_tex, 0);
   int strips_per_row = (size.x + kStrip - 1) / kStrip;
-  int strip = int(gl_GlobalInvocationID.x);
+  int strip = flat_invocation();
   int y = strip / strips_per_row;
   if (y >= size.y) return;
   int x0 = (strip % strips_per_row) * kStrip;
