@@ -10,6 +10,7 @@
 
 #include "app/cli.h"
 #include "app/commands.h"
+#include "core/json_depth.h"
 #include "gl/cpu_reference.h"
 #include "image/image.h"
 #include "image/input_file.h"
@@ -42,6 +43,8 @@ std::optional<nlohmann::json> stats_beside(const std::string& image_path) {
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) return std::nullopt;
   const std::vector<unsigned char> bytes = read_input_file(path, kMaxStatsJsonBytes);
+  // dump() recurses when a setting is quoted in an error: a deep file is refused before parsing.
+  check_json_depth(reinterpret_cast<const char*>(bytes.data()), bytes.size(), path);
   nlohmann::json json = nlohmann::json::parse(bytes.begin(), bytes.end(), nullptr, false);
   if (json.is_discarded()) return std::nullopt;
   return json;

@@ -1260,12 +1260,9 @@ ImageSize exr_data_window(const std::vector<unsigned char>& head) {
 // not a regular file: the reader then names the problem.
 ImageSize environment_size(const std::string& path) {
   constexpr size_t kHeaderBytes = 1 << 16;
-  std::error_code ec;
-  if (!fs::is_regular_file(path, ec)) return {};
-  std::ifstream in(path, std::ios::binary);
-  std::vector<unsigned char> head(kHeaderBytes);
-  in.read(reinterpret_cast<char*>(head.data()), static_cast<std::streamsize>(head.size()));
-  head.resize(static_cast<size_t>(in.gcount()));
+  // Through the shared reader: a file swapped for a FIFO after the sniff is refused, not waited on.
+  const std::vector<unsigned char> head =
+      read_input_file_head(path, std::max(kMaxExrFileBytes, kMaxStbImageFileBytes), kHeaderBytes);
   if (head.size() >= 8 && std::memcmp(head.data(), "\x76\x2f\x31\x01", 4) == 0) return exr_data_window(head);
   const gltf::ImageHeader header = gltf::probe_image(head.data(), head.size());
   if (!header.ok) return {};

@@ -141,3 +141,17 @@ TEST(SceneLimits, EnvironmentMapOverMaxTextureSizeIsRefusedBeforeDecoding) {
 }
 
 }  // namespace
+
+// A stats.json beside a reference, nested 20,000 deep: pxf diff reads it for --second-reference and
+// quotes its settings in errors (dump() recurses), so it is refused in one line before parsing.
+TEST(SceneLimits, DeepStatsJsonBesideAReferenceIsOneLine) {
+  const std::string dir = temp_dir("deep_stats");
+  ASSERT_EQ(run("render --size 16x16 --spp 1 --quiet --out " + dir + "/a").code, 0);
+  fs::create_directories(dir + "/b");
+  fs::copy_file(dir + "/a/final.exr", dir + "/b/final.exr");  // follows the link: a plain file
+  std::ofstream(dir + "/b/stats.json") << "{\"settings\":" << std::string(20000, '[') << std::string(20000, ']') << "}";
+  const Result r = run("diff " + dir + "/a/final.exr " + dir + "/a/final.exr --second-reference " + dir + "/b/final.exr");
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_EQ(lines(r.err), 1u) << r.err;
+  EXPECT_NE(r.err.find(dir + "/b/stats.json: JSON nested deeper than 256 levels"), std::string::npos) << r.err;
+}
