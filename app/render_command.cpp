@@ -116,6 +116,8 @@ int run_render(const Args& args) {
     quiet = true;  // no total to show progress against
   }
 
+  const FrameRange frames = render_frame_range(checkpoint_options, spp);  // a bad range before any load
+
   const auto start = BenchClock::now();
   Scene scene = load_scene_for(scene_options, preview_settings, cli);
   const double load_ms = elapsed_ms(start);
@@ -126,7 +128,6 @@ int run_render(const Args& args) {
   check_first_frame_fits(scene, preview_settings, scene_options.width, scene_options.height, budget_ms,
                          elapsed_ms(start));
   Preview preview(scene, preview_settings, scene_options.width, scene_options.height);
-  const FrameRange frames = render_frame_range(checkpoint_options, spp);
   Checkpointer checkpointer(checkpoint_options, out, render_sample_settings(scene_options, preview_settings),
                             frames);
   checkpointer.start(preview);
