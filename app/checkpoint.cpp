@@ -32,6 +32,16 @@ void add_checkpoint_options(CommandLine& cli, CheckpointOptions& o) {
 
 std::string state_path(const std::string& out_dir) { return out_dir + "/state.pxfs"; }
 
+bool uses_state(const CheckpointOptions& o) {
+  return o.interval_s > 0 || !o.resume.empty() || !o.frames.empty() || !o.shard.empty();
+}
+
+void check_adaptive_without_state(const CheckpointOptions& options, bool adaptive) {
+  if (adaptive && uses_state(options))
+    throw UsageError("--adaptive on does not work with --checkpoint, --resume, --frames or --shard yet: a state "
+                     "does not hold the per-pixel sample counts it would continue from");
+}
+
 FrameRange render_frame_range(const CheckpointOptions& o, int spp) {
   if (!o.frames.empty() && !o.shard.empty()) throw UsageError("--frames and --shard exclude each other");
   FrameRange range{0, static_cast<uint32_t>(spp)};
@@ -62,7 +72,7 @@ Checkpointer::Checkpointer(const CheckpointOptions& options, const std::string& 
       path_(state_path(out_dir)),
       settings_(settings),
       range_(range),
-      enabled_(options.interval_s > 0 || !options.resume.empty() || !options.frames.empty() || !options.shard.empty()),
+      enabled_(uses_state(options)),
       last_write_(std::chrono::steady_clock::now()) {}
 
 void Checkpointer::start(Preview& preview) const {

@@ -118,6 +118,8 @@ void Preview::reset() {
   uploaded_ = false;
   filtered_samples_ = -1;
   case_counts_ = {};
+  next_active_.clear();
+  active_credit_.clear();
 }
 
 void Preview::set_first_frame(uint32_t first) {
@@ -162,7 +164,20 @@ void Preview::upload() {
   const Accumulation& acc = renderer_->accumulation();
   static_assert(kVarUnknown == -1.0f, "Accumulation marks an unknown variance (n < 2) with -1");
   acc.hv_and_variance_of_mean(hv_packed_.data());
-  inputs_.upload_packed(&acc.lv_mean[0].x, hv_packed_.data());
+  const std::vector<uint32_t>& paths = renderer_->pixel_frames();
+  const uint32_t frames = static_cast<uint32_t>(samples());
+  if (std::all_of(paths.begin(), paths.end(), [frames](uint32_t n) { return n == frames; })) {
+    inputs_.upload_packed(&acc.lv_mean[0].x, hv_packed_.data());  // every factor 1
+  } else {
+    // Each pixel's threshold is t_{n_p}: its factor against the run's t_n (shared::pixel_threshold).
+    const float t_now = threshold_now();
+    lv_packed_.resize(paths.size() * 4);
+    for (size_t p = 0; p < paths.size(); ++p) {
+      for (int c = 0; c < 3; ++c) lv_packed_[4 * p + c] = acc.lv_mean[p][c];
+      lv_packed_[4 * p + 3] = t_now > 0.0f ? effective_threshold(settings_.threshold, paths[p]) / t_now : 1.0f;
+    }
+    inputs_.upload_packed_with_threshold(lv_packed_.data(), hv_packed_.data());
+  }
   last_.upload += elapsed_ms(start);
   uploaded_ = true;
 }
@@ -284,7 +299,10 @@ bool Preview::trace_frame() {
   pending_.clear();
   last_ = StageTimes{};
   const auto start = BenchClock::now();
-  const bool complete = renderer_->add_frame();
+  const bool complete = next_active_.empty() ? renderer_->add_frame() : renderer_->add_frame(next_active_);
+  last_active_share_ = next_active_.empty() ? 1.0
+                       : static_cast<double>(std::count(next_active_.begin(), next_active_.end(), 1)) /
+                             static_cast<double>(next_active_.size());
   last_.path_tracing = elapsed_ms(start);
   uploaded_ = false;
   if (!complete) return false;  // cancelled: the renderer reset its samples; the caller resets too
@@ -296,8 +314,46 @@ bool Preview::trace_frame() {
   return true;
 }
 
+void Preview::refresh_guide_images() {
+  if (range_.frames() == guide_frames_) return;
+  guide_color_ = range_.range_color_image();
+  guide_depth_ = range_.depth_image();
+  guide_frames_ = range_.frames();
+}
+
+void Preview::plan_next_frame() {
+  next_active_.clear();
+  if (!settings_.adaptive || static_cast<uint32_t>(samples()) < settings_.adaptive_params.warmup_frames) return;
+  const Accumulation& acc = renderer_->accumulation();
+  const int w = width_, h = height_;
+  Image lv = Image::rgb(w, h), hv = Image::rgb(w, h), var_lv = Image::gray(w, h);
+  for (size_t p = 0; p < acc.samples.size(); ++p) {
+    for (int c = 0; c < 3; ++c) {
+      lv.pixels[3 * p + c] = acc.lv_mean[p][c];
+      hv.pixels[3 * p + c] = acc.hv_mean[p][c];
+    }
+    var_lv.pixels[p] = acc.lv_variance_of_mean(p);
+  }
+  Image var_u = Image::gray(w, h);
+  acc.variance_of_mean_image(var_u.pixels.data(), 1);
+  const bool guide = settings_.filtering() && range_.frames() > 0;
+  if (guide) refresh_guide_images();
+  const std::vector<uint32_t>& paths = renderer_->pixel_frames();
+  const std::vector<float> need =
+      final_pixel_need(lv, hv, var_u, var_lv, paths, settings_.threshold, guide ? &guide_color_ : nullptr,
+                       guide ? &guide_depth_ : nullptr, range_weights(settings_.filter));
+  const AdaptiveParams& params = settings_.adaptive_params;
+  const std::vector<float> rates = sampling_rates(dilate_need(need, w, h, params.dilation_radius), paths, params);
+  // A frame that would trace nothing is no frame: the credits move on until some pixel is due (at
+  // most 1 / floor_rate steps, when every pixel is at the floor).
+  do {
+    next_active_ = select_active(rates, active_credit_);
+  } while (std::find(next_active_.begin(), next_active_.end(), 1) == next_active_.end());
+}
+
 void Preview::queue_passes(bool last_frame, bool display) {
   update_hv_empty();
+  plan_next_frame();
   pending_last_frame_ = last_frame;
   pending_ = {PassStep::RangeFrame, PassStep::Filter};
   if (last_frame || display) pending_.push_back(PassStep::Display);

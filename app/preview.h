@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "app/adaptive.h"
 #include "app/frame_budget.h"
 #include "app/schedule.h"
 #include "gl/blend_pass.h"
@@ -49,6 +50,11 @@ struct PreviewSettings {
   // kernel of 4 px or less the blend's mixed pixels keep about twice the perceived noise t it
   // promises (docs/measurements.md, "Shrinking sigma_s"), and that promise is the method's.
   bool shrink_sigma = false;
+  // Adaptive sampling (app/adaptive.h, issue 33): after adaptive_params.warmup_frames uniform
+  // frames, each frame traces only the pixels the allocation picks, each at its own sample index.
+  // Off by default until pxf bench shows it wins.
+  bool adaptive = false;
+  AdaptiveParams adaptive_params;
   FilterSchedule schedule = FilterSchedule::Budget;
   TonemapParams tonemap;
   RangeSettings range;
@@ -131,7 +137,10 @@ class Preview {
 
   int width() const { return width_; }
   int height() const { return height_; }
-  int samples() const { return renderer_->frames(); }
+  int samples() const { return renderer_->frames(); }  // frames traced; a pixel's own count: pixel_samples()
+  const std::vector<uint32_t>& pixel_samples() const { return renderer_->pixel_frames(); }
+  // The share of the pixels the last traced frame traced (1 for a uniform frame).
+  double last_active_share() const { return last_active_share_; }
   // The threshold the filter's skip and the blend get now: t scaled for the variance estimate's
   // own noise at this sample count (effective_threshold, docs/method.md section 3.5).
   float threshold_now() const { return effective_threshold(settings_.threshold, static_cast<uint64_t>(samples())); }
@@ -184,6 +193,10 @@ class Preview {
   void blend_and_tonemap();
   void finish_passes();
   bool range_due() const;       // one more range frame fits the pass budget
+  // The next frame's active mask (adaptive sampling): empty = every pixel.
+  void plan_next_frame();
+  // The range guide as images for the allocation's pooling, read back when the guide changed.
+  void refresh_guide_images();
   bool filter_due_now() const;  // the queued Filter step would run the filter
 
   int width_, height_;
@@ -197,6 +210,12 @@ class Preview {
   BlendPass blend_;
   TonemapPass tonemap_;
   std::vector<float> hv_packed_;  // the HV texture's data (rgb L_u, a Var[L_u]), filled by the renderer
+  std::vector<float> lv_packed_;  // the LV texture's data with per-pixel threshold factors (adaptive)
+  std::vector<uint8_t> next_active_;  // plan_next_frame()'s mask; empty = every pixel
+  std::vector<float> active_credit_;  // select_active's credits
+  double last_active_share_ = 1.0;
+  Image guide_color_, guide_depth_;   // refresh_guide_images()
+  int guide_frames_ = 0;              // range frames the read-back guide holds
   ScheduleState schedule_;
   bool have_filtered_ = false;
   bool uploaded_ = false;  // inputs hold the current samples

@@ -116,6 +116,7 @@ int run_render(const Args& args) {
     quiet = true;  // no total to show progress against
   }
 
+  check_adaptive_without_state(checkpoint_options, preview_settings.adaptive);
   const FrameRange frames = render_frame_range(checkpoint_options, spp);  // a bad range before any load
 
   const auto start = BenchClock::now();

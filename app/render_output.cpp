@@ -46,6 +46,7 @@ nlohmann::json stats_json(Preview& preview, const RenderReport& r) {
                    {"schedule", filter_schedule_names()[static_cast<int>(s.schedule)]},
                    {"sigma_s", s.filter.sigma_s},
                    {"sigma_shrink", s.shrink_sigma},
+                   {"adaptive", s.adaptive},
                    {"sigma_c", s.filter.sigma_c},
                    {"sigma_d", s.filter.sigma_d},
                    {"seed", s.trace.seed},
@@ -78,6 +79,9 @@ nlohmann::json stats_json(Preview& preview, const RenderReport& r) {
   j["filter_runs_skipped_low_hv"] = preview.filter_runs_skipped_low_hv();
   j["hv_energy_share"] = hv_energy_share(preview.renderer().accumulation());
   j["nan_samples_dropped"] = trace.nan_samples_dropped;
+  // Paths per pixel: spp for a uniform render; with --adaptive each pixel's own count.
+  const SampleCounts paths = sample_counts(preview.pixel_samples());
+  j["samples_per_pixel"] = {{"mean", paths.mean}, {"min", paths.min}, {"max", paths.max}};
   j["interrupted"] = r.interrupted;
   const auto& counts = preview.case_counts();
   j["blend_case_pixels"] = {{"no_filtered", counts[kCaseNoFiltered]}, {"case1", counts[kCaseFilteredOnly]},

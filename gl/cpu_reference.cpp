@@ -18,15 +18,22 @@ Px rgb_at(const Image& im, int x, int y) {
 }
 
 // Images as the shared code reads textures (shaders/cpu_gpu.h): texel p is the first three
-// channels of `rgb` and the first channel of `a` (0 where that image is absent), as the GL passes
-// pack L_u with Var[L_u] and the range color with the distance.
+// channels of `rgb` and the first channel of `a`, as the GL passes pack L_u with Var[L_u] and the
+// range color with the distance. Without `a`, the alpha is the fourth channel of `rgb` where it has
+// one, else 0; L_lv's texel reads 1 there instead (lv_view), as the GL texture does, whose alpha is
+// the pixel's threshold factor (shared::pixel_threshold).
 struct TexelView {
   const Image* rgb = nullptr;
   const Image* a = nullptr;
+  float a_default = 0.0f;
 };
+TexelView lv_view(const Image& lv) { return TexelView{&lv, nullptr, 1.0f}; }
 glm::vec4 texelFetch(const TexelView& t, glm::ivec2 p, int) {
-  glm::vec4 v(0.0f);
-  if (t.rgb) v = glm::vec4(t.rgb->at(p.x, p.y, 0), t.rgb->at(p.x, p.y, 1), t.rgb->at(p.x, p.y, 2), 0.0f);
+  glm::vec4 v(0.0f, 0.0f, 0.0f, t.a_default);
+  if (t.rgb) {
+    v = glm::vec4(t.rgb->at(p.x, p.y, 0), t.rgb->at(p.x, p.y, 1), t.rgb->at(p.x, p.y, 2), t.a_default);
+    if (t.rgb->num_channels() >= 4) v.a = t.rgb->at(p.x, p.y, 3);
+  }
   if (t.a) v.a = t.a->at(p.x, p.y, 0);
   return v;
 }
@@ -63,7 +70,7 @@ struct KernelSums {
 bool case2_skip_decision(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
                          const Image& depth, const FilterParams& p, float t, int x, int y) {
   const RangeWeights range = range_weights(p);
-  return shared::skip_as_case2(TexelView{&hv, &var_u}, TexelView{&lv, nullptr}, TexelView{&range_color, &depth},
+  return shared::skip_as_case2(TexelView{&hv, &var_u}, lv_view(lv), TexelView{&range_color, &depth},
                                glm::ivec2(x, y), range.k_c, range.k_d, t);
 }
 
@@ -236,7 +243,7 @@ BlendOutput cpu_blend(const Image& lv, const Image& hv, const Image& var_u, cons
           float u = vu > 0.0f ? relative_variance(vu, lb) : zero_variance_u(lum(lf.c), lb);
           const float w_centre = filtered->centre_weight.pixels.empty() ? 0.0f : filtered->centre_weight.at(x, y, 0);
           const float f = relative_variance(vf, lb);
-          d = blend_decision(u, f, t, w_centre);
+          d = blend_decision(u, f, shared::pixel_threshold(t, texelFetch(lv_view(lv), glm::ivec2(x, y), 0)), w_centre);
           if (params.bias_guard)
             d.s = shared::guarded_blend_factor(
                 shared::bias_guard_estimate_at(TexelView{&hv, &var_u},

@@ -1,7 +1,9 @@
 // Plain C++ implementation of the preview passes (docs/method.md sections 2, 3, 5) on pxf::Image: the reference the
 // GL shaders are tested against. The per-pixel formulas are the shaders' own (shaders/pass_formulas.h, compiled
 // here as C++); the kernels' loops are written again here, with sums in double.
-// Images: L_u/L_lv "R,G,B"; Var[L_u] one channel (kVarUnknown where n < 2; exactly 0 where all
+// Images: L_u "R,G,B"; L_lv "R,G,B", or "R,G,B,A" with A each pixel's threshold factor (the GL
+// texture's alpha, shared::pixel_threshold: the threshold there is t A; "R,G,B" reads A = 1);
+// Var[L_u] one channel (kVarUnknown where n < 2; exactly 0 where all
 // n >= 2 samples were equal, which the filter and blend do not trust as low variance); the range guide
 // "R,G,B" + depth one channel. Every function sanitizes exactly like the shaders (non-finite
 // inputs read as 0, magnitudes clamped to kMaxInput), so outputs are always finite.

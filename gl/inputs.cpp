@@ -13,6 +13,13 @@ void PreviewInputs::upload_packed(const float* lv_rgb, const float* hv_rgba) {
   timer_.end();
 }
 
+void PreviewInputs::upload_packed_with_threshold(const float* lv_rgba, const float* hv_rgba) {
+  timer_.begin();
+  lv_.upload(lv_rgba, 4);
+  hv_.upload(hv_rgba, 4);
+  timer_.end();
+}
+
 void PreviewInputs::upload(const float* lv_rgb, const float* hv_rgb, const float* var_of_mean) {
   const size_t n = static_cast<size_t>(width_) * height_;
   packed_.resize(n * 4);
@@ -28,9 +35,19 @@ void PreviewInputs::upload(const float* lv_rgb, const float* hv_rgb, const float
 void PreviewInputs::upload(const Image& lv, const Image& hv, const Image& var) {
   for (const Image* im : {&lv, &hv, &var})
     if (im->width != width_ || im->height != height_) throw Error("preview inputs: image size differs from the textures");
-  if (lv.num_channels() != 3 || hv.num_channels() != 3 || var.num_channels() != 1)
-    throw Error("preview inputs: expected RGB lv and hv and a one-channel variance");
-  upload(lv.pixels.data(), hv.pixels.data(), var.pixels.data());
+  if ((lv.num_channels() != 3 && lv.num_channels() != 4) || hv.num_channels() != 3 || var.num_channels() != 1)
+    throw Error("preview inputs: expected RGB (or RGBA) lv, RGB hv and a one-channel variance");
+  if (lv.num_channels() == 3) {
+    upload(lv.pixels.data(), hv.pixels.data(), var.pixels.data());
+    return;
+  }
+  const size_t n = static_cast<size_t>(width_) * height_;
+  packed_.resize(n * 4);
+  for (size_t i = 0; i < n; ++i) {
+    for (int c = 0; c < 3; ++c) packed_[4 * i + c] = hv.pixels[3 * i + c];
+    packed_[4 * i + 3] = var.pixels[i];
+  }
+  upload_packed_with_threshold(lv.pixels.data(), packed_.data());
 }
 
 void PreviewInputs::upload_albedo(const float* albedo_rgb) { albedo_.upload(albedo_rgb, 3); }

@@ -20,19 +20,25 @@ class PreviewInputs {
   int height() const { return height_; }
 
   // lv_rgb: 3 floats per pixel, top row first. hv_rgba: 4 floats per pixel, rgb L_u, a Var[L_u]
-  // (kVarUnknown where n < 2), the HV texture's layout: uploaded as it is, without a copy.
+  // (kVarUnknown where n < 2), the HV texture's layout: uploaded as it is, without a copy. The LV
+  // texture's alpha, the pixels' threshold factor (shared::pixel_threshold), is 1: every pixel holds
+  // the frame count's samples.
   void upload_packed(const float* lv_rgb, const float* hv_rgba);
+  // The same with each pixel's own threshold factor: lv_rgba 4 floats per pixel, rgb L_lv, a the
+  // factor t_{n_p} / t_n of a pixel that holds n_p samples where the run's threshold is t_n
+  // (adaptive sampling).
+  void upload_packed_with_threshold(const float* lv_rgba, const float* hv_rgba);
   // The same from separate buffers: hv_rgb 3 floats per pixel, var_of_mean one (kVarUnknown where
   // n < 2), interleaved into a staging buffer first.
   void upload(const float* lv_rgb, const float* hv_rgb, const float* var_of_mean);
-  // The same from images: lv, hv "R,G,B"; var one channel.
+  // The same from images: lv "R,G,B" (or "R,G,B,A", A the threshold factor), hv "R,G,B"; var one channel.
   void upload(const Image& lv, const Image& hv, const Image& var);
   // The per-pixel mean albedo of the first non-specular vertex (Accumulation::albedo_mean, 3 floats
   // per pixel), for albedo demodulation (gl/demodulation.h). Uploaded only when demodulating.
   void upload_albedo(const float* albedo_rgb);
   void upload_albedo(const Image& albedo);  // "R,G,B"
 
-  const Texture2D& lv() const { return lv_; }  // rgb L_lv
+  const Texture2D& lv() const { return lv_; }  // rgb L_lv, a the pixel's threshold factor
   const Texture2D& hv() const { return hv_; }  // rgb L_u, a Var[L_u] (kVarUnknown where n < 2)
   const Texture2D& albedo() const { return albedo_; }  // rgb mean albedo (upload_albedo)
   double last_upload_ms() const { return timer_.last_ms(); }

@@ -766,6 +766,58 @@ TEST(FullChain, FilterBlendTonemapOnGpuMatchesCpu) {
     EXPECT_EQ(count_nonfinite(im), 0u);
 }
 
+// Adaptive sampling: each pixel's threshold is t times the factor in its L_lv texel's alpha
+// (shared::pixel_threshold). The filter's skip and the blend read it on the GPU as the CPU
+// reference does, and the factors change the decisions (so the test fails if they are ignored).
+TEST(PixelThreshold, FactorsInTheLvAlphaReachTheSkipAndTheBlend) {
+  test::osmesa_context();
+  Scenario s = make_scenario(23);
+  Image lv_rgba = Image::rgba(W, H);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> factor(0.05f, 3.0f);
+  for (size_t i = 0; i < s.lv.pixel_count(); ++i) {
+    for (int c = 0; c < 3; ++c) lv_rgba.pixels[4 * i + c] = s.lv.pixels[3 * i + c];
+    lv_rgba.pixels[4 * i + 3] = factor(rng);
+  }
+  PreviewInputs inputs(W, H);
+  inputs.upload(lv_rgba, s.hv, s.var);
+  Texture2D guide(W, H, TextureFormat::RGBA32F);
+  guide.upload(guide_image(s));
+  const float t = 0.01f;
+  for (FilterKind kind : {FilterKind::BilateralDepth, FilterKind::Grid, FilterKind::Atrous}) {
+    SCOPED_TRACE(filter_kind_name(kind));
+    FilterParams fp;
+    fp.kind = kind;
+    FilterPass filter(W, H);
+    filter.run(inputs, guide, fp, t);
+    const FilterOutput ref = cpu_filter(s.hv, s.var, lv_rgba, s.range, s.depth, fp, t);
+    const FilterOutput uniform = cpu_filter(s.hv, s.var, s.lv, s.range, s.depth, fp, t);
+    size_t skipped = 0, skipped_uniform = 0;
+    for (size_t i = 0; i < ref.variance.pixels.size(); ++i) {
+      skipped += ref.variance.pixels[i] == kVarSkipped;
+      skipped_uniform += uniform.variance.pixels[i] == kVarSkipped;
+    }
+    EXPECT_EQ(filter.filtered_pixels(), W * H - skipped);
+    EXPECT_NE(skipped, skipped_uniform) << "the factors changed no skip decision";
+    expect_close(filter.raw_variance_image(), ref.variance, 1e-4f, 1e-12f, "Var[L_f]");
+    const BlendParams bp{range_weights(fp), true};
+    BlendPass blend(W, H);
+    blend.run(inputs, &filter, guide, t, bp);
+    const BlendOutput ref_blend = cpu_blend(lv_rgba, s.hv, s.var, &ref, t, bp, &s.range, &s.depth);
+    const BlendOutput uniform_blend = cpu_blend(s.lv, s.hv, s.var, &ref, t, bp, &s.range, &s.depth);
+    expect_close(blend.case_image(), ref_blend.blend_case, 0.0f, 0.0f, "case");
+    expect_close(blend.s_image(), ref_blend.s, 1e-4f, 1e-5f, "s");
+    expect_close(blend.final_image(), ref_blend.final_rgb, 1e-4f, 1e-6f, "final");
+    EXPECT_NE(ref_blend.s.pixels, uniform_blend.s.pixels) << "the factors changed no blend factor";
+  }
+  // A factor of 1 everywhere is the uniform threshold, bit for bit.
+  for (size_t i = 0; i < s.lv.pixel_count(); ++i) lv_rgba.pixels[4 * i + 3] = 1.0f;
+  FilterParams fp;
+  const FilterOutput ref = cpu_filter(s.hv, s.var, s.lv, s.range, s.depth, fp, t);
+  EXPECT_EQ(cpu_blend(lv_rgba, s.hv, s.var, &ref, t, {}, &s.range, &s.depth).final_rgb.pixels,
+            cpu_blend(s.lv, s.hv, s.var, &ref, t, {}, &s.range, &s.depth).final_rgb.pixels);
+}
+
 TEST(TonemapVsCpu, MatchesReference) {
   test::osmesa_context();
   std::mt19937 rng(3);

@@ -41,6 +41,8 @@ void visit_arrays(Acc& acc, Visit&& visit) {
   visit(acc.hv_lum_m2, 1);
   visit(acc.samples, 1);
   visit(acc.albedo_mean, 1);
+  visit(acc.lv_lum_mean, 1);
+  visit(acc.lv_lum_m2, 1);
   const size_t replicate_slots = acc.replicates > 1 ? static_cast<size_t>(acc.replicates) : 0;
   visit(acc.replicate_lum_sum, replicate_slots);
   visit(acc.replicate_samples, replicate_slots);
@@ -163,7 +165,8 @@ void check_pixels(const AccumulationState& state) {
     const bool finite = std::isfinite(lv.x) && std::isfinite(lv.y) && std::isfinite(lv.z) && std::isfinite(hv.x) &&
                         std::isfinite(hv.y) && std::isfinite(hv.z) && std::isfinite(a.x) && std::isfinite(a.y) &&
                         std::isfinite(a.z) && std::isfinite(acc.hv_lum_mean[i]) &&
-                        std::isfinite(acc.hv_lum_m2[i]) && acc.hv_lum_m2[i] >= 0.0;
+                        std::isfinite(acc.hv_lum_m2[i]) && acc.hv_lum_m2[i] >= 0.0 &&
+                        std::isfinite(acc.lv_lum_mean[i]) && std::isfinite(acc.lv_lum_m2[i]) && acc.lv_lum_m2[i] >= 0.0;
     if (!finite) throw Error("state file has a non-finite or negative value at pixel " + std::to_string(i));
     if (acc.replicates < 2) continue;
     // The replicate sums split the pixel's samples: their counts add up to its count.
@@ -183,6 +186,13 @@ float combine_mean(float a, uint32_t na, float b, uint32_t nb, double n) {
   return static_cast<float>((static_cast<double>(a) * na + static_cast<double>(b) * nb) / n);
 }
 
+// Chan, Golub and LeVeque's pairwise update of a Welford state (mean, M2) of na samples by one of nb.
+void combine_welford(double& mean, double& m2, uint32_t na, double from_mean, double from_m2, uint32_t nb, double n) {
+  const double delta = from_mean - mean;
+  mean += delta * nb / n;
+  m2 += from_m2 + delta * delta * (static_cast<double>(na) * nb / n);
+}
+
 void merge_into(Accumulation& into, const Accumulation& from) {
   for (size_t i = 0; i < into.samples.size(); ++i) {
     const uint32_t na = into.samples[i], nb = from.samples[i];
@@ -193,6 +203,8 @@ void merge_into(Accumulation& into, const Accumulation& from) {
       into.albedo_mean[i] = from.albedo_mean[i];
       into.hv_lum_mean[i] = from.hv_lum_mean[i];
       into.hv_lum_m2[i] = from.hv_lum_m2[i];
+      into.lv_lum_mean[i] = from.lv_lum_mean[i];
+      into.lv_lum_m2[i] = from.lv_lum_m2[i];
       into.samples[i] = nb;
       continue;
     }
@@ -202,10 +214,8 @@ void merge_into(Accumulation& into, const Accumulation& from) {
       into.hv_mean[i][c] = combine_mean(into.hv_mean[i][c], na, from.hv_mean[i][c], nb, n);
       into.albedo_mean[i][c] = combine_mean(into.albedo_mean[i][c], na, from.albedo_mean[i][c], nb, n);
     }
-    // Chan, Golub and LeVeque's pairwise update of the Welford state.
-    const double delta = from.hv_lum_mean[i] - into.hv_lum_mean[i];
-    into.hv_lum_mean[i] += delta * nb / n;
-    into.hv_lum_m2[i] += from.hv_lum_m2[i] + delta * delta * (static_cast<double>(na) * nb / n);
+    combine_welford(into.hv_lum_mean[i], into.hv_lum_m2[i], na, from.hv_lum_mean[i], from.hv_lum_m2[i], nb, n);
+    combine_welford(into.lv_lum_mean[i], into.lv_lum_m2[i], na, from.lv_lum_mean[i], from.lv_lum_m2[i], nb, n);
     into.samples[i] = na + nb;
   }
   // Each replicate's samples of disjoint frame ranges add up (frame k is in replicate k mod K).

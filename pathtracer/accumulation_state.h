@@ -11,7 +11,8 @@
 
 namespace pxf {
 
-constexpr uint32_t kStateFormatVersion = 4;  // 2: the albedo mean; 3: sampler, replicates, specular sampling; 4: replicate sums
+// 2: the albedo mean; 3: sampler, replicates, specular sampling; 4: replicate sums; 5: the LV luminance Welford state
+constexpr uint32_t kStateFormatVersion = 5;
 
 // Frame counts: one render traces at most kMaxRenderFrames frames (--spp, --frames, --shard); a
 // state, also a merge of many shards, holds at most kMaxStateFrames in all, the most the preview's

@@ -67,6 +67,8 @@ void expect_same_accumulation(const Accumulation& a, const Accumulation& b) {
     }
     EXPECT_NEAR(a.hv_lum_mean[i], b.hv_lum_mean[i], 1e-12 * std::abs(b.hv_lum_mean[i])) << i;
     EXPECT_NEAR(a.hv_lum_m2[i], b.hv_lum_m2[i], 1e-12 * std::abs(b.hv_lum_m2[i])) << i;
+    EXPECT_NEAR(a.lv_lum_mean[i], b.lv_lum_mean[i], 1e-12 * std::abs(b.lv_lum_mean[i])) << i;
+    EXPECT_NEAR(a.lv_lum_m2[i], b.lv_lum_m2[i], 1e-12 * std::abs(b.lv_lum_m2[i])) << i;
   }
 }
 
@@ -110,8 +112,8 @@ TEST(AccumulationState, EveryCorruptedByteIsRefused) {
 
 TEST(AccumulationState, OtherVersionIsRefusedByName) {
   std::vector<uint8_t> bytes = encode_state(render_frames({0, 2}));
-  bytes[8] = 3;  // the version follows the 8-byte magic; version 3 (no replicate sums) is refused
-  EXPECT_NE(decode_error(bytes).find("version 3 is not supported"), std::string::npos) << decode_error(bytes);
+  bytes[8] = 4;  // the version follows the 8-byte magic; version 4 (no LV luminance state) is refused
+  EXPECT_NE(decode_error(bytes).find("version 4 is not supported"), std::string::npos) << decode_error(bytes);
   bytes[0] = 'Q';
   EXPECT_NE(decode_error(bytes).find("not a pxf state file"), std::string::npos);
 }

@@ -24,6 +24,8 @@ AccumulationState state_of_frames(std::vector<FrameRange> ranges) {
   s.acc.albedo_mean.assign(2, glm::vec3(0.8f));
   s.acc.hv_lum_mean.assign(2, 0.25);
   s.acc.hv_lum_m2.assign(2, 0.0);
+  s.acc.lv_lum_mean.assign(2, 0.5);
+  s.acc.lv_lum_m2.assign(2, 0.0);
   s.acc.samples.assign(2, std::min<uint64_t>(s.frame_count(), UINT32_MAX));
   return s;
 }

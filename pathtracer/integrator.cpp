@@ -303,29 +303,49 @@ PathSample PathTracer::trace_pixel(const Camera& camera, int width, int height, 
   return out;
 }
 
+namespace {
+// The jobs of pixels first .. first + count - 1 (row-major in rect), all at sample index `frame`.
+void rect_jobs(const PixelRect& rect, int first, int count, uint32_t frame, PixelSampleJob* jobs) {
+  for (int i = 0; i < count; ++i)
+    jobs[i] = PixelSampleJob{rect.x0 + (first + i) % rect.width(), rect.y0 + (first + i) / rect.width(), frame};
+}
+}  // namespace
+
 void PathTracer::trace_pixels(const Camera& camera, int width, int height, const PixelRect& rect, uint32_t frame,
                               const TraceParams& params, PathSample* out) const {
   const int count = rect.count();
+  PixelSampleJob jobs[kBatchPaths];
+  for (int first = 0; first < count; first += kBatchPaths) {
+    const int batch = std::min(kBatchPaths, count - first);
+    rect_jobs(rect, first, batch, frame, jobs);
+    trace_batch<false>(camera, width, height, jobs, batch, params, out + first, nullptr);
+  }
+}
+
+void PathTracer::trace_jobs(const Camera& camera, int width, int height, const PixelSampleJob* jobs, int count,
+                            const TraceParams& params, PathSample* out) const {
   for (int first = 0; first < count; first += kBatchPaths)
-    trace_batch<false>(camera, width, height, rect, first, std::min(kBatchPaths, count - first), frame, params,
-                       out + first, nullptr);
+    trace_batch<false>(camera, width, height, jobs + first, std::min(kBatchPaths, count - first), params, out + first,
+                       nullptr);
 }
 
 void PathTracer::trace_pixels_classified(const Camera& camera, int width, int height, const PixelRect& rect,
                                          uint32_t frame, const TraceParams& params, PathSample* out,
                                          HvSampleClass* classes) const {
   const int count = rect.count();
-  for (int first = 0; first < count; first += kBatchPaths)
-    trace_batch<true>(camera, width, height, rect, first, std::min(kBatchPaths, count - first), frame, params,
-                      out + first, classes + first);
+  PixelSampleJob jobs[kBatchPaths];
+  for (int first = 0; first < count; first += kBatchPaths) {
+    const int batch = std::min(kBatchPaths, count - first);
+    rect_jobs(rect, first, batch, frame, jobs);
+    trace_batch<true>(camera, width, height, jobs, batch, params, out + first, classes + first);
+  }
 }
 
-// Pixels first .. first + count - 1 (row-major in rect) of trace_pixels, in lockstep.
+// The paths of jobs[0 .. count - 1], in lockstep.
 template <bool kClassify>
-void PathTracer::trace_batch(const Camera& camera, int width, int height, const PixelRect& rect, int first, int count,
-                             uint32_t frame, const TraceParams& params, PathSample* out, HvSampleClass* classes) const {
+void PathTracer::trace_batch(const Camera& camera, int width, int height, const PixelSampleJob* jobs, int count,
+                             const TraceParams& params, PathSample* out, HvSampleClass* classes) const {
   const CameraRays camera_rays(camera, width, height);
-  const FrameSampling frame_sampling(params.seed, frame, params.replicates);
   Path paths[kBatchPaths];
   ClassState class_states[kClassify ? kBatchPaths : 1];
   if constexpr (kClassify)
@@ -338,17 +358,19 @@ void PathTracer::trace_batch(const Camera& camera, int width, int height, const 
   // then the jitters, then the camera rays. In one loop each path's chain of dependent hashes
   // stalled the next; apart, the processor overlaps many paths' hashes.
   glm::vec2 jitters[kBatchPaths];
+  // What the sampler derives from the sample index alone, recomputed only where the index changes
+  // (a uniform frame's batch has one index).
+  FrameSampling frame_sampling(params.seed, jobs[0].index, params.replicates);
   for (int i = 0; i < count; ++i) {
-    const int x = rect.x0 + (first + i) % rect.width(), y = rect.y0 + (first + i) / rect.width();
-    const uint64_t pixel = static_cast<uint64_t>(y) * static_cast<uint64_t>(width) + static_cast<uint64_t>(x);
+    if (jobs[i].index != frame_sampling.frame) frame_sampling = FrameSampling(params.seed, jobs[i].index, params.replicates);
+    const uint64_t pixel = static_cast<uint64_t>(jobs[i].y) * static_cast<uint64_t>(width) + static_cast<uint64_t>(jobs[i].x);
     paths[i].sampler = PathSampler(params.sampler, frame_sampling, pixel);
   }
   for (int i = 0; i < count; ++i) jitters[i] = paths[i].sampler.camera_jitter();  // box filter: uniform in the pixel
   for (int i = 0; i < count; ++i) {
-    const int x = rect.x0 + (first + i) % rect.width(), y = rect.y0 + (first + i) / rect.width();
     out[i] = PathSample{};
     Path& path = paths[i];
-    path.ray = camera_rays(static_cast<float>(x) + jitters[i].x, static_cast<float>(y) + jitters[i].y);
+    path.ray = camera_rays(static_cast<float>(jobs[i].x) + jitters[i].x, static_cast<float>(jobs[i].y) + jitters[i].y);
     path.state = PathState{};
     path.out = &out[i];
   }
@@ -579,6 +601,8 @@ void resize_accumulation(Accumulation& acc, int width, int height, int replicate
   acc.albedo_mean.assign(n, glm::vec3(0.0f));
   acc.hv_lum_mean.assign(n, 0.0);
   acc.hv_lum_m2.assign(n, 0.0);
+  acc.lv_lum_mean.assign(n, 0.0);
+  acc.lv_lum_m2.assign(n, 0.0);
   acc.samples.assign(n, 0u);
   acc.replicates = std::max(1, replicates);
   const size_t replicate_slots = acc.replicates > 1 ? n * static_cast<size_t>(acc.replicates) : 0;
@@ -596,6 +620,9 @@ void accumulate_sample(Accumulation& acc, size_t pixel, glm::vec3 lv, glm::vec3 
   double delta = y - acc.hv_lum_mean[pixel];
   acc.hv_lum_mean[pixel] += delta / static_cast<double>(n);
   acc.hv_lum_m2[pixel] += delta * (y - acc.hv_lum_mean[pixel]);
+  const double y_lv = luminance(lv), delta_lv = y_lv - acc.lv_lum_mean[pixel];
+  acc.lv_lum_mean[pixel] += delta_lv / static_cast<double>(n);
+  acc.lv_lum_m2[pixel] += delta_lv * (y_lv - acc.lv_lum_mean[pixel]);
   if (acc.replicates > 1) {
     const size_t slot = pixel * static_cast<size_t>(acc.replicates) + static_cast<size_t>(replicate % acc.replicates);
     acc.replicate_lum_sum[slot] += y;
@@ -603,13 +630,23 @@ void accumulate_sample(Accumulation& acc, size_t pixel, glm::vec3 lv, glm::vec3 
   }
 }
 
-float Accumulation::per_sample_variance_of_mean(size_t pixel) const {
-  uint32_t n = samples[pixel];
+namespace {
+// s^2 / n of a Welford state of n samples; -1 when n < 2.
+float welford_variance_of_mean(double m2, uint32_t n) {
   if (n < 2) return -1.0f;
-  double var = hv_lum_m2[pixel] / static_cast<double>(n - 1) / static_cast<double>(n);
+  double var = m2 / static_cast<double>(n - 1) / static_cast<double>(n);
   // Saturate rather than overflow: a very bright but finite input (luminance near the float limit)
   // has a variance beyond float range, and an infinite variance would poison every later pass.
   return static_cast<float>(std::clamp(var, 0.0, static_cast<double>(std::numeric_limits<float>::max())));
+}
+}  // namespace
+
+float Accumulation::per_sample_variance_of_mean(size_t pixel) const {
+  return welford_variance_of_mean(hv_lum_m2[pixel], samples[pixel]);
+}
+
+float Accumulation::lv_variance_of_mean(size_t pixel) const {
+  return welford_variance_of_mean(lv_lum_m2[pixel], samples[pixel]);
 }
 
 float Accumulation::replicate_variance_of_mean(size_t pixel) const {

@@ -57,6 +57,13 @@ struct PixelRect {
   int count() const { return (x1 - x0) * (y1 - y0); }
 };
 
+// One path to trace: pixel (x, y) at sample index `index` (the frame of a uniform frame; with
+// adaptive sampling the pixel's own count of traced paths, docs/sampling.md).
+struct PixelSampleJob {
+  int x = 0, y = 0;
+  uint32_t index = 0;
+};
+
 class PathTracer {
  public:
   explicit PathTracer(const Scene& scene);
@@ -68,6 +75,11 @@ class PathTracer {
   // neither the rect nor the thread changes a pixel's value.
   void trace_pixels(const Camera& camera, int width, int height, const PixelRect& rect, uint32_t frame,
                     const TraceParams& params, PathSample* out) const;
+  // One path per job, out[i] for jobs[i]: the pixels of a frame that traces only some of them (a
+  // compacted list, so that the batches stay full). The same samples as trace_pixels gives each
+  // pixel at that index, bit for bit.
+  void trace_jobs(const Camera& camera, int width, int height, const PixelSampleJob* jobs, int count,
+                  const TraceParams& params, PathSample* out) const;
   // The path of pixel (x, y): trace_pixels on that pixel alone.
   PathSample trace_pixel(const Camera& camera, int width, int height, int x, int y, uint32_t frame,
                          const TraceParams& params) const;
@@ -91,8 +103,8 @@ class PathTracer {
   struct ShadowQueue;
   struct ClassState;
   template <bool kClassify>
-  void trace_batch(const Camera& camera, int width, int height, const PixelRect& rect, int first, int count,
-                   uint32_t frame, const TraceParams& params, PathSample* out, HvSampleClass* classes) const;
+  void trace_batch(const Camera& camera, int width, int height, const PixelSampleJob* jobs, int count,
+                   const TraceParams& params, PathSample* out, HvSampleClass* classes) const;
   template <bool kClassify>
   bool shade_vertex(Path& path, const Hit& hit, int vertex, const TraceParams& params, ShadowQueue& shadows,
                     const PathSampler::VertexNumbers* numbers, ClassState* cls) const;

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 #include <glm/glm.hpp>
+#include "core/memory.h"  // available_memory_bytes, which LoadLimits defaults to
 #include "image/image.h"
 #include "pathtracer/default_light.h"
 #include "pathtracer/sampler.h"
@@ -78,9 +79,6 @@ struct LoadLimits {
   uint64_t available_memory = 0;                  // bytes; 0 = what the system reports now
 };
 
-// Memory the system can give without swapping: MemAvailable from /proc/meminfo, else
-// sysconf's available physical pages; 0 when neither is known.
-uint64_t available_memory_bytes();
 
 // The loader's memory estimate for a scene, in bytes: what the loaded scene, the BVH, the raster
 // pass's copies and the decoding need at the peak (docs/scenes.md, "Resource limits").
@@ -136,6 +134,10 @@ struct Accumulation {
   std::vector<glm::vec3> albedo_mean;  // mean PathSample::albedo (first non-specular base color)
   std::vector<double> hv_lum_mean;     // Welford state of HV luminance
   std::vector<double> hv_lum_m2;
+  // Welford state of LV luminance: LV is never filtered, so its noise is part of what the viewer
+  // sees; adaptive sampling judges the final pixel L_lv + L_u by it (app/adaptive.h).
+  std::vector<double> lv_lum_mean;
+  std::vector<double> lv_lum_m2;
   std::vector<uint32_t> samples;       // accepted samples per pixel (NaN/Inf samples dropped)
   // Interleaved replicates (TraceParams::replicates, 1 = none): HV luminance sum and sample count
   // of replicate r of pixel p at [p * replicates + r].
@@ -155,6 +157,8 @@ struct Accumulation {
   // buffer as its HV texture as it is.
   void hv_and_variance_of_mean(float* rgba) const;
   float per_sample_variance_of_mean(size_t pixel) const;  // s^2 / n, -1 when n < 2
+  // Var[L_lv] of the LV luminance mean, s^2 / n (no replicate gain); -1 when n < 2.
+  float lv_variance_of_mean(size_t pixel) const;
   // K'/(K'-1) sum_r (n_r / n)^2 (m_r - m)^2 over the K' replicates with samples; -1 when K' < 2.
   float replicate_variance_of_mean(size_t pixel) const;
 };
@@ -168,7 +172,7 @@ struct TraceStats {
 
 class PathTracer;  // Embree scene, light and environment samplers (pathtracer internals)
 
-// The progressive state: one path per pixel per add_frame().
+// The progressive state: one path per pixel (or per active pixel) per add_frame().
 class ProgressiveRenderer {
  public:
   // The renderer keeps a reference to `scene`, not a copy: the scene must outlive the renderer and
@@ -182,13 +186,23 @@ class ProgressiveRenderer {
   void reset();                          // clears accumulation (camera, scene or params changed)
   void set_camera(const Camera& camera); // resets
   void set_params(const TraceParams& params);  // resets
-  // Traces one path per pixel, frame index = first_frame() + frames(). Returns false when
+  // Traces one path per pixel, each at its own sample index first_frame() + pixel_frames()[p]
+  // (first_frame() + frames() while every frame traced every pixel). Returns false when
   // cancel_frame() stopped it: the frame is then incomplete and the accumulation is reset.
   bool add_frame();
+  // The same for the pixels whose `active` entry is nonzero only (width x height entries, row-major;
+  // adaptive sampling, docs/sampling.md): they are compacted into full batches, and each traces the
+  // next sample of its own sequence, so the result does not depend on the thread count. Throws
+  // pxf::Error when the mask's size is not the image's.
+  bool add_frame(const std::vector<uint8_t>& active);
   // Thread-safe: a running add_frame() (on another thread) stops after the tiles in flight. For a
   // caller about to reset anyway (the explorer's camera moves), so that it need not wait a frame.
   void cancel_frame();
   int frames() const;                    // frames traced (or restored) since the last reset
+  // Paths traced into each pixel since the last reset (restored frames included), dropped
+  // non-finite ones too: the pixel's next sample index is first_frame() + this. Accumulation::samples
+  // counts the accepted ones only.
+  const std::vector<uint32_t>& pixel_frames() const;
   // Where the frame sequence starts (a shard of frames A:B starts at A); resets.
   void set_first_frame(uint32_t first);
   uint32_t first_frame() const;
@@ -228,6 +242,7 @@ class ProgressiveRenderer {
 
  private:
   struct Impl;
+  bool add_frame_of(const uint8_t* active);  // nullptr: every pixel
   std::unique_ptr<Impl> impl_;
 };
 

@@ -1,4 +1,4 @@
-// ProgressiveRenderer: one path per pixel per frame over tiles on a oneTBB arena; accumulation.
+// ProgressiveRenderer: one path per active pixel per frame, in chunks of tiles on a oneTBB arena; accumulation.
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -29,11 +29,14 @@ struct ProgressiveRenderer::Impl {
   TraceStats stats;
   std::atomic<int> frames{0};  // read by the explorer's UI thread while a worker traces
   uint32_t first_frame = 0;
+  std::vector<uint32_t> pixel_frames;  // paths traced into each pixel since the reset
+  std::vector<PixelSampleJob> jobs;    // the frame's paths (build_jobs), kept to reuse the memory
 
   Impl(const Scene& s, const TraceParams& p, int w, int h) : scene(s), camera(s.camera), params(p), width(w), height(h) {
     if (w <= 0 || h <= 0) throw Error("path tracer: image size must be positive");
     tracer = std::make_unique<PathTracer>(scene);
     resize_accumulation(acc, w, h, accumulation_replicates());
+    pixel_frames.assign(static_cast<size_t>(w) * h, 0u);
     make_arena();
   }
 
@@ -44,46 +47,71 @@ struct ProgressiveRenderer::Impl {
     arena = std::make_unique<tbb::task_arena>(threads);
   }
 
+  // The pixels a frame traces, as jobs in tile order (16x16 tiles, row-major inside each): with
+  // every pixel active a chunk of kChunk jobs is one tile, as the camera rays' coherence wants; with
+  // a mask the active pixels are compacted, so that every chunk but the last is a full batch.
+  // Each job's sample index is the pixel's own count, so a pixel's samples do not depend on which
+  // other pixels a frame traces, nor on the chunking or the thread.
+  void build_jobs(const uint8_t* active) {
+    jobs.clear();
+    const int tiles_x = (width + kTileSize - 1) / kTileSize, tiles_y = (height + kTileSize - 1) / kTileSize;
+    for (int ty = 0; ty < tiles_y; ++ty)
+      for (int tx = 0; tx < tiles_x; ++tx)
+        for (int y = ty * kTileSize; y < std::min((ty + 1) * kTileSize, height); ++y)
+          for (int x = tx * kTileSize; x < std::min((tx + 1) * kTileSize, width); ++x) {
+            const size_t p = static_cast<size_t>(y) * width + x;
+            if (active && !active[p]) continue;
+            jobs.push_back(PixelSampleJob{x, y, first_frame + pixel_frames[p]});
+          }
+  }
+
   void render_frame() {
-    const int tiles_x = (width + kTileSize - 1) / kTileSize;
-    const int tiles_y = (height + kTileSize - 1) / kTileSize;
-    const uint32_t frame = first_frame + static_cast<uint32_t>(frames);
-    const int replicate = static_cast<int>(frame % static_cast<uint32_t>(acc.replicates));
+    constexpr int kChunk = kTileSize * kTileSize;
+    const int chunks = static_cast<int>((jobs.size() + kChunk - 1) / kChunk);
+    const uint32_t replicates = static_cast<uint32_t>(acc.replicates);
     std::atomic<uint64_t> rays{0}, paths{0}, dropped{0};
-    auto render_tiles = [&](const tbb::blocked_range<int>& range) {
-      uint64_t tile_rays = 0, tile_paths = 0, tile_dropped = 0;
-      for (int tile = range.begin(); tile != range.end(); ++tile) {
+    auto render_chunks = [&](const tbb::blocked_range<int>& range) {
+      uint64_t chunk_rays = 0, chunk_paths = 0, chunk_dropped = 0;
+      for (int chunk = range.begin(); chunk != range.end(); ++chunk) {
         if (cancel.load(std::memory_order_relaxed)) break;
-        int x0 = (tile % tiles_x) * kTileSize, y0 = (tile / tiles_x) * kTileSize;
-        const PixelRect rect{x0, y0, std::min(x0 + kTileSize, width), std::min(y0 + kTileSize, height)};
-        PathSample samples[kTileSize * kTileSize];
-        tracer->trace_pixels(camera, width, height, rect, frame, params, samples);
-        for (int i = 0; i < rect.count(); ++i) {
+        const size_t first = static_cast<size_t>(chunk) * kChunk;
+        const int count = static_cast<int>(std::min<size_t>(kChunk, jobs.size() - first));
+        PathSample samples[kChunk];
+        tracer->trace_jobs(camera, width, height, &jobs[first], count, params, samples);
+        for (int i = 0; i < count; ++i) {
           const PathSample& sample = samples[i];
-          tile_rays += sample.rays;
-          ++tile_paths;
+          const PixelSampleJob& job = jobs[first + i];
+          chunk_rays += sample.rays;
+          ++chunk_paths;
           if (!sample.finite()) {  // LV and HV of a path are dropped together
-            ++tile_dropped;
+            ++chunk_dropped;
             continue;
           }
-          const int x = rect.x0 + i % rect.width(), y = rect.y0 + i / rect.width();
-          accumulate_sample(acc, static_cast<size_t>(y) * width + x, sample.lv, sample.hv, replicate, sample.albedo);
+          accumulate_sample(acc, static_cast<size_t>(job.y) * width + job.x, sample.lv, sample.hv,
+                            static_cast<int>(job.index % replicates), sample.albedo);
         }
       }
-      rays += tile_rays;
-      paths += tile_paths;
-      dropped += tile_dropped;
+      rays += chunk_rays;
+      paths += chunk_paths;
+      dropped += chunk_dropped;
     };
-    arena->execute([&] { tbb::parallel_for(tbb::blocked_range<int>(0, tiles_x * tiles_y, 1), render_tiles); });
+    arena->execute([&] { tbb::parallel_for(tbb::blocked_range<int>(0, chunks, 1), render_chunks); });
     stats.rays += rays;
     stats.paths += paths;
     stats.nan_samples_dropped += dropped;
   }
 
-  // A dark scene is black: every pixel gets an exact zero sample without tracing.
+  // A dark scene is black: every traced pixel gets an exact zero sample without tracing.
   void add_dark_frame() {
-    const int replicate = frames % acc.replicates;
-    for (size_t i = 0; i < acc.samples.size(); ++i) accumulate_sample(acc, i, glm::vec3(0.0f), glm::vec3(0.0f), replicate);
+    const uint32_t replicates = static_cast<uint32_t>(acc.replicates);
+    for (const PixelSampleJob& job : jobs)
+      accumulate_sample(acc, static_cast<size_t>(job.y) * width + job.x, glm::vec3(0.0f), glm::vec3(0.0f),
+                        static_cast<int>(job.index % replicates));
+  }
+
+  // Every traced pixel's count moves on: its next path takes the next index of its sequence.
+  void count_traced_pixels() {
+    for (const PixelSampleJob& job : jobs) ++pixel_frames[static_cast<size_t>(job.y) * width + job.x];
   }
 };
 
@@ -94,6 +122,7 @@ ProgressiveRenderer::~ProgressiveRenderer() = default;
 void ProgressiveRenderer::reset() {
   impl_->cancel.store(false);  // a cancel meant for a frame that finished first
   resize_accumulation(impl_->acc, impl_->width, impl_->height, impl_->accumulation_replicates());
+  impl_->pixel_frames.assign(impl_->pixel_frames.size(), 0u);
   impl_->stats = TraceStats{};
   impl_->frames = 0;
 }
@@ -109,8 +138,18 @@ void ProgressiveRenderer::set_params(const TraceParams& params) {
   reset();
 }
 
-bool ProgressiveRenderer::add_frame() {
+bool ProgressiveRenderer::add_frame() { return add_frame_of(nullptr); }
+
+bool ProgressiveRenderer::add_frame(const std::vector<uint8_t>& active) {
+  if (active.size() != impl_->pixel_frames.size())
+    throw Error("active mask has " + std::to_string(active.size()) + " entries, the image " +
+                std::to_string(impl_->pixel_frames.size()) + " pixels");
+  return add_frame_of(active.data());
+}
+
+bool ProgressiveRenderer::add_frame_of(const uint8_t* active) {
   auto start = std::chrono::steady_clock::now();
+  impl_->build_jobs(active);
   if (impl_->tracer->dark())
     impl_->add_dark_frame();
   else
@@ -119,6 +158,7 @@ bool ProgressiveRenderer::add_frame() {
     reset();
     return false;
   }
+  impl_->count_traced_pixels();
   ++impl_->frames;
   impl_->stats.last_frame_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return true;
@@ -127,6 +167,7 @@ bool ProgressiveRenderer::add_frame() {
 void ProgressiveRenderer::cancel_frame() { impl_->cancel.store(true); }
 
 int ProgressiveRenderer::frames() const { return impl_->frames; }
+const std::vector<uint32_t>& ProgressiveRenderer::pixel_frames() const { return impl_->pixel_frames; }
 uint32_t ProgressiveRenderer::first_frame() const { return impl_->first_frame; }
 
 void ProgressiveRenderer::set_first_frame(uint32_t first) {
@@ -144,6 +185,7 @@ void ProgressiveRenderer::restore(const Accumulation& acc, uint32_t first, int f
   impl_->acc = acc;
   impl_->first_frame = first;
   impl_->frames = frames;
+  impl_->pixel_frames.assign(impl_->pixel_frames.size(), static_cast<uint32_t>(frames));  // a state's frames are uniform
   impl_->stats = TraceStats{};
 }
 const Accumulation& ProgressiveRenderer::accumulation() const { return impl_->acc; }

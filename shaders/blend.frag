@@ -3,7 +3,7 @@
 #include "pass_formulas.h"
 
 layout(binding = kUnitHv) uniform sampler2D hv_tex;        // rgb L_u, a Var[L_u]
-layout(binding = kUnitLv) uniform sampler2D lv_tex;        // rgb L_lv
+layout(binding = kUnitLv) uniform sampler2D lv_tex;        // rgb L_lv, a the pixel's threshold factor (pixel_threshold)
 layout(binding = kUnitFiltered) uniform sampler2D filtered_tex;  // rgb L_f, a Var[L_f] (or a sentinel)
 layout(binding = kUnitGuide) uniform sampler2D guide_tex;   // rgb range color, a distance (pooling)
 layout(binding = kUnitCentreWeight) uniform sampler2D centre_weight_tex;  // r: the filter's centre weight w
@@ -13,7 +13,7 @@ uniform int has_centre_weight;  // 0: Cov[L_u, L_f] not known, left out (w = 0)
 uniform int has_guide;  // 0: u from the pixel's own variance only
 uniform float k_c;      // range weights of the variance pooling (the filter's)
 uniform float k_d;
-uniform float t;
+uniform float t;         // times the pixel's factor: pixel_threshold
 uniform int bias_guard;  // 1: raise s where L_f is measurably biased (bias_guard_factor)
 
 layout(std430, binding = kBufferCounts) buffer CaseCounts { uint case_counts[kBlendCaseCount]; };
@@ -24,7 +24,8 @@ void main() {
   ivec2 p = ivec2(gl_FragCoord.xy);
   vec4 hv = texelFetch(hv_tex, p, 0);
   vec3 lu = clean(hv.rgb);
-  vec3 lv = clean(texelFetch(lv_tex, p, 0).rgb);
+  vec4 lv_texel = texelFetch(lv_tex, p, 0);
+  vec3 lv = clean(lv_texel.rgb);
   vec3 lf = lu;
   float s = 1.0;
   int blend_case = kCaseNoFiltered;
@@ -48,7 +49,7 @@ void main() {
       float u = vu > 0.0 ? relative_variance(vu, lb) : zero_variance_u(luminance(lf), lb);
       float w = has_centre_weight != 0 ? texelFetch(centre_weight_tex, p, 0).r : 0.0;
       float f = relative_variance(vf, lb);
-      s = blend_factor_covariance(u, f, t, w, blend_case);
+      s = blend_factor_covariance(u, f, pixel_threshold(t, lv_texel), w, blend_case);
       if (bias_guard != 0) {
         vec2 g = texelFetch(guard_tex, p, 0).rg;
         BiasGuardEstimate e;

@@ -199,6 +199,12 @@ PXF_SAMPLER_FN float pooled_var_u(sampler2D hv, sampler2D guide, ivec2 p, float 
   return sw > 0.0f ? max(own, float(swv / sw)) : own;
 }
 
+// The threshold of pixel p: a run's t (the threshold after the frame count's samples, t_n of
+// docs/method.md 3.5) times the factor in the alpha of the pixel's L_lv texel, which is 1 where the
+// pixel holds the frame count's samples and, under adaptive sampling, t_{n_p} / t_n for its own
+// count n_p (gl/inputs.h). One product: a uniform frame's threshold is t itself, bit for bit.
+PXF_INLINE float pixel_threshold(float t, vec4 lv_texel) { return t * lv_texel.a; }
+
 // The filter's case-2 skip (FilterParams::skip_case2, final pass only): the blend's u (pooled
 // variance) with the unfiltered background L_b = Y(L_u) + Y(L_lv); a zero variance (all samples
 // equal, no neighbour known) is not trusted. The pooled variance is at least the pixel's own, so a
@@ -208,11 +214,13 @@ PXF_SAMPLER_FN float pooled_var_u(sampler2D hv, sampler2D guide, ivec2 p, float 
 PXF_SAMPLER_FN bool skip_as_case2(sampler2D hv, sampler2D lv, sampler2D guide, ivec2 p, float k_c, float k_d,
                                   float t) {
   vec4 hv_p = texelFetch(hv, p, 0);
-  float lb = max(luminance(clean(vec3(hv_p))) + luminance(clean(vec3(texelFetch(lv, p, 0)))), 0.0f);
+  vec4 lv_p = texelFetch(lv, p, 0);
+  float lb = max(luminance(clean(vec3(hv_p))) + luminance(clean(vec3(lv_p))), 0.0f);
+  float t_p = max(pixel_threshold(t, lv_p), 0.0f);
   float own = clean_var(hv_p.a);
-  if (own > 0.0f && relative_variance(own, lb) > max(t, 0.0f)) return false;
+  if (own > 0.0f && relative_variance(own, lb) > t_p) return false;
   float v = pooled_var_u(hv, guide, p, k_c, k_d);
-  return v > 0.0f && relative_variance(v, lb) <= max(t, 0.0f);
+  return v > 0.0f && relative_variance(v, lb) <= t_p;
 }
 
 // ---- Blend factor ----

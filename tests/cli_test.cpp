@@ -183,6 +183,31 @@ TEST(Cli, AllHvRendersDefaultToAtrousUnlessFilterIsGiven) {
   EXPECT_EQ(stats["settings"]["all_hv"], false);
 }
 
+// --adaptive on (issue 33): off by default, recorded in stats.json with the paths per pixel; after
+// the 16 uniform warm-up frames the pixels' counts part; a state is refused in one line (its
+// resume would not be exact).
+TEST(Cli, AdaptiveRenderRecordsItsPixelCountsAndRefusesStates) {
+  const std::string out = temp_dir("adaptive");
+  ASSERT_EQ(run("render --size 32x24 --spp 4 --quiet --out " + out).code, 0);
+  const auto uniform = nlohmann::json::parse(slurp(out + "/stats.json"));
+  EXPECT_EQ(uniform["settings"]["adaptive"], false);
+  EXPECT_EQ(uniform["samples_per_pixel"]["mean"].get<double>(), 4.0);
+  EXPECT_EQ(uniform["samples_per_pixel"]["max"], 4);
+  const Result r = run("render --size 32x24 --spp 48 --threshold 0.05 --adaptive on --quiet --out " + out);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto adaptive = nlohmann::json::parse(slurp(out + "/stats.json"));
+  EXPECT_EQ(adaptive["settings"]["adaptive"], true);
+  EXPECT_EQ(adaptive["samples_per_pixel"]["max"], 48);
+  EXPECT_GE(adaptive["samples_per_pixel"]["min"].get<int>(), 16 + (48 - 16) / 16);  // warm-up, then the floor
+  EXPECT_LT(adaptive["samples_per_pixel"]["mean"].get<double>(), 48.0);
+  for (const char* state : {"--checkpoint 5", "--resume nope.pxfs", "--frames 0:8", "--shard 1/2"}) {
+    const Result refused = run(std::string("render --size 32x24 --spp 8 --adaptive on --quiet ") + state + " --out " + out);
+    EXPECT_EQ(refused.code, 2) << state;
+    EXPECT_EQ(lines(refused.err), 1u) << refused.err;
+    EXPECT_NE(refused.err.find("--adaptive on"), std::string::npos) << refused.err;
+  }
+}
+
 TEST(Cli, RenderWritesEveryOutput) {
   const std::string out = temp_dir("render");
   const Result r = run("render --size 32x24 --spp 4 --schedule pow2 --quiet --out " + out);

@@ -1,0 +1,96 @@
+#include "app/adaptive.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "gl/cpu_reference.h"
+
+namespace pxf {
+
+std::vector<float> final_pixel_need(const Image& lv, const Image& hv, const Image& var_u, const Image& var_lv,
+                                    const std::vector<uint32_t>& paths, float t, const Image* range_color,
+                                    const Image* depth, const RangeWeights& range) {
+  const int w = hv.width, h = hv.height;
+  // Var[L_lv + L_u] as Var[L_u] + Var[L_lv], unknown where either is: the image the pooling reads.
+  Image var_final = Image::gray(w, h);
+  for (size_t p = 0; p < var_final.pixels.size(); ++p) {
+    const float vu = clean_var(var_u.pixels[p]), vl = clean_var(var_lv.pixels[p]);
+    var_final.pixels[p] = vu < 0.0f || vl < 0.0f ? kVarUnknown : vu + vl;
+  }
+  const bool pool = range_color && depth;
+  std::vector<float> need(var_final.pixels.size());
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const size_t p = static_cast<size_t>(y) * w + x;
+      const float v = pool ? pooled_var_u(var_final, *range_color, *depth, x, y, range) : var_final.pixels[p];
+      if (v < 0.0f) {
+        need[p] = std::numeric_limits<float>::infinity();
+        continue;
+      }
+      const float lb = std::max(luminance(clean(hv.at(x, y, 0)), clean(hv.at(x, y, 1)), clean(hv.at(x, y, 2))) +
+                                    luminance(clean(lv.at(x, y, 0)), clean(lv.at(x, y, 1)), clean(lv.at(x, y, 2))),
+                                0.0f);
+      const float t_n = effective_threshold(t, paths[p]);
+      need[p] = t_n > 0.0f ? relative_variance(v, lb) / t_n : std::numeric_limits<float>::infinity();
+    }
+  return need;
+}
+
+std::vector<float> dilate_need(const std::vector<float>& need, int width, int height, int radius) {
+  // Separable: the largest value along each row's window, then along each column's.
+  std::vector<float> rows(need.size()), out(need.size());
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      float m = -std::numeric_limits<float>::infinity();
+      for (int q = std::max(0, x - radius); q <= std::min(width - 1, x + radius); ++q)
+        m = std::max(m, need[static_cast<size_t>(y) * width + q]);
+      rows[static_cast<size_t>(y) * width + x] = m;
+    }
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      float m = -std::numeric_limits<float>::infinity();
+      for (int q = std::max(0, y - radius); q <= std::min(height - 1, y + radius); ++q)
+        m = std::max(m, rows[static_cast<size_t>(q) * width + x]);
+      out[static_cast<size_t>(y) * width + x] = m;
+    }
+  return out;
+}
+
+std::vector<float> sampling_rates(const std::vector<float>& dilated_need, const std::vector<uint32_t>& paths,
+                                  const AdaptiveParams& params) {
+  std::vector<float> rates(dilated_need.size());
+  for (size_t p = 0; p < rates.size(); ++p) {
+    float need = std::isnan(dilated_need[p]) ? std::numeric_limits<float>::infinity() : dilated_need[p];
+    if (paths[p] < params.min_samples) need = std::max(need, 1.0f);  // not retired on few samples
+    rates[p] = std::clamp(need / params.full_rate_need, params.floor_rate, 1.0f);
+  }
+  return rates;
+}
+
+std::vector<uint8_t> select_active(const std::vector<float>& rates, std::vector<float>& credit) {
+  credit.resize(rates.size(), 0.0f);
+  std::vector<uint8_t> active(rates.size());
+  for (size_t p = 0; p < rates.size(); ++p) {
+    credit[p] += rates[p];
+    active[p] = credit[p] >= 1.0f;
+    if (active[p]) credit[p] -= 1.0f;
+  }
+  return active;
+}
+
+SampleCounts sample_counts(const std::vector<uint32_t>& paths) {
+  SampleCounts c;
+  if (paths.empty()) return c;
+  uint64_t sum = 0;
+  c.min = paths[0];
+  for (uint32_t n : paths) {
+    sum += n;
+    c.min = std::min(c.min, n);
+    c.max = std::max(c.max, n);
+  }
+  c.mean = static_cast<double>(sum) / static_cast<double>(paths.size());
+  return c;
+}
+
+}  // namespace pxf

@@ -1,0 +1,72 @@
+// Adaptive sampling (issue 33): which pixels the next frame traces, from the method's own quantities.
+// Pure functions on images and per-pixel counts, so that they are tested under a fake variance
+// image (app/adaptive_test.cpp); the preview (app/preview.cpp) feeds them the accumulation.
+//
+// The rule, per frame after a uniform warm-up:
+//   need r_p = q_p / t_{n_p}: the perceived variance of the FINAL unfiltered pixel L_lv + L_u,
+//     q_p = V_p / L_b^2 with V_p = Var[L_u] + Var[L_lv] pooled over the 3x3 range neighbourhood as
+//     the blend pools Var[L_u] (shared::pooled_var_u), L_b = Y(L_u) + Y(L_lv) as the filter's
+//     case-2 skip takes it, against the threshold the blend gives that pixel, t (n_p - 3) / (n_p - 1).
+//     r_p <= 1: the pixel is clean (case 2) by its own samples.
+//   dilation: each pixel takes the largest need in the box of radius dilation_radius around it
+//     (Cycles dilates its active mask with a box): a caustic's neighbours that have not yet seen
+//     its paths are sampled with it.
+//   minimum: a pixel with fewer than min_samples paths counts as at least at the threshold (r >= 1),
+//     so that a pixel that only looks quiet (its rare bright paths not yet found) is not retired.
+//   rate a_p = clamp(r_p / full_rate_need, floor_rate, 1): paths per frame. Samples follow u / t up
+//     to one path per frame (a frame traces a pixel at most once); every pixel, clean or not, is
+//     revisited at least every 1 / floor_rate frames.
+//   selection: a per-pixel credit adds a_p each frame and the pixel is traced when it reaches 1
+//     (error diffusion in time): deterministic, exactly a_p on average, no random numbers.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "gl/pass_params.h"
+#include "image/image.h"
+
+namespace pxf {
+
+struct AdaptiveParams {
+  // Uniform frames before the first allocation. 16: below it the per-pixel variances that rank the
+  // pixels rest on too few samples (the threshold correction (n - 3) / (n - 1) is 0.87 at 16), and
+  // 16 = 2^4 uniform frames give every pixel a complete (0, 4, 2)-net prefix of its Sobol sequence.
+  uint32_t warmup_frames = 16;
+  // A pixel with fewer paths is never retired to the floor: its need counts as at least 1.
+  uint32_t min_samples = 64;
+  // The least rate of any pixel: every pixel is traced at least every 16 frames.
+  float floor_rate = 1.0f / 16.0f;
+  // The need at which a pixel is traced every frame; below it the rate is need / full_rate_need.
+  float full_rate_need = 4.0f;
+  // Radius of the box over which the need is dilated (2: the 5x5 window of the bias guard).
+  int dilation_radius = 2;
+};
+
+// r_p of every pixel (row-major): lv, hv "R,G,B" means; var_u, var_lv "Y" variances of the means
+// (negative = unknown, n < 2); paths[p] the pixel's count n_p; t the threshold (--threshold).
+// range_color and depth (both or neither): the guide for the pooling's range weights; without them
+// the pixel's own variance is used. An unknown variance gives +inf (the pixel must be sampled);
+// V = 0 (all samples equal, no known neighbour) gives 0, which min_samples guards.
+std::vector<float> final_pixel_need(const Image& lv, const Image& hv, const Image& var_u, const Image& var_lv,
+                                    const std::vector<uint32_t>& paths, float t, const Image* range_color,
+                                    const Image* depth, const RangeWeights& range);
+
+// The largest need in the (2 radius + 1)^2 box around each pixel, clipped at the border.
+std::vector<float> dilate_need(const std::vector<float>& need, int width, int height, int radius);
+
+// a_p from the dilated need and the pixel's count (the minimum and the floor applied).
+std::vector<float> sampling_rates(const std::vector<float>& dilated_need, const std::vector<uint32_t>& paths,
+                                  const AdaptiveParams& params);
+
+// The next frame's active mask from the rates: credit[p] += a_p, traced (1) when it reaches 1, which
+// takes 1 off. `credit` starts at 0 per pixel and is carried from frame to frame.
+std::vector<uint8_t> select_active(const std::vector<float>& rates, std::vector<float>& credit);
+
+// Counts of a frame's traced pixels, for stats.
+struct SampleCounts {
+  double mean = 0;
+  uint32_t min = 0, max = 0;
+};
+SampleCounts sample_counts(const std::vector<uint32_t>& paths);
+
+}  // namespace pxf

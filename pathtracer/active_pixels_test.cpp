@@ -1,0 +1,179 @@
+// Frames that trace only some pixels (adaptive sampling): each pixel takes the next sample of its
+// own sequence, so a pixel's accumulation depends only on how many paths it received, never on
+// which other pixels a frame traced, the chunking or the thread count.
+#include <gtest/gtest.h>
+
+#include <memory>
+
+#include "pathtracer/integrator.h"
+#include "pathtracer/shapes.h"
+
+namespace pxf {
+namespace {
+
+constexpr int kWidth = 37, kHeight = 21;  // not a multiple of the 16-pixel tiles: partial tiles too
+
+// The per-pixel state of pixel p, as bytes: equal bytes = bit-identical accumulations.
+std::vector<uint8_t> pixel_bytes(const Accumulation& acc, size_t p) {
+  std::vector<uint8_t> bytes;
+  auto put = [&](const void* data, size_t size) {
+    const uint8_t* b = static_cast<const uint8_t*>(data);
+    bytes.insert(bytes.end(), b, b + size);
+  };
+  put(&acc.lv_mean[p], sizeof(glm::vec3));
+  put(&acc.hv_mean[p], sizeof(glm::vec3));
+  put(&acc.albedo_mean[p], sizeof(glm::vec3));
+  put(&acc.hv_lum_mean[p], sizeof(double));
+  put(&acc.hv_lum_m2[p], sizeof(double));
+  put(&acc.lv_lum_mean[p], sizeof(double));
+  put(&acc.lv_lum_m2[p], sizeof(double));
+  put(&acc.samples[p], sizeof(uint32_t));
+  for (int r = 0; r < acc.replicates && acc.replicates > 1; ++r) {
+    put(&acc.replicate_lum_sum[p * acc.replicates + r], sizeof(double));
+    put(&acc.replicate_samples[p * acc.replicates + r], sizeof(uint32_t));
+  }
+  return bytes;
+}
+
+void expect_same_accumulation(const Accumulation& a, const Accumulation& b) {
+  ASSERT_EQ(a.samples.size(), b.samples.size());
+  for (size_t p = 0; p < a.samples.size(); ++p) ASSERT_EQ(pixel_bytes(a, p), pixel_bytes(b, p)) << "pixel " << p;
+}
+
+// A mask that changes from frame to frame: pixel p is active in frame f when (p * 7 + f * 3) % 5 < 2,
+// and the pixels of the first row always.
+std::vector<uint8_t> varying_mask(int frame) {
+  std::vector<uint8_t> mask(static_cast<size_t>(kWidth) * kHeight);
+  for (size_t p = 0; p < mask.size(); ++p) mask[p] = p < kWidth || (p * 7 + static_cast<size_t>(frame) * 3) % 5 < 2;
+  return mask;
+}
+
+TEST(ActivePixels, EveryPixelActiveIsTheUniformFrame) {
+  const Scene scene = make_cornell_box(true);
+  TraceParams params;
+  params.threads = 2;
+  ProgressiveRenderer uniform(scene, params, kWidth, kHeight), masked(scene, params, kWidth, kHeight);
+  const std::vector<uint8_t> all(static_cast<size_t>(kWidth) * kHeight, 1);
+  for (int f = 0; f < 4; ++f) {
+    ASSERT_TRUE(uniform.add_frame());
+    ASSERT_TRUE(masked.add_frame(all));
+  }
+  expect_same_accumulation(uniform.accumulation(), masked.accumulation());
+  EXPECT_EQ(masked.stats().paths, uniform.stats().paths);
+  for (uint32_t n : masked.pixel_frames()) EXPECT_EQ(n, 4u);
+}
+
+TEST(ActivePixels, UniformFrameKIsEachPixelsSampleK) {
+  // The sample index of a uniform frame is the frame: the first_frame() + frames() of before.
+  const Scene scene = make_cornell_box(true);
+  TraceParams params;
+  params.threads = 2;
+  ProgressiveRenderer renderer(scene, params, kWidth, kHeight);
+  renderer.set_first_frame(5);
+  for (int f = 0; f < 3; ++f) ASSERT_TRUE(renderer.add_frame());
+  PathTracer tracer(scene);
+  Accumulation expected;
+  resize_accumulation(expected, kWidth, kHeight);
+  for (int y = 0; y < kHeight; ++y)
+    for (int x = 0; x < kWidth; ++x)
+      for (uint32_t k = 5; k < 8; ++k) {
+        const PathSample s = tracer.trace_pixel(scene.camera, kWidth, kHeight, x, y, k, params);
+        if (s.finite()) accumulate_sample(expected, static_cast<size_t>(y) * kWidth + x, s.lv, s.hv, 0, s.albedo);
+      }
+  expect_same_accumulation(renderer.accumulation(), expected);
+}
+
+TEST(ActivePixels, APixelTracedNTimesHoldsTheFirstNSamplesOfItsSequence) {
+  // Pixels active in some frames only: each holds exactly the samples 0 .. n-1 of its own
+  // sequence, i.e. what a uniform render of n frames gives it, with replicates split by its own
+  // count (frame k of replicate k mod K).
+  const Scene scene = make_cornell_box(true);
+  for (int replicates : {1, 3}) {
+    TraceParams params;
+    params.threads = 2;
+    params.replicates = replicates;
+    ProgressiveRenderer masked(scene, params, kWidth, kHeight);
+    std::vector<uint32_t> active_frames(static_cast<size_t>(kWidth) * kHeight, 0);
+    constexpr int kFrames = 7;
+    for (int f = 0; f < kFrames; ++f) {
+      const std::vector<uint8_t> mask = varying_mask(f);
+      ASSERT_TRUE(masked.add_frame(mask));
+      for (size_t p = 0; p < mask.size(); ++p) active_frames[p] += mask[p];
+    }
+    EXPECT_EQ(masked.pixel_frames(), active_frames);
+    EXPECT_EQ(masked.frames(), kFrames);
+    std::vector<std::unique_ptr<ProgressiveRenderer>> owned;  // uniform renders of n = 0 .. kFrames frames
+    for (int n = 0; n <= kFrames; ++n) {
+      owned.push_back(std::make_unique<ProgressiveRenderer>(scene, params, kWidth, kHeight));
+      for (int f = 0; f < n; ++f) ASSERT_TRUE(owned.back()->add_frame());
+    }
+    bool some_pixel_skipped_frames = false;
+    for (size_t p = 0; p < active_frames.size(); ++p) {
+      const uint32_t n = active_frames[p];
+      some_pixel_skipped_frames |= n < kFrames;
+      ASSERT_EQ(pixel_bytes(masked.accumulation(), p), pixel_bytes(owned[n]->accumulation(), p))
+          << "pixel " << p << ", " << n << " paths, " << replicates << " replicates";
+    }
+    EXPECT_TRUE(some_pixel_skipped_frames);
+  }
+}
+
+TEST(ActivePixels, ResultsDoNotDependOnTheThreadCount) {
+  const Scene scene = make_cornell_box(true);
+  std::vector<std::unique_ptr<ProgressiveRenderer>> renders;
+  for (int threads : {1, 2, 5}) {
+    TraceParams params;
+    params.threads = threads;
+    renders.push_back(std::make_unique<ProgressiveRenderer>(scene, params, kWidth, kHeight));
+    for (int f = 0; f < 5; ++f) ASSERT_TRUE(renders.back()->add_frame(varying_mask(f)));
+  }
+  expect_same_accumulation(renders[0]->accumulation(), renders[1]->accumulation());
+  expect_same_accumulation(renders[0]->accumulation(), renders[2]->accumulation());
+}
+
+TEST(ActivePixels, AnInactivePixelIsUntouchedAndAResetClearsTheCounts) {
+  const Scene scene = make_cornell_box(true);
+  TraceParams params;
+  params.threads = 2;
+  ProgressiveRenderer renderer(scene, params, kWidth, kHeight);
+  std::vector<uint8_t> one(static_cast<size_t>(kWidth) * kHeight, 0);
+  one[kWidth * 10 + 20] = 1;
+  ASSERT_TRUE(renderer.add_frame(one));
+  ASSERT_TRUE(renderer.add_frame(one));
+  EXPECT_EQ(renderer.stats().paths, 2u);
+  for (size_t p = 0; p < one.size(); ++p) {
+    EXPECT_EQ(renderer.pixel_frames()[p], one[p] ? 2u : 0u);
+    EXPECT_EQ(renderer.accumulation().samples[p] > 0, one[p] != 0);
+  }
+  renderer.reset();
+  for (uint32_t n : renderer.pixel_frames()) EXPECT_EQ(n, 0u);
+  EXPECT_THROW(renderer.add_frame(std::vector<uint8_t>(3, 1)), Error);
+}
+
+TEST(ActivePixels, RestoredFramesCountForEveryPixel) {
+  const Scene scene = make_cornell_box(true);
+  TraceParams params;
+  params.threads = 2;
+  ProgressiveRenderer first(scene, params, kWidth, kHeight), resumed(scene, params, kWidth, kHeight);
+  for (int f = 0; f < 3; ++f) ASSERT_TRUE(first.add_frame());
+  resumed.restore(first.accumulation(), 0, 3);
+  for (uint32_t n : resumed.pixel_frames()) EXPECT_EQ(n, 3u);
+  ASSERT_TRUE(first.add_frame(varying_mask(0)));
+  ASSERT_TRUE(resumed.add_frame(varying_mask(0)));
+  expect_same_accumulation(first.accumulation(), resumed.accumulation());
+}
+
+TEST(Accumulation, LvVarianceOfMeanIsTheWelfordOfTheLvLuminance) {
+  Accumulation acc;
+  resize_accumulation(acc, 1, 1);
+  EXPECT_EQ(acc.lv_variance_of_mean(0), -1.0f);
+  accumulate_sample(acc, 0, glm::vec3(1.0f), glm::vec3(0.0f));
+  EXPECT_EQ(acc.lv_variance_of_mean(0), -1.0f);
+  accumulate_sample(acc, 0, glm::vec3(3.0f), glm::vec3(0.0f));
+  // Y = 1 and 3: s^2 = 2, Var[mean] = s^2 / n = 1; the HV variance stays 0.
+  EXPECT_FLOAT_EQ(acc.lv_variance_of_mean(0), 1.0f);
+  EXPECT_EQ(acc.per_sample_variance_of_mean(0), 0.0f);
+}
+
+}  // namespace
+}  // namespace pxf
