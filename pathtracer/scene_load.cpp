@@ -1334,18 +1334,6 @@ void check_scene_file(const std::string& path) {
 
 }  // namespace
 
-uint64_t available_memory_bytes() {
-  std::ifstream meminfo("/proc/meminfo");
-  std::string key;
-  uint64_t value = 0;
-  std::string unit;
-  while (meminfo >> key >> value) {
-    std::getline(meminfo, unit);
-    if (key == "MemAvailable:") return value * 1024;  // kB
-  }
-  const long pages = sysconf(_SC_AVPHYS_PAGES), page_size = sysconf(_SC_PAGESIZE);
-  return pages > 0 && page_size > 0 ? static_cast<uint64_t>(pages) * static_cast<uint64_t>(page_size) : 0;
-}
 
 // Per instanced vertex: the loader's attributes (position, normal, tangent, two uv sets, color:
 // 72 B) and the raster pass's vertex, in its staging copy and its GL buffer (2 x 64 B). Per
