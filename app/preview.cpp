@@ -243,6 +243,11 @@ void Preview::run_filter() {
   if (settings_.filter.skip_case2 && filter_.filtered_pixels() == 0) schedule_.all_pixels_case2 = true;
 }
 
+double Preview::case2_share() const {
+  const double pixels = static_cast<double>(width_) * static_cast<double>(height_);
+  return pixels > 0 ? case_counts_[kCaseUnfiltered] / pixels : 0.0;
+}
+
 bool Preview::filter_worthwhile() {
   if (hv_energy_share(renderer_->accumulation()) >= kMinHvShare) return true;
   ++low_hv_skips_;

@@ -158,6 +158,8 @@ class Preview {
   // finish after it (last filter run if due, upload, blend, tone map), from measured costs.
   TimeBudget predict_next_frame(double budget_ms, double elapsed_ms) const;
   bool filter_stopped() const { return schedule_.all_pixels_case2; }
+  // The share of pixels in case 2 at the last blend (1 = clean: the unbiased image at threshold t).
+  double case2_share() const;
   // Filter runs left out because HV's energy share was below kMinHvShare.
   int filter_runs_skipped_low_hv() const { return low_hv_skips_; }
   // Pixels per blend case (kCase* in shaders/pass_formulas.h) of the last displayed frame.

@@ -1,4 +1,5 @@
 // pxf render: headless progressive capture with pixel filtering (issue 4 item 6).
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <csignal>
@@ -106,15 +107,21 @@ int run_render(const Args& args) {
   cli.option("--reference", &reference, "REF.exr", "report NRMSE of the final and the unfiltered image against it");
   cli.option("--out", &out, "DIR", "output folder (default out)");
   cli.flag("--quiet", &quiet, "no progress bar");
+  bool until_clean = false;
+  cli.flag("--until-clean", &until_clean,
+           "stop once every pixel is case 2 (the unbiased image at threshold t), counted by a blend after each filter run; "
+           "or earlier at --spp (unbounded without it), --time or Ctrl-C");
   CheckpointOptions checkpoint_options;
   add_checkpoint_options(cli, checkpoint_options);
   if (!cli.parse(args)) return 0;
   if (print_scene_list_if_asked(scene_options)) return 0;
   const double budget_ms = time_s * 1000.0;
-  if (budget_ms > 0 && !cli.given("--spp")) {
+  if ((budget_ms > 0 || until_clean) && !cli.given("--spp")) {
     spp = static_cast<int>(kMaxRenderFrames);
     quiet = true;  // no total to show progress against
   }
+  // Without a filter the blend has no case 2 to count.
+  if (until_clean && !preview_settings.filtering()) throw UsageError("--until-clean needs a filter (not --filter none)");
 
   check_adaptive_without_state(checkpoint_options, preview_settings.adaptive);
   const FrameRange frames = render_frame_range(checkpoint_options, spp);  // a bad range before any load
@@ -138,20 +145,35 @@ int run_render(const Args& args) {
   const int total = static_cast<int>(frames.count());
   ProgressBar progress(total);
   const int first = preview.samples();  // > 0 after --resume
+  RenderReport report;
+  report.until_clean = until_clean;
+  int next_clean_check = 16;
   for (int i = first; i < total && !g_stop_signal; ++i) {
     // The first frame always traces; the next ones only while they and the finish fit the budget.
     if (i > first && !next_frame_fits(preview.predict_next_frame(budget_ms, elapsed_ms(start)))) break;
     // With a budget the first frame is displayed: that measures the finish's blend and tone map.
-    preview.add_frame(/*last_frame=*/false, /*display=*/i == first && budget_ms > 0);
+    // Clean is the blend's finding on a fresh filter run: a check frame is run like a last frame
+    // (filter and blend), from 16 samples on (fewer are never clean at a strict t) and then
+    // whenever the samples grew by a quarter, so a render is found clean within 25 % of the
+    // samples it needed, at about log(n) / log(1.25) extra filter runs.
+    const bool check_clean = until_clean && preview.samples() + 1 >= next_clean_check;
+    preview.add_frame(/*last_frame=*/check_clean, /*display=*/check_clean || (i == first && budget_ms > 0));
+    if (check_clean) {
+      report.case2_share_over_time.push_back({elapsed_ms(start), double(preview.samples()), preview.case2_share()});
+      next_clean_check = std::max(preview.samples() + 1, preview.samples() * 5 / 4);
+    }
     checkpointer.maybe_write(preview);
     if (!quiet) progress.update(i + 1, i + 1 == total);
+    if (check_clean && preview.case2_share() == 1.0) {
+      report.clean_ms = elapsed_ms(start);
+      break;
+    }
   }
   preview.finish();
   const double used_ms = elapsed_ms(start);
   const std::string state_error = checkpointer.write_final(preview);  // reported after the outputs
   if (!quiet) progress.finish();
 
-  RenderReport report;
   report.scene = &scene_options;
   report.interrupted = g_stop_signal != 0;
   report.gl_backend = context->backend_name();

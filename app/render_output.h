@@ -2,6 +2,7 @@
 // stats.json in an output folder, replaced as one unit (app/output_set.h): after any kill the
 // folder shows the whole previous set or the whole new one.
 #pragma once
+#include <array>
 #include <optional>
 #include <string>
 
@@ -20,6 +21,11 @@ struct RenderReport {
   bool interrupted = false;
   std::string gl_backend, gl_renderer;
   std::string reference_path;  // optional: NRMSE of the final and the unfiltered image against it
+  // --until-clean: when every pixel became case 2 (ms from the start, < 0 = not reached), and the
+  // share of case-2 pixels at each filter run: {ms from the start, spp, share}.
+  bool until_clean = false;
+  double clean_ms = -1;
+  std::vector<std::array<double, 3>> case2_share_over_time;
   std::optional<ImageMetrics> final_vs_reference, unfiltered_vs_reference;  // filled by the writer
 };
 

@@ -776,3 +776,45 @@ TEST(Cli, KillsAtRandomMomentsNeverLeavePartialOrMixedOutputs) {
   ASSERT_EQ(run("render --size 16x16 --spp 1 --quiet --out " + out).code, 0);
   EXPECT_TRUE(leftovers(out).empty());
 }
+
+// --until-clean (issue 33 item 2): a diffuse-only box at a loose threshold gets clean and stops
+// there, unbounded by --spp; cornell with its mirror and glass at a strict one stops at its cap.
+TEST(Cli, UntilCleanStopsWhenEveryPixelIsCase2OrAtItsCap) {
+  const std::string dir = temp_dir("until_clean");
+  const std::string diffuse = edited_cornell(dir + "/diffuse", [](nlohmann::json& doc) {
+    auto& roots = doc["scenes"][0]["nodes"];
+    nlohmann::json kept = nlohmann::json::array();
+    for (const auto& n : roots) {
+      const std::string name = doc["nodes"][n.get<int>()].value("name", "");
+      if (name != "mirror_sphere" && name != "glass_sphere") kept.push_back(n);
+    }
+    roots = kept;
+  });
+  if (diffuse.empty()) GTEST_SKIP() << "assets/cornell not generated";
+  const Result clean = run("render --scene " + diffuse + " --size 16x16 --threshold 0.1 --until-clean --quiet --out " +
+                           dir + "/clean");
+  ASSERT_EQ(clean.code, 0) << clean.err;
+  const auto stats = nlohmann::json::parse(slurp(dir + "/clean/stats.json"));
+  EXPECT_TRUE(stats["clean"].get<bool>());
+  EXPECT_EQ(stats["blend_case_pixels"]["case2"].get<int>(), 16 * 16);
+  const auto& until = stats["until_clean"];
+  EXPECT_TRUE(until["requested"].get<bool>());
+  ASSERT_TRUE(until["time_to_clean_ms"].is_number());
+  const auto& series = until["case2_share_over_time"];
+  ASSERT_GE(series.size(), 2u);
+  EXPECT_EQ(series.back()[2].get<double>(), 1.0);
+  EXPECT_LT(series.front()[2].get<double>(), 1.0) << "clean at the first check: the test shows no stop";
+  EXPECT_EQ(series.back()[1].get<int>(), stats["settings"]["spp"].get<int>()) << "did not stop at the clean check";
+
+  const Result capped = run("render --size 16x16 --threshold 0.000001 --spp 40 --until-clean --quiet --out " + dir +
+                            "/capped");
+  ASSERT_EQ(capped.code, 0) << capped.err;
+  const auto capped_stats = nlohmann::json::parse(slurp(dir + "/capped/stats.json"));
+  EXPECT_FALSE(capped_stats["clean"].get<bool>());
+  EXPECT_EQ(capped_stats["settings"]["spp"].get<int>(), 40);
+  EXPECT_TRUE(capped_stats["until_clean"]["time_to_clean_ms"].is_null());
+
+  const Result unfiltered = run("render --size 16x16 --filter none --until-clean --out " + dir + "/none");
+  EXPECT_EQ(unfiltered.code, 2);
+  EXPECT_EQ(lines(unfiltered.err), 1u) << unfiltered.err;
+}
