@@ -37,23 +37,28 @@ std::vector<float> final_pixel_need(const Image& lv, const Image& hv, const Imag
   return need;
 }
 
+namespace {
+
+// out = the largest value of `in` within `radius` cells along one axis: `lines` lines of `count`
+// cells, `step` apart in the array, the lines `line_step` apart.
+void window_max(const std::vector<float>& in, std::vector<float>& out, int count, int step, int lines, int line_step,
+                int radius) {
+  for (int line = 0; line < lines; ++line)
+    for (int i = 0; i < count; ++i) {
+      float m = -std::numeric_limits<float>::infinity();
+      for (int q = std::max(0, i - radius); q <= std::min(count - 1, i + radius); ++q)
+        m = std::max(m, in[static_cast<size_t>(line) * line_step + static_cast<size_t>(q) * step]);
+      out[static_cast<size_t>(line) * line_step + static_cast<size_t>(i) * step] = m;
+    }
+}
+
+}  // namespace
+
 std::vector<float> dilate_need(const std::vector<float>& need, int width, int height, int radius) {
   // Separable: the largest value along each row's window, then along each column's.
   std::vector<float> rows(need.size()), out(need.size());
-  for (int y = 0; y < height; ++y)
-    for (int x = 0; x < width; ++x) {
-      float m = -std::numeric_limits<float>::infinity();
-      for (int q = std::max(0, x - radius); q <= std::min(width - 1, x + radius); ++q)
-        m = std::max(m, need[static_cast<size_t>(y) * width + q]);
-      rows[static_cast<size_t>(y) * width + x] = m;
-    }
-  for (int y = 0; y < height; ++y)
-    for (int x = 0; x < width; ++x) {
-      float m = -std::numeric_limits<float>::infinity();
-      for (int q = std::max(0, y - radius); q <= std::min(height - 1, y + radius); ++q)
-        m = std::max(m, rows[static_cast<size_t>(q) * width + x]);
-      out[static_cast<size_t>(y) * width + x] = m;
-    }
+  window_max(need, rows, width, 1, height, width, radius);
+  window_max(rows, out, height, width, width, 1, radius);
   return out;
 }
 
