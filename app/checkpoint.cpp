@@ -36,12 +36,6 @@ bool uses_state(const CheckpointOptions& o) {
   return o.interval_s > 0 || !o.resume.empty() || !o.frames.empty() || !o.shard.empty();
 }
 
-void check_adaptive_without_state(const CheckpointOptions& options, bool adaptive) {
-  if (adaptive && uses_state(options))
-    throw UsageError("--adaptive on does not work with --checkpoint, --resume, --frames or --shard yet: a state "
-                     "does not hold the per-pixel sample counts it would continue from");
-}
-
 FrameRange render_frame_range(const CheckpointOptions& o, int spp) {
   if (!o.frames.empty() && !o.shard.empty()) throw UsageError("--frames and --shard exclude each other");
   FrameRange range{0, static_cast<uint32_t>(spp)};
@@ -62,8 +56,10 @@ FrameRange render_frame_range(const CheckpointOptions& o, int spp) {
 }
 
 SampleSettings render_sample_settings(const SceneOptions& scene, const PreviewSettings& settings) {
-  return sample_settings(scene_content_hash(scene.scene, scene.env, scene.env_strength), scene.width, scene.height,
-                         settings.trace);
+  SampleSettings s = sample_settings(scene_content_hash(scene.scene, scene.env, scene.env_strength), scene.width,
+                                     scene.height, settings.trace);
+  s.adaptive = settings.adaptive ? 1u : 0u;
+  return s;
 }
 
 Checkpointer::Checkpointer(const CheckpointOptions& options, const std::string& out_dir,
@@ -86,7 +82,7 @@ void Checkpointer::start(Preview& preview) const {
   if (state.frames.size() != 1 || state.frames[0].begin != range_.begin || state.frames[0].end > range_.end)
     throw Error(options_.resume + ": the state holds frames " + frame_ranges_text(state.frames) +
                 ", which do not start this render's frames " + frame_ranges_text({range_}));
-  preview.load_accumulation(state.acc, state.frames[0].begin, static_cast<int>(state.frames[0].count()));
+  preview.load_state(state);
 }
 
 AccumulationState Checkpointer::state_of(const Preview& preview) const {
@@ -95,6 +91,14 @@ AccumulationState Checkpointer::state_of(const Preview& preview) const {
   const uint32_t first = preview.renderer().first_frame();
   state.frames = {FrameRange{first, first + static_cast<uint32_t>(preview.samples())}};
   state.acc = preview.renderer().accumulation();
+  state.traced = preview.pixel_samples();
+  if (settings_.adaptive) {
+    const size_t pixels = state.traced.size();
+    state.credit = preview.allocation_credit();
+    state.credit.resize(pixels, 0.0f);  // no allocation yet (warm-up): every credit 0
+    state.next_active = preview.next_active();
+    state.next_active.resize(pixels, uint8_t{1});  // empty = every pixel
+  }
   return state;
 }
 

@@ -21,10 +21,6 @@ struct CheckpointOptions {
 void add_checkpoint_options(CommandLine& cli, CheckpointOptions& options);
 // True when the options ask for a state (--checkpoint, --resume, --frames or --shard).
 bool uses_state(const CheckpointOptions& options);
-// Throws UsageError when an adaptive render asks for a state: a state (format 5) does not hold the
-// per-pixel sample counts and allocation credits an adaptive render continues from, so its resume
-// or merge would not be exact (issue 33).
-void check_adaptive_without_state(const CheckpointOptions& options, bool adaptive);
 std::string state_path(const std::string& out_dir);  // DIR/state.pxfs
 
 // The frames a render traces: --frames A:B, the i-th of n near-equal parts of 0:spp for

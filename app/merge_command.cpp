@@ -25,6 +25,7 @@ void take_settings_from_state(const SampleSettings& s, SceneOptions& scene, Prev
   preview.trace.all_hv = s.all_hv != 0;
   preview.trace.sampler = static_cast<SamplerType>(s.sampler);
   preview.trace.replicates = static_cast<int>(s.replicates);
+  preview.adaptive = s.adaptive != 0;
   const auto mode = static_cast<SpecularSamplingMode>(s.specular_sampling);
   preview.trace.specular_sampling = mode == SpecularSamplingMode::All;
   preview.trace.near_specular_sampling = mode == SpecularSamplingMode::Near;
@@ -63,7 +64,7 @@ int run_merge(const Args& args) {
   set_gl_timing(scene_options.stage_timing);
   auto context = create_gl_context(parse_gl_backend(scene_options.gl));
   Preview preview(scene, preview_settings, scene_options.width, scene_options.height);
-  preview.load_accumulation(merged.acc, merged.frames.front().begin, static_cast<int>(merged.frame_count()));
+  preview.load_state(merged);
   preview.finish();
 
   RenderReport report;

@@ -133,6 +133,16 @@ void Preview::load_accumulation(const Accumulation& acc, uint32_t first, int fra
   update_hv_empty();
 }
 
+void Preview::load_state(const AccumulationState& state) {
+  reset();
+  renderer_->restore(state.acc, state.frames.front().begin, static_cast<int>(state.frame_count()), state.traced);
+  update_hv_empty();
+  if (!state.settings.adaptive) return;
+  active_credit_ = state.credit;
+  const bool every_pixel = std::all_of(state.next_active.begin(), state.next_active.end(), [](uint8_t a) { return a; });
+  if (!every_pixel) next_active_ = state.next_active;
+}
+
 void Preview::set_camera(const Camera& camera) {
   renderer_->set_camera(camera);
   range_.set_camera(camera);
@@ -216,7 +226,10 @@ FilterParams Preview::filter_params_now() const {
 void Preview::run_filter() {
   const double range_before = last_.range;
   const FilterParams params = filter_params_now();
-  if (range_.frames() == 0) step_range_buffer();
+  if (allocating())
+    converge_range_buffer();  // the guide the allocation used (plan_next_frame), also after a resume
+  else if (range_.frames() == 0)
+    step_range_buffer();
   upload();
   double filter_ms = 0;
   filtered_demodulated_ = settings_.demodulate;
@@ -326,9 +339,13 @@ void Preview::refresh_guide_images() {
   guide_frames_ = range_.frames();
 }
 
+bool Preview::allocating() const {
+  return settings_.adaptive && static_cast<uint32_t>(samples()) >= settings_.adaptive_params.warmup_frames;
+}
+
 void Preview::plan_next_frame() {
   next_active_.clear();
-  if (!settings_.adaptive || static_cast<uint32_t>(samples()) < settings_.adaptive_params.warmup_frames) return;
+  if (!allocating()) return;
   const Accumulation& acc = renderer_->accumulation();
   const int w = width_, h = height_;
   Image lv = Image::rgb(w, h), hv = Image::rgb(w, h), var_lv = Image::gray(w, h);
@@ -341,8 +358,14 @@ void Preview::plan_next_frame() {
   }
   Image var_u = Image::gray(w, h);
   acc.variance_of_mean_image(var_u.pixels.data(), 1);
-  const bool guide = settings_.filtering() && range_.frames() > 0;
-  if (guide) refresh_guide_images();
+  // The pooling's guide is the converged range buffer, not whatever the time-driven schedule has
+  // accumulated so far: the allocation then depends on the samples alone, so that a render is the
+  // same whatever the machine's speed, and a resumed one continues it exactly.
+  const bool guide = settings_.filtering();
+  if (guide) {
+    converge_range_buffer();
+    refresh_guide_images();
+  }
   const std::vector<uint32_t>& paths = renderer_->pixel_frames();
   const std::vector<float> need =
       final_pixel_need(lv, hv, var_u, var_lv, paths, settings_.threshold, guide ? &guide_color_ : nullptr,

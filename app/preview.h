@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "app/adaptive.h"
+#include "pathtracer/accumulation_state.h"
 #include "app/frame_budget.h"
 #include "app/schedule.h"
 #include "gl/blend_pass.h"
@@ -130,6 +131,10 @@ class Preview {
   // Replaces the samples by a saved accumulation of the frames [first, first + frames) (resume,
   // merge); the passes then run on it as on traced frames.
   void load_accumulation(const Accumulation& acc, uint32_t first, int frames);
+  // The same from a state (resume, merge) with its per-pixel traced counts; an adaptive state's
+  // allocation (credits and the planned mask) too, so that the next frame is the one the
+  // interrupted render would have traced. The state's frames must be one range.
+  void load_state(const AccumulationState& state);
   // Blend and tone map the current state (e.g. after a display-only change).
   void redisplay();
   // Runs the range pass until it has converged (the explorer's range views need it unfiltered too).
@@ -141,6 +146,10 @@ class Preview {
   const std::vector<uint32_t>& pixel_samples() const { return renderer_->pixel_frames(); }
   // The share of the pixels the last traced frame traced (1 for a uniform frame).
   double last_active_share() const { return last_active_share_; }
+  // Adaptive sampling's allocation: the next frame's mask (1 = traced; empty = every pixel) and the
+  // per-pixel credits it was selected with (empty before the first allocation; app/adaptive.h).
+  const std::vector<uint8_t>& next_active() const { return next_active_; }
+  const std::vector<float>& allocation_credit() const { return active_credit_; }
   // The threshold the filter's skip and the blend get now: t scaled for the variance estimate's
   // own noise at this sample count (effective_threshold, docs/method.md section 3.5).
   float threshold_now() const { return effective_threshold(settings_.threshold, static_cast<uint64_t>(samples())); }
@@ -197,6 +206,7 @@ class Preview {
   bool range_due() const;       // one more range frame fits the pass budget
   // The next frame's active mask (adaptive sampling): empty = every pixel.
   void plan_next_frame();
+  bool allocating() const;  // adaptive sampling is past its warm-up: frames follow plan_next_frame()
   // The range guide as images for the allocation's pooling, read back when the guide changed.
   void refresh_guide_images();
   bool filter_due_now() const;  // the queued Filter step would run the filter

@@ -123,7 +123,6 @@ int run_render(const Args& args) {
   // Without a filter the blend has no case 2 to count.
   if (until_clean && !preview_settings.filtering()) throw UsageError("--until-clean needs a filter (not --filter none)");
 
-  check_adaptive_without_state(checkpoint_options, preview_settings.adaptive);
   const FrameRange frames = render_frame_range(checkpoint_options, spp);  // a bad range before any load
 
   const auto start = BenchClock::now();
@@ -147,7 +146,11 @@ int run_render(const Args& args) {
   const int first = preview.samples();  // > 0 after --resume
   RenderReport report;
   report.until_clean = until_clean;
+  // The check frames are 16, then each a quarter more samples than the last: the same frames
+  // after a --resume as in the uninterrupted render, so that it stops at the same frame.
+  auto after_check = [](int samples) { return std::max(samples + 1, samples * 5 / 4); };
   int next_clean_check = 16;
+  while (next_clean_check <= first) next_clean_check = after_check(next_clean_check);
   for (int i = first; i < total && !g_stop_signal; ++i) {
     // The first frame always traces; the next ones only while they and the finish fit the budget.
     if (i > first && !next_frame_fits(preview.predict_next_frame(budget_ms, elapsed_ms(start)))) break;
@@ -160,7 +163,7 @@ int run_render(const Args& args) {
     preview.add_frame(/*last_frame=*/check_clean, /*display=*/check_clean || (i == first && budget_ms > 0));
     if (check_clean) {
       report.case2_share_over_time.push_back({elapsed_ms(start), double(preview.samples()), preview.case2_share()});
-      next_clean_check = std::max(preview.samples() + 1, preview.samples() * 5 / 4);
+      next_clean_check = after_check(preview.samples());
     }
     checkpointer.maybe_write(preview);
     if (!quiet) progress.update(i + 1, i + 1 == total);

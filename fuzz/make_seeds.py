@@ -5,9 +5,9 @@
   exr_reader/   scanline EXRs, uncompressed, RLE, ZIPS and ZIP, float/half/uint, odd data windows;
   hdr_reader/   Radiance HDR, flat and run-length encoded scanlines;
   png_reader/   PNG in every colour type and bit depth stb reads, plus a few other formats.
-The state_reader seeds are states written by `pxf render --checkpoint` (named by their SHA-1, as
-libFuzzer names the inputs it keeps) and inputs the campaigns kept; rendered EXR/PNG outputs come
-from `pxf render` too.
+The state_reader seeds: the named ones are written by fuzz/make_state_seeds.sh with `pxf render`
+and `pxf merge` (rerun it after a state format version bump); the ones named by their SHA-1 are
+inputs the campaigns kept, as libFuzzer names them. Rendered EXR/PNG outputs come from `pxf render`.
 Usage: fuzz/make_seeds.py [corpus folder, default fuzz/corpus]"""
 import base64, json, math, os, struct, sys, zlib
 

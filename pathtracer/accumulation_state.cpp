@@ -48,6 +48,17 @@ void visit_arrays(Acc& acc, Visit&& visit) {
   visit(acc.replicate_samples, replicate_slots);
 }
 
+// The per-pixel arrays of a state: the accumulation's, then the traced counts and, in an adaptive
+// state, the allocation's credits and next mask.
+template <class State, class Visit>
+void visit_state_arrays(State& state, Visit&& visit) {
+  visit_arrays(state.acc, visit);
+  visit(state.traced, 1);
+  const size_t allocation_slots = state.settings.adaptive ? 1 : 0;
+  visit(state.credit, allocation_slots);
+  visit(state.next_active, allocation_slots);
+}
+
 // The replicates a state's accumulation has sums for.
 int state_replicates(const SampleSettings& s) {
   return accumulated_replicates(static_cast<SamplerType>(s.sampler), static_cast<int>(s.replicates));
@@ -107,6 +118,7 @@ void put_settings(Writer& w, const SampleSettings& s) {
   w.put(s.sampler);
   w.put(s.replicates);
   w.put(s.specular_sampling);
+  w.put(s.adaptive);
 }
 
 SampleSettings get_settings(Reader& r) {
@@ -121,8 +133,10 @@ SampleSettings get_settings(Reader& r) {
   s.sampler = r.get<uint32_t>("header");
   s.replicates = r.get<uint32_t>("header");
   s.specular_sampling = r.get<uint32_t>("header");
-  if (s.all_hv > 1 || s.specular_sampling > static_cast<uint32_t>(SpecularSamplingMode::Near) || s.sampler > 1)
-    throw Error("state file has an invalid setting flag (all-hv, sampler or specular sampling)");
+  s.adaptive = r.get<uint32_t>("header");
+  if (s.all_hv > 1 || s.specular_sampling > static_cast<uint32_t>(SpecularSamplingMode::Near) || s.sampler > 1 ||
+      s.adaptive > 1)
+    throw Error("state file has an invalid setting flag (all-hv, sampler, specular sampling or adaptive)");
   if (s.replicates < 1 || s.replicates > kMaxReplicates)
     throw Error("state file has an invalid replicate count " + std::to_string(s.replicates));
   if (s.width == 0 || s.height == 0 || s.width > kMaxSide || s.height > kMaxSide)
@@ -144,12 +158,13 @@ void check_frame_total(uint64_t frames, const std::string& what) {
                 " a state can hold");
 }
 
-void check_frame_ranges(const std::vector<FrameRange>& ranges) {
+void check_frame_ranges(const std::vector<FrameRange>& ranges, bool adaptive) {
   for (size_t i = 0; i < ranges.size(); ++i) {
     if (ranges[i].begin >= ranges[i].end) throw Error("state file has an empty or reversed frame range");
-    // Every writer joins adjacent ranges (a render writes one, a merge joins them), so adjacent
-    // ranges are not a state pxf wrote; refusing them keeps a decoded state canonical.
-    if (i > 0 && ranges[i].begin <= ranges[i - 1].end)
+    // A uniform writer joins adjacent ranges (a render writes one, a merge joins them), so adjacent
+    // ranges are not a uniform state pxf wrote; refusing them keeps a decoded state canonical. An
+    // adaptive merge keeps them apart (merge_states).
+    if (i > 0 && (ranges[i].begin < ranges[i - 1].end || (!adaptive && ranges[i].begin == ranges[i - 1].end)))
       throw Error("state file has unsorted, overlapping or unjoined adjacent frame ranges");
   }
   check_frame_total(total_frames(ranges), "state file has");
@@ -159,8 +174,14 @@ void check_pixels(const AccumulationState& state) {
   const Accumulation& acc = state.acc;
   const uint32_t frames = state.frame_count();
   for (size_t i = 0; i < acc.samples.size(); ++i) {
-    // Samples are per frame at most one per pixel (non-finite ones are dropped).
-    if (acc.samples[i] > frames) throw Error("state file has more samples in a pixel than frames");
+    // A frame traces a pixel at most once, every frame of a uniform state every pixel; non-finite
+    // samples are traced but dropped.
+    if (state.traced[i] > frames || (!state.settings.adaptive && state.traced[i] != frames))
+      throw Error("state file has a traced count that does not fit its frames at pixel " + std::to_string(i));
+    if (acc.samples[i] > state.traced[i]) throw Error("state file has more samples in a pixel than it traced");
+    if (state.settings.adaptive &&
+        (!(state.credit[i] >= 0.0f && state.credit[i] < 1.0f) || state.next_active[i] > 1))
+      throw Error("state file has an invalid adaptive allocation at pixel " + std::to_string(i));
     const glm::vec3 lv = acc.lv_mean[i], hv = acc.hv_mean[i], a = acc.albedo_mean[i];
     const bool finite = std::isfinite(lv.x) && std::isfinite(lv.y) && std::isfinite(lv.z) && std::isfinite(hv.x) &&
                         std::isfinite(hv.y) && std::isfinite(hv.z) && std::isfinite(a.x) && std::isfinite(a.y) &&
@@ -246,6 +267,7 @@ std::string SampleSettings::difference(const SampleSettings& o) const {
   if (sampler != o.sampler) return diff("sampler", sampler_type_names()[sampler], sampler_type_names()[o.sampler]);
   if (replicates != o.replicates) return diff("replicates", replicates, o.replicates);
   if (specular_sampling != o.specular_sampling) return diff("specular sampling", specular_sampling, o.specular_sampling);
+  if (adaptive != o.adaptive) return std::string("adaptive sampling ") + (adaptive ? "on" : "off") + " vs " + (o.adaptive ? "on" : "off");
   return "";
 }
 
@@ -308,7 +330,11 @@ std::vector<uint8_t> encode_state(const AccumulationState& state) {
   if (state.acc.replicates != state_replicates(state.settings))
     throw Error("cannot save a state whose accumulation has " + std::to_string(state.acc.replicates) +
                 " replicates under settings with " + std::to_string(state_replicates(state.settings)));
-  visit_arrays(state.acc, [&](const auto& array, size_t) { w.put_array(array); });
+  const size_t pixels = static_cast<size_t>(state.settings.width) * state.settings.height;
+  visit_state_arrays(state, [&](const auto& array, size_t per_pixel) {
+    if (array.size() != pixels * per_pixel) throw Error("cannot save a state with a per-pixel array of the wrong size");
+    w.put_array(array);
+  });
   w.put(fnv1a64(w.bytes.data(), w.bytes.size()));
   return std::move(w.bytes);
 }
@@ -339,12 +365,12 @@ AccumulationState decode_state(const uint8_t* data, size_t size) {
     range.begin = r.get<uint32_t>("the frame ranges");
     range.end = r.get<uint32_t>("the frame ranges");
   }
-  check_frame_ranges(state.frames);
+  check_frame_ranges(state.frames, state.settings.adaptive != 0);
   const size_t pixels = static_cast<size_t>(state.settings.width) * state.settings.height;
   state.acc.width = static_cast<int>(state.settings.width);
   state.acc.height = static_cast<int>(state.settings.height);
   state.acc.replicates = state_replicates(state.settings);
-  visit_arrays(state.acc, [&](auto& array, size_t per_pixel) {
+  visit_state_arrays(state, [&](auto& array, size_t per_pixel) {
     r.get_array(array, pixels * per_pixel, per_pixel > 1 ? "the replicate arrays" : "the pixel arrays");
   });
   if (r.remaining() != sizeof(uint64_t)) throw Error("state file has trailing bytes");
@@ -386,10 +412,11 @@ uint64_t max_state_file_bytes() {
   header.put(kStateFormatVersion);
   put_settings(header, SampleSettings{});
   header.put(uint32_t{0});  // the range count
-  Accumulation pixel;
-  pixel.replicates = kMaxReplicates;
+  AccumulationState pixel;
+  pixel.acc.replicates = kMaxReplicates;
+  pixel.settings.adaptive = 1;
   uint64_t per_pixel = 0;
-  visit_arrays(pixel, [&](const auto& array, size_t slots) {
+  visit_state_arrays(pixel, [&](const auto& array, size_t slots) {
     per_pixel += slots * sizeof(typename std::decay_t<decltype(array)>::value_type);
   });
   return header.bytes.size() + uint64_t{kMaxFrameRanges} * 2 * sizeof(uint32_t) +
@@ -417,6 +444,11 @@ AccumulationState merge_states(const std::vector<AccumulationState>& states) {
     if (!diff.empty()) throw Error("state " + std::to_string(i + 1) + " was rendered with other settings: " + diff);
     merged.frames.insert(merged.frames.end(), states[i].frames.begin(), states[i].frames.end());
     merge_into(merged.acc, states[i].acc);
+    for (size_t p = 0; p < merged.traced.size(); ++p) merged.traced[p] += states[i].traced[p];
+  }
+  if (merged.settings.adaptive) {  // no allocation to continue: a merged state is not resumed
+    std::fill(merged.credit.begin(), merged.credit.end(), 0.0f);
+    std::fill(merged.next_active.begin(), merged.next_active.end(), uint8_t{1});
   }
   std::sort(merged.frames.begin(), merged.frames.end(),
             [](const FrameRange& a, const FrameRange& b) { return a.begin < b.begin; });
@@ -424,9 +456,11 @@ AccumulationState merge_states(const std::vector<AccumulationState>& states) {
     if (merged.frames[i].begin < merged.frames[i - 1].end)
       throw Error("frame ranges overlap (" + frame_ranges_text(merged.frames) + "): a frame would count twice");
   // Adjacent ranges become one, so the shards of 0:N merge into the state of a plain 0:N render.
+  // Not in an adaptive merge: there a pixel's samples of 0:A and A:B are the first traced[p] of each
+  // range, no prefix of 0:B, and a resume from one joined range would trace some indices twice.
   std::vector<FrameRange> joined;
   for (const FrameRange& r : merged.frames) {
-    if (!joined.empty() && joined.back().end == r.begin)
+    if (!joined.empty() && joined.back().end == r.begin && !merged.settings.adaptive)
       joined.back().end = r.end;
     else
       joined.push_back(r);

@@ -11,8 +11,9 @@
 
 namespace pxf {
 
-// 2: the albedo mean; 3: sampler, replicates, specular sampling; 4: replicate sums; 5: the LV luminance Welford state
-constexpr uint32_t kStateFormatVersion = 5;
+// 2: the albedo mean; 3: sampler, replicates, specular sampling; 4: replicate sums; 5: the LV luminance Welford
+// state; 6: adaptive sampling (the flag, per-pixel traced counts, the allocation's credits and next mask)
+constexpr uint32_t kStateFormatVersion = 6;
 
 // Frame counts: one render traces at most kMaxRenderFrames frames (--spp, --frames, --shard); a
 // state, also a merge of many shards, holds at most kMaxStateFrames in all, the most the preview's
@@ -39,6 +40,10 @@ struct SampleSettings {
   uint32_t sampler = 0;            // SamplerType: 0 sobol, 1 independent
   uint32_t replicates = 1;         // TraceParams::replicates (which scrambled sequence frame k uses)
   uint32_t specular_sampling = 0;  // 0 none, 1 at every diffuse vertex, 2 near only (the default)
+  // 1: adaptive sampling (--adaptive on): pixels are traced unevenly, each at its own sample index.
+  // Not a property of a sample, but a resume must continue the same allocation, and a merge of
+  // adaptive and uniform shards would be a render neither option describes.
+  uint32_t adaptive = 0;
   bool operator==(const SampleSettings& o) const;
   // "" when equal, else one phrase naming the first difference ("seed 1 vs 2").
   std::string difference(const SampleSettings& o) const;
@@ -48,6 +53,16 @@ struct AccumulationState {
   SampleSettings settings;
   std::vector<FrameRange> frames;  // sorted, disjoint, non-empty ranges
   Accumulation acc;
+  // Paths traced into each pixel (ProgressiveRenderer::pixel_frames: dropped non-finite ones too).
+  // Pixel p used the sample indices [begin, begin + traced[p]) of each range it was traced in; in a
+  // uniform state every entry is frame_count().
+  std::vector<uint32_t> traced;
+  // Adaptive sampling's allocation (settings.adaptive only, else empty; app/adaptive.h): each
+  // pixel's credit after the last planned frame and that frame's mask (1 = traced next), so that a
+  // resumed render traces exactly what the uninterrupted one would. A merged state keeps zeros and
+  // ones: it is not resumed (its frames are not one range).
+  std::vector<float> credit;
+  std::vector<uint8_t> next_active;
   uint32_t frame_count() const;
 };
 

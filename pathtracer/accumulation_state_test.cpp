@@ -3,6 +3,7 @@
 // accumulation (Chan's combination of the Welford state).
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <limits>
 #include <random>
 
@@ -31,6 +32,7 @@ AccumulationState render_frames(FrameRange range, int replicates = 1) {
   params.replicates = replicates;
   state.settings = sample_settings(0x1234, kW, kH, params);
   state.frames = {range};
+  state.traced.assign(static_cast<size_t>(kW) * kH, range.count());
   resize_accumulation(state.acc, kW, kH, replicates);
   for (uint32_t f = range.begin; f < range.end; ++f)
     for (size_t p = 0; p < state.acc.samples.size(); ++p) {
@@ -119,10 +121,15 @@ TEST(AccumulationState, OtherVersionIsRefusedByName) {
 }
 
 TEST(AccumulationState, HeaderWithHugeCountsIsRefusedWithoutAllocating) {
-  // A valid checksum over a header claiming 2^15 x 2^15 pixels and no arrays.
-  AccumulationState state = render_frames({0, 1});
-  state.settings.width = state.settings.height = 1u << 15;
-  std::vector<uint8_t> bytes = encode_state(state);
+  // A valid checksum over a header claiming 2^15 x 2^15 pixels and a 5x3 image's arrays: the size
+  // is patched into an encoded state (the writer refuses arrays of another size) after the magic,
+  // the version and the scene hash, and the checksum recomputed.
+  std::vector<uint8_t> bytes = encode_state(render_frames({0, 1}));
+  const uint32_t huge = 1u << 15;
+  std::memcpy(&bytes[20], &huge, sizeof(huge));
+  std::memcpy(&bytes[24], &huge, sizeof(huge));
+  const uint64_t checksum = fnv1a64(bytes.data(), bytes.size() - sizeof(uint64_t));
+  std::memcpy(&bytes[bytes.size() - sizeof(uint64_t)], &checksum, sizeof(checksum));
   EXPECT_NE(decode_error(bytes).find("truncated"), std::string::npos) << decode_error(bytes);
 }
 
@@ -267,4 +274,107 @@ TEST(AccumulationState, ReplicateCountsThatDoNotAddUpAreRefused) {
   state.acc.replicate_lum_sum[0] = std::numeric_limits<double>::infinity();
   const std::vector<uint8_t> inf_bytes = encode_state(state);
   EXPECT_NE(decode_error(inf_bytes).find("non-finite replicate sum at pixel 0"), std::string::npos);
+}
+
+namespace {
+
+// An adaptive state of the frames `range` in which pixel p was traced in only some frames: its
+// k-th path is sample index range.begin + k (as the renderer's per-pixel count gives it).
+AccumulationState render_adaptive(FrameRange range) {
+  AccumulationState state = render_frames(range);
+  state.settings.adaptive = 1;
+  resize_accumulation(state.acc, kW, kH, 1);
+  const size_t pixels = state.acc.samples.size();
+  state.traced.assign(pixels, 0);
+  state.credit.assign(pixels, 0.0f);
+  state.next_active.assign(pixels, 0);
+  for (size_t p = 0; p < pixels; ++p) {
+    state.traced[p] = 1 + static_cast<uint32_t>(p % range.count());  // 1..frames paths
+    for (uint32_t k = 0; k < state.traced[p]; ++k) {
+      glm::vec3 lv, hv;
+      sample_of(p, range.begin + k, lv, hv);
+      accumulate_sample(state.acc, p, lv, hv, 0, glm::vec3(0.5f));
+    }
+    state.credit[p] = 0.125f * static_cast<float>(p % 8);
+    state.next_active[p] = p % 3 == 0;
+  }
+  return state;
+}
+
+}  // namespace
+
+// Format 6: an adaptive state carries each pixel's traced count and the allocation (credits and
+// the next frame's mask), exactly, so that a resumed adaptive render continues the same allocation.
+TEST(AccumulationState, AdaptiveAllocationRoundTripsExactly) {
+  const AccumulationState state = render_adaptive({3, 11});
+  const std::vector<uint8_t> bytes = encode_state(state);
+  const AccumulationState back = decode_state(bytes.data(), bytes.size());
+  EXPECT_EQ(back.settings.adaptive, 1u);
+  EXPECT_EQ(back.traced, state.traced);
+  EXPECT_EQ(back.credit, state.credit);
+  EXPECT_EQ(back.next_active, state.next_active);
+  EXPECT_EQ(back.acc.samples, state.acc.samples);
+  EXPECT_EQ(encode_state(back), bytes);
+  // A uniform state has no allocation arrays: one float and one byte per pixel fewer.
+  const AccumulationState uniform = render_frames({3, 11});
+  EXPECT_EQ(encode_state(uniform).size() + uniform.acc.samples.size() * (sizeof(float) + 1), bytes.size());
+}
+
+TEST(AccumulationState, AdaptiveCountsAndAllocationOutOfRangeAreRefused) {
+  AccumulationState state = render_adaptive({0, 8});
+  state.traced[4] = 9;  // more paths than frames
+  EXPECT_NE(decode_error(encode_state(state)).find("traced count that does not fit its frames at pixel 4"),
+            std::string::npos);
+  state = render_adaptive({0, 8});
+  state.traced[2] = state.acc.samples[2] - 1;  // more accepted samples than traced paths
+  EXPECT_NE(decode_error(encode_state(state)).find("more samples in a pixel than it traced"), std::string::npos);
+  for (float bad : {-0.5f, 1.0f, std::numeric_limits<float>::quiet_NaN()}) {
+    state = render_adaptive({0, 8});
+    state.credit[6] = bad;
+    EXPECT_NE(decode_error(encode_state(state)).find("invalid adaptive allocation at pixel 6"), std::string::npos)
+        << bad;
+  }
+  state = render_adaptive({0, 8});
+  state.next_active[1] = 2;
+  EXPECT_NE(decode_error(encode_state(state)).find("invalid adaptive allocation at pixel 1"), std::string::npos);
+  // A uniform state's pixels were traced in every frame.
+  AccumulationState uniform = render_frames({0, 8});
+  uniform.traced[0] = 7;
+  EXPECT_NE(decode_error(encode_state(uniform)).find("traced count that does not fit"), std::string::npos);
+}
+
+// An adaptive shard of frames A:B traces pixel p at sample indices A..A + traced[p] - 1, so shards
+// of disjoint ranges hold disjoint samples and their merge is their exact sum. It is not resumed:
+// adjacent ranges stay apart (one joined range would let a resume trace some indices twice), and
+// the allocation is cleared. Adaptive and uniform states do not merge.
+TEST(AccumulationState, AdaptiveShardsMergeAsTheirSumAndStayApart) {
+  const AccumulationState a = render_adaptive({0, 6}), b = render_adaptive({6, 16});
+  const AccumulationState merged = merge_states({a, b});
+  EXPECT_EQ(frame_ranges_text(merged.frames), "0:6,6:16");
+  EXPECT_EQ(merged.frame_count(), 16u);
+  for (size_t p = 0; p < merged.traced.size(); ++p) {
+    EXPECT_EQ(merged.traced[p], a.traced[p] + b.traced[p]);
+    EXPECT_EQ(merged.acc.samples[p], a.acc.samples[p] + b.acc.samples[p]);
+    EXPECT_EQ(merged.credit[p], 0.0f);
+    EXPECT_EQ(merged.next_active[p], 1);
+    // The merged mean is the sample-weighted mean of the shards' samples.
+    const double n = static_cast<double>(a.acc.samples[p]) + b.acc.samples[p];
+    EXPECT_NEAR(merged.acc.hv_lum_mean[p],
+                (a.acc.hv_lum_mean[p] * a.acc.samples[p] + b.acc.hv_lum_mean[p] * b.acc.samples[p]) / n,
+                1e-12 * std::abs(merged.acc.hv_lum_mean[p]));
+  }
+  const std::vector<uint8_t> bytes = encode_state(merged);
+  EXPECT_EQ(decode_error(bytes), "");  // adjacent ranges are canonical in an adaptive state
+  EXPECT_NE(std::string(decode_error(encode_state([&] {
+              AccumulationState overlapping = merged;
+              overlapping.frames = {{0, 6}, {5, 16}};
+              return overlapping;
+            }()))).find("overlapping"),
+            std::string::npos);
+  try {
+    merge_states({a, render_frames({6, 16})});
+    ADD_FAILURE() << "an adaptive and a uniform state merged";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("adaptive sampling off vs on"), std::string::npos) << e.what();
+  }
 }

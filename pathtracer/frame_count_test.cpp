@@ -27,6 +27,7 @@ AccumulationState state_of_frames(std::vector<FrameRange> ranges) {
   s.acc.lv_lum_mean.assign(2, 0.5);
   s.acc.lv_lum_m2.assign(2, 0.0);
   s.acc.samples.assign(2, std::min<uint64_t>(s.frame_count(), UINT32_MAX));
+  s.traced = s.acc.samples;
   return s;
 }
 

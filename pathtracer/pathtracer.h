@@ -207,8 +207,10 @@ class ProgressiveRenderer {
   void set_first_frame(uint32_t first);
   uint32_t first_frame() const;
   // Continues from a saved accumulation holding the frames [first, first + frames) (checkpoint
-  // resume, merged shards). Throws pxf::Error when its size differs from the renderer's.
-  void restore(const Accumulation& acc, uint32_t first, int frames);
+  // resume, merged shards). `traced`: each pixel's traced paths (pixel_frames(); an adaptive
+  // render's), empty = `frames` for every pixel. Throws pxf::Error when a size differs from the
+  // renderer's.
+  void restore(const Accumulation& acc, uint32_t first, int frames, const std::vector<uint32_t>& traced = {});
 
   const Accumulation& accumulation() const;
   const TraceStats& stats() const;

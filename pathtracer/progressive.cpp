@@ -175,17 +175,24 @@ void ProgressiveRenderer::set_first_frame(uint32_t first) {
   reset();
 }
 
-void ProgressiveRenderer::restore(const Accumulation& acc, uint32_t first, int frames) {
+void ProgressiveRenderer::restore(const Accumulation& acc, uint32_t first, int frames,
+                                  const std::vector<uint32_t>& traced) {
   if (acc.width != impl_->width || acc.height != impl_->height || acc.samples.size() != impl_->acc.samples.size())
     throw Error("saved accumulation is " + std::to_string(acc.width) + "x" + std::to_string(acc.height) +
                 ", the render " + std::to_string(impl_->width) + "x" + std::to_string(impl_->height));
   if (acc.replicates != impl_->accumulation_replicates())
     throw Error("saved accumulation has " + std::to_string(acc.replicates) + " replicates, the render " +
                 std::to_string(impl_->accumulation_replicates()));
+  if (!traced.empty() && traced.size() != impl_->pixel_frames.size())
+    throw Error("saved traced counts have " + std::to_string(traced.size()) + " entries, the image " +
+                std::to_string(impl_->pixel_frames.size()) + " pixels");
   impl_->acc = acc;
   impl_->first_frame = first;
   impl_->frames = frames;
-  impl_->pixel_frames.assign(impl_->pixel_frames.size(), static_cast<uint32_t>(frames));  // a state's frames are uniform
+  if (traced.empty())
+    impl_->pixel_frames.assign(impl_->pixel_frames.size(), static_cast<uint32_t>(frames));
+  else
+    impl_->pixel_frames = traced;
   impl_->stats = TraceStats{};
 }
 const Accumulation& ProgressiveRenderer::accumulation() const { return impl_->acc; }

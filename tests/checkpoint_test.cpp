@@ -65,11 +65,14 @@ std::vector<std::string> split(const std::string& text) {
   return words;
 }
 
+// Whether every layer is the same, bit for bit; a failure names the layers that differ.
 bool same_pixels(const std::vector<Layer>& a, const std::vector<Layer>& b) {
   if (a.size() != b.size()) return false;
+  std::string differing;
   for (size_t i = 0; i < a.size(); ++i)
-    if (a[i].name != b[i].name || a[i].image.pixels != b[i].image.pixels) return false;
-  return true;
+    if (a[i].name != b[i].name || a[i].image.pixels != b[i].image.pixels) differing += " " + a[i].name;
+  if (!differing.empty()) ADD_FAILURE() << "layers differ:" << differing;
+  return differing.empty();
 }
 
 // Every file under an output name is complete: it reads back whole.
@@ -95,10 +98,14 @@ using test_support::expect_merge_close;
 
 }  // namespace
 
-TEST(Checkpoint, ResumeAfterSigkillAtRandomMomentsIsBitIdentical) {
-  const std::string ref = temp_dir("uninterrupted");
+namespace {
+
+// `trials` renders of `scene` at kSpp, each killed with SIGKILL at a random moment and resumed
+// from its last periodic state (or started again), give the uninterrupted render's images bit for bit.
+void expect_resume_after_kills_is_bit_identical(const std::string& scene, const std::string& name, int trials) {
+  const std::string ref = temp_dir(name + "_uninterrupted");
   const auto started = std::chrono::steady_clock::now();
-  ASSERT_EQ(pxf_run("render " + kScene + " --spp " + std::to_string(kSpp) + " --out " + ref).code, 0);
+  ASSERT_EQ(pxf_run("render " + scene + " --spp " + std::to_string(kSpp) + " --out " + ref).code, 0);
   const int render_ms = static_cast<int>(
       std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now() - started).count());
   const std::vector<Layer> ref_buffers = read_exr_layers(ref + "/buffers.exr");
@@ -109,10 +116,10 @@ TEST(Checkpoint, ResumeAfterSigkillAtRandomMomentsIsBitIdentical) {
   std::mt19937 rng(13);
   std::uniform_int_distribution<int> kill_after_ms(20, std::max(1500, render_ms));
   int resumed = 0;
-  for (int trial = 0; trial < 20; ++trial) {
+  for (int trial = 0; trial < trials; ++trial) {
     SCOPED_TRACE("trial " + std::to_string(trial));
-    const std::string out = temp_dir("killed_" + std::to_string(trial));
-    const pid_t pid = pxf_spawn(split("render " + kScene + " --spp " + std::to_string(kSpp) +
+    const std::string out = temp_dir(name + "_killed_" + std::to_string(trial));
+    const pid_t pid = pxf_spawn(split("render " + scene + " --spp " + std::to_string(kSpp) +
                                       " --checkpoint 0.05 --out " + out));
     ASSERT_GT(pid, 0);
     std::this_thread::sleep_for(std::chrono::milliseconds(kill_after_ms(rng)));
@@ -123,12 +130,80 @@ TEST(Checkpoint, ResumeAfterSigkillAtRandomMomentsIsBitIdentical) {
     const std::string state = out + "/state.pxfs";
     const std::string resume = fs::exists(state) ? " --resume " + state : "";
     resumed += !resume.empty();
-    const Result r = pxf_run("render " + kScene + " --spp " + std::to_string(kSpp) + resume + " --out " + out);
+    const Result r = pxf_run("render " + scene + " --spp " + std::to_string(kSpp) + resume + " --out " + out);
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_TRUE(same_pixels(read_exr_layers(out + "/buffers.exr"), ref_buffers));
     EXPECT_EQ(read_exr(out + "/final.exr").pixels, ref_final.pixels);
   }
-  EXPECT_GE(resumed, 5) << "too few kills landed after the first checkpoint to test resuming";
+  EXPECT_GE(resumed, trials / 4) << "too few kills landed after the first checkpoint to test resuming";
+}
+
+}  // namespace
+
+TEST(Checkpoint, ResumeAfterSigkillAtRandomMomentsIsBitIdentical) {
+  expect_resume_after_kills_is_bit_identical(kScene, "uniform", 20);
+}
+
+// Issue 33: an adaptive render's state holds each pixel's traced count and the allocation's credits
+// and next mask (format 6), and the allocation's guide is the converged range buffer whatever the
+// timing, so a resumed adaptive render traces exactly what the uninterrupted one did. 16 warm-up
+// frames, then 8 allocated ones.
+TEST(Checkpoint, AdaptiveResumeAfterSigkillIsBitIdentical) {
+  expect_resume_after_kills_is_bit_identical(kScene + " --adaptive on", "adaptive", 8);
+}
+
+// An adaptive shard (--frames A:B or --shard i/n with --adaptive on) is an adaptive render of B - A
+// frames whose pixel p takes the sample indices A, A + 1, ... as far as its allocation goes, so
+// shards hold disjoint samples and their merge is their exact sum: counts add, means are the
+// sample-weighted means. A merged adaptive state is not resumed, and an adaptive and a uniform
+// state do not merge.
+TEST(Checkpoint, AdaptiveShardsMergeIntoTheirExactSum) {
+  const std::string scene = kScene + " --adaptive on";
+  std::vector<std::string> dirs;
+  std::string states;
+  for (const char* shard : {"0/2", "1/2"}) {
+    dirs.push_back(temp_dir(std::string("adaptive_shard_") + shard[0]));
+    const Result r = pxf_run("render " + scene + " --spp 48 --shard " + shard + " --out " + dirs.back());
+    ASSERT_EQ(r.code, 0) << r.err;
+    states += " " + dirs.back() + "/state.pxfs";
+  }
+  const std::string merged_dir = temp_dir("adaptive_merged");
+  const Result r = pxf_run("merge" + states + " --scene cornell --out " + merged_dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::vector<Layer> merged = read_exr_layers(merged_dir + "/buffers.exr");
+  const std::vector<Layer> a = read_exr_layers(dirs[0] + "/buffers.exr"), b = read_exr_layers(dirs[1] + "/buffers.exr");
+  const Image& na = layer_image(a, "samples");
+  const Image& nb = layer_image(b, "samples");
+  const Image& n = layer_image(merged, "samples");
+  bool uneven = false;
+  for (size_t p = 0; p < n.pixels.size(); ++p) {
+    ASSERT_EQ(n.pixels[p], na.pixels[p] + nb.pixels[p]) << p;
+    uneven |= na.pixels[p] != na.pixels[0];
+    for (const char* layer : {"lv", "hv"})
+      for (int c = 0; c < 3; ++c) {
+        const float va = layer_image(a, layer).pixels[3 * p + c], vb = layer_image(b, layer).pixels[3 * p + c];
+        const float expected = (va * na.pixels[p] + vb * nb.pixels[p]) / n.pixels[p];
+        EXPECT_NEAR(layer_image(merged, layer).pixels[3 * p + c], expected, 2e-5f * std::abs(expected) + 1e-6f)
+            << layer << " " << p;
+      }
+  }
+  EXPECT_TRUE(uneven) << "the shards' allocation traced every pixel alike: nothing adaptive was merged";
+  const nlohmann::json stats = nlohmann::json::parse(slurp(merged_dir + "/stats.json"));
+  EXPECT_EQ(stats["settings"]["adaptive"], true);
+
+  const Result resume = pxf_run("render " + scene + " --spp 64 --resume " + merged_dir + "/state.pxfs --out " +
+                                temp_dir("adaptive_resumed_merge"));
+  EXPECT_EQ(resume.code, 1);
+  EXPECT_NE(resume.err.find("do not start this render's frames"), std::string::npos) << resume.err;
+  const std::string uniform = temp_dir("uniform_shard");
+  ASSERT_EQ(pxf_run("render " + kScene + " --frames 48:50 --out " + uniform).code, 0);
+  const Result mixed = pxf_run("merge" + states + " " + uniform + "/state.pxfs --scene cornell --out " +
+                               temp_dir("mixed_merge"));
+  EXPECT_EQ(mixed.code, 1);
+  EXPECT_NE(mixed.err.find("adaptive sampling"), std::string::npos) << mixed.err;
+  const Result other = pxf_run("render " + kScene + " --spp 48 --resume " + dirs[0] + "/state.pxfs --out " + dirs[0]);
+  EXPECT_EQ(other.code, 1);
+  EXPECT_NE(other.err.find("adaptive sampling"), std::string::npos) << other.err;
 }
 
 TEST(Checkpoint, MergeOfUnevenShardsEqualsOneRender) {
