@@ -186,6 +186,7 @@ class Explorer {
       options_.scene.scene = path;
       scene_error_.clear();
       history_.clear();
+      if (views_) views_->set_sampling(SamplingSnapshot::of(*preview_));
     } catch (const Error& e) {
       if (first) throw;
       scene_error_ = e.what();  // keep the previous scene running
@@ -296,6 +297,11 @@ class Explorer {
     ImGui::GetWindowDrawList()->AddRect(ImVec2(at.x + kHalf * cell, at.y + kHalf * cell),
                                         ImVec2(at.x + (kHalf + 1) * cell, at.y + (kHalf + 1) * cell), IM_COL32(255, 255, 255, 255));
     ImGui::Text("pixel (%d, %d)   n = %u", p.x, p.y, p.n);
+    const SamplingSnapshot& sampling = views_->sampling();
+    const size_t i = static_cast<size_t>(y) * width_ + x;
+    if (i < sampling.paths.size())
+      ImGui::Text("paths %u   next frame: %s", sampling.paths[i],
+                  sampling.active.size() > i && sampling.active[i] == 0 ? "skipped" : "traced");
     ImGui::Text("final     %.4g %.4g %.4g", p.final_s.r, p.final_s.g, p.final_s.b);
     ImGui::Text("LV        %.4g %.4g %.4g", p.lv.r, p.lv.g, p.lv.b);
     ImGui::Text("HV L_u    %.4g %.4g %.4g", p.hv_var.r, p.hv_var.g, p.hv_var.b);
@@ -349,6 +355,7 @@ class Explorer {
       cases += part;
     }
     ImGui::TextUnformatted(cases.c_str());
+    ImGui::TextWrapped("%s", sampling_status_line(preview_->case2_share(), views_->sampling()).c_str());  // wider than the panel
     const std::vector<float> plot(history_.begin(), history_.end());
     char overlay[64];
     std::snprintf(overlay, sizeof(overlay), "pixels at s = 1: %.1f%%", plot.empty() ? 0.0 : 100.0 * plot.back());
@@ -360,7 +367,10 @@ class Explorer {
 
   void view_section() {
     if (!ImGui::CollapsingHeader("Buffer view (keys 1-0)", ImGuiTreeNodeFlags_DefaultOpen)) return;
-    ImGui::BeginChild("views", ImVec2(0, 11 * ImGui::GetTextLineHeightWithSpacing() + 4), true);
+    // Every view without a scrollbar: the rows plus the child's own padding above and below.
+    ImGui::BeginChild("views",
+                      ImVec2(0, kBufferViewCount * ImGui::GetTextLineHeightWithSpacing() + 2 * ImGui::GetStyle().WindowPadding.y),
+                      true);
     for (int i = 0; i < kBufferViewCount; ++i)
       if (ImGui::Selectable(buffer_view_label(BufferView(i)), view_ == BufferView(i))) view_ = BufferView(i);
     ImGui::EndChild();
@@ -377,6 +387,19 @@ class Explorer {
         ImGui::SameLine();
         ImGui::Text("%-26s %5.1f%%", style.label, 100.0 * counts[c] / (width_ * height_));
       }
+      return;
+    }
+    if (view == BufferView::Active) {
+      const SamplingSnapshot& sampling = views_->sampling();
+      const double traced = active_share(sampling.active);
+      for (int a = 1; a >= 0; --a) {
+        const CaseStyle& style = active_styles()[a];
+        ImGui::ColorButton(style.label, ImVec4(style.r, style.g, style.b, 1), ImGuiColorEditFlags_NoTooltip, ImVec2(14, 14));
+        ImGui::SameLine();
+        ImGui::Text("%-26s %5.1f%%", style.label, 100.0 * (a == 1 ? traced : 1.0 - traced));
+      }
+      if (sampling.active.empty())
+        ImGui::TextDisabled(settings_.adaptive ? "uniform warm-up: every pixel is traced" : "adaptive sampling off (--adaptive on)");
       return;
     }
     if (!is_scalar_view(view)) return;
@@ -397,6 +420,7 @@ class Explorer {
     if (view == BufferView::VarU || view == BufferView::VarF)
       ImGui::TextDisabled("log scale; dark gray: unknown (n < 2)%s", view == BufferView::VarF ? ", light: skipped" : "");
     if (view == BufferView::Depth) ImGui::TextDisabled("scene units; black: no surface");
+    if (view == BufferView::Samples) ImGui::TextDisabled("paths traced into each pixel, linear");
     if (view == BufferView::Blend) return;
     ImGui::PushID(static_cast<int>(view));
     ImGui::Checkbox("auto range", &s.automatic);
@@ -544,16 +568,20 @@ class Explorer {
   void apply_changes() {
     if (camera_changed_ && tracing_) stop_tracing(/*cancel=*/true);
     if (tracing_ || preview_->passes_pending()) return;
+    const bool camera = camera_changed_;
     if (camera_changed_) preview_->set_camera(controller_->camera());
     camera_changed_ = false;
     const bool moving = fast_while_moving_ && (dragging_camera_ || flying_);
-    if (settings_changed_ || moving != applied_moving_) {
+    const bool settings = settings_changed_ || moving != applied_moving_;
+    if (settings) {
       PreviewSettings effective = settings_;
       if (moving) effective.filter.kind = FilterKind::None;
       preview_->set_settings(effective);
       settings_changed_ = false;
       applied_moving_ = moving;
     }
+    // Either may have reset the samples (and cleared the mask): the views show the reset at once.
+    if (camera || settings) views_->set_sampling(SamplingSnapshot::of(*preview_));
   }
 
   bool spp_reached() const {
@@ -586,6 +614,9 @@ class Explorer {
     const int samples = preview_->samples();
     const bool last = options_.spp > 0 && samples == options_.spp;
     preview_->queue_passes(last, /*display=*/true);
+    // After queue_passes: it plans the next frame's mask. The worker is idle until the next
+    // start_trace, so the per-pixel counts can be copied now (the views must not read them live).
+    views_->set_sampling(SamplingSnapshot::of(*preview_));
     finished_ = last;
     samples_snapshot_ = preview_->renderer().accumulation().samples;
     ++frames_since_display_;

@@ -3,17 +3,24 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <sstream>
 #include <string>
 
+#include "app/adaptive.h"
 #include "app/explorer_camera.h"
 #include "app/explorer_views.h"
+#include "app/preview.h"
+#include "gl/context.h"
 #include "image/image.h"
+#include "pathtracer/pathtracer.h"
 
 namespace pxf {
 namespace {
@@ -96,6 +103,134 @@ TEST(ExplorerViews, NamesDigitsAndScalarViews) {
   EXPECT_EQ(buffer_view_of_digit(10), -1);
   EXPECT_TRUE(is_scalar_view(BufferView::VarU));
   EXPECT_FALSE(is_scalar_view(BufferView::Final));
+  // Issue 33's views: reachable by name (--view, --split, the UI's list), no number key.
+  EXPECT_EQ(parse_buffer_view("samples"), BufferView::Samples);
+  EXPECT_EQ(parse_buffer_view("active"), BufferView::Active);
+  for (int digit = 0; digit <= 9; ++digit) {
+    EXPECT_NE(BufferView(buffer_view_of_digit(digit)), BufferView::Samples);
+    EXPECT_NE(BufferView(buffer_view_of_digit(digit)), BufferView::Active);
+  }
+  EXPECT_TRUE(is_scalar_view(BufferView::Samples));  // false color with a legend
+  EXPECT_FALSE(is_scalar_view(BufferView::Active));  // two colors with the shares
+}
+
+// --- issue 33: the samples and active views and the status line, headless ----------------------
+
+// The status line from known counts: every figure and its format, and the empty mask (adaptive off
+// or warm-up) counted as every pixel active.
+TEST(ExplorerSampling, StatusLineNamesCleanShareCountsAndActiveShare) {
+  SamplingSnapshot s;
+  s.paths = {10, 20, 30, 41};
+  s.active = {1, 0, 0, 0};
+  EXPECT_EQ(sampling_status_line(0.375, s), "clean (case 2): 37.5 %   paths/pixel mean 25.2 (min 10, max 41)   active 25.0 %");
+  s.active.clear();
+  EXPECT_EQ(sampling_status_line(1.0, s), "clean (case 2): 100.0 %   paths/pixel mean 25.2 (min 10, max 41)   active 100.0 %");
+  EXPECT_DOUBLE_EQ(active_share({}), 1.0);
+  EXPECT_DOUBLE_EQ(active_share({0, 0, 1, 1, 1}), 0.6);
+}
+
+// The turbo polynomial of shaders/view_colormap.glsl, on the CPU (an independent copy: the test
+// fails if the shader's mapping or the view's scale changes).
+glm::vec3 turbo(float x) {
+  const glm::vec4 r4(0.13572138f, 4.61539260f, -42.66032258f, 132.13108234f);
+  const glm::vec4 g4(0.09140261f, 2.19418839f, 4.84296658f, -14.18503333f);
+  const glm::vec4 b4(0.10667330f, 12.64194608f, -60.58204836f, 110.36276771f);
+  const glm::vec2 r2(-152.94239396f, 59.28637943f), g2(4.27729857f, 2.82956604f), b2(-89.90310912f, 27.34824973f);
+  x = std::clamp(x, 0.0f, 1.0f);
+  const glm::vec4 v4(1.0f, x, x * x, x * x * x);
+  const glm::vec2 v2 = glm::vec2(v4.z, v4.w) * v4.z;
+  return glm::clamp(glm::vec3(glm::dot(v4, r4) + glm::dot(v2, r2), glm::dot(v4, g4) + glm::dot(v2, g2),
+                              glm::dot(v4, b4) + glm::dot(v2, b2)),
+                    0.0f, 1.0f);
+}
+
+GlContext& headless_context() {
+  static std::unique_ptr<GlContext> context = create_gl_context(GlBackend::OSMesa);
+  context->make_current();
+  return *context;
+}
+
+// Cornell at 32x24, adaptive, 40 frames (16 uniform warm-up frames, then the allocation): uneven
+// counts and a next mask that traces some pixels and skips others. The scene outlives the preview.
+class ExplorerSamplingViews : public ::testing::Test {
+ protected:
+  static constexpr int kW = 32, kH = 24;
+  void SetUp() override {
+    headless_context();
+    static const Scene scene = load_scene("cornell");
+    PreviewSettings settings;
+    settings.adaptive = true;
+    settings.threshold = 0.05f;  // loose: many pixels clean early, so the allocation differs per pixel
+    preview_ = std::make_unique<Preview>(scene, settings, kW, kH);
+    for (int i = 0; i < 40; ++i) preview_->add_frame(i + 1 == 40);
+    views_ = std::make_unique<ViewRenderer>(kW, kH);
+    views_->set_sampling(SamplingSnapshot::of(*preview_));
+  }
+  // The view as RGB in [0,1], top row first.
+  Image shown(BufferView view) { return views_->render(view, *preview_, 0).download({"R", "G", "B"}); }
+  std::unique_ptr<Preview> preview_;
+  std::unique_ptr<ViewRenderer> views_;
+};
+
+TEST_F(ExplorerSamplingViews, SamplesViewIsTheCountsOnTheLegendsLinearScale) {
+  const std::vector<uint32_t>& paths = preview_->pixel_samples();
+  ASSERT_EQ(paths.size(), static_cast<size_t>(kW * kH));
+  const SampleCounts counts = sample_counts(paths);
+  ASSERT_LT(counts.min, counts.max) << "the allocation traced every pixel alike: nothing uneven to show";
+  EXPECT_EQ(counts.max, 40u);
+  const ScalarScale& s = views_->scale(BufferView::Samples);  // set by set_sampling, no update call
+  EXPECT_FALSE(s.log);
+  EXPECT_EQ(s.lo, float(counts.min));  // the whole range of the image
+  EXPECT_EQ(s.hi, float(counts.max));
+  const Image image = shown(BufferView::Samples);
+  double worst = 0;
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) {
+      const float n = float(paths[static_cast<size_t>(y) * kW + x]);  // row-major, top row first
+      const glm::vec3 want = turbo((n - s.lo) / (s.hi - s.lo));
+      for (int c = 0; c < 3; ++c) worst = std::max(worst, double(std::abs(image.at(x, y, c) - want[c])));
+    }
+  EXPECT_LE(worst, 1.5 / 255) << "samples view differs from the CPU mapping";
+  // Equal counts (a uniform render) sit mid-scale, one path wide.
+  SamplingSnapshot uniform{std::vector<uint32_t>(kW * kH, 7), {}};
+  views_->set_sampling(uniform);
+  EXPECT_EQ(views_->scale(BufferView::Samples).lo, 6.5f);
+  EXPECT_EQ(views_->scale(BufferView::Samples).hi, 7.5f);
+  const Image flat = shown(BufferView::Samples);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(flat.at(kW - 1, kH - 1, c), turbo(0.5f)[c], 1.5 / 255);
+}
+
+TEST_F(ExplorerSamplingViews, ActiveViewShowsTheNextMaskAndAnEmptyMaskAsEveryPixel) {
+  const std::vector<uint8_t>& mask = preview_->next_active();
+  ASSERT_EQ(mask.size(), static_cast<size_t>(kW * kH));
+  const double share = active_share(mask);
+  ASSERT_GT(share, 0.0);
+  ASSERT_LT(share, 1.0) << "the next frame traces every pixel: nothing skipped to show";
+  auto expect_colors = [&](const Image& image, const std::vector<uint8_t>& active) {
+    int wrong = 0;
+    for (int y = 0; y < kH; ++y)
+      for (int x = 0; x < kW; ++x) {
+        const size_t p = static_cast<size_t>(y) * kW + x;
+        const CaseStyle& style = active_styles()[active.empty() || active[p] == 1 ? 1 : 0];
+        const float want[3] = {style.r, style.g, style.b};
+        for (int c = 0; c < 3; ++c) wrong += std::abs(image.at(x, y, c) - want[c]) > 0.6f / 255;
+      }
+    return wrong;
+  };
+  EXPECT_EQ(expect_colors(shown(BufferView::Active), mask), 0);
+  views_->set_sampling(SamplingSnapshot{preview_->pixel_samples(), {}});  // adaptive off, or warm-up
+  EXPECT_EQ(expect_colors(shown(BufferView::Active), {}), 0);
+}
+
+// The status line of this preview: its figures are the preview's own.
+TEST_F(ExplorerSamplingViews, StatusLineOfAnAdaptivePreview) {
+  const SampleCounts counts = sample_counts(preview_->pixel_samples());
+  const std::vector<uint8_t>& mask = preview_->next_active();
+  const double active = 100.0 * std::count(mask.begin(), mask.end(), 1) / mask.size();
+  char want[200];
+  std::snprintf(want, sizeof want, "clean (case 2): %.1f %%   paths/pixel mean %.1f (min %u, max %u)   active %.1f %%",
+                100.0 * preview_->case_counts()[kCaseUnfiltered] / (kW * kH), counts.mean, counts.min, counts.max, active);
+  EXPECT_EQ(sampling_status_line(preview_->case2_share(), views_->sampling()), want);
 }
 
 // --- the explorer in a window ----------------------------------------------------------------

@@ -2,7 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <utility>
 
+#include "app/adaptive.h"
 #include "gl/gl.h"
 
 namespace pxf {
@@ -27,6 +30,8 @@ const ViewInfo kViews[kBufferViewCount] = {
     {BufferView::Blend, "blend", "9  blend factor s"},
     {BufferView::Case, "case", "0  blend case"},
     {BufferView::Unfiltered, "unfiltered", "   unfiltered L_lv + L_u"},
+    {BufferView::Samples, "samples", "   paths per pixel"},
+    {BufferView::Active, "active", "   next frame's active pixels"},
 };
 
 // The legend's colors are the case view's (shared::case_color, shaders/view_case.frag).
@@ -41,6 +46,13 @@ const std::array<CaseStyle, kBlendCaseCount> kCaseStyles = {{
     case_style("3  mixed (0 < s < 1)", kCaseMixed),
     case_style("4  n < 2 (s = 0)", kCaseUnknownVar),
     case_style("5  bias guard (s raised)", kCaseBiasGuard),
+}};
+
+// Far apart in hue and lightness, and unlike the turbo scale's ends, so that the mask does not
+// read as a scalar view: skipped pixels dark slate, traced ones bright amber.
+const std::array<CaseStyle, 2> kActiveStyles = {{
+    {"skipped by the next frame", 0.15f, 0.20f, 0.35f},
+    {"traced by the next frame", 1.00f, 0.78f, 0.20f},
 }};
 
 constexpr int kLegendWidth = 256;
@@ -79,10 +91,25 @@ int buffer_view_of_digit(int digit) {
 }
 
 bool is_scalar_view(BufferView v) {
-  return v == BufferView::VarU || v == BufferView::VarF || v == BufferView::Blend || v == BufferView::Depth;
+  return v == BufferView::VarU || v == BufferView::VarF || v == BufferView::Blend || v == BufferView::Depth ||
+         v == BufferView::Samples;
 }
 
 const std::array<CaseStyle, kBlendCaseCount>& case_styles() { return kCaseStyles; }
+const std::array<CaseStyle, 2>& active_styles() { return kActiveStyles; }
+
+double active_share(const std::vector<uint8_t>& active) {
+  if (active.empty()) return 1.0;
+  return static_cast<double>(std::count(active.begin(), active.end(), uint8_t{1})) / static_cast<double>(active.size());
+}
+
+std::string sampling_status_line(double case2_share, const SamplingSnapshot& sampling) {
+  const SampleCounts counts = sample_counts(sampling.paths);  // the same figures stats.json reports
+  char line[160];
+  std::snprintf(line, sizeof line, "clean (case 2): %.1f %%   paths/pixel mean %.1f (min %u, max %u)   active %.1f %%",
+                100.0 * case2_share, counts.mean, counts.min, counts.max, 100.0 * active_share(sampling.active));
+  return line;
+}
 
 ViewRenderer::ViewRenderer(int width, int height)
     : width_(width),
@@ -95,7 +122,9 @@ ViewRenderer::ViewRenderer(int width, int height)
       legend_ramp_(kLegendWidth, 1, TextureFormat::R32F),
       legend_output_(kLegendWidth, 1, TextureFormat::RGBA8),
       hdr_tonemap_(width, height),
-      unfiltered_(width, height) {
+      unfiltered_(width, height),
+      samples_(width, height, TextureFormat::R32F),
+      active_(width, height, TextureFormat::RGBA8) {
   for (int i = 0; i < 3; ++i) {
     outputs_[i] = Texture2D(width, height, TextureFormat::RGBA8);
     outputs_[i].set_filter(false);  // magnified views show pixels, not blur
@@ -112,6 +141,46 @@ ViewRenderer::ViewRenderer(int width, int height)
   scale(BufferView::Depth) = ScalarScale{0.0f, 10.0f, /*log=*/false, /*automatic=*/true};
   scale(BufferView::VarU) = ScalarScale{1e-6f, 1.0f, /*log=*/true, /*automatic=*/true};
   scale(BufferView::VarF) = ScalarScale{1e-6f, 1.0f, /*log=*/true, /*automatic=*/true};
+  // Linear: an adaptive render's counts span about one decade (a pixel is traced between every
+  // 16th frame and every frame), and a linear scale reads directly as paths.
+  scale(BufferView::Samples) = ScalarScale{0.0f, 1.0f, /*log=*/false, /*automatic=*/true};
+}
+
+void ViewRenderer::set_sampling(SamplingSnapshot sampling) {
+  sampling_ = std::move(sampling);
+  sampling_uploaded_ = false;
+  // No read-back here, only a pass over the counts: the automatic scale follows every snapshot, so
+  // the legend's ends are the image's fewest and most paths (the status line's min and max).
+  set_samples_scale();
+}
+
+void ViewRenderer::set_samples_scale() {
+  // The whole range, not percentiles: counts have no outliers to hide, and the few pixels at the
+  // most or fewest paths are the ones to see. Equal counts sit mid-scale on a range of one path.
+  ScalarScale& s = scale(BufferView::Samples);
+  if (!s.automatic || sampling_.paths.empty()) return;
+  const SampleCounts c = sample_counts(sampling_.paths);
+  s.lo = c.min == c.max ? c.min - 0.5f : static_cast<float>(c.min);
+  s.hi = c.min == c.max ? c.max + 0.5f : static_cast<float>(c.max);
+}
+
+void ViewRenderer::upload_sampling() {
+  if (sampling_uploaded_) return;
+  const size_t pixels = static_cast<size_t>(width_) * height_;
+  std::vector<float> paths(pixels, 0.0f);
+  if (sampling_.paths.size() == pixels) std::copy(sampling_.paths.begin(), sampling_.paths.end(), paths.begin());
+  samples_.upload(paths.data(), 1);
+  const bool every_pixel = sampling_.active.size() != pixels;  // empty: adaptive off or still warming up
+  std::vector<unsigned char> rgba(4 * pixels);
+  for (size_t p = 0; p < pixels; ++p) {
+    const CaseStyle& c = kActiveStyles[every_pixel || sampling_.active[p] == 1 ? 1 : 0];
+    rgba[4 * p + 0] = static_cast<unsigned char>(std::lround(255.0f * c.r));
+    rgba[4 * p + 1] = static_cast<unsigned char>(std::lround(255.0f * c.g));
+    rgba[4 * p + 2] = static_cast<unsigned char>(std::lround(255.0f * c.b));
+    rgba[4 * p + 3] = 255;
+  }
+  active_.upload_rgba8(rgba.data());
+  sampling_uploaded_ = true;
 }
 
 void ViewRenderer::draw_scalar(const Texture2D& source, int channel, const ScalarScale& s, bool sentinels,
@@ -183,6 +252,14 @@ const Texture2D& ViewRenderer::render(BufferView view, Preview& preview, int slo
       case_.use();
       quad_.draw(target, width_, height_);
       break;
+    case BufferView::Samples:  // CPU data: the snapshot, not the preview (set_sampling)
+      upload_sampling();
+      draw_scalar(samples_, 0, scale(view), false, 0.0f, target, width_, height_);
+      break;
+    case BufferView::Active:  // colors made on the CPU, copied as they are
+      upload_sampling();
+      draw_display(active_, false, slot);
+      break;
   }
   check_gl_error("explorer view");
   return outputs_[slot];
@@ -214,6 +291,7 @@ const Texture2D& ViewRenderer::legend(BufferView view) {
 void ViewRenderer::update_auto_scale(BufferView view, Preview& preview) {
   ScalarScale& s = scale(view);
   if (!s.automatic || !is_scalar_view(view) || view == BufferView::Blend) return;
+  if (view == BufferView::Samples) return set_samples_scale();
   Image source;
   if (view == BufferView::VarU) source = preview.inputs().var_image();
   else if (view == BufferView::VarF && preview.has_filtered()) source = preview.filtered_variance_image();

@@ -7,6 +7,7 @@
 //   const Texture2D& both = views.split(views.render(a, preview, 0), views.render(b, preview, 1), x);
 #pragma once
 #include <array>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -17,12 +18,13 @@
 
 namespace pxf {
 
-// In the order of the number keys 1..9, 0; Unfiltered (L_lv + L_u) has no key.
-enum class BufferView { Final, Lv, Hv, HvFiltered, RangeColor, Depth, VarU, VarF, Blend, Case, Unfiltered };
-constexpr int kBufferViewCount = 11;
+// In the order of the number keys 1..9, 0; Unfiltered (L_lv + L_u), Samples (paths traced into
+// each pixel) and Active (the next frame's adaptive mask, issue 33) have no key.
+enum class BufferView { Final, Lv, Hv, HvFiltered, RangeColor, Depth, VarU, VarF, Blend, Case, Unfiltered, Samples, Active };
+constexpr int kBufferViewCount = 13;
 
 // Command-line names ("final", "lv", "hv", "hv-filtered", "range", "depth", "var-u", "var-f",
-// "blend", "case", "unfiltered") and UI labels.
+// "blend", "case", "unfiltered", "samples", "active") and UI labels.
 const std::vector<std::string>& buffer_view_names();
 const char* buffer_view_label(BufferView view);
 BufferView parse_buffer_view(const std::string& name);  // throws pxf::Error listing the names
@@ -35,7 +37,7 @@ struct ScalarScale {
   bool log = true;
   bool automatic = true;  // follow the image's range (percentiles), updated now and then
 };
-bool is_scalar_view(BufferView view);  // VarU, VarF, Blend, Depth
+bool is_scalar_view(BufferView view);  // VarU, VarF, Blend, Depth, Samples
 
 // Colors of the case view, also for its legend: index = case code (kCase*).
 struct CaseStyle {
@@ -43,6 +45,23 @@ struct CaseStyle {
   float r, g, b;
 };
 const std::array<CaseStyle, kBlendCaseCount>& case_styles();
+// Colors of the active view, also for its legend: [0] skipped by the next frame, [1] traced.
+const std::array<CaseStyle, 2>& active_styles();
+
+// Adaptive sampling per pixel (issue 33), copied from the preview while it is not tracing: the
+// explorer's worker writes the per-pixel counts during a frame, so the samples and active views
+// and the status line read this copy (taken after each traced frame) instead of the live vectors.
+struct SamplingSnapshot {
+  std::vector<uint32_t> paths;  // Preview::pixel_samples(): paths traced into each pixel, row-major, top row first
+  std::vector<uint8_t> active;  // Preview::next_active(): 1 = the next frame traces it; empty = every pixel
+  static SamplingSnapshot of(const Preview& preview) { return {preview.pixel_samples(), preview.next_active()}; }
+};
+// The share of the pixels the next frame traces: 1 when the mask is empty (every pixel).
+double active_share(const std::vector<uint8_t>& active);
+// The explorer's status line of adaptive sampling:
+// "clean (case 2): X.X %   paths/pixel mean M (min a, max b)   active Y.Y %" with the case-2 share
+// of the last blend (Preview::case2_share()) and the active share of the next frame.
+std::string sampling_status_line(double case2_share, const SamplingSnapshot& sampling);
 
 class ViewRenderer {
  public:
@@ -65,14 +84,24 @@ class ViewRenderer {
   const Texture2D& shown(bool split) const { return split ? split_output_ : outputs_[0]; }
 
   ScalarScale& scale(BufferView view) { return scales_[static_cast<int>(view)]; }
-  // Sets the automatic scales of the view from the preview's buffer (a read-back: call now and then).
+  // Sets the automatic scales of the view from the preview's buffer (a read-back: call now and then;
+  // the samples view's follows set_sampling by itself).
   void update_auto_scale(BufferView view, Preview& preview);
+
+  // The per-pixel data of the samples and active views (and of the explorer's status line): the
+  // caller copies it from the preview while the preview is not tracing (SamplingSnapshot::of);
+  // uploaded when one of those views is next rendered, and the samples view's automatic scale set
+  // from it. Until the first call both views show an empty snapshot: 0 paths, every pixel active.
+  void set_sampling(SamplingSnapshot sampling);
+  const SamplingSnapshot& sampling() const { return sampling_; }
 
  private:
   void draw_scalar(const Texture2D& source, int channel, const ScalarScale& scale, bool sentinels, float background,
                    const Framebuffer& target, int width, int height);
   void draw_display(const Texture2D& source, bool encode_srgb, int slot);
   void tonemap_like_final(const Texture2D& hdr, Preview& preview, int slot);
+  void upload_sampling();  // the snapshot into samples_ and active_, if it changed
+  void set_samples_scale();  // the automatic scale of the samples view from the snapshot
 
   int width_, height_;
   Program scalar_, case_, display_, split_;
@@ -84,6 +113,10 @@ class ViewRenderer {
   BlendPass unfiltered_;     // without L_f the blend is L_lv + L_u
   FullscreenPass quad_;
   std::array<ScalarScale, kBufferViewCount> scales_;
+  SamplingSnapshot sampling_;
+  bool sampling_uploaded_ = false;
+  Texture2D samples_;  // R32F: paths per pixel as floats (exact below 2^24)
+  Texture2D active_;   // RGBA8: active_styles() colors, drawn as they are
 };
 
 }  // namespace pxf
