@@ -4,6 +4,9 @@
 #include <cmath>
 #include <limits>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include "gl/cpu_reference.h"
 
 namespace pxf {
@@ -20,20 +23,24 @@ std::vector<float> final_pixel_need(const Image& lv, const Image& hv, const Imag
   }
   const bool pool = range_color && depth;
   std::vector<float> need(var_final.pixels.size());
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      const size_t p = static_cast<size_t>(y) * w + x;
-      const float v = pool ? pooled_var_u(var_final, *range_color, *depth, x, y, range) : var_final.pixels[p];
-      if (v < 0.0f) {
-        need[p] = std::numeric_limits<float>::infinity();
-        continue;
+  // Rows in parallel: each pixel's need reads the inputs only, so the result is the same whatever
+  // the thread count. The 3x3 range-weighted pooling is most of the allocation's cost.
+  tbb::parallel_for(tbb::blocked_range<int>(0, h, 8), [&](const tbb::blocked_range<int>& rows) {
+    for (int y = rows.begin(); y != rows.end(); ++y)
+      for (int x = 0; x < w; ++x) {
+        const size_t p = static_cast<size_t>(y) * w + x;
+        const float v = pool ? pooled_var_u(var_final, *range_color, *depth, x, y, range) : var_final.pixels[p];
+        if (v < 0.0f) {
+          need[p] = std::numeric_limits<float>::infinity();
+          continue;
+        }
+        const float lb = std::max(luminance(clean(hv.at(x, y, 0)), clean(hv.at(x, y, 1)), clean(hv.at(x, y, 2))) +
+                                      luminance(clean(lv.at(x, y, 0)), clean(lv.at(x, y, 1)), clean(lv.at(x, y, 2))),
+                                  0.0f);
+        const float t_n = effective_threshold(t, paths[p]);
+        need[p] = t_n > 0.0f ? relative_variance(v, lb) / t_n : std::numeric_limits<float>::infinity();
       }
-      const float lb = std::max(luminance(clean(hv.at(x, y, 0)), clean(hv.at(x, y, 1)), clean(hv.at(x, y, 2))) +
-                                    luminance(clean(lv.at(x, y, 0)), clean(lv.at(x, y, 1)), clean(lv.at(x, y, 2))),
-                                0.0f);
-      const float t_n = effective_threshold(t, paths[p]);
-      need[p] = t_n > 0.0f ? relative_variance(v, lb) / t_n : std::numeric_limits<float>::infinity();
-    }
+  });
   return need;
 }
 

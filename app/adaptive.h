@@ -40,6 +40,11 @@ struct AdaptiveParams {
   float full_rate_need = 4.0f;
   // Radius of the box over which the need is dilated (2: the 5x5 window of the bias guard).
   int dilation_radius = 2;
+  // The rates are recomputed after the warm-up and then whenever the frames grew by 1/16 (at least
+  // one frame): the pooling over the range guide costs about half a path-tracing frame of cornell
+  // at 64x64 when run every frame, while a pixel's variance estimate moves by a few per cent in
+  // 1/16 more samples. Cycles likewise updates its adaptive mask every few samples.
+  int replan_divisor = 16;
 };
 
 // r_p of every pixel (row-major): lv, hv "R,G,B" means; var_u, var_lv "Y" variances of the means
@@ -61,6 +66,29 @@ std::vector<float> sampling_rates(const std::vector<float>& dilated_need, const 
 // The next frame's active mask from the rates: credit[p] += a_p, traced (1) when it reaches 1, which
 // takes 1 off. `credit` starts at 0 per pixel and is carried from frame to frame.
 std::vector<uint8_t> select_active(const std::vector<float>& rates, std::vector<float>& credit);
+
+// Frame counts that grow with the render: `first`, then each time the frames grew by 1/divisor (at
+// least by one). Built from the frames a render has done, it names the same later frames as the
+// uninterrupted render's schedule: a resumed render checks and replans where that one did.
+class GrowingSchedule {
+ public:
+  GrowingSchedule(int first, int divisor, int frames_done = 0) : next_(first), divisor_(divisor) {
+    while (next_ <= frames_done) next_ = after(next_);
+  }
+  // Whether the count `frames` has reached the next scheduled one.
+  bool due(int frames) const { return frames >= next_; }
+  void done(int frames) { next_ = after(frames); }
+
+ private:
+  int after(int frames) const { return frames + (frames / divisor_ > 1 ? frames / divisor_ : 1); }
+  int next_, divisor_;
+};
+
+// When `pxf render --until-clean` (and pxf bench --adaptive) asks whether the image is clean, by a
+// fresh filter run and blend: from 16 frames on (fewer are never clean at a strict t), then
+// whenever the frames grew by a quarter, so a render is found clean within 25 % of the frames it
+// needed, at about log(n) / log(1.25) extra filter runs. due() takes the count after the frame.
+inline GrowingSchedule clean_checks(int frames_done = 0) { return GrowingSchedule(16, 4, frames_done); }
 
 // Counts of a frame's traced pixels, for stats.
 struct SampleCounts {

@@ -4,6 +4,7 @@
 //   pxf bench --pathtracer    paths/s, rays/s, ms/frame and the raw Embree ray rate
 //   pxf bench --pathtracer --sampler-error | --variance-ratio   the samplers (app/sampler_bench.h)
 //   pxf bench --threshold-fidelity   the blend's threshold against the empirical variance (app/fidelity_bench.h)
+//   pxf bench --adaptive      adaptive against uniform sampling (app/adaptive_bench.h)
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -13,6 +14,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "app/adaptive_bench.h"
+#include "app/bench_runs.h"
 #include "app/commands.h"
 #include "app/options.h"
 #include "app/plot.h"
@@ -39,15 +42,6 @@ void write_text(const std::string& path, const std::string& text) {
   });
 }
 
-// The error figures of one bench row, one call per row: HDR NRMSE, and on the images tone-mapped
-// with the reference's key and log-average, display NRMSE and mean LDR-FLIP (image/metrics.h).
-struct RowError {
-  double hdr_nrmse = 0, display_nrmse = 0, flip = 0;
-};
-RowError row_error(const Image& test, const Image& reference) {
-  const DisplayMetrics m = compare_display(test, reference);
-  return {m.hdr.nrmse_percent, m.display_nrmse_percent, m.flip_mean};
-}
 // CSV columns beside the HDR NRMSE ones: "<prefix>display_nrmse_percent,<prefix>flip".
 std::string display_csv_header(const std::string& prefix) {
   return prefix + "display_nrmse_percent," + prefix + "flip";
@@ -152,34 +146,8 @@ PlainRun run_plain(const BenchSetup& b, int min_frames, int max_frames, double s
   return run;
 }
 
-// One job under `--time` (the render command's machinery): frames while the next one, its due
-// passes and the finish fit the budget, then the finish. One row of the equal-time table; columns
-// are added per row.
-struct TimedRun {
-  int spp = 0;
-  double used_ms = 0;
-  int filter_runs = 0;
-  StageTimes times;
-  RowError error;  // HDR NRMSE, display NRMSE, FLIP
-  Image image;     // the final linear image
-};
-
 TimedRun run_timed(const BenchSetup& b, const PreviewSettings& settings, double budget_ms, const Image& reference) {
-  const auto start = Clock::now();
-  Preview preview(b.scene, settings, b.width, b.height);
-  for (int i = 0;; ++i) {
-    if (i > 0 && !next_frame_fits(preview.predict_next_frame(budget_ms, elapsed_ms(start)))) break;
-    preview.add_frame(false, /*display=*/i == 0);  // the first display measures the finish's
-  }
-  preview.finish();
-  TimedRun run;
-  run.used_ms = elapsed_ms(start);
-  run.image = preview.final_image();
-  run.spp = preview.samples();
-  run.filter_runs = preview.filter_runs();
-  run.times = preview.total_times();
-  run.error = row_error(preview.final_image(), reference);
-  return run;
+  return run_timed(b.scene, settings, b.width, b.height, budget_ms, reference);
 }
 
 struct EqualTimeRow {
@@ -473,7 +441,8 @@ int run_bench(const Args& args) {
   PreviewSettings preview_settings;
   bool pathtracer = false, variants = false, stage_table = false, sampler_error = false, variance_ratio = false;
   bool demodulation_ab = false;
-  bool threshold_fidelity = false;
+  bool threshold_fidelity = false, adaptive = false;
+  double clean_cap_s = 300;
   int variant_spp = 4, variant_rounds = 5;
   std::string extra_taps_text;
   std::string reference_path, out = "bench-out", budgets_text = "8,32,128,256";
@@ -496,8 +465,14 @@ int run_bench(const Args& args) {
                   "--reference, e.g. buffers.exr of `pxf render --filter none`; default: rendered and cached).");
   scene_options.stage_timing = GlTiming::Finish;  // exact per-stage figures
   add_scene_options(cli, scene_options, /*headless=*/true);
-  add_preview_options(cli, preview_settings);
+  add_preview_options(cli, preview_settings, /*adaptive_option=*/false);
   cli.flag("--pathtracer", &pathtracer, "path tracer throughput only");
+  cli.flag("--adaptive", &adaptive,
+           "instead of 1-4: adaptive against uniform sampling, both filtered (app/adaptive_bench.h): paths/s at\n"
+           "100/50/10 % active pixels, display and HDR NRMSE at equal wall time (--budgets, default 8,32,128,512;\n"
+           "--rounds, default 3), starved dark pixels, and the clean share over time up to --clean-cap");
+  cli.option("--clean-cap", &clean_cap_s, "seconds of each until-clean run of --adaptive (default 300; 0: none)", 0.0,
+             1e6);
   cli.flag("--variants", &variants, "the filter variant table (time vs HV-only NRMSE)");
   cli.option("--variant-spp", &variant_spp, "spp of the --variants HV buffer (default 4)", 1, 1 << 16);
   cli.option("--variant-rounds", &variant_rounds, "timed rounds of --variants (default 5, after a warm-up)", 1, 1000);
@@ -519,7 +494,7 @@ int run_bench(const Args& args) {
   cli.flag("--demodulation-ab", &demodulation_ab,
            "instead of 1-4: albedo demodulation off vs on at equal wall time (--budgets, --rounds rounds, back\n"
            "to back with the unfiltered run); writes demodulation.csv and demod_*.png");
-  cli.option("--rounds", &rounds, "rounds of --sampler-error (default 7) and --demodulation-ab (default 3)", 1, 1000);
+  cli.option("--rounds", &rounds, "rounds of --sampler-error (default 7), --demodulation-ab and --adaptive (default 3)", 1, 1000);
   cli.option("--timed-frames", &timed, "timed frames of --pathtracer (after 3 warm-up frames)", 1, 100000);
   cli.option("--reference", &reference_path, "REF.exr", "reference image (default: render and cache one)");
   cli.option("--reference-spp", &reference_spp, "samples of the rendered reference (default 2048)", 1, 1 << 20);
@@ -580,6 +555,16 @@ int run_bench(const Args& args) {
   const Image reference = obtain_reference(b, reference_path, reference_spp, scene_options.scene);
   if (reference.width != b.width || reference.height != b.height) throw Error("reference size differs from --size");
 
+  if (adaptive) {
+    AdaptiveBenchPlan plan;
+    plan.budgets = parse_counts("--budgets", cli.given("--budgets") ? budgets_text : "8,32,128,512");
+    plan.rounds = cli.given("--rounds") ? rounds : 3;
+    plan.clean_cap_s = clean_cap_s;
+    run_adaptive_bench({b.scene, std::filesystem::path(scene_options.scene).stem().string(), b.filtered, b.width,
+                        b.height, out, reference},
+                       plan);
+    return 0;
+  }
   if (demodulation_ab) {
     // The budgets' unit: the median path-tracing frame of a short unfiltered warm-up.
     Preview warm(b.scene, b.plain, b.width, b.height);

@@ -94,6 +94,8 @@ AccumulationState Checkpointer::state_of(const Preview& preview) const {
   state.traced = preview.pixel_samples();
   if (settings_.adaptive) {
     const size_t pixels = state.traced.size();
+    state.rate = preview.allocation_rates_now();
+    state.rate.resize(pixels, 0.0f);  // 0: no allocation yet
     state.credit = preview.allocation_credit();
     state.credit.resize(pixels, 0.0f);  // no allocation yet (warm-up): every credit 0
     state.next_active = preview.next_active();

@@ -30,7 +30,7 @@ void add_scene_options(CommandLine& cli, SceneOptions& o, bool headless) {
                  gl_timing_names()[static_cast<int>(o.stage_timing)]);
 }
 
-void add_preview_options(CommandLine& cli, PreviewSettings& s) {
+void add_preview_options(CommandLine& cli, PreviewSettings& s, bool adaptive_option) {
   cli.option("--threshold", &s.threshold, "blend threshold t on perceived variance (default 0.001)", 0.0f, 1e6f);
   cli.option("--sigma-s", &s.filter.sigma_s, "spatial sigma in pixels (default 8)", 0.1f, kMaxFilterRadius / 3.0f);
   cli.option("--sigma-c", &s.filter.sigma_c, "range color sigma, linear RGB (default 0.02)", 1e-6f, 1e6f);
@@ -51,9 +51,10 @@ void add_preview_options(CommandLine& cli, PreviewSettings& s) {
              "shrink the filter's sigma_s as samples accumulate: --sigma-s up to 4 spp, then\n"
              "sigma_s sqrt(4 / spp), at least 2 px (default off: --sigma-s for every filter run; on lowers\n"
              "the error but mixed pixels keep more noise than t, docs/method.md 2.5)");
-  cli.choice("--adaptive", &s.adaptive, {"off", "on"},
-             "adaptive sampling: after 16 uniform frames each frame traces the pixels whose final pixel is\n"
-             "furthest from the threshold, every pixel at least every 16 frames (default off; app/adaptive.h)");
+  if (adaptive_option)
+    cli.choice("--adaptive", &s.adaptive, {"off", "on"},
+               "adaptive sampling: after 16 uniform frames each frame traces the pixels whose final pixel is\n"
+               "furthest from the threshold, every pixel at least every 16 frames (default off; app/adaptive.h)");
   cli.option("--seed", &s.trace.seed, "random seed", 0, 2147483647);
   cli.choice("--sampler", &s.trace.sampler, sampler_type_names(),
              "random numbers of the path tracer: Owen-scrambled Sobol (default) or independent PCG32");

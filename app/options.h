@@ -37,7 +37,8 @@ constexpr FilterKind kAllHvFilter = FilterKind::Atrous;
 
 void add_scene_options(CommandLine& cli, SceneOptions& options, bool headless);
 // Binds the command line to the one PreviewSettings (enums through their name tables).
-void add_preview_options(CommandLine& cli, PreviewSettings& settings);
+// adaptive_option false: without --adaptive (pxf bench, whose --adaptive compares both).
+void add_preview_options(CommandLine& cli, PreviewSettings& settings, bool adaptive_option = true);
 
 // Prints the built-in scenes when options.scene == "list" (returns true: nothing else to do).
 bool print_scene_list_if_asked(const SceneOptions& options);

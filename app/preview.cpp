@@ -120,6 +120,13 @@ void Preview::reset() {
   case_counts_ = {};
   next_active_.clear();
   active_credit_.clear();
+  rates_.clear();
+  replans_ = replan_schedule(0);
+}
+
+GrowingSchedule Preview::replan_schedule(int frames_done) const {
+  const AdaptiveParams& params = settings_.adaptive_params;
+  return GrowingSchedule(static_cast<int>(params.warmup_frames), params.replan_divisor, frames_done);
 }
 
 void Preview::set_first_frame(uint32_t first) {
@@ -138,6 +145,8 @@ void Preview::load_state(const AccumulationState& state) {
   renderer_->restore(state.acc, state.frames.front().begin, static_cast<int>(state.frame_count()), state.traced);
   update_hv_empty();
   if (!state.settings.adaptive) return;
+  replans_ = replan_schedule(samples());
+  if (std::any_of(state.rate.begin(), state.rate.end(), [](float r) { return r > 0.0f; })) rates_ = state.rate;
   active_credit_ = state.credit;
   const bool every_pixel = std::all_of(state.next_active.begin(), state.next_active.end(), [](uint8_t a) { return a; });
   if (!every_pixel) next_active_ = state.next_active;
@@ -343,9 +352,7 @@ bool Preview::allocating() const {
   return settings_.adaptive && static_cast<uint32_t>(samples()) >= settings_.adaptive_params.warmup_frames;
 }
 
-void Preview::plan_next_frame() {
-  next_active_.clear();
-  if (!allocating()) return;
+std::vector<float> Preview::allocation_rates() {
   const Accumulation& acc = renderer_->accumulation();
   const int w = width_, h = height_;
   Image lv = Image::rgb(w, h), hv = Image::rgb(w, h), var_lv = Image::gray(w, h);
@@ -371,7 +378,17 @@ void Preview::plan_next_frame() {
       final_pixel_need(lv, hv, var_u, var_lv, paths, settings_.threshold, guide ? &guide_color_ : nullptr,
                        guide ? &guide_depth_ : nullptr, range_weights(settings_.filter));
   const AdaptiveParams& params = settings_.adaptive_params;
-  const std::vector<float> rates = sampling_rates(dilate_need(need, w, h, params.dilation_radius), paths, params);
+  return sampling_rates(dilate_need(need, w, h, params.dilation_radius), paths, params);
+}
+
+void Preview::plan_next_frame() {
+  next_active_.clear();
+  if (!allocating()) return;
+  if (replans_.due(samples()) || rates_.empty()) {
+    rates_ = allocation_rates();
+    replans_.done(samples());
+  }
+  const std::vector<float>& rates = rates_;
   // A frame that would trace nothing is no frame: the credits move on until some pixel is due (at
   // most 1 / floor_rate steps, when every pixel is at the floor).
   do {

@@ -150,6 +150,7 @@ class Preview {
   // per-pixel credits it was selected with (empty before the first allocation; app/adaptive.h).
   const std::vector<uint8_t>& next_active() const { return next_active_; }
   const std::vector<float>& allocation_credit() const { return active_credit_; }
+  const std::vector<float>& allocation_rates_now() const { return rates_; }  // empty before the first
   // The threshold the filter's skip and the blend get now: t scaled for the variance estimate's
   // own noise at this sample count (effective_threshold, docs/method.md section 3.5).
   float threshold_now() const { return effective_threshold(settings_.threshold, static_cast<uint64_t>(samples())); }
@@ -206,6 +207,8 @@ class Preview {
   bool range_due() const;       // one more range frame fits the pass budget
   // The next frame's active mask (adaptive sampling): empty = every pixel.
   void plan_next_frame();
+  std::vector<float> allocation_rates();  // each pixel's paths per frame from the current samples
+  GrowingSchedule replan_schedule(int frames_done) const;
   bool allocating() const;  // adaptive sampling is past its warm-up: frames follow plan_next_frame()
   // The range guide as images for the allocation's pooling, read back when the guide changed.
   void refresh_guide_images();
@@ -225,6 +228,8 @@ class Preview {
   std::vector<float> lv_packed_;  // the LV texture's data with per-pixel threshold factors (adaptive)
   std::vector<uint8_t> next_active_;  // plan_next_frame()'s mask; empty = every pixel
   std::vector<float> active_credit_;  // select_active's credits
+  std::vector<float> rates_;          // the last allocation's rates; empty before the first
+  GrowingSchedule replans_{16, 16};   // when the rates are recomputed (replan_schedule)
   double last_active_share_ = 1.0;
   Image guide_color_, guide_depth_;   // refresh_guide_images()
   int guide_frames_ = 0;              // range frames the read-back guide holds

@@ -146,24 +146,18 @@ int run_render(const Args& args) {
   const int first = preview.samples();  // > 0 after --resume
   RenderReport report;
   report.until_clean = until_clean;
-  // The check frames are 16, then each a quarter more samples than the last: the same frames
-  // after a --resume as in the uninterrupted render, so that it stops at the same frame.
-  auto after_check = [](int samples) { return std::max(samples + 1, samples * 5 / 4); };
-  int next_clean_check = 16;
-  while (next_clean_check <= first) next_clean_check = after_check(next_clean_check);
+  GrowingSchedule checks = clean_checks(first);
   for (int i = first; i < total && !g_stop_signal; ++i) {
     // The first frame always traces; the next ones only while they and the finish fit the budget.
     if (i > first && !next_frame_fits(preview.predict_next_frame(budget_ms, elapsed_ms(start)))) break;
     // With a budget the first frame is displayed: that measures the finish's blend and tone map.
     // Clean is the blend's finding on a fresh filter run: a check frame is run like a last frame
-    // (filter and blend), from 16 samples on (fewer are never clean at a strict t) and then
-    // whenever the samples grew by a quarter, so a render is found clean within 25 % of the
-    // samples it needed, at about log(n) / log(1.25) extra filter runs.
-    const bool check_clean = until_clean && preview.samples() + 1 >= next_clean_check;
+    // (filter and blend; app/adaptive.h, clean_checks).
+    const bool check_clean = until_clean && checks.due(preview.samples() + 1);
     preview.add_frame(/*last_frame=*/check_clean, /*display=*/check_clean || (i == first && budget_ms > 0));
     if (check_clean) {
       report.case2_share_over_time.push_back({elapsed_ms(start), double(preview.samples()), preview.case2_share()});
-      next_clean_check = after_check(preview.samples());
+      checks.done(preview.samples());
     }
     checkpointer.maybe_write(preview);
     if (!quiet) progress.update(i + 1, i + 1 == total);

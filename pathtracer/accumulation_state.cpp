@@ -55,6 +55,7 @@ void visit_state_arrays(State& state, Visit&& visit) {
   visit_arrays(state.acc, visit);
   visit(state.traced, 1);
   const size_t allocation_slots = state.settings.adaptive ? 1 : 0;
+  visit(state.rate, allocation_slots);
   visit(state.credit, allocation_slots);
   visit(state.next_active, allocation_slots);
 }
@@ -180,7 +181,8 @@ void check_pixels(const AccumulationState& state) {
       throw Error("state file has a traced count that does not fit its frames at pixel " + std::to_string(i));
     if (acc.samples[i] > state.traced[i]) throw Error("state file has more samples in a pixel than it traced");
     if (state.settings.adaptive &&
-        (!(state.credit[i] >= 0.0f && state.credit[i] < 1.0f) || state.next_active[i] > 1))
+        (!(state.rate[i] >= 0.0f && state.rate[i] <= 1.0f) || !(state.credit[i] >= 0.0f && state.credit[i] < 1.0f) ||
+         state.next_active[i] > 1))
       throw Error("state file has an invalid adaptive allocation at pixel " + std::to_string(i));
     const glm::vec3 lv = acc.lv_mean[i], hv = acc.hv_mean[i], a = acc.albedo_mean[i];
     const bool finite = std::isfinite(lv.x) && std::isfinite(lv.y) && std::isfinite(lv.z) && std::isfinite(hv.x) &&
@@ -447,6 +449,7 @@ AccumulationState merge_states(const std::vector<AccumulationState>& states) {
     for (size_t p = 0; p < merged.traced.size(); ++p) merged.traced[p] += states[i].traced[p];
   }
   if (merged.settings.adaptive) {  // no allocation to continue: a merged state is not resumed
+    std::fill(merged.rate.begin(), merged.rate.end(), 0.0f);
     std::fill(merged.credit.begin(), merged.credit.end(), 0.0f);
     std::fill(merged.next_active.begin(), merged.next_active.end(), uint8_t{1});
   }

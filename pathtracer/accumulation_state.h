@@ -58,9 +58,11 @@ struct AccumulationState {
   // uniform state every entry is frame_count().
   std::vector<uint32_t> traced;
   // Adaptive sampling's allocation (settings.adaptive only, else empty; app/adaptive.h): each
-  // pixel's credit after the last planned frame and that frame's mask (1 = traced next), so that a
-  // resumed render traces exactly what the uninterrupted one would. A merged state keeps zeros and
-  // ones: it is not resumed (its frames are not one range).
+  // pixel's rate (paths per frame) of the last recomputation, 0 before the first; its credit after
+  // the last planned frame and that frame's mask (1 = traced next), so that a resumed render traces
+  // exactly what the uninterrupted one would. A merged state keeps zeros and ones: it is not resumed
+  // (its frames are not one range).
+  std::vector<float> rate;
   std::vector<float> credit;
   std::vector<uint8_t> next_active;
   uint32_t frame_count() const;

@@ -286,6 +286,7 @@ AccumulationState render_adaptive(FrameRange range) {
   resize_accumulation(state.acc, kW, kH, 1);
   const size_t pixels = state.acc.samples.size();
   state.traced.assign(pixels, 0);
+  state.rate.assign(pixels, 0.0f);
   state.credit.assign(pixels, 0.0f);
   state.next_active.assign(pixels, 0);
   for (size_t p = 0; p < pixels; ++p) {
@@ -295,6 +296,7 @@ AccumulationState render_adaptive(FrameRange range) {
       sample_of(p, range.begin + k, lv, hv);
       accumulate_sample(state.acc, p, lv, hv, 0, glm::vec3(0.5f));
     }
+    state.rate[p] = 1.0f / static_cast<float>(1 + p % 16);
     state.credit[p] = 0.125f * static_cast<float>(p % 8);
     state.next_active[p] = p % 3 == 0;
   }
@@ -311,13 +313,14 @@ TEST(AccumulationState, AdaptiveAllocationRoundTripsExactly) {
   const AccumulationState back = decode_state(bytes.data(), bytes.size());
   EXPECT_EQ(back.settings.adaptive, 1u);
   EXPECT_EQ(back.traced, state.traced);
+  EXPECT_EQ(back.rate, state.rate);
   EXPECT_EQ(back.credit, state.credit);
   EXPECT_EQ(back.next_active, state.next_active);
   EXPECT_EQ(back.acc.samples, state.acc.samples);
   EXPECT_EQ(encode_state(back), bytes);
-  // A uniform state has no allocation arrays: one float and one byte per pixel fewer.
+  // A uniform state has no allocation arrays: two floats and one byte per pixel fewer.
   const AccumulationState uniform = render_frames({3, 11});
-  EXPECT_EQ(encode_state(uniform).size() + uniform.acc.samples.size() * (sizeof(float) + 1), bytes.size());
+  EXPECT_EQ(encode_state(uniform).size() + uniform.acc.samples.size() * (2 * sizeof(float) + 1), bytes.size());
 }
 
 TEST(AccumulationState, AdaptiveCountsAndAllocationOutOfRangeAreRefused) {
@@ -334,6 +337,9 @@ TEST(AccumulationState, AdaptiveCountsAndAllocationOutOfRangeAreRefused) {
     EXPECT_NE(decode_error(encode_state(state)).find("invalid adaptive allocation at pixel 6"), std::string::npos)
         << bad;
   }
+  state = render_adaptive({0, 8});
+  state.rate[3] = 1.5f;
+  EXPECT_NE(decode_error(encode_state(state)).find("invalid adaptive allocation at pixel 3"), std::string::npos);
   state = render_adaptive({0, 8});
   state.next_active[1] = 2;
   EXPECT_NE(decode_error(encode_state(state)).find("invalid adaptive allocation at pixel 1"), std::string::npos);
@@ -355,6 +361,7 @@ TEST(AccumulationState, AdaptiveShardsMergeAsTheirSumAndStayApart) {
   for (size_t p = 0; p < merged.traced.size(); ++p) {
     EXPECT_EQ(merged.traced[p], a.traced[p] + b.traced[p]);
     EXPECT_EQ(merged.acc.samples[p], a.acc.samples[p] + b.acc.samples[p]);
+    EXPECT_EQ(merged.rate[p], 0.0f);
     EXPECT_EQ(merged.credit[p], 0.0f);
     EXPECT_EQ(merged.next_active[p], 1);
     // The merged mean is the sample-weighted mean of the shards' samples.
