@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 
 #include <tbb/blocked_range.h>
@@ -13,7 +14,7 @@ namespace pxf {
 
 std::vector<float> final_pixel_need(const Image& lv, const Image& hv, const Image& var_u, const Image& var_lv,
                                     const std::vector<uint32_t>& paths, float t, const Image* range_color,
-                                    const Image* depth, const RangeWeights& range) {
+                                    const Image* depth, const RangeWeights& range, float exact_below) {
   const int w = hv.width, h = hv.height;
   // Var[L_lv + L_u] as Var[L_u] + Var[L_lv], unknown where either is: the image the pooling reads.
   Image var_final = Image::gray(w, h);
@@ -29,16 +30,18 @@ std::vector<float> final_pixel_need(const Image& lv, const Image& hv, const Imag
     for (int y = rows.begin(); y != rows.end(); ++y)
       for (int x = 0; x < w; ++x) {
         const size_t p = static_cast<size_t>(y) * w + x;
-        const float v = pool ? pooled_var_u(var_final, *range_color, *depth, x, y, range) : var_final.pixels[p];
-        if (v < 0.0f) {
+        const float t_n = effective_threshold(t, paths[p]);
+        const float own = var_final.pixels[p];
+        if (own < 0.0f || !(t_n > 0.0f)) {
           need[p] = std::numeric_limits<float>::infinity();
           continue;
         }
         const float lb = std::max(luminance(clean(hv.at(x, y, 0)), clean(hv.at(x, y, 1)), clean(hv.at(x, y, 2))) +
                                       luminance(clean(lv.at(x, y, 0)), clean(lv.at(x, y, 1)), clean(lv.at(x, y, 2))),
                                   0.0f);
-        const float t_n = effective_threshold(t, paths[p]);
-        need[p] = t_n > 0.0f ? relative_variance(v, lb) / t_n : std::numeric_limits<float>::infinity();
+        need[p] = relative_variance(own, lb) / t_n;
+        if (pool && need[p] < exact_below)
+          need[p] = relative_variance(pooled_var_u(var_final, *range_color, *depth, x, y, range), lb) / t_n;
       }
   });
   return need;
@@ -69,14 +72,32 @@ std::vector<float> dilate_need(const std::vector<float>& need, int width, int he
   return out;
 }
 
+namespace {
+
+// The need at which a pixel is traced every frame: full_rate_need, or the need of the pixel at the
+// top full_rate_share of `needs` where that is larger (nth_element: O(pixels)).
+float full_rate_scale(std::vector<float> needs, const AdaptiveParams& params) {
+  if (!(params.full_rate_share > 0.0f) || needs.empty()) return params.full_rate_need;
+  // The pixel with share * n - 1 pixels above it: exactly the top share is at or past it.
+  const size_t share_count = static_cast<size_t>(params.full_rate_share * static_cast<float>(needs.size()));
+  const size_t top = std::min(needs.size(), std::max<size_t>(share_count, 1)) - 1;
+  std::nth_element(needs.begin(), needs.begin() + top, needs.end(), std::greater<float>());
+  const float at_share = needs[top];
+  return std::isfinite(at_share) ? std::max(params.full_rate_need, at_share) : params.full_rate_need;
+}
+
+}  // namespace
+
 std::vector<float> sampling_rates(const std::vector<float>& dilated_need, const std::vector<uint32_t>& paths,
                                   const AdaptiveParams& params) {
-  std::vector<float> rates(dilated_need.size());
-  for (size_t p = 0; p < rates.size(); ++p) {
-    float need = std::isnan(dilated_need[p]) ? std::numeric_limits<float>::infinity() : dilated_need[p];
-    if (paths[p] < params.min_samples) need = std::max(need, 1.0f);  // not retired on few samples
-    rates[p] = std::clamp(need / params.full_rate_need, params.floor_rate, 1.0f);
+  std::vector<float> needs(dilated_need.size());
+  for (size_t p = 0; p < needs.size(); ++p) {
+    needs[p] = std::isnan(dilated_need[p]) ? std::numeric_limits<float>::infinity() : dilated_need[p];
+    if (paths[p] < params.min_samples) needs[p] = std::max(needs[p], 1.0f);  // not retired on few samples
   }
+  const float scale = full_rate_scale(needs, params);
+  std::vector<float> rates(needs.size());
+  for (size_t p = 0; p < rates.size(); ++p) rates[p] = std::clamp(needs[p] / scale, params.floor_rate, 1.0f);
   return rates;
 }
 

@@ -13,13 +13,15 @@
 //     its paths are sampled with it.
 //   minimum: a pixel with fewer than min_samples paths counts as at least at the threshold (r >= 1),
 //     so that a pixel that only looks quiet (its rare bright paths not yet found) is not retired.
-//   rate a_p = clamp(r_p / full_rate_need, floor_rate, 1): paths per frame. Samples follow u / t up
-//     to one path per frame (a frame traces a pixel at most once); every pixel, clean or not, is
-//     revisited at least every 1 / floor_rate frames.
+//   rate a_p = clamp(r_p / c, floor_rate, 1): paths per frame, c = full_rate_need, or the need at the
+//     top full_rate_share of the pixels where that is larger. Samples follow u / t up to one path
+//     per frame (a frame traces a pixel at most once); every pixel, clean or not, is revisited at
+//     least every 1 / floor_rate frames.
 //   selection: a per-pixel credit adds a_p each frame and the pixel is traced when it reaches 1
 //     (error diffusion in time): deterministic, exactly a_p on average, no random numbers.
 #pragma once
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "gl/pass_params.h"
@@ -38,6 +40,11 @@ struct AdaptiveParams {
   float floor_rate = 1.0f / 16.0f;
   // The need at which a pixel is traced every frame; below it the rate is need / full_rate_need.
   float full_rate_need = 4.0f;
+  // ... raised, where more than this share of the pixels is past it, to the need of the pixel at
+  // that share (the neediest full_rate_share of the pixels are traced every frame, the others in
+  // proportion). While most pixels are far from t, a fixed scale would trace nearly all of them every
+  // frame, which is uniform sampling; this keeps a frame's paths on the neediest pixels. 0: off.
+  float full_rate_share = 0.25f;
   // Radius of the box over which the need is dilated (2: the 5x5 window of the bias guard).
   int dilation_radius = 2;
   // The rates are recomputed after the warm-up and then whenever the frames grew by 1/16 (at least
@@ -52,9 +59,13 @@ struct AdaptiveParams {
 // range_color and depth (both or neither): the guide for the pooling's range weights; without them
 // the pixel's own variance is used. An unknown variance gives +inf (the pixel must be sampled);
 // V = 0 (all samples equal, no known neighbour) gives 0, which min_samples guards.
+// exact_below: a pixel whose own variance already gives a need of at least this keeps that need
+// without the pooling (which can only raise it): above full_rate_need every need means the same
+// rate, and the dilation's maximum is past it too. The default pools every pixel.
 std::vector<float> final_pixel_need(const Image& lv, const Image& hv, const Image& var_u, const Image& var_lv,
                                     const std::vector<uint32_t>& paths, float t, const Image* range_color,
-                                    const Image* depth, const RangeWeights& range);
+                                    const Image* depth, const RangeWeights& range,
+                                    float exact_below = std::numeric_limits<float>::infinity());
 
 // The largest need in the (2 radius + 1)^2 box around each pixel, clipped at the border.
 std::vector<float> dilate_need(const std::vector<float>& need, int width, int height, int radius);

@@ -3,6 +3,7 @@
 // it up to one per frame; the floor, the minimum and the dilation hold.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -69,6 +70,26 @@ TEST(AdaptiveNeed, IsDecidedOnThePooledVarianceAsTheBlendDoes) {
   EXPECT_NEAR(f.need(t, &range, &depth)[4], own, 1e-3f * own);
 }
 
+// The pooling only raises a need, and every need above full_rate_need gives the same rate: a pixel
+// whose own variance already puts it there skips the pooling, the others are pooled as before.
+TEST(AdaptiveNeed, PoolingIsSkippedOnlyWhereTheOwnNeedIsAlreadyPastExactBelow) {
+  FakeImages f(3, 3, 0.3f, 0.2f, 0.004f, 0.0f, 100);
+  f.var_u.at(1, 1, 0) = 1e-6f;  // quiet centre: its own need is tiny, its pooled need large
+  Image range = Image::rgb(3, 3), depth = Image::gray(3, 3);
+  for (float& v : range.pixels) v = 0.5f;
+  for (float& v : depth.pixels) v = 1.0f;
+  const float t = 0.001f;
+  const std::vector<float> all_pooled = f.need(t, &range, &depth);
+  const std::vector<float> own = f.need(t);
+  const std::vector<float> skipped =
+      final_pixel_need(f.lv, f.hv, f.var_u, f.var_lv, f.paths, t, &range, &depth, range_weights(FilterParams{}), 4.0f);
+  ASSERT_GE(own[0], 4.0f);           // the noisy corner is past the bound on its own
+  EXPECT_EQ(skipped[0], own[0]);     // so it keeps its own need
+  ASSERT_LT(own[4], 4.0f);           // the quiet centre is not
+  EXPECT_EQ(skipped[4], all_pooled[4]);  // so it is pooled exactly as without the bound
+  EXPECT_GT(skipped[4], 100.0f * own[4]);
+}
+
 TEST(AdaptiveDilation, EveryPixelInTheBoxTakesTheLargestNeed) {
   const int w = 9, h = 7;
   std::vector<float> need(w * h, 0.5f);
@@ -97,7 +118,8 @@ std::vector<int> traced_over(const std::vector<float>& rates, int frames) {
 }
 
 TEST(AdaptiveRates, SamplesFollowTheNeedUpToOnePerFrame) {
-  const AdaptiveParams params;
+  AdaptiveParams params;
+  params.full_rate_share = 0.0f;  // the fixed scale full_rate_need (the share: the next test)
   const std::vector<float> need = {0.5f, 1.0f, 2.0f, 3.0f, 4.0f, 30.0f, kInf};
   const std::vector<uint32_t> paths(need.size(), 1000);  // past the minimum
   const std::vector<float> rates = sampling_rates(need, paths, params);
@@ -110,6 +132,32 @@ TEST(AdaptiveRates, SamplesFollowTheNeedUpToOnePerFrame) {
   // Proportional: twice the need, twice the samples (below a path per frame).
   EXPECT_NEAR(static_cast<double>(traced[2]) / traced[1], 2.0, 0.02);
   EXPECT_NEAR(static_cast<double>(traced[3]) / traced[0], 6.0, 0.1);
+}
+
+// While most pixels are far from t, only the neediest full_rate_share of them are traced every frame
+// and the others in proportion to their need; once few are past full_rate_need, the fixed scale holds.
+TEST(AdaptiveRates, TheNeediestShareIsTracedEveryFrameTheOthersInProportion) {
+  AdaptiveParams params;  // full_rate_share 0.25
+  std::vector<float> need(100);
+  for (size_t p = 0; p < need.size(); ++p) need[p] = 10.0f + static_cast<float>(p);  // 10 .. 109, all past 4
+  const std::vector<uint32_t> paths(need.size(), 1000);
+  const std::vector<float> rates = sampling_rates(need, paths, params);
+  const float scale = need[75];  // the pixel with 25 pixels above it
+  for (size_t p = 0; p < need.size(); ++p)
+    EXPECT_FLOAT_EQ(rates[p], std::min(1.0f, need[p] / scale)) << p;
+  EXPECT_EQ(std::count(rates.begin(), rates.end(), 1.0f), 25);
+  // Few pixels past full_rate_need: the scale stays full_rate_need.
+  std::vector<float> mostly_clean(100, 0.5f);
+  mostly_clean[7] = 40.0f;
+  const std::vector<float> clean_rates = sampling_rates(mostly_clean, paths, params);
+  EXPECT_EQ(clean_rates[7], 1.0f);
+  EXPECT_FLOAT_EQ(clean_rates[0], 0.5f / params.full_rate_need);
+  // Unknown variances (infinite need) are traced every frame and do not make the scale infinite.
+  std::vector<float> unknown(need);
+  for (size_t p = 0; p < 40; ++p) unknown[p] = kInf;
+  const std::vector<float> unknown_rates = sampling_rates(unknown, paths, params);
+  EXPECT_EQ(unknown_rates[0], 1.0f);
+  EXPECT_GT(unknown_rates[99], params.floor_rate);
 }
 
 TEST(AdaptiveRates, TheFloorRevisitsEveryPixelRegularly) {
@@ -135,6 +183,7 @@ TEST(AdaptiveRates, TheFloorRevisitsEveryPixelRegularly) {
 
 TEST(AdaptiveRates, APixelBelowTheMinimumIsNotRetired) {
   AdaptiveParams params;
+  params.full_rate_share = 0.0f;
   const std::vector<float> need = {0.0f, 0.0f, 8.0f};
   const std::vector<uint32_t> paths = {params.min_samples - 1, params.min_samples, params.min_samples - 1};
   const std::vector<float> rates = sampling_rates(need, paths, params);

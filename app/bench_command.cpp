@@ -487,7 +487,7 @@ int run_bench(const Args& args) {
   cli.flag("--threshold-fidelity", &threshold_fidelity,
            "empirical perceived variance of the final image over --seeds seeds at --spp (default 16,64,256) "
            "against t = 0.001 and 0.01, by blend case (the --filter's; bilateral and bilateral-depth give the "
-           "blend the covariance of L_u and L_f)");
+           "blend the covariance of L_u and L_f); with --adaptive also adaptive sampling at the uniform job's wall time");
   cli.option("--spp", &spp_text, "LIST",
              "spp of --sampler-error (default 8,32,128), --variance-ratio (4,16,64,256) or --threshold-fidelity (16,64,256)");
   cli.option("--seeds", &seeds, "seeds of --variance-ratio and --threshold-fidelity (default 32), --sampler-error (8)", 2, 4096);
@@ -537,8 +537,9 @@ int run_bench(const Args& args) {
   if (pathtracer) return run_pathtracer_bench(b, timed);
   if (threshold_fidelity) {
     auto context = create_gl_context(parse_gl_backend(scene_options.gl));
-    const FidelityBenchSetup fb{b.scene, std::filesystem::path(scene_options.scene).stem().string(), b.filtered,
-                                b.width, b.height, out};
+    FidelityBenchSetup fb{b.scene, std::filesystem::path(scene_options.scene).stem().string(), b.filtered,
+                          b.width, b.height, out};
+    fb.with_adaptive = adaptive;
     run_threshold_fidelity_bench(fb, parse_counts("--spp", spp_text.empty() ? "16,64,256" : spp_text), {0.001f, 0.01f},
                                  seeds);
     return 0;

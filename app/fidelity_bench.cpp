@@ -75,72 +75,132 @@ Summary summarize(const Samples& s, float t, int want, const std::vector<int>& m
 
 }  // namespace
 
+namespace {
+
+// One seed's final image at one sample count, blended at each threshold `ts` (the same samples).
+void record(Preview& preview, const std::vector<float>& ts, std::vector<Samples>& out_per_t,
+            size_t first_t = 0) {
+  const size_t pixels = static_cast<size_t>(preview.width()) * static_cast<size_t>(preview.height());
+  for (size_t ti = 0; ti < ts.size(); ++ti) {
+    PreviewSettings s = preview.settings();
+    if (s.threshold != ts[ti]) {
+      s.threshold = ts[ti];
+      preview.set_settings(s);  // the same samples, filtered and blended for this t
+    }
+    preview.redisplay();
+    const std::vector<Layer> buffers = preview.buffers();
+    const Image& final_rgb = layer_image(buffers, "final");
+    const Image& lv = layer_image(buffers, "lv");
+    const Image& blend_case = layer_image(buffers, "case");
+    Samples& out = out_per_t[first_t + ti];
+    out.hv.emplace_back(pixels);
+    out.total.emplace_back(pixels);
+    out.blend_case.emplace_back(pixels);
+    for (size_t p = 0; p < pixels; ++p) {
+      const float y = luminance_at(final_rgb, p);
+      out.total.back()[p] = y;
+      out.hv.back()[p] = y - luminance_at(lv, p);
+      out.blend_case.back()[p] = static_cast<uint8_t>(blend_case.pixels[p]);
+    }
+  }
+}
+
+PreviewSettings seed_settings(const FidelityBenchSetup& b, int seed) {
+  PreviewSettings settings = b.settings;
+  settings.trace.seed = b.settings.trace.seed + 1000 + static_cast<uint64_t>(seed);
+  settings.schedule = FilterSchedule::PowersOfTwo;
+  settings.adaptive = false;
+  return settings;
+}
+
+// Uniform frames up to the largest spp, recording at each; returns each spp's time (the recording
+// left out).
+std::vector<double> run_uniform_seed(const FidelityBenchSetup& b, int seed, const std::vector<int>& spps,
+                                     const std::vector<float>& ts, std::vector<std::vector<Samples>>& samples) {
+  Preview preview(b.scene, seed_settings(b, seed), b.width, b.height);
+  std::vector<double> ms(spps.size());
+  double elapsed = 0;
+  for (int frame = 1; frame <= *std::max_element(spps.begin(), spps.end()); ++frame) {
+    const auto it = std::find(spps.begin(), spps.end(), frame);
+    const auto start = BenchClock::now();
+    preview.add_frame(it != spps.end(), false);
+    elapsed += elapsed_ms(start);
+    if (it == spps.end()) continue;
+    const size_t k = static_cast<size_t>(it - spps.begin());
+    ms[k] = elapsed;
+    record(preview, ts, samples[k]);
+  }
+  return ms;
+}
+
+// Adaptive frames for threshold ts[ti] (the allocation follows it), recorded when the job has taken
+// the uniform run's time at each spp: spp-equivalents at equal time.
+void run_adaptive_seed(const FidelityBenchSetup& b, int seed, const std::vector<double>& uniform_ms,
+                       const std::vector<float>& ts, size_t ti, std::vector<std::vector<Samples>>& samples) {
+  PreviewSettings settings = seed_settings(b, seed);
+  settings.adaptive = true;
+  settings.threshold = ts[ti];
+  Preview preview(b.scene, settings, b.width, b.height);
+  double elapsed = 0;
+  for (size_t k = 0; k < uniform_ms.size(); ++k) {
+    while (elapsed < uniform_ms[k]) {
+      const auto start = BenchClock::now();
+      preview.add_frame(false, false);
+      elapsed += elapsed_ms(start);
+    }
+    const auto start = BenchClock::now();
+    preview.finish();  // the fresh filter run the uniform job's checkpoint frame had
+    elapsed += elapsed_ms(start);
+    record(preview, {ts[ti]}, samples[k], ti);
+  }
+}
+
+}  // namespace
+
 void run_threshold_fidelity_bench(const FidelityBenchSetup& b, const std::vector<int>& spps,
                                   const std::vector<float>& thresholds, int seeds) {
   const size_t pixels = static_cast<size_t>(b.width) * static_cast<size_t>(b.height);
-  const int max_spp = *std::max_element(spps.begin(), spps.end());
-  // samples[spp][t]
-  std::vector<std::vector<Samples>> samples(spps.size(), std::vector<Samples>(thresholds.size()));
+  // samples[mode][spp][t], mode 0 uniform, 1 adaptive at equal time (b.with_adaptive only)
+  const int modes = b.with_adaptive ? 2 : 1;
+  std::vector<std::vector<std::vector<Samples>>> samples(
+      modes, std::vector<std::vector<Samples>>(spps.size(), std::vector<Samples>(thresholds.size())));
   const auto start = BenchClock::now();
   for (int seed = 0; seed < seeds; ++seed) {
-    PreviewSettings settings = b.settings;
-    settings.trace.seed = b.settings.trace.seed + 1000 + static_cast<uint64_t>(seed);
-    settings.schedule = FilterSchedule::PowersOfTwo;
-    Preview preview(b.scene, settings, b.width, b.height);
-    for (int frame = 1; frame <= max_spp; ++frame) {
-      const auto it = std::find(spps.begin(), spps.end(), frame);
-      preview.add_frame(it != spps.end(), false);
-      if (it == spps.end()) continue;
-      const size_t k = static_cast<size_t>(it - spps.begin());
-      for (size_t ti = 0; ti < thresholds.size(); ++ti) {
-        PreviewSettings s = preview.settings();
-        s.threshold = thresholds[ti];
-        preview.set_settings(s);  // the same samples, filtered and blended for this t
-        preview.redisplay();
-        const std::vector<Layer> buffers = preview.buffers();
-        const Image& final_rgb = layer_image(buffers, "final");
-        const Image& lv = layer_image(buffers, "lv");
-        const Image& blend_case = layer_image(buffers, "case");
-        Samples& out = samples[k][ti];
-        out.hv.emplace_back(pixels);
-        out.total.emplace_back(pixels);
-        out.blend_case.emplace_back(pixels);
-        for (size_t p = 0; p < pixels; ++p) {
-          const float y = luminance_at(final_rgb, p);
-          out.total.back()[p] = y;
-          out.hv.back()[p] = y - luminance_at(lv, p);
-          out.blend_case.back()[p] = static_cast<uint8_t>(blend_case.pixels[p]);
-        }
-      }
-    }
+    const std::vector<double> uniform_ms = run_uniform_seed(b, seed, spps, thresholds, samples[0]);
+    for (size_t ti = 0; b.with_adaptive && ti < thresholds.size(); ++ti)
+      run_adaptive_seed(b, seed, uniform_ms, thresholds, ti, samples[1]);
     std::fprintf(stderr, "\rseed %d/%d (%.0f s)", seed + 1, seeds, elapsed_ms(start) / 1000);
   }
   std::fprintf(stderr, "\n");
 
   std::ostringstream csv;
-  csv << "scene,filter,spp,t,case,pixels,fraction_at_most_t,median_ratio,median_ratio_sd\n";
+  csv << "scene,filter,mode,spp,t,case,pixels,fraction_at_most_t,median_ratio,median_ratio_sd\n";
   std::printf("%s %dx%d, filter %s, %d seeds: empirical perceived variance Var[Y(L - L_lv)] / L_b^2 of the final "
-              "image against t, by the pixel's most frequent blend case\n",
-              b.scene_name.c_str(), b.width, b.height, filter_kind_name(b.settings.filter.kind), seeds);
-  std::printf("%6s %7s %6s %8s %12s %22s\n", "spp", "t", "case", "pixels", "<= t", "median empirical / t");
-  for (size_t k = 0; k < spps.size(); ++k)
-    for (size_t ti = 0; ti < thresholds.size(); ++ti) {
-      const Samples& s = samples[k][ti];
-      std::vector<int> majority(pixels, -1);
-      for (size_t p = 0; p < pixels; ++p) {
-        int count[kBlendCaseCount] = {};
-        for (const auto& c : s.blend_case) ++count[std::min<int>(c[p], kBlendCaseCount - 1)];
-        majority[p] = static_cast<int>(std::max_element(count, count + kBlendCaseCount) - count);
+              "image against t, by the pixel's most frequent blend case%s\n",
+              b.scene_name.c_str(), b.width, b.height, filter_kind_name(b.settings.filter.kind), seeds,
+              b.with_adaptive ? "; adaptive: at the uniform job's wall time at each spp, the allocation for that t" : "");
+  std::printf("%9s %6s %7s %6s %8s %12s %22s\n", "mode", "spp", "t", "case", "pixels", "<= t", "median empirical / t");
+  for (int mode = 0; mode < modes; ++mode)
+    for (size_t k = 0; k < spps.size(); ++k)
+      for (size_t ti = 0; ti < thresholds.size(); ++ti) {
+        const Samples& s = samples[mode][k][ti];
+        std::vector<int> majority(pixels, -1);
+        for (size_t p = 0; p < pixels; ++p) {
+          int count[kBlendCaseCount] = {};
+          for (const auto& c : s.blend_case) ++count[std::min<int>(c[p], kBlendCaseCount - 1)];
+          majority[p] = static_cast<int>(std::max_element(count, count + kBlendCaseCount) - count);
+        }
+        const char* mode_name = mode ? "adaptive" : "uniform";
+        for (int want : {kCaseUnfiltered, kCaseMixed, kCaseBiasGuard}) {
+          const Summary r = summarize(s, thresholds[ti], want, majority);
+          const double fraction = r.pixels ? static_cast<double>(r.at_most_t) / r.pixels : 0;
+          std::printf("%9s %6d %7g %6d %8zu %11.1f%% %13.3f +- %.3f\n", mode_name, spps[k], thresholds[ti], want,
+                      r.pixels, 100 * fraction, r.median_ratio, r.median_ratio_sd);
+          csv << b.scene_name << "," << filter_kind_name(b.settings.filter.kind) << "," << mode_name << "," << spps[k]
+              << "," << thresholds[ti] << "," << want << "," << r.pixels << "," << fraction << "," << r.median_ratio
+              << "," << r.median_ratio_sd << "\n";
+        }
       }
-      for (int want : {kCaseUnfiltered, kCaseMixed, kCaseBiasGuard}) {
-        const Summary r = summarize(s, thresholds[ti], want, majority);
-        const double fraction = r.pixels ? static_cast<double>(r.at_most_t) / r.pixels : 0;
-        std::printf("%6d %7g %6d %8zu %11.1f%% %13.3f +- %.3f\n", spps[k], thresholds[ti], want, r.pixels,
-                    100 * fraction, r.median_ratio, r.median_ratio_sd);
-        csv << b.scene_name << "," << filter_kind_name(b.settings.filter.kind) << "," << spps[k] << "," << thresholds[ti] << ","
-            << want << "," << r.pixels << "," << fraction << "," << r.median_ratio << "," << r.median_ratio_sd << "\n";
-      }
-    }
   const std::string path = b.out + "/threshold_fidelity_" + b.scene_name + ".csv";
   std::ofstream file(path);
   file << csv.str();

@@ -184,7 +184,8 @@ TEST(Cli, AllHvRendersDefaultToAtrousUnlessFilterIsGiven) {
 }
 
 // --adaptive on (issue 33): off by default, recorded in stats.json with the paths per pixel; after
-// the 16 uniform warm-up frames the pixels' counts part. (Its states: tests/checkpoint_test.cpp.)
+// the 16 uniform warm-up frames the pixels' counts part, the same with one thread and two. (Its
+// states: tests/checkpoint_test.cpp.)
 TEST(Cli, AdaptiveRenderRecordsItsPixelCounts) {
   const std::string out = temp_dir("adaptive");
   ASSERT_EQ(run("render --size 32x24 --spp 4 --quiet --out " + out).code, 0);
@@ -199,6 +200,17 @@ TEST(Cli, AdaptiveRenderRecordsItsPixelCounts) {
   EXPECT_EQ(adaptive["samples_per_pixel"]["max"], 48);
   EXPECT_GE(adaptive["samples_per_pixel"]["min"].get<int>(), 16 + (48 - 16) / 16);  // warm-up, then the floor
   EXPECT_LT(adaptive["samples_per_pixel"]["mean"].get<double>(), 48.0);
+  // The whole adaptive render (allocation, its guide, the masked frames) does not depend on the
+  // thread count: the same samples, bit for bit, with one thread and with two.
+  std::vector<Layer> by_threads[2];
+  for (int threads = 1; threads <= 2; ++threads) {
+    const std::string dir = out + "_threads" + std::to_string(threads);
+    ASSERT_EQ(run("render --size 32x24 --spp 40 --threshold 0.05 --adaptive on --quiet --threads " +
+                  std::to_string(threads) + " --out " + dir).code, 0);
+    by_threads[threads - 1] = read_exr_layers(dir + "/buffers.exr");
+  }
+  for (const char* layer : {"lv", "hv", "var_u", "samples", "final"})
+    EXPECT_EQ(layer_image(by_threads[0], layer).pixels, layer_image(by_threads[1], layer).pixels) << layer;
 }
 
 TEST(Cli, RenderWritesEveryOutput) {
