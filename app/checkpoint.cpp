@@ -82,6 +82,9 @@ void Checkpointer::start(Preview& preview) const {
   if (state.frames.size() != 1 || state.frames[0].begin != range_.begin || state.frames[0].end > range_.end)
     throw Error(options_.resume + ": the state holds frames " + frame_ranges_text(state.frames) +
                 ", which do not start this render's frames " + frame_ranges_text({range_}));
+  if (state.settings.guiding && state.guiding_field.empty())
+    throw Error(options_.resume + ": the state holds no guiding field (a merge of guided shards), so it cannot be "
+                "continued exactly");
   preview.load_state(state);
 }
 
@@ -92,6 +95,7 @@ AccumulationState Checkpointer::state_of(const Preview& preview) const {
   state.frames = {FrameRange{first, first + static_cast<uint32_t>(preview.samples())}};
   state.acc = preview.renderer().accumulation();
   state.traced = preview.pixel_samples();
+  if (settings_.guiding) state.guiding_field = preview.renderer().guiding_field();
   if (settings_.adaptive) {
     const size_t pixels = state.traced.size();
     state.rate = preview.allocation_rates_now();

@@ -26,6 +26,7 @@ void take_settings_from_state(const SampleSettings& s, SceneOptions& scene, Prev
   preview.trace.sampler = static_cast<SamplerType>(s.sampler);
   preview.trace.replicates = static_cast<int>(s.replicates);
   preview.adaptive = s.adaptive != 0;
+  preview.trace.guiding = s.guiding != 0;
   const auto mode = static_cast<SpecularSamplingMode>(s.specular_sampling);
   preview.trace.specular_sampling = mode == SpecularSamplingMode::All;
   preview.trace.near_specular_sampling = mode == SpecularSamplingMode::Near;

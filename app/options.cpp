@@ -70,6 +70,10 @@ void add_preview_options(CommandLine& cli, PreviewSettings& s, bool adaptive_opt
              "the same at the first diffuse vertex only, toward mirror and glass objects that fill at least pi sr\n"
              "of its view: the focus a glass object throws on the floor it stands on (default on;\n"
              "docs/sampling.md#near-specular-sampling)");
+  cli.choice("--guiding", &s.trace.guiding, {"off", "on"},
+             "path guiding: learn where indirect light comes from (an SD-tree, Mueller et al. 2017) and send\n"
+             "half of the diffuse and glossy directions there, MIS-combined with BSDF sampling: unbiased\n"
+             "(default off; docs/guiding.md)");
   cli.flag("--all-hv", &s.trace.all_hv, "put every contribution into the HV buffer but what the camera sees directly or through\nmirrors and glass (environment-lit scenes)");
   cli.option("--key", &s.tonemap.key, "Reinhard key a (default 0.18)", 1e-4f, 100.0f);
   cli.option("--white", &s.tonemap.white, "Reinhard white point (0 = none)", 0.0f, 1e9f);

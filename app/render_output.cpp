@@ -57,6 +57,7 @@ nlohmann::json stats_json(Preview& preview, const RenderReport& r) {
                    {"all_hv", s.trace.all_hv},
                    {"specular_sampling", s.trace.specular_sampling},
                    {"near_specular_sampling", s.trace.near_specular_sampling},
+                   {"guiding", s.trace.guiding},
                    {"key", s.tonemap.key},
                    {"gl", r.gl_backend},
                    {"stage_timing", gl_timing_names()[static_cast<int>(gl_timing())]},
@@ -69,6 +70,7 @@ nlohmann::json stats_json(Preview& preview, const RenderReport& r) {
   j["filter_range_share_of_tracing"] = pass_share_of_tracing(total);
   j["load_ms"] = r.load_ms;
   j["peak_memory_mib"] = peak_memory_mib();
+  if (s.trace.guiding) j["guiding_field_bytes"] = preview.renderer().guiding_memory_bytes();  // docs/guiding.md
   // The loader's estimate (docs/robustness.md), beside the peak it bounds: 0 for a built-in scene.
   j["estimated_load_mib"] = preview.renderer().scene().estimated_load_bytes / (1024.0 * 1024.0);
   j["paths_per_second"] = total.path_tracing > 0 ? trace.paths / (total.path_tracing / 1000.0) : 0.0;

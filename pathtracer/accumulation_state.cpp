@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "image/input_file.h"
+#include "pathtracer/guiding_field.h"
 
 namespace pxf {
 
@@ -22,6 +23,9 @@ constexpr char kMagic[8] = {'P', 'X', 'F', 'S', 'T', 'A', 'T', 'E'};
 constexpr uint32_t kMaxSide = 1u << 15;     // a bound that keeps a corrupt header from allocating
 constexpr uint32_t kMaxFrameRanges = 1u << 20;
 constexpr uint32_t kMaxReplicates = 64;       // --replicates' bound
+// A serialized guiding field: its trees are bounded by GuidingSettings::max_bytes (16 MiB by
+// default) and its pending records are flushed after every frame, so this is far beyond any pxf writes.
+constexpr uint64_t kMaxGuidingFieldBytes = uint64_t(1) << 30;
 
 bool little_endian() {
   const uint16_t one = 1;
@@ -120,6 +124,7 @@ void put_settings(Writer& w, const SampleSettings& s) {
   w.put(s.replicates);
   w.put(s.specular_sampling);
   w.put(s.adaptive);
+  w.put(s.guiding);
 }
 
 SampleSettings get_settings(Reader& r) {
@@ -135,9 +140,10 @@ SampleSettings get_settings(Reader& r) {
   s.replicates = r.get<uint32_t>("header");
   s.specular_sampling = r.get<uint32_t>("header");
   s.adaptive = r.get<uint32_t>("header");
+  s.guiding = r.get<uint32_t>("header");
   if (s.all_hv > 1 || s.specular_sampling > static_cast<uint32_t>(SpecularSamplingMode::Near) || s.sampler > 1 ||
-      s.adaptive > 1)
-    throw Error("state file has an invalid setting flag (all-hv, sampler, specular sampling or adaptive)");
+      s.adaptive > 1 || s.guiding > 1)
+    throw Error("state file has an invalid setting flag (all-hv, sampler, specular sampling, adaptive or guiding)");
   if (s.replicates < 1 || s.replicates > kMaxReplicates)
     throw Error("state file has an invalid replicate count " + std::to_string(s.replicates));
   if (s.width == 0 || s.height == 0 || s.width > kMaxSide || s.height > kMaxSide)
@@ -270,6 +276,7 @@ std::string SampleSettings::difference(const SampleSettings& o) const {
   if (replicates != o.replicates) return diff("replicates", replicates, o.replicates);
   if (specular_sampling != o.specular_sampling) return diff("specular sampling", specular_sampling, o.specular_sampling);
   if (adaptive != o.adaptive) return std::string("adaptive sampling ") + (adaptive ? "on" : "off") + " vs " + (o.adaptive ? "on" : "off");
+  if (guiding != o.guiding) return std::string("guiding ") + (guiding ? "on" : "off") + " vs " + (o.guiding ? "on" : "off");
   return "";
 }
 
@@ -289,6 +296,7 @@ SampleSettings sample_settings(uint64_t scene_hash, int width, int height, const
   s.sampler = static_cast<uint32_t>(params.sampler);
   s.replicates = static_cast<uint32_t>(std::max(params.replicates, 1));
   s.specular_sampling = static_cast<uint32_t>(specular_sampling_mode(params));
+  s.guiding = params.guiding ? 1u : 0u;
   return s;
 }
 
@@ -337,6 +345,13 @@ std::vector<uint8_t> encode_state(const AccumulationState& state) {
     if (array.size() != pixels * per_pixel) throw Error("cannot save a state with a per-pixel array of the wrong size");
     w.put_array(array);
   });
+  if (state.settings.guiding) {  // the field, length-prefixed (0: none)
+    if (state.guiding_field.size() > kMaxGuidingFieldBytes) throw Error("cannot save a guiding field this large");
+    w.put(static_cast<uint64_t>(state.guiding_field.size()));
+    w.put_array(state.guiding_field);
+  } else if (!state.guiding_field.empty()) {
+    throw Error("cannot save a guiding field in a state without guiding");
+  }
   w.put(fnv1a64(w.bytes.data(), w.bytes.size()));
   return std::move(w.bytes);
 }
@@ -375,6 +390,18 @@ AccumulationState decode_state(const uint8_t* data, size_t size) {
   visit_state_arrays(state, [&](auto& array, size_t per_pixel) {
     r.get_array(array, pixels * per_pixel, per_pixel > 1 ? "the replicate arrays" : "the pixel arrays");
   });
+  if (state.settings.guiding) {
+    const uint64_t bytes = r.get<uint64_t>("the guiding field");
+    if (bytes > kMaxGuidingFieldBytes || bytes > r.remaining()) throw Error("state file has an invalid guiding field size");
+    r.get_array(state.guiding_field, static_cast<size_t>(bytes), "the guiding field");
+    if (!state.guiding_field.empty()) {
+      try {  // validated here, so that a decoded state always restores
+        GuidingField::deserialize(state.guiding_field.data(), state.guiding_field.size());
+      } catch (const Error& e) {
+        throw Error(std::string("state file has an invalid guiding field: ") + e.what());
+      }
+    }
+  }
   if (r.remaining() != sizeof(uint64_t)) throw Error("state file has trailing bytes");
   check_pixels(state);
   return state;
@@ -406,7 +433,8 @@ void write_state_file(const std::string& path, const AccumulationState& state) {
 
 namespace {
 // The largest file decode_state can accept, every count at its bound: the header, kMaxFrameRanges
-// frame ranges, kMaxSide^2 pixels with kMaxReplicates replicate slots each, the checksum. About
+// frame ranges, kMaxSide^2 pixels with kMaxReplicates replicate slots each, the largest guiding
+// field, the checksum. About
 // 824 GiB: no practical size, but a bound on what is read, derived from the format itself.
 uint64_t max_state_file_bytes() {
   Writer header;
@@ -422,7 +450,7 @@ uint64_t max_state_file_bytes() {
     per_pixel += slots * sizeof(typename std::decay_t<decltype(array)>::value_type);
   });
   return header.bytes.size() + uint64_t{kMaxFrameRanges} * 2 * sizeof(uint32_t) +
-         uint64_t{kMaxSide} * kMaxSide * per_pixel + sizeof(uint64_t);
+         uint64_t{kMaxSide} * kMaxSide * per_pixel + sizeof(uint64_t) + kMaxGuidingFieldBytes + sizeof(uint64_t);
 }
 }  // namespace
 
@@ -453,6 +481,9 @@ AccumulationState merge_states(const std::vector<AccumulationState>& states) {
     std::fill(merged.credit.begin(), merged.credit.end(), 0.0f);
     std::fill(merged.next_active.begin(), merged.next_active.end(), uint8_t{1});
   }
+  // Each shard learned its own guiding field; their samples average exactly, but no field continues
+  // them: a merged guided state keeps none and is not resumed (Checkpointer refuses it).
+  if (states.size() > 1) merged.guiding_field.clear();
   std::sort(merged.frames.begin(), merged.frames.end(),
             [](const FrameRange& a, const FrameRange& b) { return a.begin < b.begin; });
   for (size_t i = 1; i < merged.frames.size(); ++i)

@@ -12,7 +12,8 @@
 namespace pxf {
 
 // 2: the albedo mean; 3: sampler, replicates, specular sampling; 4: replicate sums; 5: the LV luminance Welford
-// state; 6: adaptive sampling (the flag, per-pixel traced counts, the allocation's credits and next mask)
+// state; 6: adaptive sampling (the flag, per-pixel traced counts, the allocation's credits and next mask) and path
+// guiding (the flag, the serialized field)
 constexpr uint32_t kStateFormatVersion = 6;
 
 // Frame counts: one render traces at most kMaxRenderFrames frames (--spp, --frames, --shard); a
@@ -44,6 +45,9 @@ struct SampleSettings {
   // Not a property of a sample, but a resume must continue the same allocation, and a merge of
   // adaptive and uniform shards would be a render neither option describes.
   uint32_t adaptive = 0;
+  // 1: path guiding (TraceParams::guiding): a sample depends on the field learned before it, so a
+  // resume must continue the same field (AccumulationState::guiding_field).
+  uint32_t guiding = 0;
   bool operator==(const SampleSettings& o) const;
   // "" when equal, else one phrase naming the first difference ("seed 1 vs 2").
   std::string difference(const SampleSettings& o) const;
@@ -65,6 +69,10 @@ struct AccumulationState {
   std::vector<float> rate;
   std::vector<float> credit;
   std::vector<uint8_t> next_active;
+  // Path guiding's field (settings.guiding only): GuidingField::serialize() of what the render had
+  // learned, so that a resumed render continues exactly; empty in a merged state (each shard learned
+  // its own field), which is therefore not resumed.
+  std::vector<uint8_t> guiding_field;
   uint32_t frame_count() const;
 };
 

@@ -85,6 +85,8 @@ class Bsdf {
 
   bool is_perfectly_specular() const { return !has_nondelta_; }
   bool has_nondelta() const { return has_nondelta_; }
+  // The probability that sample() picks a non-delta lobe (1 for a BSDF without delta lobes).
+  float nondelta_probability() const { return p_diffuse_ + (glossy_delta_ ? 0.0f : p_glossy_); }
   // sample() reads u_lobe only when more than one lobe can be picked.
   bool has_lobe_choice() const { return (p_diffuse_ > 0.0f) + (p_glossy_ > 0.0f) + (p_glass_ > 0.0f) > 1; }
   bool is_black() const { return black_; }

@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "pathtracer/bsdf.h"
+#include "pathtracer/guiding_field.h"
 #include "pathtracer/sampler.h"
 
 namespace pxf {
@@ -15,6 +16,8 @@ constexpr int kMaxSpecularChainBounces = 8;
 // Paths traced together; a 16 x 16 tile of the progressive renderer is one batch. The batch state
 // lives on the stack (about 45 KB).
 constexpr int kBatchPaths = 256;
+// Path guiding: the non-delta vertices of a path that record what they received (deeper ones do not).
+constexpr int kMaxGuidingVertices = 16;
 
 struct PathState {
   glm::vec3 throughput{1.0f};
@@ -98,12 +101,39 @@ struct PathTracer::ClassState {
   }
 };
 
+// The BSDF-side strategy of a vertex: BSDF sampling alone (field null), or with path guiding the
+// one-sample mixture that picks the guided direction with probability alpha.
+struct PathTracer::GuidingMixture {
+  const GuidingField* field = nullptr;
+  glm::vec3 position{0.0f};
+  float alpha = 0.0f;
+  // The solid-angle pdf of direction wi under the strategy, given the BSDF's own pdf of it.
+  float pdf(float bsdf_pdf, glm::vec3 wi) const {
+    return field ? alpha * field->pdf(position, wi) + (1.0f - alpha) * bsdf_pdf : bsdf_pdf;
+  }
+};
+
+// Path guiding's learning: a non-delta vertex the path left by a sampled direction. When the path
+// is done, the light it gathered after the vertex divided by its throughput there is the radiance
+// that arrived along `direction` (PathTracer::trace_batch records it into the field).
+struct PathTracer::GuidingVertex {
+  glm::vec3 position{0.0f}, direction{0.0f};
+  glm::vec3 throughput{0.0f};  // after the vertex's sample (and Russian roulette)
+  glm::vec3 before{0.0f};      // the path's lv + hv once the vertex's own light was in
+  float pdf = 0.0f;            // of the sampled direction (the mixture's where guided)
+};
+
 // One path of a batch: its random stream, the ray it traces next, and what it has gathered.
 struct PathTracer::Path {
   PathSampler sampler;
   Ray ray;
   PathState state;
   PathSample* out = nullptr;
+  // Path guiding's learning (null without it): up to kMaxGuidingVertices vertices; `open`: the last
+  // one's `before` is still to be taken (at the next vertex, when its NEE has been resolved).
+  GuidingVertex* guiding = nullptr;
+  int guiding_count = 0;
+  bool guiding_open = false;
 };
 
 // The next event estimation contributions of one vertex step of a batch, each waiting on its
@@ -234,9 +264,10 @@ float PathTracer::specular_pdf(glm::vec3 p, glm::vec3 wi, bool near_only) const 
   return candidates > 0 ? sum / static_cast<float>(candidates) : 0.0f;
 }
 
-glm::vec3 PathTracer::specular_chain_light(const SurfacePoint& sp, const Bsdf& bsdf, glm::vec3 throughput, int vertex,
-                                           bool near_only, int candidates, PathSampler& sampler,
-                                           const TraceParams& params, uint32_t* rays, bool* through_glass) const {
+glm::vec3 PathTracer::specular_chain_light(const SurfacePoint& sp, const Bsdf& bsdf, const GuidingMixture& mixture,
+                                           glm::vec3 throughput, int vertex, bool near_only, int candidates,
+                                           PathSampler& sampler, const TraceParams& params, uint32_t* rays,
+                                           bool* through_glass) const {
   const Scene& scene = geometry_.scene();
   const PathSampler::SpecularNumbers numbers = sampler.specular_numbers(vertex);
   const float u_select = numbers.select;
@@ -261,7 +292,7 @@ glm::vec3 PathTracer::specular_chain_light(const SurfacePoint& sp, const Bsdf& b
   const float pdf = specular_pdf(sp.position, wi, near_only);
   if (!(max_component(f) > 0.0f) || !(pdf > 0.0f)) return glm::vec3(0.0f);
   glm::vec3 t = throughput * f / pdf;
-  const float w = power_heuristic(pdf, bsdf_pdf);
+  const float w = power_heuristic(pdf, mixture.pdf(bsdf_pdf, wi));
   glm::vec3 light(0.0f);
   Ray ray{offset_ray_origin(sp.position, sp.geometric_normal, wi), wi};
   // The chain's vertices get the indices the path's own would: the same length limit as BSDF sampling.
@@ -374,6 +405,13 @@ void PathTracer::trace_batch(const Camera& camera, int width, int height, const 
     path.state = PathState{};
     path.out = &out[i];
   }
+  // Path guiding's learning: each path's vertices, on the heap (16 KB a path would not fit the stack).
+  const bool learn = guiding_ && params.guiding;
+  thread_local std::vector<GuidingVertex> guiding_vertices;
+  if (learn) {
+    guiding_vertices.resize(static_cast<size_t>(kBatchPaths) * kMaxGuidingVertices);
+    for (int i = 0; i < count; ++i) paths[i].guiding = &guiding_vertices[static_cast<size_t>(i) * kMaxGuidingVertices];
+  }
   // live[k] is the k-th path still being traced; rays[k] and hits[k] are its ray and hit.
   int live[kBatchPaths];
   int live_count = count;
@@ -400,6 +438,32 @@ void PathTracer::trace_batch(const Camera& camera, int width, int height, const 
     live_count = still_live;
     shadows.resolve<kClassify>(geometry_, params.all_hv);
   }
+  if (learn) record_guiding(paths, jobs, count, width, height);
+}
+
+// Records each finished path's guiding vertices: the luminance of the light it gathered after the
+// vertex over its throughput there, with weight 1 / pdf. Keyed by (sample index, pixel, vertex),
+// so the field's order does not depend on batches or threads.
+void PathTracer::record_guiding(const Path* paths, const PixelSampleJob* jobs, int count, int width, int height) const {
+  const uint64_t pixels = static_cast<uint64_t>(width) * static_cast<uint64_t>(height);
+  for (int i = 0; i < count; ++i) {
+    const Path& path = paths[i];
+    if (path.guiding_count == 0 || !path.out->finite()) continue;
+    const glm::vec3 total = path.out->lv + path.out->hv;
+    const uint64_t pixel = static_cast<uint64_t>(jobs[i].y) * static_cast<uint64_t>(width) + static_cast<uint64_t>(jobs[i].x);
+    const uint64_t key = (static_cast<uint64_t>(jobs[i].index) * pixels + pixel) * kMaxGuidingVertices;
+    for (int r = 0; r < path.guiding_count; ++r) {
+      const GuidingVertex& g = path.guiding[r];
+      const glm::vec3 before = (r == path.guiding_count - 1 && path.guiding_open) ? total : g.before;
+      const glm::vec3 after = glm::max(total - before, glm::vec3(0.0f));
+      glm::vec3 radiance(0.0f);
+      for (int c = 0; c < 3; ++c)
+        if (g.throughput[c] > 0.0f) radiance[c] = after[c] / g.throughput[c];
+      const float y = luminance(radiance);
+      if (!(y >= 0.0f) || !std::isfinite(y) || !(g.pdf > 0.0f)) continue;
+      guiding_->record(key + static_cast<uint64_t>(r), g.position, g.direction, y, 1.0f / g.pdf);
+    }
+  }
 }
 
 // Vertex `vertex` of a path at `hit`: the emission found there, next event estimation (queued on
@@ -412,6 +476,10 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
   PathSample& out = *path.out;
   PathSampler& sampler = path.sampler;
   ++out.rays;
+  if (path.guiding_open) {  // the last guiding vertex's own light (its NEE included) is in now
+    path.guiding[path.guiding_count - 1].before = out.lv + out.hv;
+    path.guiding_open = false;
+  }
   if (!hit.valid()) {  // the environment is the light vertex
     if (lights_.has_environment()) {
       float w = s.prev_delta ? s.chain_mis : power_heuristic(s.prev_pdf, lights_.pdf_environment(path.ray.direction));
@@ -454,6 +522,16 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
   }
   if (last_vertex || bsdf.is_black()) return false;
 
+  // Path guiding: once the field is trained, the BSDF-side strategy of a non-delta vertex is the
+  // mixture that takes the guided direction with probability alpha (times the share of the
+  // BSDF's non-delta lobes: its delta lobes keep their samples).
+  GuidingMixture mixture;
+  if (guiding_ && params.guiding && bsdf.has_nondelta() && guiding_->trained()) {
+    mixture.field = guiding_;
+    mixture.position = sp.position;
+    mixture.alpha = kGuidingAlpha * bsdf.nondelta_probability();
+  }
+
   // Next event estimation (the light vertex is vertex + 1 <= max_vertices).
   const PathSampler::LightNumbers u_light = numbers ? numbers->light : sampler.light_numbers(vertex, bsdf.has_nondelta());
   if (bsdf.has_nondelta()) {
@@ -466,7 +544,7 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
                           ? ShadowRay{offset_ray_origin(sp.position, sp.geometric_normal, ls.wi), ls.wi, ls.distance}
                           : shadow_ray_between(sp.position, sp.geometric_normal, ls.point, ls.normal);
       ++out.rays;
-      float w = ls.delta ? 1.0f : power_heuristic(ls.pdf, bsdf_pdf);
+      float w = ls.delta ? 1.0f : power_heuristic(ls.pdf, mixture.pdf(bsdf_pdf, ls.wi));
       if constexpr (kClassify) {
         shadows.class_out[shadows.count] = cls->out;
         shadows.classes[shadows.count] = cls->classify(s.nonspecular, false);
@@ -492,8 +570,8 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
   const bool specular_sampling = candidates > 0;
   if (specular_sampling) {
     bool through_glass = false;
-    const glm::vec3 light = specular_chain_light(sp, bsdf, s.throughput, vertex, near_only, candidates, sampler,
-                                                 params, &out.rays, &through_glass);
+    const glm::vec3 light = specular_chain_light(sp, bsdf, mixture, s.throughput, vertex, near_only, candidates,
+                                                 sampler, params, &out.rays, &through_glass);
     if (max_component(light) > 0.0f) {
       out.hv += light;
       if constexpr (kClassify) {
@@ -508,7 +586,31 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
   const bool roulette = vertex >= params.rr_start_vertex;
   const PathSampler::BsdfNumbers u = numbers ? numbers->bsdf : sampler.bsdf_numbers(vertex, bsdf.has_lobe_choice(), roulette);
   BsdfSample bs;
-  if (!bsdf.sample(u.lobe, u.direction, &bs)) return false;
+  if (!mixture.field) {
+    if (!bsdf.sample(u.lobe, u.direction, &bs)) return false;
+  } else {
+    // One-sample MIS: either strategy's direction is weighted by f cos / the mixture's pdf.
+    const PathSampler::GuidingNumbers g = sampler.guiding_numbers(vertex);
+    const float alpha = mixture.alpha;
+    if (g.choice < alpha) {
+      float guide_pdf, bsdf_pdf;
+      bs.wi = guiding_->sample(sp.position, g.direction, &guide_pdf);
+      const glm::vec3 f = bsdf.eval(bs.wi, &bsdf_pdf);
+      if (!(max_component(f) > 0.0f)) return false;
+      bs.pdf = alpha * guide_pdf + (1.0f - alpha) * bsdf_pdf;
+      bs.weight = f / bs.pdf;
+      bs.delta = bs.transmitted = false;
+    } else {
+      if (!bsdf.sample(u.lobe, u.direction, &bs)) return false;
+      if (bs.delta) {
+        bs.weight /= 1.0f - alpha;  // a delta lobe's share of the mixture
+      } else {
+        const float pdf = mixture.pdf(bs.pdf, bs.wi);
+        bs.weight *= bs.pdf / pdf;
+        bs.pdf = pdf;
+      }
+    }
+  }
   if constexpr (kClassify) {
     if (bs.delta) {
       const bool glass = bsdf_params.transmission > 0.0f && bsdf_params.metallic < 1.0f;
@@ -539,6 +641,14 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
   s.prev_position = sp.position;
   path.ray.origin = offset_ray_origin(sp.position, sp.geometric_normal, bs.wi);
   path.ray.direction = bs.wi;
+  if (path.guiding && !bs.delta && path.guiding_count < kMaxGuidingVertices) {
+    GuidingVertex& g = path.guiding[path.guiding_count++];
+    g.position = sp.position;
+    g.direction = bs.wi;
+    g.throughput = s.throughput;
+    g.pdf = bs.pdf;
+    path.guiding_open = true;
+  }
   return true;
 }
 

@@ -14,6 +14,7 @@
 namespace pxf {
 
 class Bsdf;
+class GuidingField;
 
 // One path's contributions. LV = E S* L and E S* D L (both MIS strategies at that D vertex);
 // HV = everything else. With all_hv, LV holds E S* L only (what the camera sees directly or through
@@ -93,6 +94,12 @@ class PathTracer {
   // The ray's first surface emits toward it (the emission the path tracer adds at vertex 1).
   bool first_hit_is_emissive(const Ray& camera_ray) const;
 
+  // Path guiding (TraceParams::guiding, docs/guiding.md): traces with params.guiding sample from
+  // `field` once it is trained() and record into it at every non-delta vertex; nullptr (the
+  // default) traces without guiding whatever params.guiding says. The field must not change
+  // (apply_records, end_iteration) while a trace runs; recording is thread-safe.
+  void set_guiding(GuidingField* field) { guiding_ = field; }
+
   bool dark() const { return lights_.empty(); }
   bool has_perfect_specular() const { return has_perfect_specular_; }
   const EmbreeScene& geometry() const { return geometry_; }
@@ -102,9 +109,12 @@ class PathTracer {
   struct Path;
   struct ShadowQueue;
   struct ClassState;
+  struct GuidingMixture;
+  struct GuidingVertex;
   template <bool kClassify>
   void trace_batch(const Camera& camera, int width, int height, const PixelSampleJob* jobs, int count,
                    const TraceParams& params, PathSample* out, HvSampleClass* classes) const;
+  void record_guiding(const Path* paths, const PixelSampleJob* jobs, int count, int width, int height) const;
   template <bool kClassify>
   bool shade_vertex(Path& path, const Hit& hit, int vertex, const TraceParams& params, ShadowQueue& shadows,
                     const PathSampler::VertexNumbers* numbers, ClassState* cls) const;
@@ -123,9 +133,11 @@ class PathTracer {
   int chain_target_count(glm::vec3 p, bool near_only) const;
   float specular_pdf(glm::vec3 p, glm::vec3 wi, bool near_only) const;
   // `candidates`: chain_target_count(sp.position, near_only), at least 1.
-  glm::vec3 specular_chain_light(const SurfacePoint& sp, const Bsdf& bsdf, glm::vec3 throughput, int vertex,
-                                 bool near_only, int candidates, PathSampler& sampler, const TraceParams& params,
-                                 uint32_t* rays, bool* through_glass) const;
+  // `mixture`: the pdf of the vertex's BSDF-side strategy (the guided mixture where guiding samples).
+  glm::vec3 specular_chain_light(const SurfacePoint& sp, const Bsdf& bsdf, const GuidingMixture& mixture,
+                                 glm::vec3 throughput, int vertex, bool near_only, int candidates,
+                                 PathSampler& sampler, const TraceParams& params, uint32_t* rays,
+                                 bool* through_glass) const;
 
   // The BsdfMaterial at sp: the one precomputed for its material when eval_material() reads no
   // texture of it and the vertex color is white (base color x 1 is exact, so the values are the
@@ -142,6 +154,7 @@ class PathTracer {
   std::vector<SpecularTarget> specular_targets_;
   bool has_perfect_specular_ = false;
   bool has_near_targets_ = false;  // a target that fills its bounding sphere enough for near chains
+  GuidingField* guiding_ = nullptr;
 };
 
 // Adds one accepted sample to pixel `pixel`: running means of LV/HV RGB and Welford (double) of

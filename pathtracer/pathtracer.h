@@ -41,7 +41,16 @@ struct TraceParams {
   // that near) and about halves the variance there (docs/sampling.md#near-specular-sampling). Ignored with
   // specular_sampling, which does this and more.
   bool near_specular_sampling = true;
+  // Path guiding (docs/guiding.md): the renderer learns an SD-tree of the incident radiance from its
+  // own paths, and once trained every non-delta vertex samples its direction from it with
+  // probability kGuidingAlpha (times the BSDF's non-delta share), from the BSDF otherwise, weighted
+  // by the mixture pdf (one-sample MIS; NEE and specular sampling MIS against that mixture). Off by
+  // default; off traces the samples of before, bit for bit.
+  bool guiding = false;
 };
+
+// The guided share of a guided vertex's directions (Müller et al. 2017's fixed 0.5).
+constexpr float kGuidingAlpha = 0.5f;
 
 // A sphere subtends solid angle 2 pi (1 - cos a) from a point at distance d from its center, with
 // sin a = r / d. Near: at least pi sr (a >= 60 degrees), i.e. d^2 <= r^2 / sin^2 a = r^2 / (1 - cos^2 a).
@@ -210,7 +219,16 @@ class ProgressiveRenderer {
   // resume, merged shards). `traced`: each pixel's traced paths (pixel_frames(); an adaptive
   // render's), empty = `frames` for every pixel. Throws pxf::Error when a size differs from the
   // renderer's.
-  void restore(const Accumulation& acc, uint32_t first, int frames, const std::vector<uint32_t>& traced = {});
+  // `guiding_field`: GuidingField::serialize() of the field the saved render had learned
+  // (guiding_field()); with TraceParams::guiding an empty one starts a new field (the render then
+  // does not continue exactly), without guiding it is ignored. Throws pxf::Error on a field that
+  // does not deserialize.
+  void restore(const Accumulation& acc, uint32_t first, int frames, const std::vector<uint32_t>& traced = {},
+               const std::vector<uint8_t>& guiding_field = {});
+  // The guiding field learned so far, serialized (empty without TraceParams::guiding), and its
+  // memory (GuidingField::memory_bytes(), 0 without guiding).
+  std::vector<uint8_t> guiding_field() const;
+  size_t guiding_memory_bytes() const;
 
   const Accumulation& accumulation() const;
   const TraceStats& stats() const;

@@ -2,11 +2,14 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
+#include <limits>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include "pathtracer/guiding_field.h"
 #include "pathtracer/integrator.h"
 #include "pathtracer/pathtracer.h"
 
@@ -14,6 +17,25 @@ namespace pxf {
 namespace {
 
 constexpr int kTileSize = 16;
+
+// The box path guiding's field covers: the scene's triangles, a little larger (points on the
+// boundary stay inside), or a unit box without any.
+void guiding_box(const Scene& scene, glm::vec3* lo, glm::vec3* hi) {
+  *lo = glm::vec3(std::numeric_limits<float>::max());
+  *hi = glm::vec3(-std::numeric_limits<float>::max());
+  for (const Mesh& mesh : scene.meshes)
+    for (const glm::vec3& p : mesh.positions) {
+      *lo = glm::min(*lo, p);
+      *hi = glm::max(*hi, p);
+    }
+  if (!(lo->x <= hi->x) || !std::isfinite(lo->x + lo->y + lo->z + hi->x + hi->y + hi->z)) {
+    *lo = glm::vec3(-0.5f);
+    *hi = glm::vec3(0.5f);
+  }
+  const glm::vec3 margin = 1e-3f * (*hi - *lo) + glm::vec3(1e-6f);
+  *lo -= margin;
+  *hi += margin;
+}
 
 }  // namespace
 
@@ -31,6 +53,8 @@ struct ProgressiveRenderer::Impl {
   uint32_t first_frame = 0;
   std::vector<uint32_t> pixel_frames;  // paths traced into each pixel since the reset
   std::vector<PixelSampleJob> jobs;    // the frame's paths (build_jobs), kept to reuse the memory
+  // Path guiding (params.guiding): learned since the last reset, read by the tracing threads.
+  std::unique_ptr<GuidingField> guiding;
 
   Impl(const Scene& s, const TraceParams& p, int w, int h) : scene(s), camera(s.camera), params(p), width(w), height(h) {
     if (w <= 0 || h <= 0) throw Error("path tracer: image size must be positive");
@@ -38,6 +62,27 @@ struct ProgressiveRenderer::Impl {
     resize_accumulation(acc, w, h, accumulation_replicates());
     pixel_frames.assign(static_cast<size_t>(w) * h, 0u);
     make_arena();
+    reset_guiding();
+  }
+
+  // A new, untrained field (params.guiding), or none.
+  void reset_guiding() {
+    guiding.reset();
+    if (params.guiding) {
+      glm::vec3 lo, hi;
+      guiding_box(scene, &lo, &hi);
+      guiding = std::make_unique<GuidingField>(lo, hi);
+    }
+    tracer->set_guiding(guiding.get());
+  }
+
+  // After a complete frame (single-threaded): the frame's records go into the field, and at the
+  // end of each iteration of doubling length (GuidingField::iteration_ends_after) the field
+  // becomes what the iteration learned.
+  void learn_guiding() {
+    if (!guiding) return;
+    guiding->apply_records();
+    if (GuidingField::iteration_ends_after(static_cast<uint64_t>(frames.load()))) guiding->end_iteration();
   }
 
   int accumulation_replicates() const { return accumulated_replicates(params.sampler, params.replicates); }
@@ -125,6 +170,7 @@ void ProgressiveRenderer::reset() {
   impl_->pixel_frames.assign(impl_->pixel_frames.size(), 0u);
   impl_->stats = TraceStats{};
   impl_->frames = 0;
+  impl_->reset_guiding();
 }
 
 void ProgressiveRenderer::set_camera(const Camera& camera) {
@@ -160,6 +206,7 @@ bool ProgressiveRenderer::add_frame_of(const uint8_t* active) {
   }
   impl_->count_traced_pixels();
   ++impl_->frames;
+  impl_->learn_guiding();
   impl_->stats.last_frame_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return true;
 }
@@ -176,7 +223,7 @@ void ProgressiveRenderer::set_first_frame(uint32_t first) {
 }
 
 void ProgressiveRenderer::restore(const Accumulation& acc, uint32_t first, int frames,
-                                  const std::vector<uint32_t>& traced) {
+                                  const std::vector<uint32_t>& traced, const std::vector<uint8_t>& guiding_field) {
   if (acc.width != impl_->width || acc.height != impl_->height || acc.samples.size() != impl_->acc.samples.size())
     throw Error("saved accumulation is " + std::to_string(acc.width) + "x" + std::to_string(acc.height) +
                 ", the render " + std::to_string(impl_->width) + "x" + std::to_string(impl_->height));
@@ -186,6 +233,14 @@ void ProgressiveRenderer::restore(const Accumulation& acc, uint32_t first, int f
   if (!traced.empty() && traced.size() != impl_->pixel_frames.size())
     throw Error("saved traced counts have " + std::to_string(traced.size()) + " entries, the image " +
                 std::to_string(impl_->pixel_frames.size()) + " pixels");
+  if (impl_->params.guiding) {
+    if (guiding_field.empty()) {
+      impl_->reset_guiding();
+    } else {
+      impl_->guiding = std::make_unique<GuidingField>(GuidingField::deserialize(guiding_field.data(), guiding_field.size()));
+      impl_->tracer->set_guiding(impl_->guiding.get());
+    }
+  }
   impl_->acc = acc;
   impl_->first_frame = first;
   impl_->frames = frames;
@@ -195,6 +250,10 @@ void ProgressiveRenderer::restore(const Accumulation& acc, uint32_t first, int f
     impl_->pixel_frames = traced;
   impl_->stats = TraceStats{};
 }
+std::vector<uint8_t> ProgressiveRenderer::guiding_field() const {
+  return impl_->guiding ? impl_->guiding->serialize() : std::vector<uint8_t>{};
+}
+size_t ProgressiveRenderer::guiding_memory_bytes() const { return impl_->guiding ? impl_->guiding->memory_bytes() : 0; }
 const Accumulation& ProgressiveRenderer::accumulation() const { return impl_->acc; }
 const TraceStats& ProgressiveRenderer::stats() const { return impl_->stats; }
 const Scene& ProgressiveRenderer::scene() const { return impl_->scene; }

@@ -19,8 +19,11 @@
 //   vertex v, specular: 0,1 direction in the chosen object's cone (2D) | 2 object selection
 //   (with TraceParams::specular_sampling, or near_specular_sampling at the first diffuse vertex;
 //   the chain's delta choices: one group per bounce b)
+//   vertex v, guiding : 0,1 guided direction (2D) | 2 guided-vs-BSDF choice (TraceParams::guiding,
+//                       only at non-delta vertices once the field is trained: docs/guiding.md)
 // Group ids: camera = 0, light of vertex v = 2v, bsdf of vertex v = 2v + 1 (v >= 2); specular
-// sampling of vertex v = 4096 + v, its chain bounce b = 8192 + 1024 v + b (v, b < 1024: --max-vertices caps both).
+// sampling of vertex v = 4096 + v, its chain bounce b = 8192 + 1024 v + b (v, b < 1024: --max-vertices caps both);
+// guiding of vertex v = kGuidingGroup + v (above every chain group).
 // Only the coordinates a vertex uses are computed (no lobe with one lobe, no roulette before
 // --rr-start, no light sample on a delta surface).
 // The path leaves the Sobol sequences after its first non-delta bounce (leave_qmc): the vertices
@@ -328,6 +331,26 @@ class PathSampler {
     const sobol::ScrambledGroup g = group(4096 + vertex);
     n.direction = g.unit_pair();
     n.select = g.unit(2);
+    return n;
+  }
+
+  // Path guiding at vertex `vertex`: the guided-vs-BSDF choice and the guided direction. Drawn only
+  // where guiding may be chosen, so a render without guiding draws exactly what it did before.
+  static constexpr int kGuidingGroup = 1 << 21;
+  struct GuidingNumbers {
+    float choice = 0.0f;
+    glm::vec2 direction{0.0f};
+  };
+  GuidingNumbers guiding_numbers(int vertex) {
+    GuidingNumbers n;
+    if (type_ == SamplerType::Independent) {
+      n.choice = rng_.next_float();
+      n.direction = rng_.next_2d();
+      return n;
+    }
+    const sobol::ScrambledGroup g = group(kGuidingGroup + vertex);
+    n.direction = g.unit_pair();
+    n.choice = g.unit(2);
     return n;
   }
 

@@ -206,6 +206,51 @@ TEST(Checkpoint, AdaptiveShardsMergeIntoTheirExactSum) {
   EXPECT_NE(other.err.find("adaptive sampling"), std::string::npos) << other.err;
 }
 
+// Path guiding (docs/guiding.md): the state holds the field learned so far, so a resumed guided
+// render continues exactly, whatever moment of the field's iterations it was killed at.
+TEST(Checkpoint, GuidedResumeAfterSigkillIsBitIdentical) {
+  expect_resume_after_kills_is_bit_identical(kScene + " --guiding on", "guided", 3);
+}
+
+// Guided shards each learn their own field: their merge is the exact sum of their samples, but it
+// keeps no field, so it is not resumed.
+TEST(Checkpoint, GuidedShardsMergeButAreNotResumed) {
+  const std::string scene = kScene + " --guiding on";
+  std::vector<std::string> dirs;
+  std::string states;
+  for (const char* shard : {"0/2", "1/2"}) {
+    dirs.push_back(temp_dir(std::string("guided_shard_") + shard[0]));
+    const Result r = pxf_run("render " + scene + " --spp 16 --shard " + shard + " --out " + dirs.back());
+    ASSERT_EQ(r.code, 0) << r.err;
+    states += " " + dirs.back() + "/state.pxfs";
+  }
+  const std::string merged_dir = temp_dir("guided_merged");
+  const Result r = pxf_run("merge" + states + " --scene cornell --out " + merged_dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::vector<Layer> merged = read_exr_layers(merged_dir + "/buffers.exr");
+  const std::vector<Layer> a = read_exr_layers(dirs[0] + "/buffers.exr"), b = read_exr_layers(dirs[1] + "/buffers.exr");
+  const Image& n = layer_image(merged, "samples");
+  for (size_t p = 0; p < n.pixels.size(); ++p)
+    for (const char* layer : {"lv", "hv"})
+      for (int c = 0; c < 3; ++c) {
+        const float va = layer_image(a, layer).pixels[3 * p + c], vb = layer_image(b, layer).pixels[3 * p + c];
+        const float na = layer_image(a, "samples").pixels[p], nb = layer_image(b, "samples").pixels[p];
+        const float expected = (va * na + vb * nb) / n.pixels[p];
+        EXPECT_NEAR(layer_image(merged, layer).pixels[3 * p + c], expected, 2e-5f * std::abs(expected) + 1e-6f)
+            << layer << " " << p;
+      }
+  const nlohmann::json stats = nlohmann::json::parse(slurp(merged_dir + "/stats.json"));
+  EXPECT_EQ(stats["settings"]["guiding"], true);
+  const Result resume = pxf_run("render " + scene + " --spp 32 --resume " + merged_dir + "/state.pxfs --out " +
+                                temp_dir("guided_resumed_merge"));
+  EXPECT_EQ(resume.code, 1);
+  EXPECT_NE(resume.err.find("no guiding field"), std::string::npos) << resume.err;
+  const Result unguided = pxf_run("render " + kScene + " --spp 16 --resume " + dirs[0] + "/state.pxfs --out " +
+                                  temp_dir("unguided_resume"));
+  EXPECT_EQ(unguided.code, 1);
+  EXPECT_NE(unguided.err.find("guiding on vs off"), std::string::npos) << unguided.err;
+}
+
 TEST(Checkpoint, MergeOfUnevenShardsEqualsOneRender) {
   const std::string ref = temp_dir("single");
   ASSERT_EQ(pxf_run("render " + kScene + " --spp " + std::to_string(kSpp) + " --out " + ref).code, 0);

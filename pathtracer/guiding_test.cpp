@@ -1,0 +1,277 @@
+// Path guiding in the integrator and the renderer (TraceParams::guiding, docs/guiding.md): white
+// furnaces stay at 1, a guided image agrees with an unguided one of another seed (block Z-test),
+// guiding off and an untrained field trace the samples of before, the image and the field do not
+// depend on the thread count (masked frames too), a restored field continues the render exactly,
+// and the state file keeps the field.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+
+#include "pathtracer/accumulation_state.h"
+#include "pathtracer/guiding_field.h"
+#include "pathtracer/integrator.h"
+#include "pathtracer/shapes.h"
+
+namespace pxf {
+namespace {
+
+Environment uniform_environment(float radiance) {
+  Environment env;
+  env.image.width = 8;
+  env.image.height = 4;
+  env.image.texels.assign(32, glm::vec4(radiance, radiance, radiance, 1.0f));
+  return env;
+}
+
+TraceParams guided_params() {
+  TraceParams params;
+  params.guiding = true;
+  params.threads = 2;
+  return params;
+}
+
+bool same_accumulation(const Accumulation& a, const Accumulation& b) {
+  return a.samples == b.samples &&
+         std::memcmp(a.lv_mean.data(), b.lv_mean.data(), a.lv_mean.size() * sizeof(glm::vec3)) == 0 &&
+         std::memcmp(a.hv_mean.data(), b.hv_mean.data(), a.hv_mean.size() * sizeof(glm::vec3)) == 0 &&
+         std::memcmp(a.hv_lum_m2.data(), b.hv_lum_m2.data(), a.hv_lum_m2.size() * sizeof(double)) == 0 &&
+         std::memcmp(a.lv_lum_m2.data(), b.lv_lum_m2.data(), a.lv_lum_m2.size() * sizeof(double)) == 0;
+}
+
+// A white furnace: a white Lambertian sphere, a perfect mirror sphere and a white sphere with a
+// smooth clear coat (a diffuse and a delta lobe: the mixture's delta branch) in a uniform sky of
+// radiance 1. Every pixel's expectation is exactly 1; MIS weights of guiding, BSDF sampling, NEE and
+// near specular chains that did not sum to 1 would move it.
+Scene furnace_scene() {
+  Scene scene;
+  Material coated = make_diffuse(glm::vec3(1.0f));
+  coated.roughness = 0.0f;
+  coated.specular = 1.0f;
+  scene.materials = {make_diffuse(glm::vec3(1.0f)), make_mirror(glm::vec3(1.0f)), coated};
+  scene.meshes.push_back(make_sphere(glm::vec3(-0.51f, 0.3f, 0), 0.5f, 0, 64, 32));
+  scene.meshes.push_back(make_sphere(glm::vec3(0.51f, 0.3f, 0), 0.5f, 1, 64, 32));
+  scene.meshes.push_back(make_sphere(glm::vec3(0.0f, -0.62f, 0), 0.4f, 2, 64, 32));
+  scene.environment = uniform_environment(1.0f);
+  scene.camera = look_at_camera(glm::vec3(0, 0, 3.0f), glm::vec3(0), glm::vec3(0, 1, 0), 0.75f);
+  return scene;
+}
+
+TEST(Guiding, WhiteFurnaceStaysOne) {
+  const Scene scene = furnace_scene();
+  TraceParams params = guided_params();
+  params.max_vertices = 64;
+  const int size = 32, frames = 128;
+  ProgressiveRenderer guided(scene, params, size, size);
+  for (int i = 0; i < frames; ++i) guided.add_frame();
+  const Accumulation& acc = guided.accumulation();
+  // Each pixel within its noise (5 standard errors, from the LV and HV Welford states) plus the
+  // tessellated spheres' shading normals' 0.02 either way.
+  double sum = 0, worst = 0, worst_excess = 0;
+  for (size_t i = 0; i < acc.samples.size(); ++i) {
+    const double y = luminance(acc.lv_mean[i] + acc.hv_mean[i]), n = acc.samples[i];
+    const double sd = std::sqrt(acc.lv_lum_m2[i] / (n - 1)) + std::sqrt(acc.hv_lum_m2[i] / (n - 1));
+    sum += y;
+    worst = std::max(worst, std::abs(y - 1.0));
+    worst_excess = std::max(worst_excess, std::abs(y - 1.0) - 5.0 * sd / std::sqrt(n));
+  }
+  const double mean = sum / static_cast<double>(acc.samples.size());
+  std::printf("guided furnace: mean %.5f, worst pixel off by %.4f (beyond 5 se: %.4f), field %zu bytes\n", mean,
+              worst, worst_excess, guided.guiding_memory_bytes());
+  EXPECT_NEAR(mean, 1.0, 2e-3);
+  EXPECT_LT(worst_excess, 0.03);
+  // The field learned and was used: the image is not the unguided one.
+  params.guiding = false;
+  ProgressiveRenderer plain(scene, params, size, size);
+  for (int i = 0; i < frames; ++i) plain.add_frame();
+  EXPECT_FALSE(same_accumulation(acc, plain.accumulation()));
+  EXPECT_GT(GuidingField::deserialize(guided.guiding_field().data(), guided.guiding_field().size()).iteration(), 5);
+}
+
+// The mean luminance of each 4x4 block and the variance of that mean, from the accumulation's
+// Welford states of LV and HV (Var[LV + HV] <= (sd_LV + sd_HV)^2: no covariance is kept).
+struct Blocks {
+  std::vector<double> mean, variance;
+};
+Blocks blocks_of(const Accumulation& acc, int block) {
+  Blocks b;
+  const int bx = acc.width / block, by = acc.height / block;
+  b.mean.assign(static_cast<size_t>(bx * by), 0.0);
+  b.variance.assign(b.mean.size(), 0.0);
+  const double pixels = block * block;
+  for (int y = 0; y < by * block; ++y)
+    for (int x = 0; x < bx * block; ++x) {
+      const size_t p = static_cast<size_t>(y) * acc.width + x, k = static_cast<size_t>((y / block) * bx + x / block);
+      const double n = acc.samples[p];
+      const double sd = std::sqrt(acc.lv_lum_m2[p] / (n - 1)) + std::sqrt(acc.hv_lum_m2[p] / (n - 1));
+      b.mean[k] += luminance(acc.lv_mean[p] + acc.hv_mean[p]) / pixels;
+      b.variance[k] += sd * sd / n / (pixels * pixels);
+    }
+  return b;
+}
+
+// Unbiased: the guided cornell box (mirror and glass spheres: caustics, near specular chains) agrees
+// with an unguided render of another seed, block by block and over the whole image.
+TEST(Guiding, GuidedImageAgreesWithUnguidedReference) {
+  const Scene scene = make_cornell_box(true);
+  const int size = 32, frames = 256, block = 4;
+  TraceParams params = guided_params();
+  params.seed = 11;
+  ProgressiveRenderer guided(scene, params, size, size);
+  params.guiding = false;
+  params.seed = 12;
+  ProgressiveRenderer plain(scene, params, size, size);
+  for (int i = 0; i < frames; ++i) {
+    guided.add_frame();
+    plain.add_frame();
+  }
+  const Blocks g = blocks_of(guided.accumulation(), block), r = blocks_of(plain.accumulation(), block);
+  double worst = 0, sum_g = 0, sum_r = 0, var = 0;
+  int beyond3 = 0;
+  for (size_t k = 0; k < g.mean.size(); ++k) {
+    const double z = (g.mean[k] - r.mean[k]) / std::sqrt(g.variance[k] + r.variance[k]);
+    worst = std::max(worst, std::abs(z));
+    beyond3 += std::abs(z) > 3.0;
+    sum_g += g.mean[k];
+    sum_r += r.mean[k];
+    var += g.variance[k] + r.variance[k];
+  }
+  const double z_image = (sum_g - sum_r) / std::sqrt(var);
+  std::printf("guided vs unguided: %zu blocks, worst |z| %.2f, %d beyond 3, image z %.2f (means %.5f, %.5f)\n",
+              g.mean.size(), worst, beyond3, z_image, sum_g / g.mean.size(), sum_r / r.mean.size());
+  EXPECT_LT(worst, 4.5);
+  EXPECT_LE(beyond3, 2);
+  EXPECT_LT(std::abs(z_image), 4.0);
+}
+
+// Before the first iteration ends (frame 1) the field is untrained: the guided renderer traces the
+// unguided samples, bit for bit (no guiding numbers are drawn, no pdf changes); afterwards it does not.
+TEST(Guiding, UntrainedFieldTracesTheUnguidedSamples) {
+  const Scene scene = make_cornell_box(true);
+  TraceParams params = guided_params();
+  ProgressiveRenderer guided(scene, params, 24, 20);
+  params.guiding = false;
+  ProgressiveRenderer plain(scene, params, 24, 20);
+  guided.add_frame();
+  plain.add_frame();
+  EXPECT_TRUE(same_accumulation(guided.accumulation(), plain.accumulation()));
+  EXPECT_EQ(guided.stats().rays, plain.stats().rays);
+  EXPECT_TRUE(plain.guiding_field().empty());
+  EXPECT_EQ(plain.guiding_memory_bytes(), 0u);
+  guided.add_frame();
+  plain.add_frame();
+  EXPECT_FALSE(same_accumulation(guided.accumulation(), plain.accumulation()));
+}
+
+// The field's records are keyed and sorted, the sampling field is fixed during a frame: the image
+// and the field are the same with 1 and 2 threads, also for frames that trace a mask of pixels.
+TEST(Guiding, DeterministicAcrossThreadCounts) {
+  const Scene scene = make_cornell_box(true);
+  TraceParams params = guided_params();
+  params.seed = 77;
+  params.threads = 1;
+  ProgressiveRenderer one(scene, params, 40, 30);
+  params.threads = 2;
+  ProgressiveRenderer two(scene, params, 40, 30);
+  std::vector<uint8_t> mask(40 * 30);
+  for (size_t p = 0; p < mask.size(); ++p) mask[p] = (p % 3) != 0;
+  for (int i = 0; i < 9; ++i) {
+    if (i % 4 == 3) {
+      one.add_frame(mask);
+      two.add_frame(mask);
+    } else {
+      one.add_frame();
+      two.add_frame();
+    }
+  }
+  EXPECT_TRUE(same_accumulation(one.accumulation(), two.accumulation()));
+  EXPECT_EQ(one.stats().rays, two.stats().rays);
+  EXPECT_EQ(one.guiding_field(), two.guiding_field());
+}
+
+// A render restored from its accumulation and its field after k frames continues exactly: the
+// same image and field as the uninterrupted render, for a k inside an iteration and at its end.
+TEST(Guiding, RestoredFieldContinuesExactly) {
+  const Scene scene = make_cornell_box(true);
+  const TraceParams params = guided_params();
+  const int w = 24, h = 20, frames = 12;
+  ProgressiveRenderer whole(scene, params, w, h);
+  for (int i = 0; i < frames; ++i) whole.add_frame();
+  for (int k : {3, 5}) {
+    SCOPED_TRACE(k);
+    ProgressiveRenderer first(scene, params, w, h);
+    for (int i = 0; i < k; ++i) first.add_frame();
+    ProgressiveRenderer resumed(scene, params, w, h);
+    resumed.restore(first.accumulation(), 0, k, first.pixel_frames(), first.guiding_field());
+    for (int i = k; i < frames; ++i) resumed.add_frame();
+    EXPECT_TRUE(same_accumulation(resumed.accumulation(), whole.accumulation()));
+    EXPECT_EQ(resumed.guiding_field(), whole.guiding_field());
+  }
+  // Without the field the render goes on with a new one: not the same samples.
+  ProgressiveRenderer first(scene, params, w, h);
+  for (int i = 0; i < 5; ++i) first.add_frame();
+  ProgressiveRenderer fresh(scene, params, w, h);
+  fresh.restore(first.accumulation(), 0, 5, first.pixel_frames());
+  for (int i = 5; i < frames; ++i) fresh.add_frame();
+  EXPECT_FALSE(same_accumulation(fresh.accumulation(), whole.accumulation()));
+  // A field that is not one is refused.
+  ProgressiveRenderer broken(scene, params, w, h);
+  EXPECT_THROW(broken.restore(first.accumulation(), 0, 5, first.pixel_frames(), std::vector<uint8_t>{1, 2, 3}), Error);
+}
+
+// The state file keeps the guiding flag and the field; a corrupt field is refused; a merge of
+// guided shards keeps no field.
+TEST(Guiding, StateKeepsTheField) {
+  const Scene scene = make_cornell_box(true);
+  const TraceParams params = guided_params();
+  const int w = 8, h = 6;
+  ProgressiveRenderer r(scene, params, w, h);
+  for (int i = 0; i < 4; ++i) r.add_frame();
+  AccumulationState state;
+  state.settings = sample_settings(0x1234, w, h, params);
+  EXPECT_EQ(state.settings.guiding, 1u);
+  state.frames = {FrameRange{0, 4}};
+  state.acc = r.accumulation();
+  state.traced = r.pixel_frames();
+  state.guiding_field = r.guiding_field();
+  ASSERT_FALSE(state.guiding_field.empty());
+  const std::vector<uint8_t> bytes = encode_state(state);
+  const AccumulationState back = decode_state(bytes.data(), bytes.size());
+  EXPECT_EQ(back.settings.guiding, 1u);
+  EXPECT_EQ(back.guiding_field, state.guiding_field);
+  EXPECT_EQ(encode_state(back), bytes);
+
+  SampleSettings unguided = state.settings;
+  unguided.guiding = 0;
+  EXPECT_EQ(state.settings.difference(unguided), "guiding on vs off");
+
+  // A corrupted byte inside the field, the checksum recomputed: refused by the field's own checks
+  // (the field's header counts and indices) or accepted only as a valid field.
+  std::vector<uint8_t> corrupt = bytes;
+  const size_t field_start = corrupt.size() - 8 - state.guiding_field.size();
+  corrupt[field_start + 4] ^= 0xff;  // in the field's header
+  const uint64_t hash = fnv1a64(corrupt.data(), corrupt.size() - 8);
+  std::memcpy(corrupt.data() + corrupt.size() - 8, &hash, 8);
+  try {
+    decode_state(corrupt.data(), corrupt.size());
+    ADD_FAILURE() << "a corrupt field was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("guiding field"), std::string::npos) << e.what();
+  }
+  // A state without guiding cannot carry a field.
+  AccumulationState wrong = state;
+  wrong.settings.guiding = 0;
+  EXPECT_THROW(encode_state(wrong), Error);
+
+  // Shards: each learned its own field; the merge keeps none.
+  AccumulationState second = state;
+  second.frames = {FrameRange{4, 8}};
+  const AccumulationState merged = merge_states({state, second});
+  EXPECT_TRUE(merged.guiding_field.empty());
+  const std::vector<uint8_t> merged_bytes = encode_state(merged);
+  EXPECT_TRUE(decode_state(merged_bytes.data(), merged_bytes.size()).guiding_field.empty());
+}
+
+}  // namespace
+}  // namespace pxf
