@@ -15,7 +15,7 @@ bool same_trace_params(const TraceParams& a, const TraceParams& b) {
   return a.max_vertices == b.max_vertices && a.rr_start_vertex == b.rr_start_vertex && a.all_hv == b.all_hv &&
          specular_sampling_mode(a) == specular_sampling_mode(b) &&
          a.seed == b.seed && a.threads == b.threads &&
-         a.sampler == b.sampler && a.replicates == b.replicates;
+         a.sampler == b.sampler && a.replicates == b.replicates && a.guiding == b.guiding;
 }
 
 bool same_filter_params(const PreviewSettings& a, const PreviewSettings& b) {
@@ -143,7 +143,8 @@ void Preview::load_accumulation(const Accumulation& acc, uint32_t first, int fra
 
 void Preview::load_state(const AccumulationState& state) {
   reset();
-  renderer_->restore(state.acc, state.frames.front().begin, static_cast<int>(state.frame_count()), state.traced);
+  renderer_->restore(state.acc, state.frames.front().begin, static_cast<int>(state.frame_count()), state.traced,
+                     state.guiding_field);
   update_hv_empty();
   if (!state.settings.adaptive) return;
   replans_ = replan_schedule(samples());
