@@ -5,70 +5,39 @@
 #include <functional>
 #include <limits>
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include "gl/cpu_reference.h"
 
 namespace pxf {
 
 std::vector<float> final_pixel_need(const Image& lv, const Image& hv, const Image& var_u, const Image& var_lv,
-                                    const std::vector<uint32_t>& paths, float t, const Image* range_color,
-                                    const Image* depth, const RangeWeights& range, float exact_below) {
-  const int w = hv.width, h = hv.height;
-  // Var[L_lv + L_u] as Var[L_u] + Var[L_lv], unknown where either is: the image the pooling reads.
-  Image var_final = Image::gray(w, h);
-  for (size_t p = 0; p < var_final.pixels.size(); ++p) {
+                                    const std::vector<uint32_t>& paths, float t) {
+  std::vector<float> need(paths.size());
+  for (size_t p = 0; p < need.size(); ++p) {
+    // Var[L_lv + L_u] as Var[L_u] + Var[L_lv], unknown where either is.
     const float vu = clean_var(var_u.pixels[p]), vl = clean_var(var_lv.pixels[p]);
-    var_final.pixels[p] = vu < 0.0f || vl < 0.0f ? kVarUnknown : vu + vl;
+    const float t_n = effective_threshold(t, paths[p]);
+    if (vu < 0.0f || vl < 0.0f || !(t_n > 0.0f)) {
+      need[p] = std::numeric_limits<float>::infinity();
+      continue;
+    }
+    const float lb = std::max(luminance(clean(hv.pixels[3 * p]), clean(hv.pixels[3 * p + 1]), clean(hv.pixels[3 * p + 2])) +
+                                  luminance(clean(lv.pixels[3 * p]), clean(lv.pixels[3 * p + 1]), clean(lv.pixels[3 * p + 2])),
+                              0.0f);
+    need[p] = relative_variance(vu + vl, lb) / t_n;
   }
-  const bool pool = range_color && depth;
-  std::vector<float> need(var_final.pixels.size());
-  // Rows in parallel: each pixel's need reads the inputs only, so the result is the same whatever
-  // the thread count. The 3x3 range-weighted pooling is most of the allocation's cost.
-  tbb::parallel_for(tbb::blocked_range<int>(0, h, 8), [&](const tbb::blocked_range<int>& rows) {
-    for (int y = rows.begin(); y != rows.end(); ++y)
-      for (int x = 0; x < w; ++x) {
-        const size_t p = static_cast<size_t>(y) * w + x;
-        const float t_n = effective_threshold(t, paths[p]);
-        const float own = var_final.pixels[p];
-        if (own < 0.0f || !(t_n > 0.0f)) {
-          need[p] = std::numeric_limits<float>::infinity();
-          continue;
-        }
-        const float lb = std::max(luminance(clean(hv.at(x, y, 0)), clean(hv.at(x, y, 1)), clean(hv.at(x, y, 2))) +
-                                      luminance(clean(lv.at(x, y, 0)), clean(lv.at(x, y, 1)), clean(lv.at(x, y, 2))),
-                                  0.0f);
-        need[p] = relative_variance(own, lb) / t_n;
-        if (pool && need[p] < exact_below)
-          need[p] = relative_variance(pooled_var_u(var_final, *range_color, *depth, x, y, range), lb) / t_n;
-      }
-  });
   return need;
 }
 
-namespace {
-
-// out = the largest value of `in` within `radius` cells along one axis: `lines` lines of `count`
-// cells, `step` apart in the array, the lines `line_step` apart.
-void window_max(const std::vector<float>& in, std::vector<float>& out, int count, int step, int lines, int line_step,
-                int radius) {
-  for (int line = 0; line < lines; ++line)
-    for (int i = 0; i < count; ++i) {
-      float m = -std::numeric_limits<float>::infinity();
-      for (int q = std::max(0, i - radius); q <= std::min(count - 1, i + radius); ++q)
-        m = std::max(m, in[static_cast<size_t>(line) * line_step + static_cast<size_t>(q) * step]);
-      out[static_cast<size_t>(line) * line_step + static_cast<size_t>(i) * step] = m;
+std::vector<float> neighbourhood_need(const std::vector<float>& need, int width, int height, int radius) {
+  std::vector<float> out(need.size());
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      float m = 0.0f;
+      for (int qy = std::max(0, y - radius); qy <= std::min(height - 1, y + radius); ++qy)
+        for (int qx = std::max(0, x - radius); qx <= std::min(width - 1, x + radius); ++qx)
+          if (qx != x || qy != y) m = std::max(m, need[static_cast<size_t>(qy) * width + qx]);
+      out[static_cast<size_t>(y) * width + x] = m;
     }
-}
-
-}  // namespace
-
-std::vector<float> dilate_need(const std::vector<float>& need, int width, int height, int radius) {
-  // Separable: the largest value along each row's window, then along each column's.
-  std::vector<float> rows(need.size()), out(need.size());
-  window_max(need, rows, width, 1, height, width, radius);
-  window_max(rows, out, height, width, width, 1, radius);
   return out;
 }
 

@@ -1,5 +1,5 @@
 // The allocation of adaptive sampling (app/adaptive.h) under fake variance images: the need is the
-// final pixel's perceived variance over its own threshold, pooled like the blend's; samples follow
+// final pixel's perceived variance over its own threshold, decided for each pixel by the others in its box; samples follow
 // it up to one per frame; the floor, the minimum and the dilation hold.
 #include <gtest/gtest.h>
 
@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "app/adaptive.h"
+#include "gl/pass_params.h"
 
 namespace pxf {
 namespace {
@@ -26,8 +27,8 @@ struct FakeImages {
     for (float& v : var_u.pixels) v = vu;
     for (float& v : var_lv.pixels) v = vl;
   }
-  std::vector<float> need(float t, const Image* range = nullptr, const Image* depth = nullptr) const {
-    return final_pixel_need(lv, hv, var_u, var_lv, paths, t, range, depth, range_weights(FilterParams{}));
+  std::vector<float> need(float t) const {
+    return final_pixel_need(lv, hv, var_u, var_lv, paths, t);
   }
 };
 
@@ -55,55 +56,41 @@ TEST(AdaptiveNeed, UnknownVarianceMustBeSampledAndZeroIsNoNeed) {
   EXPECT_EQ(need[1], 0.0f);
 }
 
-TEST(AdaptiveNeed, IsDecidedOnThePooledVarianceAsTheBlendDoes) {
-  // A pixel that looks quiet among noisy neighbours of the same range takes their mean variance (3x3,
-  // range-weighted): it has likely missed the rare paths they found. Across a range edge it keeps its own.
-  FakeImages f(3, 3, 0.3f, 0.2f, 0.004f, 0.0f, 100);
-  f.var_u.at(1, 1, 0) = 1e-6f;
-  Image range = Image::rgb(3, 3), depth = Image::gray(3, 3);
-  for (float& v : range.pixels) v = 0.5f;
-  for (float& v : depth.pixels) v = 1.0f;
-  const float t = 0.001f;
-  const float pooled = f.need(t, &range, &depth)[4], own = f.need(t)[4];
-  EXPECT_GT(pooled, 100.0f * own);
-  for (int c = 0; c < 3; ++c) range.at(1, 1, c) = 0.0f;  // the centre shows another surface
-  EXPECT_NEAR(f.need(t, &range, &depth)[4], own, 1e-3f * own);
-}
-
-// The pooling only raises a need, and every need above full_rate_need gives the same rate: a pixel
-// whose own variance already puts it there skips the pooling, the others are pooled as before.
-TEST(AdaptiveNeed, PoolingIsSkippedOnlyWhereTheOwnNeedIsAlreadyPastExactBelow) {
-  FakeImages f(3, 3, 0.3f, 0.2f, 0.004f, 0.0f, 100);
-  f.var_u.at(1, 1, 0) = 1e-6f;  // quiet centre: its own need is tiny, its pooled need large
-  Image range = Image::rgb(3, 3), depth = Image::gray(3, 3);
-  for (float& v : range.pixels) v = 0.5f;
-  for (float& v : depth.pixels) v = 1.0f;
-  const float t = 0.001f;
-  const std::vector<float> all_pooled = f.need(t, &range, &depth);
-  const std::vector<float> own = f.need(t);
-  const std::vector<float> skipped =
-      final_pixel_need(f.lv, f.hv, f.var_u, f.var_lv, f.paths, t, &range, &depth, range_weights(FilterParams{}), 4.0f);
-  ASSERT_GE(own[0], 4.0f);           // the noisy corner is past the bound on its own
-  EXPECT_EQ(skipped[0], own[0]);     // so it keeps its own need
-  ASSERT_LT(own[4], 4.0f);           // the quiet centre is not
-  EXPECT_EQ(skipped[4], all_pooled[4]);  // so it is pooled exactly as without the bound
-  EXPECT_GT(skipped[4], 100.0f * own[4]);
-}
-
-TEST(AdaptiveDilation, EveryPixelInTheBoxTakesTheLargestNeed) {
+TEST(AdaptiveNeighbourhood, EachPixelTakesTheLargestNeedOfTheOthersInItsBox) {
   const int w = 9, h = 7;
   std::vector<float> need(w * h, 0.5f);
   need[3 * w + 4] = 20.0f;
   need[0] = 7.0f;
-  const std::vector<float> d = dilate_need(need, w, h, 2);
+  const std::vector<float> d = neighbourhood_need(need, w, h, 2);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
-      const bool near_hot = std::abs(x - 4) <= 2 && std::abs(y - 3) <= 2;
-      const bool near_corner = x <= 2 && y <= 2;
+      const bool hot = x == 4 && y == 3, corner = x == 0 && y == 0;
+      const bool near_hot = std::abs(x - 4) <= 2 && std::abs(y - 3) <= 2 && !hot;
+      const bool near_corner = x <= 2 && y <= 2 && !corner;
       const float expected = near_hot ? 20.0f : near_corner ? 7.0f : 0.5f;
       EXPECT_EQ(d[y * w + x], expected) << x << "," << y;
     }
-  EXPECT_EQ(dilate_need(need, w, h, 0), need);
+  EXPECT_EQ(neighbourhood_need(need, w, h, 0), std::vector<float>(w * h, 0.0f));  // no others
+}
+
+// The property that keeps adaptive means unbiased (tests/consistency_test.cpp): whatever a pixel's
+// own samples say, its rate is the same; its neighbours' rates follow it. (With full_rate_share the
+// scale is the need at the top quarter of all pixels, to which each pixel adds 1/N: off here.)
+TEST(AdaptiveNeighbourhood, APixelsOwnNeedNeverDecidesItsRate) {
+  const int w = 7, h = 7;
+  AdaptiveParams params;
+  params.full_rate_share = 0.0f;
+  const std::vector<uint32_t> paths(w * h, 500);
+  std::vector<float> need(w * h, 0.3f);
+  need[2 * w + 2] = 6.0f;
+  const size_t centre = 3 * w + 3;
+  std::vector<std::vector<float>> rates;
+  for (float own : {0.0f, 1.0f, 50.0f, kInf}) {
+    need[centre] = own;
+    rates.push_back(sampling_rates(neighbourhood_need(need, w, h, params.dilation_radius), paths, params));
+  }
+  for (const auto& r : rates) EXPECT_EQ(r[centre], rates[0][centre]);
+  EXPECT_LT(rates[0][5 * w + 5], rates[2][5 * w + 5]);  // a neighbour's rate does follow it
 }
 
 // Frames traced per pixel over `frames` frames of fixed rates.
@@ -194,20 +181,22 @@ TEST(AdaptiveRates, APixelBelowTheMinimumIsNotRetired) {
   EXPECT_EQ(sampling_rates(need, paths, params)[0], params.floor_rate);
 }
 
-TEST(AdaptiveRates, ADilatedCausticKeepsItsQuietNeighboursSampled) {
-  // The chain from a fake need image to the masks: a hot pixel (need 40) among clean ones (0.1) past
-  // the minimum. Its 5x5 box is traced every frame, the rest at the floor.
+TEST(AdaptiveRates, ACausticKeepsItselfAndItsQuietNeighboursSampled) {
+  // The chain from a fake need image to the masks: a 2x2 caustic (need 40) among clean pixels (0.1)
+  // past the minimum. The caustic's pixels keep each other traced every frame, and so is every pixel
+  // within 2 of it; the rest is at the floor.
   const int w = 12, h = 10;
   const AdaptiveParams params;
   std::vector<float> need(w * h, 0.1f);
-  need[5 * w + 6] = 40.0f;
-  const std::vector<float> rates =
-      sampling_rates(dilate_need(need, w, h, params.dilation_radius), std::vector<uint32_t>(w * h, 500), params);
+  for (int y = 5; y <= 6; ++y)
+    for (int x = 6; x <= 7; ++x) need[y * w + x] = 40.0f;
+  const std::vector<float> rates = sampling_rates(neighbourhood_need(need, w, h, params.dilation_radius),
+                                                  std::vector<uint32_t>(w * h, 500), params);
   const std::vector<int> traced = traced_over(rates, 32);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
-      const bool in_box = std::abs(x - 6) <= 2 && std::abs(y - 5) <= 2;
-      EXPECT_EQ(traced[y * w + x], in_box ? 32 : 2) << x << "," << y;
+      const bool near = x >= 4 && x <= 9 && y >= 3 && y <= 8;
+      EXPECT_EQ(traced[y * w + x], near ? 32 : 2) << x << "," << y;
     }
 }
 

@@ -122,7 +122,6 @@ void Preview::reset() {
   active_credit_.clear();
   rates_.clear();
   replans_ = replan_schedule(0);
-  if (range_.frames() == 0) guide_frames_ = 0;  // a new guide comes with the range buffer's first frame
 }
 
 GrowingSchedule Preview::replan_schedule(int frames_done) const {
@@ -208,20 +207,8 @@ bool Preview::step_range_buffer() {
   const bool stepped = range_.step([this](const std::vector<uint32_t>& pixels, glm::vec2 jitter) {
     return renderer_->trace_specular_chains(pixels, jitter);
   });
-  if (stepped && range_.frames() == 1 && settings_.adaptive) capture_allocation_guide();
   last_.range += elapsed_ms(start);
   return stepped;
-}
-
-// The allocation pools its variances over the range buffer's first frame, read back when it is
-// made: later frames only antialias the guide, and how many the time-driven schedule has added by
-// a given path-tracing frame depends on the machine's speed. With the first frame the allocation
-// depends on the samples alone (a render is the same on any machine, a resumed one continues it
-// exactly), and it needs no extra range frames.
-void Preview::capture_allocation_guide() {
-  guide_color_ = range_.range_color_image();
-  guide_depth_ = range_.depth_image();
-  guide_frames_ = 1;
 }
 
 void Preview::converge_range_buffer() {
@@ -369,16 +356,10 @@ std::vector<float> Preview::allocation_rates() {
   }
   Image var_u = Image::gray(w, h);
   acc.variance_of_mean_image(var_u.pixels.data(), 1);
-  const bool guide = settings_.filtering();
-  if (guide && range_.frames() == 0) step_range_buffer();  // captures the guide (capture_allocation_guide)
-  if (guide && guide_frames_ == 0) capture_allocation_guide();  // adaptive turned on later (explorer)
   const std::vector<uint32_t>& paths = renderer_->pixel_frames();
-  const std::vector<float> need =
-      final_pixel_need(lv, hv, var_u, var_lv, paths, settings_.threshold, guide ? &guide_color_ : nullptr,
-                       guide ? &guide_depth_ : nullptr, range_weights(settings_.filter),
-                       settings_.adaptive_params.full_rate_need);
+  const std::vector<float> need = final_pixel_need(lv, hv, var_u, var_lv, paths, settings_.threshold);
   const AdaptiveParams& params = settings_.adaptive_params;
-  return sampling_rates(dilate_need(need, w, h, params.dilation_radius), paths, params);
+  return sampling_rates(neighbourhood_need(need, w, h, params.dilation_radius), paths, params);
 }
 
 void Preview::plan_next_frame() {

@@ -211,7 +211,6 @@ class Preview {
   GrowingSchedule replan_schedule(int frames_done) const;
   bool allocating() const;  // adaptive sampling is past its warm-up: frames follow plan_next_frame()
   // The range guide as images for the allocation's pooling, read back when the guide changed.
-  void capture_allocation_guide();
   bool filter_due_now() const;  // the queued Filter step would run the filter
 
   int width_, height_;
@@ -231,8 +230,6 @@ class Preview {
   std::vector<float> rates_;          // the last allocation's rates; empty before the first
   GrowingSchedule replans_{16, 16};   // when the rates are recomputed (replan_schedule)
   double last_active_share_ = 1.0;
-  Image guide_color_, guide_depth_;   // the allocation's guide (capture_allocation_guide)
-  int guide_frames_ = 0;              // 1 once captured, 0 before
   ScheduleState schedule_;
   bool have_filtered_ = false;
   bool uploaded_ = false;  // inputs hold the current samples
