@@ -5,6 +5,7 @@
 //   pxf bench --pathtracer --sampler-error | --variance-ratio   the samplers (app/sampler_bench.h)
 //   pxf bench --threshold-fidelity   the blend's threshold against the empirical variance (app/fidelity_bench.h)
 //   pxf bench --adaptive      adaptive against uniform sampling (app/adaptive_bench.h)
+//   pxf bench --guiding-ab    path guiding against none, unfiltered (app/guiding_bench.h)
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -15,6 +16,7 @@
 #include <sstream>
 
 #include "app/adaptive_bench.h"
+#include "app/guiding_bench.h"
 #include "app/bench_runs.h"
 #include "app/commands.h"
 #include "app/options.h"
@@ -440,7 +442,7 @@ int run_bench(const Args& args) {
   SceneOptions scene_options;
   PreviewSettings preview_settings;
   bool pathtracer = false, variants = false, stage_table = false, sampler_error = false, variance_ratio = false;
-  bool demodulation_ab = false;
+  bool demodulation_ab = false, guiding_ab = false;
   bool threshold_fidelity = false, adaptive = false;
   double clean_cap_s = 300;
   int variant_spp = 4, variant_rounds = 5;
@@ -491,6 +493,10 @@ int run_bench(const Args& args) {
   cli.option("--spp", &spp_text, "LIST",
              "spp of --sampler-error (default 8,32,128), --variance-ratio (4,16,64,256) or --threshold-fidelity (16,64,256)");
   cli.option("--seeds", &seeds, "seeds of --variance-ratio and --threshold-fidelity (default 32), --sampler-error (8)", 2, 4096);
+  cli.flag("--guiding-ab", &guiding_ab,
+           "instead of 1-4: path guiding against none, unfiltered (app/guiding_bench.h): ms per frame at equal spp\n"
+           "(--frames), and HDR and display NRMSE at equal wall time of --budgets SECONDS (default 2,8), median of\n"
+           "--rounds (default 5) alternating rounds");
   cli.flag("--demodulation-ab", &demodulation_ab,
            "instead of 1-4: albedo demodulation off vs on at equal wall time (--budgets, --rounds rounds, back\n"
            "to back with the unfiltered run); writes demodulation.csv and demod_*.png");
@@ -556,6 +562,14 @@ int run_bench(const Args& args) {
   const Image reference = obtain_reference(b, reference_path, reference_spp, scene_options.scene);
   if (reference.width != b.width || reference.height != b.height) throw Error("reference size differs from --size");
 
+  if (guiding_ab) {
+    GuidingBenchPlan plan;
+    plan.budgets_s = parse_counts("--budgets", cli.given("--budgets") ? budgets_text : "2,8");
+    plan.rounds = cli.given("--rounds") ? rounds : 5;
+    plan.cost_frames = frames;
+    run_guiding_bench({b.scene, b.plain.trace, b.width, b.height, out, reference}, plan);
+    return 0;
+  }
   if (adaptive) {
     AdaptiveBenchPlan plan;
     plan.budgets = parse_counts("--budgets", cli.given("--budgets") ? budgets_text : "8,32,128,512");
