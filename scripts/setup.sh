@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs whatever Debian 12 packages are missing, then configures and builds pxf (Release) in
-# build/ (or $PXF_BUILD_DIR). Idempotent: with everything installed and built it takes seconds.
+# build/ (or $PXF_BUILD_DIR): the pxf executable, or the targets in $PXF_BUILD_TARGETS (test.sh:
+# all). Idempotent: with everything installed and built it takes seconds.
 #   scripts/setup.sh [extra cmake arguments]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -37,4 +38,6 @@ if [ ! -f "$BUILD_DIR/CMakeCache.txt" ]; then
 elif [ $# -gt 0 ]; then
   cmake -S . -B "$BUILD_DIR" "$@" >/dev/null
 fi
-cmake --build "$BUILD_DIR" -j "$JOBS"
+# The main job needs the pxf executable only; scripts/test.sh asks for every target (the test
+# programs and fuzz replays are most of the build: a first run then renders sooner).
+cmake --build "$BUILD_DIR" -j "$JOBS" --target ${PXF_BUILD_TARGETS:-pxf}

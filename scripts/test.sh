@@ -6,7 +6,7 @@
 # and libFuzzer work; any crash, leak, sanitizer report or timeout fails the script.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-scripts/setup.sh
+PXF_BUILD_TARGETS=all scripts/setup.sh
 ctest --test-dir build --output-on-failure -j "$(nproc)" --timeout 600
 
 if [ "${PXF_SKIP_SANITIZERS:-0}" != "1" ]; then
