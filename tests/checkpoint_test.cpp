@@ -149,7 +149,7 @@ TEST(Checkpoint, ResumeAfterSigkillAtRandomMomentsIsBitIdentical) {
 // timing, so a resumed adaptive render traces exactly what the uninterrupted one did. 16 warm-up
 // frames, then 8 allocated ones.
 TEST(Checkpoint, AdaptiveResumeAfterSigkillIsBitIdentical) {
-  expect_resume_after_kills_is_bit_identical(kScene + " --adaptive on", "adaptive", 8);
+  expect_resume_after_kills_is_bit_identical(kScene + " --adaptive on", "adaptive", 5);
 }
 
 // An adaptive shard (--frames A:B or --shard i/n with --adaptive on) is an adaptive render of B - A
