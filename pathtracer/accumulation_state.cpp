@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "image/input_file.h"
+#include "pathtracer/byte_io.h"
 #include "pathtracer/guiding_field.h"
 
 namespace pxf {
@@ -69,50 +70,7 @@ int state_replicates(const SampleSettings& s) {
   return accumulated_replicates(static_cast<SamplerType>(s.sampler), static_cast<int>(s.replicates));
 }
 
-class Writer {
- public:
-  template <class T>
-  void put(const T& v) { put_bytes(&v, sizeof(T)); }
-  template <class T>
-  void put_array(const std::vector<T>& v) { put_bytes(v.data(), v.size() * sizeof(T)); }
-  void put_bytes(const void* p, size_t n) {
-    const uint8_t* b = static_cast<const uint8_t*>(p);
-    bytes.insert(bytes.end(), b, b + n);
-  }
-  std::vector<uint8_t> bytes;
-};
-
-// Every read is bounds-checked against the buffer: a truncated or fuzzed file ends in pxf::Error.
-class Reader {
- public:
-  Reader(const uint8_t* data, size_t size) : data_(data), size_(size) {}
-  template <class T>
-  T get(const char* what) {
-    T v;
-    get_bytes(&v, sizeof(T), what);
-    return v;
-  }
-  template <class T>
-  void get_array(std::vector<T>& v, size_t count, const char* what) {
-    if (count > remaining() / sizeof(T)) throw Error(std::string("state file truncated in ") + what);
-    v.resize(count);
-    get_bytes(v.data(), count * sizeof(T), what);
-  }
-  void get_bytes(void* out, size_t n, const char* what) {
-    if (n > remaining()) throw Error(std::string("state file truncated in ") + what);
-    if (n == 0) return;  // an empty array (no replicates): its data() may be null, which memcpy must not get
-    std::memcpy(out, data_ + pos_, n);
-    pos_ += n;
-  }
-  size_t remaining() const { return size_ - pos_; }
-  size_t pos() const { return pos_; }
-
- private:
-  const uint8_t* data_;
-  size_t size_, pos_ = 0;
-};
-
-void put_settings(Writer& w, const SampleSettings& s) {
+void put_settings(ByteWriter& w, const SampleSettings& s) {
   w.put(s.scene_hash);
   w.put(s.width);
   w.put(s.height);
@@ -127,7 +85,7 @@ void put_settings(Writer& w, const SampleSettings& s) {
   w.put(s.guiding);
 }
 
-SampleSettings get_settings(Reader& r) {
+SampleSettings get_settings(ByteReader& r) {
   SampleSettings s;
   s.scene_hash = r.get<uint64_t>("header");
   s.width = r.get<uint32_t>("header");
@@ -300,15 +258,6 @@ SampleSettings sample_settings(uint64_t scene_hash, int width, int height, const
   return s;
 }
 
-uint64_t fnv1a64(const void* data, size_t size, uint64_t hash) {
-  const uint8_t* b = static_cast<const uint8_t*>(data);
-  for (size_t i = 0; i < size; ++i) {
-    hash ^= b[i];
-    hash *= 0x100000001b3ull;
-  }
-  return hash;
-}
-
 namespace {
 // `max_bytes`: the bound of the reader that loads the file.
 uint64_t hash_file(const std::string& path, uint64_t max_bytes, uint64_t hash) {
@@ -328,7 +277,7 @@ uint64_t scene_content_hash(const std::string& scene, const std::string& env_pat
 
 std::vector<uint8_t> encode_state(const AccumulationState& state) {
   if (!little_endian()) throw Error("state files are little-endian; this machine is not");
-  Writer w;
+  ByteWriter w;
   w.put_bytes(kMagic, sizeof(kMagic));
   w.put(kStateFormatVersion);
   put_settings(w, state.settings);
@@ -358,7 +307,7 @@ std::vector<uint8_t> encode_state(const AccumulationState& state) {
 
 AccumulationState decode_state(const uint8_t* data, size_t size) {
   if (!little_endian()) throw Error("state files are little-endian; this machine is not");
-  Reader r(data, size);
+  ByteReader r(data, size, "state file");
   char magic[sizeof(kMagic)];
   r.get_bytes(magic, sizeof(magic), "the magic number");
   if (std::memcmp(magic, kMagic, sizeof(kMagic)) != 0) throw Error("not a pxf state file (bad magic number)");
@@ -437,7 +386,7 @@ namespace {
 // field, the checksum. About
 // 824 GiB: no practical size, but a bound on what is read, derived from the format itself.
 uint64_t max_state_file_bytes() {
-  Writer header;
+  ByteWriter header;
   header.put_bytes(kMagic, sizeof(kMagic));
   header.put(kStateFormatVersion);
   put_settings(header, SampleSettings{});

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "pathtracer/byte_io.h"
 #include "pathtracer/pathtracer.h"
 
 namespace pxf {
@@ -82,7 +83,6 @@ SampleSettings sample_settings(uint64_t scene_hash, int width, int height, const
 // every buffer and image file beside it is NOT included: see docs/state-format.md), the
 // environment file's bytes and the environment strength.
 uint64_t scene_content_hash(const std::string& scene_name_or_path, const std::string& env_path, float env_strength);
-uint64_t fnv1a64(const void* data, size_t size, uint64_t hash = 0xcbf29ce484222325ull);
 
 // The file image of a state, and back. decode_state throws pxf::Error with a one-line message for
 // any buffer that is not a complete, uncorrupted state of this format version.

@@ -14,6 +14,7 @@
 #include <tbb/parallel_sort.h>
 
 #include "core/error.h"
+#include "pathtracer/byte_io.h"
 
 namespace pxf {
 
@@ -224,47 +225,6 @@ bool record_before(const GuidingRecord& a, const GuidingRecord& b) {
          std::make_tuple(b.leaf, b.key, float_bits(b.u), float_bits(b.v), float_bits(b.energy));
 }
 
-uint64_t fnv1a64(const uint8_t* data, size_t size) {
-  uint64_t hash = 0xcbf29ce484222325ull;
-  for (size_t i = 0; i < size; ++i) hash = (hash ^ data[i]) * 0x100000001b3ull;
-  return hash;
-}
-
-struct Writer {
-  template <class T>
-  void put(T v) {
-    const uint8_t* b = reinterpret_cast<const uint8_t*>(&v);
-    bytes.insert(bytes.end(), b, b + sizeof(T));
-  }
-  std::vector<uint8_t> bytes;
-};
-
-// Every read is bounds-checked: a truncated buffer ends in pxf::Error, never in a read past it.
-class Reader {
- public:
-  Reader(const uint8_t* data, size_t size) : data_(data), size_(size) {}
-  template <class T>
-  T get(const char* what) {
-    T v;
-    if (sizeof(T) > remaining()) throw Error(std::string("guiding field truncated in ") + what);
-    std::memcpy(&v, data_ + pos_, sizeof(T));
-    pos_ += sizeof(T);
-    return v;
-  }
-  // A count of items of at least `item_bytes` bytes each, checked against what is left before
-  // anything is allocated for them.
-  size_t get_count(size_t item_bytes, const char* what) {
-    const uint64_t count = get<uint64_t>(what);
-    if (count > remaining() / item_bytes) throw Error(std::string("guiding field truncated in ") + what);
-    return static_cast<size_t>(count);
-  }
-  size_t remaining() const { return size_ - pos_; }
-
- private:
-  const uint8_t* data_;
-  size_t size_, pos_ = 0;
-};
-
 bool non_negative_finite(double x) { return x >= 0.0 && std::isfinite(x); }
 
 // Every node but the root is the child of exactly one node with a smaller index, no deeper than
@@ -288,7 +248,7 @@ void check_tree(const std::vector<Node>& tree, int max_level, const char* what) 
 }
 
 template <class Node>
-void put_tree(Writer& w, const std::vector<Node>& tree) {
+void put_tree(ByteWriter& w, const std::vector<Node>& tree) {
   w.put(static_cast<uint64_t>(tree.size()));
   for (const Node& n : tree) {
     for (int q = 0; q < 4; ++q) w.put(n.child[q]);
@@ -301,7 +261,7 @@ void put_tree(Writer& w, const std::vector<Node>& tree) {
 }
 
 template <class Node>
-std::vector<Node> get_tree(Reader& r, int max_level, const char* what) {
+std::vector<Node> get_tree(ByteReader& r, int max_level, const char* what) {
   const size_t count = r.get_count(sizeof(Node), what);
   if (count == 0 || count > kMaxDirectionalNodes)
     throw Error(std::string("guiding field has a ") + what + " tree of " + std::to_string(count) + " nodes");
@@ -559,7 +519,7 @@ GuidingField::Stats GuidingField::stats() const {
 }
 
 std::vector<uint8_t> GuidingField::serialize() const {
-  Writer w;
+  ByteWriter w;
   for (char c : kMagic) w.put(c);
   w.put(kFormatVersion);
   w.put(settings_.spatial_threshold);
@@ -599,7 +559,7 @@ GuidingField GuidingField::deserialize(const uint8_t* data, size_t size) {
     throw Error("guiding field truncated (" + std::to_string(size) + " bytes)");
   uint64_t checksum;
   std::memcpy(&checksum, data + size - sizeof checksum, sizeof checksum);
-  Reader r(data, size - sizeof checksum);
+  ByteReader r(data, size - sizeof checksum, "guiding field");
   for (char c : kMagic)
     if (r.get<char>("header") != c) throw Error("not a guiding field (bad magic)");
   const uint32_t version = r.get<uint32_t>("header");

@@ -322,16 +322,8 @@ class PathSampler {
     glm::vec2 direction{0.0f};
   };
   SpecularNumbers specular_numbers(int vertex) {
-    SpecularNumbers n;
-    if (type_ == SamplerType::Independent) {
-      n.select = rng_.next_float();
-      n.direction = rng_.next_2d();
-      return n;
-    }
-    const sobol::ScrambledGroup g = group(4096 + vertex);
-    n.direction = g.unit_pair();
-    n.select = g.unit(2);
-    return n;
+    const NumberAndPair n = number_and_pair(4096 + vertex);
+    return {n.number, n.pair};
   }
 
   // Path guiding at vertex `vertex`: the guided-vs-BSDF choice and the guided direction. Drawn only
@@ -342,15 +334,26 @@ class PathSampler {
     glm::vec2 direction{0.0f};
   };
   GuidingNumbers guiding_numbers(int vertex) {
-    GuidingNumbers n;
+    const NumberAndPair n = number_and_pair(kGuidingGroup + vertex);
+    return {n.number, n.pair};
+  }
+
+  // One number and a pair: with the independent sampler two draws (the number first), else the pair
+  // of Sobol group `group_index` and its third dimension.
+  struct NumberAndPair {
+    float number = 0.0f;
+    glm::vec2 pair{0.0f};
+  };
+  NumberAndPair number_and_pair(int group_index) {
+    NumberAndPair n;
     if (type_ == SamplerType::Independent) {
-      n.choice = rng_.next_float();
-      n.direction = rng_.next_2d();
+      n.number = rng_.next_float();
+      n.pair = rng_.next_2d();
       return n;
     }
-    const sobol::ScrambledGroup g = group(kGuidingGroup + vertex);
-    n.direction = g.unit_pair();
-    n.choice = g.unit(2);
+    const sobol::ScrambledGroup g = group(group_index);
+    n.pair = g.unit_pair();
+    n.number = g.unit(2);
     return n;
   }
 
