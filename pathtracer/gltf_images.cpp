@@ -2,6 +2,7 @@
 
 #include <stb_image.h>
 #include <tiny_gltf.h>
+#include <webp/decode.h>
 
 #include <climits>
 #include <cstdint>
@@ -12,9 +13,48 @@
 
 namespace pxf::gltf {
 
+namespace {
+
+// EXT_texture_webp's images: "RIFF", a length, "WEBP".
+bool is_webp(const unsigned char* bytes, size_t size) {
+  return size >= 12 && std::memcmp(bytes, "RIFF", 4) == 0 && std::memcmp(bytes + 8, "WEBP", 4) == 0;
+}
+
+ImageHeader probe_webp(const unsigned char* bytes, size_t size) {
+  ImageHeader header;
+  WebPBitstreamFeatures features;
+  if (WebPGetFeatures(bytes, size, &features) != VP8_STATUS_OK) return header;
+  header.width = features.width;
+  header.height = features.height;
+  header.channels = features.has_alpha ? 4 : 3;
+  header.ok = header.width > 0 && header.height > 0;
+  return header;
+}
+
+// 8-bit RGBA like stb's 8-bit images (a missing alpha becomes 255).
+bool decode_webp(const unsigned char* bytes, size_t size, DecodedImage& out) {
+  const ImageHeader header = probe_webp(bytes, size);
+  int width = 0, height = 0;
+  uint8_t* rgba = header.ok ? WebPDecodeRGBA(bytes, size, &width, &height) : nullptr;
+  if (!rgba) {
+    out.failure = "malformed WebP data";
+    return false;
+  }
+  out.bytes.assign(rgba, rgba + static_cast<size_t>(width) * height * 4);
+  WebPFree(rgba);
+  out.width = width;
+  out.height = height;
+  out.channels = header.channels;
+  out.decoded = true;
+  return true;
+}
+
+}  // namespace
+
 ImageHeader probe_image(const unsigned char* bytes, size_t size) {
   ImageHeader header;
   if (size == 0 || size > static_cast<size_t>(INT_MAX)) return header;
+  if (is_webp(bytes, size)) return probe_webp(bytes, size);
   int len = static_cast<int>(size);
   if (!stbi_info_from_memory(bytes, len, &header.width, &header.height, &header.channels)) {
     // stb refuses PNG headers whose image would exceed 1 GiB; the size is still worth reporting.
@@ -43,6 +83,7 @@ bool decode_image(const unsigned char* bytes, size_t size, DecodedImage& out) {
     out.failure = "empty or oversized image data";
     return false;
   }
+  if (is_webp(bytes, size)) return decode_webp(bytes, size, out);
   int len = static_cast<int>(size);
   int w = 0, h = 0, c = 0;
   size_t n = 0;

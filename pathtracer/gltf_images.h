@@ -46,10 +46,10 @@ class ImageStore {
   std::vector<std::vector<unsigned char>> encoded_;
 };
 
-// Reads the header of PNG/JPEG/HDR/... bytes.
+// Reads the header of PNG/JPEG/HDR/... (stb) or WebP (libwebp) bytes.
 ImageHeader probe_image(const unsigned char* bytes, size_t size);
 
-// Decodes PNG/JPEG/HDR/... bytes with stb; false (and `failure` set) on error.
+// Decodes PNG/JPEG/HDR/... bytes with stb, WebP with libwebp; false (and `failure` set) on error.
 bool decode_image(const unsigned char* bytes, size_t size, DecodedImage& out);
 
 }  // namespace pxf::gltf

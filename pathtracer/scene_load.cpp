@@ -28,8 +28,12 @@
 #include "pathtracer/auto_camera.h"
 #include "pathtracer/default_light.h"
 #include "pathtracer/gltf_accessor.h"
+#include "pathtracer/gltf_draco.h"
 #include "pathtracer/gltf_geometry.h"
 #include "pathtracer/gltf_images.h"
+#include "pathtracer/gltf_instancing.h"
+#include "pathtracer/gltf_meshopt.h"
+#include "pathtracer/gltf_prepass.h"
 #include "pathtracer/pathtracer.h"
 #include "pathtracer/spec_gloss.h"
 #include "pathtracer/texture.h"
@@ -55,7 +59,8 @@ const std::set<std::string>& supported_extensions() {
       "KHR_lights_punctual",      "KHR_texture_transform", "KHR_materials_emissive_strength",
       "KHR_materials_transmission", "KHR_materials_ior",   "KHR_materials_specular",
       "KHR_materials_volume",     "KHR_materials_pbrSpecularGlossiness",
-      "KHR_mesh_quantization"};
+      "KHR_mesh_quantization",    "KHR_draco_mesh_compression", "EXT_meshopt_compression",
+      "EXT_texture_webp",         "EXT_mesh_gpu_instancing"};
   return names;
 }
 
@@ -245,10 +250,12 @@ class GltfLoader {
  private:
   Scene build() {
     check_extensions();
+    gltf::decode_meshopt_views(model_, file_);  // bounded by the file's size; images may be in such views
     load_materials();    // registers the used textures; nothing is decoded yet
     count_instances();   // the triangle cap, before any geometry is read
     probe_textures();    // the texture size cap, from the image headers
     check_memory();      // the estimate against the available memory
+    gltf::decode_draco_primitives(model_, file_);  // to the accessor counts just checked
     decode_textures();
     convert_spec_gloss();  // after decoding: textures are baked from their texels
     traverse_scene();
@@ -310,6 +317,12 @@ class GltfLoader {
     if (size > std::numeric_limits<unsigned int>::max()) fail("file larger than 4 GiB");
     const bool binary = size >= 4 && std::memcmp(data, "glTF", 4) == 0;
     check_json_nesting(data, size, binary);
+    const gltf::PreparedJson prepared = gltf::prepare_json(data, size, binary, file_, supported_extensions());
+    if (prepared.rewritten) {
+      data = prepared.bytes.data();
+      size = prepared.bytes.size();
+      if (size > std::numeric_limits<unsigned int>::max()) fail("file larger than 4 GiB");
+    }
     tinygltf::TinyGLTF loader;
     loader.SetFsCallbacks({&GltfLoader::uri_exists, &GltfLoader::resolve_uri, &GltfLoader::read_uri,
                            &tinygltf::WriteWholeFile, &base_dir_});
@@ -326,6 +339,7 @@ class GltfLoader {
       fail(std::string("invalid glTF: ") + e.what());
     }
     if (!ok) fail(first_line(err.empty() ? warn_text : err));
+    gltf::restore_draco_index_accessors(model_, prepared);
     // tinygltf's image warnings ("File not found", "Failed to load external 'uri' for image[0]") are
     // replaced by our single line per texture, which says which material loses what.
     for (const std::string& line : lines_of(warn_text))
@@ -346,9 +360,8 @@ class GltfLoader {
     check_json_depth(reinterpret_cast<const char*>(data) + begin, length, file_);
   }
 
+  // Required extensions were checked before tinygltf parsed the file (gltf::prepare_json).
   void check_extensions() {
-    for (const std::string& name : model_.extensionsRequired)
-      if (!supported_extensions().count(name)) fail("required extension " + name + " is not supported");
     std::string unsupported;
     for (const std::string& name : model_.extensionsUsed)
       if (!supported_extensions().count(name)) unsupported += (unsupported.empty() ? "" : ", ") + name;
@@ -424,17 +437,32 @@ class GltfLoader {
     const tinygltf::Texture& texture = model_.textures[index];
     int& slot_index = texture_cache_[key];
     slot_index = -1;
-    if (texture.source < 0) {
-      warn("texture " + std::to_string(index) + " has no supported image source; material '" + material +
-           "' renders without its " + slot + " texture");
+    const int source = image_source(texture);
+    if (source < 0) {
+      const bool ktx2_only = find_extension(texture.extensions, "KHR_texture_basisu") != nullptr;
+      warn("texture " + std::to_string(index) +
+           (ktx2_only ? " has only a KTX2 image (KHR_texture_basisu), which pxf cannot decode"
+                      : " has no supported image source") +
+           "; material '" + material + "' renders without its " + slot + " texture");
       return -1;
     }
-    if (texture.source >= static_cast<int>(model_.images.size()))
-      fail("texture " + std::to_string(index) + " references image " + std::to_string(texture.source) + " out of range");
-    scene_.textures.push_back(texture_settings(texture, model_.images[texture.source]));
-    pending_.push_back({texture.source, srgb, material, slot});
+    if (source >= static_cast<int>(model_.images.size()))
+      fail("texture " + std::to_string(index) + " references image " + std::to_string(source) + " out of range");
+    scene_.textures.push_back(texture_settings(texture, model_.images[source]));
+    pending_.push_back({source, srgb, material, slot});
     slot_index = static_cast<int>(scene_.textures.size()) - 1;
     return slot_index;
+  }
+
+  // EXT_texture_webp's image when the texture has one (also when it has a PNG/JPEG source beside
+  // it); else the texture's own source. KHR_texture_basisu's KTX2 image cannot be decoded, so such a
+  // texture falls back to its source, the PNG/JPEG the extension asks exporters to keep.
+  static int image_source(const tinygltf::Texture& texture) {
+    if (const tinygltf::Value* webp = find_extension(texture.extensions, "EXT_texture_webp")) {
+      const int source = int_or(webp->Get("source"), -1);
+      if (source >= 0) return source;
+    }
+    return texture.source;
   }
 
   static Wrap wrap_mode(int gl_wrap) {
@@ -756,6 +784,7 @@ class GltfLoader {
   }
 
   static uint64_t saturating_add(uint64_t a, uint64_t b) { return a > UINT64_MAX - b ? UINT64_MAX : a + b; }
+  static uint64_t saturating_multiply(uint64_t a, uint64_t b) { return b != 0 && a > UINT64_MAX / b ? UINT64_MAX : a * b; }
 
   // The instanced totals of the scene, each node's subtree counted once (a node referenced from
   // many parents is not walked again, so a hierarchy that instances exponentially is cheap to
@@ -763,6 +792,13 @@ class GltfLoader {
   void count_instances() {
     struct Counts {
       uint64_t vertices = 0, triangles = 0, nodes = 0, primitives = 0, lights = 0;
+      Counts times(uint64_t n) const {
+        Counts c;
+        c.vertices = saturating_multiply(vertices, n);
+        c.triangles = saturating_multiply(triangles, n);
+        c.primitives = saturating_multiply(primitives, n);
+        return c;
+      }
       void add(const Counts& o) {
         vertices = saturating_add(vertices, o.vertices);
         triangles = saturating_add(triangles, o.triangles);
@@ -807,8 +843,10 @@ class GltfLoader {
         }
         const tinygltf::Node& node = model_.nodes[index];
         Counts c;
-        if (node.mesh >= 0 && node.mesh < static_cast<int>(mesh_counts.size())) c = mesh_counts[node.mesh];
-        c.nodes = 1;
+        // EXT_mesh_gpu_instancing: the mesh once per instance, each instance a visit like a node's.
+        const uint64_t instances = gltf::instance_count(model_, node);
+        if (node.mesh >= 0 && node.mesh < static_cast<int>(mesh_counts.size())) c = mesh_counts[node.mesh].times(instances);
+        c.nodes = saturating_add(1, instances > 1 ? instances : 0);
         c.lights = find_extension(node.extensions, "KHR_lights_punctual") ? 1 : 0;
         for (int child : children)
           if (child >= 0 && child < static_cast<int>(node_count) && state[child] == 2) c.add(subtree[child]);
@@ -882,7 +920,7 @@ class GltfLoader {
       on_path[index] = true;
       const tinygltf::Node& node = model_.nodes[index];
       glm::mat4 world = parent_world * node_local_transform(node);
-      if (node.mesh >= 0) add_mesh(node.mesh, world);
+      if (node.mesh >= 0) add_mesh_instances(index, world);
       else if (node.mesh < -1) fail("node " + std::to_string(index) + " mesh index out of range");
       if (node.camera >= 0) add_camera(node.camera, world);
       if (const tinygltf::Value* ext = find_extension(node.extensions, "KHR_lights_punctual"))
@@ -984,6 +1022,14 @@ class GltfLoader {
   }
 
   // -- meshes -----------------------------------------------------------------------------------
+
+  // The node's mesh, once per EXT_mesh_gpu_instancing instance (its transform after the node's).
+  void add_mesh_instances(int node_index, const glm::mat4& world) {
+    const tinygltf::Node& node = model_.nodes[node_index];
+    const auto instances = gltf::instance_transforms(model_, node, file_, "node " + std::to_string(node_index));
+    if (!instances) return add_mesh(node.mesh, world);
+    for (const glm::mat4& instance : *instances) add_mesh(node.mesh, world * instance);
+  }
 
   void add_mesh(int index, const glm::mat4& world) {
     if (index >= static_cast<int>(model_.meshes.size())) fail("mesh " + std::to_string(index) + " out of range");

@@ -13,6 +13,9 @@ PACKAGES=(
   libglfw3-dev libimgui-dev            # explorer window and UI
   libglm-dev libtinygltf-dev nlohmann-json3-dev libstb-dev
   libopenexr-dev libembree-dev libtbb-dev
+  libdraco-dev                         # KHR_draco_mesh_compression: Debian's tinygltf is built without Draco
+  libwebp-dev                          # EXT_texture_webp images (stb reads no WebP)
+  libmeshoptimizer-dev                 # EXT_meshopt_compression (gltfpack's output): its decoders and filters
   libgtest-dev
   xvfb xauth                           # explorer test under a virtual display
   slurm-wlm munge                      # Slurm.* test: a single-node Slurm on localhost
