@@ -5,6 +5,9 @@
   exr_reader/   scanline EXRs, uncompressed, RLE, ZIPS and ZIP, float/half/uint, odd data windows;
   hdr_reader/   Radiance HDR, flat and run-length encoded scanlines;
   png_reader/   PNG in every colour type and bit depth stb reads, plus a few other formats.
+The gltf_scene seeds named compressed_* (Draco, meshopt, WebP, KTX2 and GPU instancing, valid and
+malformed) need the libraries' encoders, so a C++ program writes them:
+  cmake --build build --target make_compressed_gltf && build/fuzz/make_compressed_gltf seeds fuzz/corpus/gltf_scene
 The state_reader seeds: the named ones are written by fuzz/make_state_seeds.sh with `pxf render`
 and `pxf merge` (rerun it after a state format version bump); the ones named by their SHA-1 are
 inputs the campaigns kept, as libFuzzer names them. Rendered EXR/PNG outputs come from `pxf render`.

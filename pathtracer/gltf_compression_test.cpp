@@ -205,6 +205,8 @@ TEST(GltfBasisu, RequiredIsRefusedByNameUsedFallsBackToThePng) {
   glb.doc["extensionsUsed"] = {"KHR_texture_basisu"};
   const Scene used = load(glb.bytes());
   EXPECT_EQ(base_color_texels(used), rgba);
+  EXPECT_TRUE(has_warning(used, "KTX2 images cannot be decoded; its textures use their PNG/JPEG source"));
+  EXPECT_FALSE(has_warning(used, "ignoring unsupported extensions"));
 
   glb.doc["extensionsRequired"] = {"KHR_texture_basisu"};
   const std::string message = error_of(glb.bytes());

@@ -363,8 +363,12 @@ class GltfLoader {
   // Required extensions were checked before tinygltf parsed the file (gltf::prepare_json).
   void check_extensions() {
     std::string unsupported;
-    for (const std::string& name : model_.extensionsUsed)
-      if (!supported_extensions().count(name)) unsupported += (unsupported.empty() ? "" : ", ") + name;
+    for (const std::string& name : model_.extensionsUsed) {
+      if (name == "KHR_texture_basisu")
+        warn("KHR_texture_basisu's KTX2 images cannot be decoded; its textures use their PNG/JPEG source where they have one");
+      else if (!supported_extensions().count(name))
+        unsupported += (unsupported.empty() ? "" : ", ") + name;
+    }
     if (!unsupported.empty()) warn("ignoring unsupported extensions " + unsupported + " (rendered without them)");
   }
 
