@@ -472,27 +472,30 @@ void GuidingField::split_leaves(double threshold) {
   leaves_.shrink_to_fit();
 }
 
-glm::vec3 GuidingField::sample(const glm::vec3& position, glm::vec2 u, float* pdf_out) const {
-  const GuidingLeaf& leaf = leaves_[find_leaf(position)];
+GuidingField::Distribution GuidingField::distribution(const glm::vec3& position) const {
+  return Distribution(leaves_[find_leaf(position)].sampling, settings_.uniform_fraction);
+}
+
+glm::vec3 GuidingField::Distribution::sample(glm::vec2 u, float* pdf_out) const {
   glm::dvec2 w(unit_interval(u.x), unit_interval(u.y));
-  const double uniform = settings_.uniform_fraction;
+  const double uniform = uniform_fraction_;
   glm::vec3 direction;
   if (w.x < uniform) {
     direction = direction_of(glm::dvec2(unit_interval(w.x / uniform), w.y));
   } else {
     w.x = unit_interval((w.x - uniform) / (1.0 - uniform));
     Square square;
-    const glm::dvec2 uv = sample_tree(leaf.sampling, w, &square);
+    const glm::dvec2 uv = sample_tree(*tree_, w, &square);
     direction = direction_in(uv, square);
   }
   // pdf() of the direction, not a density carried down the descent: the two could differ in the
   // last bits, and MIS weights of the same direction must agree whichever technique drew it.
-  if (pdf_out) *pdf_out = direction_pdf(leaf.sampling, uniform, direction);
+  if (pdf_out) *pdf_out = pdf(direction);
   return direction;
 }
 
-float GuidingField::pdf(const glm::vec3& position, const glm::vec3& direction) const {
-  return direction_pdf(leaves_[find_leaf(position)].sampling, settings_.uniform_fraction, direction);
+float GuidingField::Distribution::pdf(const glm::vec3& direction) const {
+  return direction_pdf(*tree_, uniform_fraction_, direction);
 }
 
 size_t GuidingField::memory_bytes() const {

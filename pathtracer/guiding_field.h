@@ -131,12 +131,28 @@ class GuidingField {
 
   // --- Sampling (thread-safe, read-only).
 
-  // A unit direction for the point and its solid-angle density, which is pdf(position, direction)
-  // exactly (> 0). u in [0,1)^2 (values outside are clamped).
-  glm::vec3 sample(const glm::vec3& position, glm::vec2 u, float* pdf) const;
-  // The solid-angle density of sample() at the point for a direction of any length (0 for a zero
-  // or non-finite one). Uniform (1 / 4 pi) where the leaf learned no energy.
-  float pdf(const glm::vec3& position, const glm::vec3& direction) const;
+  // The directional distribution of the spatial leaf that holds a point: what sample() and pdf()
+  // below use, found once for the several calls of a path vertex.
+  class Distribution {
+   public:
+    Distribution() = default;  // none: call neither function
+    // A unit direction and its solid-angle density, which is pdf(direction) exactly (> 0).
+    // u in [0,1)^2 (values outside are clamped).
+    glm::vec3 sample(glm::vec2 u, float* pdf) const;
+    // The solid-angle density of sample() for a direction of any length (0 for a zero or
+    // non-finite one). Uniform (1 / 4 pi) where the leaf learned no energy.
+    float pdf(const glm::vec3& direction) const;
+
+   private:
+    friend class GuidingField;
+    Distribution(const std::vector<GuidingSamplingNode>& tree, float uniform_fraction)
+        : tree_(&tree), uniform_fraction_(uniform_fraction) {}
+    const std::vector<GuidingSamplingNode>* tree_ = nullptr;
+    float uniform_fraction_ = 0.0f;
+  };
+  Distribution distribution(const glm::vec3& position) const;
+  glm::vec3 sample(const glm::vec3& position, glm::vec2 u, float* pdf) const { return distribution(position).sample(u, pdf); }
+  float pdf(const glm::vec3& position, const glm::vec3& direction) const { return distribution(position).pdf(direction); }
 
   // --- Inspection.
   static constexpr uint64_t kMinBytes = 128;  // one leaf with one node per tree

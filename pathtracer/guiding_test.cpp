@@ -111,6 +111,51 @@ Blocks blocks_of(const Accumulation& acc, int block) {
   return b;
 }
 
+// The guiding learns what it is for. In the cornell box the heaviest-tailed light is the ceiling
+// light's reflection in the mirror sphere, reaching the walls as a caustic (D S L) that BSDF
+// sampling finds about once in a thousand directions, each find a firefly. After training, guided
+// paths must find it at least 1.6x as often, with smaller weights (measured: 2.1x at 128x128 after
+// 31 frames, the second moment of those samples 0.66x). Without the photons (camera paths do not
+// find the caustic often enough to learn it), or with Russian roulette on the guided throughput
+// (it killed the guided paths and gave the survivors their weight back), they found it about as
+// often as unguided ones (0.9-1.1x).
+TEST(Guiding, TrainedFieldFindsTheMirrorCaustic) {
+  const Scene scene = make_cornell_box(true);
+  const int size = 128, train = 31, measure = 16;
+  TraceParams params = guided_params();
+  ProgressiveRenderer trainer(scene, params, size, size);
+  for (int i = 0; i < train; ++i) trainer.add_frame();
+  const std::vector<uint8_t> bytes = trainer.guiding_field();
+  GuidingField field = GuidingField::deserialize(bytes.data(), bytes.size());
+  ASSERT_TRUE(field.trained());
+  auto caustic_samples = [&](bool guided) {
+    PathTracer tracer(scene);
+    if (guided) tracer.set_guiding(&field);
+    TraceParams p = params;
+    p.guiding = guided;
+    p.seed = 5;
+    const PixelRect rect{0, 0, size, size};
+    std::vector<PathSample> out(static_cast<size_t>(rect.count()));
+    std::vector<HvSampleClass> classes(out.size());
+    int found = 0;
+    double moment = 0.0;
+    for (int frame = 0; frame < measure; ++frame) {
+      tracer.trace_pixels_classified(scene.camera, size, size, rect, 1000 + frame, p, out.data(), classes.data());
+      for (size_t i = 0; i < out.size(); ++i)
+        if (classes[i].dominant == HvClass::CausticMirror) {
+          ++found;
+          moment += double(classes[i].dominant_luminance) * classes[i].dominant_luminance;
+        }
+    }
+    std::printf("%s: %d samples found the mirror caustic, their second moment %.5f per sample\n",
+                guided ? "guided" : "unguided", found, moment / (double(out.size()) * measure));
+    return found;
+  };
+  const int unguided = caustic_samples(false), guided = caustic_samples(true);
+  EXPECT_GT(unguided, 50);
+  EXPECT_GT(guided, 1.6 * unguided);
+}
+
 // Unbiased: the guided cornell box (mirror and glass spheres: caustics, near specular chains) agrees
 // with an unguided render of another seed, block by block and over the whole image.
 TEST(Guiding, GuidedImageAgreesWithUnguidedReference) {

@@ -9,6 +9,8 @@
 #include "pathtracer/guiding_field.h"
 #include "pathtracer/sampler.h"
 
+#include <tbb/parallel_for.h>
+
 namespace pxf {
 namespace {
 
@@ -16,8 +18,8 @@ constexpr int kMaxSpecularChainBounces = 8;
 // Paths traced together; a 16 x 16 tile of the progressive renderer is one batch. The batch state
 // lives on the stack (about 45 KB).
 constexpr int kBatchPaths = 256;
-// Path guiding: the non-delta vertices of a path that record what they received (deeper ones do not).
-constexpr int kMaxGuidingVertices = 16;
+// Path guiding: the surfaces of a training photon's path that can record (the key's room per photon).
+constexpr int kMaxPhotonSurfaces = 16;
 
 struct PathState {
   glm::vec3 throughput{1.0f};
@@ -29,7 +31,18 @@ struct PathState {
   // Specular sampling: the MIS weight of light found after the last non-delta sample through a
   // chain of perfectly specular surfaces (D S+ L), against the specular strategy; 1 without it.
   float chain_mis = 1.0f;
+  // Russian roulette's view of the throughput: what it would be had every guided vertex sampled
+  // its BSDF alone (the product of p_mixture / p_bsdf over them; 1 without guiding). A guided
+  // direction toward bright light has a small weight f / p_mixture; rouletting on that weight
+  // would kill most such paths and give the survivors back the weight guiding took away.
+  float roulette_scale = 1.0f;
 };
+
+// The factor from a guided vertex's weight f / p_mixture to BSDF sampling's f / p_bsdf, for
+// PathState::roulette_scale; bounded so that the scale stays finite (any factor keeps roulette unbiased).
+float unguided_weight_ratio(float mixture_pdf, float bsdf_pdf) {
+  return bsdf_pdf > 0.0f ? std::min(mixture_pdf / bsdf_pdf, 1e6f) : 1e6f;
+}
 
 // Emission leaves a surface toward the ray only on its front face, unless it is double-sided.
 bool emission_visible(const Material& material, const SurfacePoint& sp) {
@@ -101,26 +114,16 @@ struct PathTracer::ClassState {
   }
 };
 
-// The BSDF-side strategy of a vertex: BSDF sampling alone (field null), or with path guiding the
+// The BSDF-side strategy of a vertex: BSDF sampling alone (not guided), or with path guiding the
 // one-sample mixture that picks the guided direction with probability alpha.
 struct PathTracer::GuidingMixture {
-  const GuidingField* field = nullptr;
-  glm::vec3 position{0.0f};
+  bool guided = false;
+  GuidingField::Distribution guide;  // the field's at the vertex, when guided
   float alpha = 0.0f;
   // The solid-angle pdf of direction wi under the strategy, given the BSDF's own pdf of it.
   float pdf(float bsdf_pdf, glm::vec3 wi) const {
-    return field ? alpha * field->pdf(position, wi) + (1.0f - alpha) * bsdf_pdf : bsdf_pdf;
+    return guided ? alpha * guide.pdf(wi) + (1.0f - alpha) * bsdf_pdf : bsdf_pdf;
   }
-};
-
-// Path guiding's learning: a non-delta vertex the path left by a sampled direction. When the path
-// is done, the light it gathered after the vertex divided by its throughput there is the radiance
-// that arrived along `direction` (PathTracer::trace_batch records it into the field).
-struct PathTracer::GuidingVertex {
-  glm::vec3 position{0.0f}, direction{0.0f};
-  glm::vec3 throughput{0.0f};  // after the vertex's sample (and Russian roulette)
-  glm::vec3 before{0.0f};      // the path's lv + hv once the vertex's own light was in
-  float pdf = 0.0f;            // of the sampled direction (the mixture's where guided)
 };
 
 // One path of a batch: its random stream, the ray it traces next, and what it has gathered.
@@ -129,11 +132,6 @@ struct PathTracer::Path {
   Ray ray;
   PathState state;
   PathSample* out = nullptr;
-  // Path guiding's learning (null without it): up to kMaxGuidingVertices vertices; `open`: the last
-  // one's `before` is still to be taken (at the next vertex, when its NEE has been resolved).
-  GuidingVertex* guiding = nullptr;
-  int guiding_count = 0;
-  bool guiding_open = false;
 };
 
 // The next event estimation contributions of one vertex step of a batch, each waiting on its
@@ -405,13 +403,6 @@ void PathTracer::trace_batch(const Camera& camera, int width, int height, const 
     path.state = PathState{};
     path.out = &out[i];
   }
-  // Path guiding's learning: each path's vertices, on the heap (16 KB a path would not fit the stack).
-  const bool learn = guiding_ && params.guiding;
-  thread_local std::vector<GuidingVertex> guiding_vertices;
-  if (learn) {
-    guiding_vertices.resize(static_cast<size_t>(kBatchPaths) * kMaxGuidingVertices);
-    for (int i = 0; i < count; ++i) paths[i].guiding = &guiding_vertices[static_cast<size_t>(i) * kMaxGuidingVertices];
-  }
   // live[k] is the k-th path still being traced; rays[k] and hits[k] are its ray and hit.
   int live[kBatchPaths];
   int live_count = count;
@@ -438,31 +429,49 @@ void PathTracer::trace_batch(const Camera& camera, int width, int height, const 
     live_count = still_live;
     shadows.resolve<kClassify>(geometry_, params.all_hv);
   }
-  if (learn) record_guiding(paths, jobs, count, width, height);
 }
 
-// Records each finished path's guiding vertices: the luminance of the light it gathered after the
-// vertex over its throughput there, with weight 1 / pdf. Keyed by (sample index, pixel, vertex),
-// so the field's order does not depend on batches or threads.
-void PathTracer::record_guiding(const Path* paths, const PixelSampleJob* jobs, int count, int width, int height) const {
-  const uint64_t pixels = static_cast<uint64_t>(width) * static_cast<uint64_t>(height);
-  for (int i = 0; i < count; ++i) {
-    const Path& path = paths[i];
-    if (path.guiding_count == 0 || !path.out->finite()) continue;
-    const glm::vec3 total = path.out->lv + path.out->hv;
-    const uint64_t pixel = static_cast<uint64_t>(jobs[i].y) * static_cast<uint64_t>(width) + static_cast<uint64_t>(jobs[i].x);
-    const uint64_t key = (static_cast<uint64_t>(jobs[i].index) * pixels + pixel) * kMaxGuidingVertices;
-    for (int r = 0; r < path.guiding_count; ++r) {
-      const GuidingVertex& g = path.guiding[r];
-      const glm::vec3 before = (r == path.guiding_count - 1 && path.guiding_open) ? total : g.before;
-      const glm::vec3 after = glm::max(total - before, glm::vec3(0.0f));
-      glm::vec3 radiance(0.0f);
-      for (int c = 0; c < 3; ++c)
-        if (g.throughput[c] > 0.0f) radiance[c] = after[c] / g.throughput[c];
-      const float y = luminance(radiance);
-      if (!(y >= 0.0f) || !std::isfinite(y) || !(g.pdf > 0.0f)) continue;
-      guiding_->record(key + static_cast<uint64_t>(r), g.position, g.direction, y, 1.0f / g.pdf);
-    }
+void PathTracer::trace_guiding_photons(uint32_t frame, int count, const TraceParams& params) const {
+  if (!guiding_ || count <= 0 || lights_.empty()) return;
+  tbb::parallel_for(tbb::blocked_range<int>(0, count, 64), [&](const tbb::blocked_range<int>& range) {
+    for (int i = range.begin(); i != range.end(); ++i)
+      trace_guiding_photon(frame, static_cast<uint32_t>(i), params);
+  });
+}
+
+// One photon: the flux it carries is recorded (key: frame, photon, bounce) at its non-delta
+// surfaces from the second on, then it scatters by BSDF sampling (the BSDF is treated as
+// symmetric: the shading-normal correction of adjoint transport only changes the guide's
+// weights, never an image's expectation) with Russian roulette on its share of the emitted flux.
+void PathTracer::trace_guiding_photon(uint32_t frame, uint32_t index, const TraceParams& params) const {
+  constexpr uint64_t kPhotonStream = 0x70686f746f6e73ULL;  // apart from every camera path's stream
+  Rng rng(params.seed ^ kPhotonStream, index, frame);
+  EmittedPhoton photon;
+  const glm::vec2 u_select = rng.next_2d(), u_position = rng.next_2d(), u_direction = rng.next_2d();
+  if (!lights_.sample_emission(u_select, u_position, u_direction, &photon)) return;
+  const float emitted = max_component(photon.flux);
+  Ray ray{photon.origin, photon.direction};
+  glm::vec3 flux = photon.flux;
+  const uint64_t key = (static_cast<uint64_t>(frame) << 36) | (static_cast<uint64_t>(index) << 4);  // + surface < 16
+  const int max_surfaces = std::min(params.max_vertices - 1, kMaxPhotonSurfaces);
+  for (int surface = 0; surface < max_surfaces; ++surface) {
+    const Hit hit = geometry_.intersect(ray);
+    if (!hit.valid()) return;
+    const SurfacePoint sp = geometry_.surface_point(hit, ray);
+    if (!sp.front_face && sp.material->has_volume()) flux *= volume_transmittance(*sp.material, hit.t);
+    BsdfMaterial scratch;
+    const Bsdf bsdf(bsdf_material_at(sp, &scratch), sp.shading_normal, sp.geometric_normal, -ray.direction, sp.front_face);
+    if (bsdf.is_black()) return;
+    if (surface > 0 && bsdf.has_nondelta())
+      guiding_->record(key + static_cast<uint64_t>(surface), sp.position, -ray.direction, luminance(flux), 1.0f);
+    BsdfSample bs;
+    const float u_lobe = rng.next_float();
+    if (!bsdf.sample(u_lobe, rng.next_2d(), &bs)) return;
+    flux *= bs.weight;
+    const float survive = std::min(1.0f, max_component(flux) / emitted);
+    if (!(rng.next_float() < survive)) return;
+    flux /= survive;
+    ray = Ray{offset_ray_origin(sp.position, sp.geometric_normal, bs.wi), bs.wi};
   }
 }
 
@@ -476,10 +485,6 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
   PathSample& out = *path.out;
   PathSampler& sampler = path.sampler;
   ++out.rays;
-  if (path.guiding_open) {  // the last guiding vertex's own light (its NEE included) is in now
-    path.guiding[path.guiding_count - 1].before = out.lv + out.hv;
-    path.guiding_open = false;
-  }
   if (!hit.valid()) {  // the environment is the light vertex
     if (lights_.has_environment()) {
       float w = s.prev_delta ? s.chain_mis : power_heuristic(s.prev_pdf, lights_.pdf_environment(path.ray.direction));
@@ -522,13 +527,15 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
   }
   if (last_vertex || bsdf.is_black()) return false;
 
-  // Path guiding: once the field is trained, the BSDF-side strategy of a non-delta vertex is the
-  // mixture that takes the guided direction with probability alpha (times the share of the
-  // BSDF's non-delta lobes: its delta lobes keep their samples).
+  // Path guiding: once the field is trained, the BSDF-side strategy of the path's first non-delta
+  // vertex is the mixture that takes the guided direction with probability alpha (times the share
+  // of the BSDF's non-delta lobes: its delta lobes keep their samples). Deeper vertices sample the
+  // BSDF alone: most of the heavy-tailed light arrives at the first, and a guided vertex pays
+  // field lookups for its sample and every MIS weight (measured in docs/guiding.md).
   GuidingMixture mixture;
-  if (guiding_ && params.guiding && bsdf.has_nondelta() && guiding_->trained()) {
-    mixture.field = guiding_;
-    mixture.position = sp.position;
+  if (guiding_ && params.guiding && s.nonspecular == 0 && bsdf.has_nondelta() && guiding_->trained()) {
+    mixture.guided = true;
+    mixture.guide = guiding_->distribution(sp.position);
     mixture.alpha = kGuidingAlpha * bsdf.nondelta_probability();
   }
 
@@ -586,7 +593,7 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
   const bool roulette = vertex >= params.rr_start_vertex;
   const PathSampler::BsdfNumbers u = numbers ? numbers->bsdf : sampler.bsdf_numbers(vertex, bsdf.has_lobe_choice(), roulette);
   BsdfSample bs;
-  if (!mixture.field) {
+  if (!mixture.guided) {
     if (!bsdf.sample(u.lobe, u.direction, &bs)) return false;
   } else {
     // One-sample MIS: either strategy's direction is weighted by f cos / the mixture's pdf.
@@ -594,19 +601,22 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
     const float alpha = mixture.alpha;
     if (g.choice < alpha) {
       float guide_pdf, bsdf_pdf;
-      bs.wi = guiding_->sample(sp.position, g.direction, &guide_pdf);
+      bs.wi = mixture.guide.sample(g.direction, &guide_pdf);
       const glm::vec3 f = bsdf.eval(bs.wi, &bsdf_pdf);
       if (!(max_component(f) > 0.0f)) return false;
       bs.pdf = alpha * guide_pdf + (1.0f - alpha) * bsdf_pdf;
       bs.weight = f / bs.pdf;
+      s.roulette_scale *= unguided_weight_ratio(bs.pdf, bsdf_pdf);
       bs.delta = bs.transmitted = false;
     } else {
       if (!bsdf.sample(u.lobe, u.direction, &bs)) return false;
       if (bs.delta) {
         bs.weight /= 1.0f - alpha;  // a delta lobe's share of the mixture
+        s.roulette_scale *= 1.0f - alpha;
       } else {
         const float pdf = mixture.pdf(bs.pdf, bs.wi);
         bs.weight *= bs.pdf / pdf;
+        s.roulette_scale *= unguided_weight_ratio(pdf, bs.pdf);
         bs.pdf = pdf;
       }
     }
@@ -634,21 +644,13 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
   s.prev_delta = bs.delta;
   s.prev_pdf = bs.pdf;
   if (roulette) {
-    float q = std::min(1.0f, max_component(s.throughput));
+    float q = std::min(1.0f, max_component(s.throughput) * s.roulette_scale);
     if (!(u.roulette < q)) return false;
     s.throughput /= q;
   }
   s.prev_position = sp.position;
   path.ray.origin = offset_ray_origin(sp.position, sp.geometric_normal, bs.wi);
   path.ray.direction = bs.wi;
-  if (path.guiding && !bs.delta && path.guiding_count < kMaxGuidingVertices) {
-    GuidingVertex& g = path.guiding[path.guiding_count++];
-    g.position = sp.position;
-    g.direction = bs.wi;
-    g.throughput = s.throughput;
-    g.pdf = bs.pdf;
-    path.guiding_open = true;
-  }
   return true;
 }
 

@@ -95,10 +95,17 @@ class PathTracer {
   bool first_hit_is_emissive(const Ray& camera_ray) const;
 
   // Path guiding (TraceParams::guiding, docs/guiding.md): traces with params.guiding sample from
-  // `field` once it is trained() and record into it at every non-delta vertex; nullptr (the
+  // `field` once it is trained(), and trace_guiding_photons records into it; nullptr (the
   // default) traces without guiding whatever params.guiding says. The field must not change
-  // (apply_records, end_iteration) while a trace runs; recording is thread-safe.
+  // (apply_records, end_iteration) while a trace runs.
   void set_guiding(GuidingField* field) { guiding_ = field; }
+
+  // Path guiding's training light (docs/guiding.md): `count` photons of frame `frame`, traced from
+  // the lights; at every non-delta surface a photon reaches after its first bounce (light NEE does
+  // not find), the field records the flux that arrived and the direction it came from. A photon's
+  // numbers depend on (params.seed, frame, its index) only and the field orders its records, so
+  // the field does not depend on the thread count. Call it between frames, with a field set.
+  void trace_guiding_photons(uint32_t frame, int count, const TraceParams& params) const;
 
   bool dark() const { return lights_.empty(); }
   bool has_perfect_specular() const { return has_perfect_specular_; }
@@ -110,11 +117,10 @@ class PathTracer {
   struct ShadowQueue;
   struct ClassState;
   struct GuidingMixture;
-  struct GuidingVertex;
   template <bool kClassify>
   void trace_batch(const Camera& camera, int width, int height, const PixelSampleJob* jobs, int count,
                    const TraceParams& params, PathSample* out, HvSampleClass* classes) const;
-  void record_guiding(const Path* paths, const PixelSampleJob* jobs, int count, int width, int height) const;
+  void trace_guiding_photon(uint32_t frame, uint32_t index, const TraceParams& params) const;
   template <bool kClassify>
   bool shade_vertex(Path& path, const Hit& hit, int vertex, const TraceParams& params, ShadowQueue& shadows,
                     const PathSampler::VertexNumbers* numbers, ClassState* cls) const;

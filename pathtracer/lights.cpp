@@ -33,14 +33,19 @@ float spot_attenuation(const PunctualLight& light, glm::vec3 to_point) {
 
 // The radius of a sphere around the scene's geometry (1 without geometry): environment and
 // directional lights deliver their power through its cross-section.
-float scene_bounding_radius(const Scene& scene) {
+// A sphere around the scene's geometry (radius 1 without geometry): environment and directional
+// lights deliver their power through its cross-section.
+void scene_bounding_sphere(const Scene& scene, glm::vec3* center, float* radius) {
   glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
   for (const Mesh& mesh : scene.meshes)
     for (const glm::vec3& p : mesh.positions)
       if (is_finite(p)) lo = glm::min(lo, p), hi = glm::max(hi, p);
-  if (!(hi.x >= lo.x)) return 1.0f;
+  *center = glm::vec3(0.0f);
+  *radius = 1.0f;
+  if (!(hi.x >= lo.x)) return;
+  *center = 0.5f * (lo + hi);
   const float r = 0.5f * glm::length(hi - lo);
-  return r > 0.0f ? r : 1.0f;
+  if (r > 0.0f && std::isfinite(r)) *radius = r;
 }
 
 }  // namespace
@@ -199,8 +204,16 @@ LightSampler::LightSampler(const Scene& scene) : scene_(scene) {
 
   bool has_tri = triangle_dist_.valid(), has_env = env_ != nullptr, has_punctual = !punctual_.empty();
   category_count_ = int(has_tri) + int(has_env) + int(has_punctual);
+  scene_bounding_sphere(scene, &scene_center_, &scene_radius_);
+  const float scene_radius = scene_radius_;
+  std::vector<float> emission_powers{has_tri ? static_cast<float>(triangle_power(triangle_dist_.total())) : 0.0f,
+                                     has_env ? static_cast<float>(environment_power(*env_, scene_radius)) : 0.0f};
+  for (const auto* lights : {&punctual_, &suns_})
+    for (const PunctualLight* light : *lights) emission_powers.push_back(static_cast<float>(punctual_power(*light, scene_radius)));
+  for (float& power : emission_powers)
+    if (!std::isfinite(power)) power = 0.0f;
+  emission_dist_ = Distribution1D(emission_powers);
   if (category_count_ == 0) return;
-  const float scene_radius = scene_bounding_radius(scene);
   power_triangles_ = has_tri ? triangle_power(triangle_dist_.total()) : 0.0;
   power_environment_ = has_env ? environment_power(*env_, scene_radius) : 0.0;
   power_punctual_ = 0.0;
@@ -588,6 +601,77 @@ bool LightSampler::sample_punctual(glm::vec3 position, float u_select, LightSamp
   if (light.type == PunctualLight::Type::Spot) falloff *= spot_attenuation(light, -out->wi);
   out->radiance = power * falloff;
   return falloff > 0.0f;
+}
+
+bool LightSampler::sample_emission(glm::vec2 u_select, glm::vec2 u_position, glm::vec2 u_direction,
+                                   EmittedPhoton* out) const {
+  if (!emission_dist_.valid()) return false;
+  float pmf = 0.0f;
+  const size_t choice = emission_dist_.sample(u_select.x, nullptr, &pmf);
+  if (!(pmf > 0.0f)) return false;
+  if (choice == 0) {
+    if (!emit_from_triangle(u_select, u_position, u_direction, out)) return false;
+  } else if (choice == 1) {
+    float pdf = 0.0f;
+    const glm::vec3 toward_light = sample_environment_direction(u_direction, &pdf);
+    if (!(pdf > 0.0f)) return false;
+    *out = emit_from_infinity(toward_light, environment_radiance(toward_light), pdf, u_position);
+  } else {
+    const size_t index = choice - 2;
+    const bool sun = index >= punctual_.size();
+    const PunctualLight& light = sun ? *suns_[index - punctual_.size()] : *punctual_[index];
+    const glm::vec3 power = light.color * light.intensity;
+    if (light.type == PunctualLight::Type::Directional) {
+      *out = emit_from_infinity(-glm::normalize(light.direction), power, 1.0f, u_position);
+    } else {  // point and spot: uniform directions, the spot's cone weighting the flux
+      out->origin = light.position;
+      out->direction = sample_uniform_sphere(u_direction);
+      float scale = 4.0f * kPi;
+      if (light.type == PunctualLight::Type::Spot) scale *= spot_attenuation(light, out->direction);
+      out->flux = power * scale;
+    }
+  }
+  out->flux /= pmf;
+  return max_component(out->flux) > 0.0f && is_finite(out->flux) && is_finite(out->origin);
+}
+
+// A uniform point on a triangle picked by power and a cosine-distributed direction on an
+// emitting side: flux = L pi area sides / the triangle's probability.
+bool LightSampler::emit_from_triangle(glm::vec2 u_select, glm::vec2 u_position, glm::vec2 u_direction,
+                                      EmittedPhoton* out) const {
+  float pmf = 0.0f;
+  const size_t index = triangle_dist_.sample(u_select.y, nullptr, &pmf);
+  const EmissiveTriangle& e = triangles_[index];
+  if (!(pmf > 0.0f)) return false;
+  const glm::vec2 b = sample_triangle_barycentrics(u_position);
+  out->origin = e.p0 + b.x * e.e1 + b.y * e.e2;
+  glm::vec3 normal = e.normal;
+  float sides = 1.0f;
+  if (e.material->double_sided) {  // either side, by the direction's first number
+    sides = 2.0f;
+    if (u_direction.x < 0.5f) {
+      normal = -normal;
+      u_direction.x *= 2.0f;
+    } else {
+      u_direction.x = 2.0f * u_direction.x - 1.0f;
+    }
+    u_direction.x = std::min(u_direction.x, 0x1.fffffep-1f);
+  }
+  out->direction = Frame::from_normal(normal).to_world(sample_cosine_hemisphere(u_direction));
+  out->origin += normal * (1e-4f * std::max(1.0f, max_component(glm::abs(out->origin))));
+  out->flux = e.material->emissive * (kPi * e.area * sides / pmf);
+  return true;
+}
+
+EmittedPhoton LightSampler::emit_from_infinity(glm::vec3 toward_light, glm::vec3 radiance, float pdf,
+                                               glm::vec2 u_position) const {
+  const Frame frame = Frame::from_normal(toward_light);
+  const glm::vec2 disc = sample_concentric_disk(u_position) * scene_radius_;
+  EmittedPhoton photon;
+  photon.origin = scene_center_ + scene_radius_ * toward_light + frame.t * disc.x + frame.b * disc.y;
+  photon.direction = -toward_light;
+  photon.flux = radiance * (kPi * scene_radius_ * scene_radius_ / pdf);
+  return photon;
 }
 
 }  // namespace pxf

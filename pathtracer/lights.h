@@ -27,6 +27,12 @@ struct LightSample {
 glm::vec2 equirect_uv(glm::vec3 direction);
 glm::vec3 equirect_direction(glm::vec2 uv);
 
+// A light path's start (path guiding's training light, docs/guiding.md): it leaves `origin` along
+// `direction` carrying `flux` (the power it stands for: the lights' total over the number drawn).
+struct EmittedPhoton {
+  glm::vec3 origin{0.0f}, direction{0.0f}, flux{0.0f};
+};
+
 class LightSampler {
  public:
   explicit LightSampler(const Scene& scene);
@@ -40,6 +46,12 @@ class LightSampler {
   // (low-discrepancy) u then stays stratified on every light, which a separate selection number
   // does not give.
   bool sample(glm::vec3 position, glm::vec2 u, LightSample* out) const;
+
+  // A photon from all the lights' emission, each light chosen in proportion to its power (suns
+  // and the environment enter through a disc facing them that covers the scene). Emissive
+  // textures count at their material's factor: the photons only train a guide, so an
+  // approximate emission costs variance, never bias. False when nothing emits.
+  bool sample_emission(glm::vec2 u_select, glm::vec2 u_position, glm::vec2 u_direction, EmittedPhoton* out) const;
 
   // Solid-angle pdf (incl. selection) with which sample() would pick this point of an emissive
   // triangle seen from `from`; 0 for triangles that are not lights.
@@ -174,6 +186,11 @@ class LightSampler {
   size_t pair_triangle(const Parallelogram& q, glm::vec2 uv, glm::vec2* barycentrics) const;
   void find_parallelograms(size_t first, size_t end);
 
+  bool emit_from_triangle(glm::vec2 u_select, glm::vec2 u_position, glm::vec2 u_direction, EmittedPhoton* out) const;
+  // A photon of a light at infinity reaching the scene from `toward_light`, with that radiance
+  // (environment) or irradiance (sun) over the given solid-angle density (1 for a sun).
+  EmittedPhoton emit_from_infinity(glm::vec3 toward_light, glm::vec3 radiance, float pdf, glm::vec2 u_position) const;
+
   const Scene& scene_;
   std::vector<EmissiveTriangle> triangles_;
   std::vector<Parallelogram> parallelograms_;
@@ -197,6 +214,10 @@ class LightSampler {
   std::vector<const PunctualLight*> suns_;  // sampled at every vertex (kMaxSuns)
   // Category selection: [0, p_tri) triangles, [p_tri, p_tri + p_env) environment, rest punctual.
   float p_triangles_ = 0.0f, p_environment_ = 0.0f, p_punctual_ = 0.0f;
+  // sample_emission's choice by power: [triangles, environment, each of punctual_, each of suns_].
+  Distribution1D emission_dist_;
+  glm::vec3 scene_center_{0.0f};
+  float scene_radius_ = 1.0f;
   double power_triangles_ = 0.0, power_environment_ = 0.0, power_punctual_ = 0.0;
   int category_count_ = 0;
 };

@@ -613,5 +613,64 @@ TEST(Lights, PunctualFalloffs) {
   EXPECT_FALSE(lights.sample(glm::vec3(std::tan(0.5f) * 2.0f, 0, 0), 0.5f, glm::vec2(0.5f), &ls));  // outside
 }
 
+// Path guiding's training photons (sample_emission): on average a photon carries the lights' total
+// power (per channel: pi L area for each one-sided emitter, pi r^2 E for a sun through the scene's
+// cross-section, 4 pi I for a point light), emitters send them to their lit side with cosine
+// directions from points on them, and a sun's photons cross the scene's bounding sphere.
+TEST(Lights, EmissionPhotonsCarryTheLightsPower) {
+  Scene scene;
+  scene.materials = {make_diffuse(glm::vec3(0.5f)), make_emitter(glm::vec3(1.0f, 2.0f, 3.0f)), make_emitter(glm::vec3(10.0f))};
+  scene.meshes.push_back(make_quad(glm::vec3(-5, 0, -5), glm::vec3(10, 0, 0), glm::vec3(0, 0, 10), 0));
+  scene.meshes.push_back(make_quad(glm::vec3(0, 2, 0), glm::vec3(1, 0, 0), glm::vec3(0, 0, 1), 1));  // faces -y
+  scene.meshes.push_back(make_quad(glm::vec3(2, 3, 0), glm::vec3(0.5f, 0, 0), glm::vec3(0, 0, 0.5f), 2));
+  PunctualLight sun;
+  sun.type = PunctualLight::Type::Directional;
+  sun.color = glm::vec3(1.0f, 0.9f, 0.8f);
+  sun.intensity = 3.0f;
+  sun.direction = glm::normalize(glm::vec3(0.3f, -1.0f, 0.2f));
+  PunctualLight point;
+  point.position = glm::vec3(0, 1, 0);
+  point.color = glm::vec3(0.2f, 0.4f, 0.6f);
+  point.intensity = 5.0f;
+  scene.lights = {sun, point};
+  const LightSampler lights(scene);
+  const float radius = 0.5f * glm::length(glm::vec3(10, 3, 10));  // the scene's box: (-5,0,-5)..(5,3,5)
+  const glm::vec3 center(0.0f, 1.5f, 0.0f);
+  const glm::dvec3 expected = glm::dvec3(scene.materials[1].emissive) * (kPi * 1.0) +
+                              glm::dvec3(scene.materials[2].emissive) * (kPi * 0.25) +
+                              glm::dvec3(sun.color * sun.intensity) * (kPi * double(radius) * double(radius)) +
+                              glm::dvec3(point.color * point.intensity) * (4.0 * kPi);
+  const int n = 400000;
+  Rng rng(17);
+  glm::dvec3 sum(0.0), sum2(0.0);
+  double quad_cos = 0.0;
+  int quad_photons = 0;
+  for (int i = 0; i < n; ++i) {
+    EmittedPhoton photon;
+    ASSERT_TRUE(lights.sample_emission(rng.next_2d(), rng.next_2d(), rng.next_2d(), &photon));
+    ASSERT_NEAR(glm::length(photon.direction), 1.0f, 1e-5f);
+    sum += glm::dvec3(photon.flux);
+    sum2 += glm::dvec3(photon.flux) * glm::dvec3(photon.flux);
+    if (std::abs(photon.origin.y - 2.0f) < 1e-3f) {  // the quad under y = 2 (its offset is tiny)
+      EXPECT_TRUE(photon.origin.x >= 0.0f && photon.origin.x <= 1.0f && photon.origin.z >= 0.0f && photon.origin.z <= 1.0f);
+      EXPECT_LT(photon.direction.y, 0.0f);
+      quad_cos += -photon.direction.y;
+      ++quad_photons;
+    } else if (glm::length(photon.direction - sun.direction) < 1e-5f) {  // the sun's: aimed through the scene
+      const glm::vec3 to_center = center - photon.origin;
+      const float miss = glm::length(to_center - glm::dot(to_center, photon.direction) * photon.direction);
+      EXPECT_LE(miss, radius * 1.0001f);
+    }
+  }
+  for (int c = 0; c < 3; ++c) {
+    const double mean = sum[c] / n, se = std::sqrt((sum2[c] / n - mean * mean) / n);
+    EXPECT_NEAR(mean, expected[c], 4.0 * se + 1e-4 * expected[c]) << "channel " << c;
+  }
+  ASSERT_GT(quad_photons, 1000);
+  EXPECT_NEAR(quad_cos / quad_photons, 2.0 / 3.0, 0.01);  // cosine-distributed: E[cos] = 2/3
+  EmittedPhoton none;
+  EXPECT_FALSE(LightSampler(Scene{}).sample_emission(glm::vec2(0.5f), glm::vec2(0.5f), glm::vec2(0.5f), &none));
+}
+
 }  // namespace
 }  // namespace pxf

@@ -41,11 +41,12 @@ struct TraceParams {
   // that near) and about halves the variance there (docs/sampling.md#near-specular-sampling). Ignored with
   // specular_sampling, which does this and more.
   bool near_specular_sampling = true;
-  // Path guiding (docs/guiding.md): the renderer learns an SD-tree of the incident radiance from its
-  // own paths, and once trained every non-delta vertex samples its direction from it with
-  // probability kGuidingAlpha (times the BSDF's non-delta share), from the BSDF otherwise, weighted
-  // by the mixture pdf (one-sample MIS; NEE and specular sampling MIS against that mixture). Off by
-  // default; off traces the samples of before, bit for bit.
+  // Path guiding (docs/guiding.md): the renderer learns an SD-tree of the indirect light from
+  // photons it traces from the lights after each frame, and once trained each path's first
+  // non-delta vertex samples its direction from it with probability kGuidingAlpha (times the
+  // BSDF's non-delta share), from the BSDF otherwise, weighted by the mixture pdf (one-sample MIS;
+  // NEE and specular sampling MIS against that mixture). Off by default; off traces the samples
+  // of before, bit for bit.
   bool guiding = false;
 };
 

@@ -10,6 +10,7 @@
 #include <tbb/task_arena.h>
 
 #include "pathtracer/guiding_field.h"
+#include <cstdio>
 #include "pathtracer/integrator.h"
 #include "pathtracer/pathtracer.h"
 
@@ -17,6 +18,23 @@ namespace pxf {
 namespace {
 
 constexpr int kTileSize = 16;
+
+// Path guiding's training (docs/guiding.md, measured there): after each frame, a quarter of a
+// photon per pixel, but at least kGuidingMinPhotonsPerFrame (the field's resolution depends on the
+// scene, not on the image), and no iteration (2^k frames) traces more than
+// kGuidingPhotonsPerIteration, so the training's cost per frame falls once the field has that
+// many. The field's spatial leaves split at c = 300 records (x sqrt(2^k)), not the paper's 12000,
+// which left a Cornell box wall in one leaf at these photon counts.
+constexpr double kGuidingPhotonsPerPixel = 0.25;
+constexpr double kGuidingMinPhotonsPerFrame = 16384;
+constexpr double kGuidingPhotonsPerIteration = double(1 << 22);
+constexpr float kGuidingSpatialThreshold = 300.0f;
+
+int guiding_photons_per_frame(int width, int height, int iteration) {
+  const double wanted = std::max(kGuidingMinPhotonsPerFrame, kGuidingPhotonsPerPixel * width * height);
+  const double per_frame = std::min(wanted, kGuidingPhotonsPerIteration / std::ldexp(1.0, std::min(iteration, 60)));
+  return static_cast<int>(std::ceil(per_frame));
+}
 
 // The box path guiding's field covers: the scene's triangles, a little larger (points on the
 // boundary stay inside), or a unit box without any.
@@ -71,7 +89,9 @@ struct ProgressiveRenderer::Impl {
     if (params.guiding) {
       glm::vec3 lo, hi;
       guiding_box(scene, &lo, &hi);
-      guiding = std::make_unique<GuidingField>(lo, hi);
+      GuidingSettings settings;
+      settings.spatial_threshold = kGuidingSpatialThreshold;
+      guiding = std::make_unique<GuidingField>(lo, hi, settings);
     }
     tracer->set_guiding(guiding.get());
   }
@@ -81,8 +101,13 @@ struct ProgressiveRenderer::Impl {
   // becomes what the iteration learned.
   void learn_guiding() {
     if (!guiding) return;
-    guiding->apply_records();
-    if (GuidingField::iteration_ends_after(static_cast<uint64_t>(frames.load()))) guiding->end_iteration();
+    const uint32_t frame = static_cast<uint32_t>(frames.load() - 1);
+    const int photons = guiding_photons_per_frame(width, height, guiding->iteration());
+    arena->execute([&] {
+      tracer->trace_guiding_photons(frame, photons, params);
+      guiding->apply_records();
+      if (GuidingField::iteration_ends_after(static_cast<uint64_t>(frames.load()))) guiding->end_iteration();
+    });
   }
 
   int accumulation_replicates() const { return accumulated_replicates(params.sampler, params.replicates); }
