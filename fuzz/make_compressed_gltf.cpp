@@ -4,12 +4,14 @@
 //       the gltf_scene fuzz seeds of issue 35: Draco, meshopt (every mode and filter, instancing),
 //       WebP and KTX2 textures, each valid and malformed (fuzz/corpus/gltf_scene/compressed_*);
 //   make_compressed_gltf draco-pair SIDE DIR
-//       DIR/grid_plain.glb and DIR/grid_draco.glb, a grid of 2 SIDE^2 triangles uncompressed and
-//       Draco-compressed (SIDE 152: 46,208 triangles, DamagedHelmet's count), for load-time and
-//       memory measurements (docs/gltf-extensions.md);
+//       DIR/grid_plain.glb, DIR/grid_draco.glb and DIR/grid_draco_quantized.glb, a grid of 2 SIDE^2
+//       triangles uncompressed, Draco-compressed losslessly and with Blender's default quantization
+//       (SIDE 152: 46,208 triangles, DamagedHelmet's count), for load-time and memory measurements
+//       (docs/gltf-extensions.md);
 //   make_compressed_gltf draco-glb IN.glb OUT.glb
 //       IN with every primitive (float attributes, uint32 or uint16 indices, triangles)
-//       Draco-compressed and its uncompressed geometry dropped: pxf_helmet_like's GLB, compressed.
+//       Draco-compressed with Blender's default quantization and its uncompressed geometry dropped:
+//       pxf_helmet_like's GLB, compressed as an exporter would.
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -68,7 +70,10 @@ void write_draco_pair(int side, const std::string& dir) {
   const GridMesh grid = make_grid(side);
   write(dir + "/grid_plain.glb", plain_grid_glb(grid).bytes());
   write(dir + "/grid_draco.glb", draco_grid_glb(grid).bytes());
-  std::printf("wrote %s/grid_plain.glb and grid_draco.glb: %zu triangles\n", dir.c_str(), grid.indices.size() / 3);
+  const DracoQuantization blender;
+  write(dir + "/grid_draco_quantized.glb", draco_grid_glb(grid, &blender).bytes());
+  std::printf("wrote %s/grid_plain.glb, grid_draco.glb and grid_draco_quantized.glb: %zu triangles\n", dir.c_str(),
+              grid.indices.size() / 3);
 }
 
 // ---------------------------------------------------------------------------------------- draco-glb
@@ -134,7 +139,8 @@ void write_draco_glb(const std::string& in, const std::string& out) {
   }
   for (json& mesh : result.doc["meshes"])
     for (json& primitive : mesh["primitives"]) {
-      Glb compressed = draco_grid_glb(primitive_mesh(source, primitive));
+      const DracoQuantization blender;
+      Glb compressed = draco_grid_glb(primitive_mesh(source, primitive), &blender);
       const json& compressed_primitive = compressed.doc["meshes"][0]["primitives"][0];
       json ext = compressed_primitive["extensions"]["KHR_draco_mesh_compression"];
       ext["bufferView"] = result.view(compressed.bin.data(), compressed.bin.size());

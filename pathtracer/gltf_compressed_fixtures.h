@@ -127,9 +127,15 @@ inline Glb plain_grid_glb(const GridMesh& g) {
 
 // ------------------------------------------------------------------------------------- Draco
 
-// The grid Draco-encoded without quantization (lossless: the twin's values exactly), edgebreaker.
-// The accessors keep their counts and types and have no bufferView, as exporters write them.
-inline Glb draco_grid_glb(const GridMesh& g) {
+// Blender's default Draco quantization (bits): what most Draco files in the wild carry.
+struct DracoQuantization {
+  int position = 14, normal = 10, uv = 12;
+};
+
+// The grid Draco-encoded with edgebreaker: without quantization by default (lossless: the twin's
+// values exactly), or quantized as `quantization` says. The accessors keep their counts and types
+// and have no bufferView, as exporters write them.
+inline Glb draco_grid_glb(const GridMesh& g, const DracoQuantization* quantization = nullptr) {
   draco::Mesh mesh;
   const size_t n = g.vertex_count();
   mesh.set_num_points(static_cast<uint32_t>(n));
@@ -148,6 +154,11 @@ inline Glb draco_grid_glb(const GridMesh& g) {
     mesh.AddFace({draco::PointIndex(g.indices[t]), draco::PointIndex(g.indices[t + 1]), draco::PointIndex(g.indices[t + 2])});
   draco::Encoder encoder;
   encoder.SetEncodingMethod(draco::MESH_EDGEBREAKER_ENCODING);
+  if (quantization) {
+    encoder.SetAttributeQuantization(draco::GeometryAttribute::POSITION, quantization->position);
+    encoder.SetAttributeQuantization(draco::GeometryAttribute::NORMAL, quantization->normal);
+    encoder.SetAttributeQuantization(draco::GeometryAttribute::TEX_COORD, quantization->uv);
+  }
   draco::EncoderBuffer encoded;
   const draco::Status status = encoder.EncodeMeshToBuffer(mesh, &encoded);
   if (!status.ok()) throw std::runtime_error("Draco encoding failed: " + status.error_msg_string());

@@ -146,19 +146,15 @@ DecodedArray decode_indices(const draco::Mesh& mesh, const tinygltf::Model& mode
   return out;
 }
 
-// The decoded arrays become one new buffer, a bufferView and an accessor each; the primitive
-// names the new accessors.
+// Each decoded array becomes a buffer of its own (moved, not copied), a bufferView and an
+// accessor; the primitive names the new accessors.
 void install(tinygltf::Model& model, tinygltf::Primitive& primitive, std::vector<DecodedArray>& arrays) {
-  tinygltf::Buffer buffer;
-  const int buffer_index = static_cast<int>(model.buffers.size());
   for (DecodedArray& array : arrays) {
-    while (buffer.data.size() % 4) buffer.data.push_back(0);
     tinygltf::BufferView view;
-    view.buffer = buffer_index;
-    view.byteOffset = buffer.data.size();
+    view.buffer = static_cast<int>(model.buffers.size());
     view.byteLength = array.bytes.size();
-    buffer.data.insert(buffer.data.end(), array.bytes.begin(), array.bytes.end());
-    std::vector<unsigned char>().swap(array.bytes);
+    model.buffers.emplace_back();
+    model.buffers.back().data = std::move(array.bytes);
     model.bufferViews.push_back(view);
     array.accessor.bufferView = static_cast<int>(model.bufferViews.size()) - 1;
     array.accessor.byteOffset = 0;
@@ -169,7 +165,6 @@ void install(tinygltf::Model& model, tinygltf::Primitive& primitive, std::vector
     if (array.semantic.empty()) primitive.indices = accessor_index;
     else primitive.attributes[array.semantic] = accessor_index;
   }
-  model.buffers.push_back(std::move(buffer));
   primitive.mode = TINYGLTF_MODE_TRIANGLES;
 }
 

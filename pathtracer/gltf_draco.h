@@ -1,5 +1,5 @@
 // KHR_draco_mesh_compression with libdraco (Debian's tinygltf is built without it). Each Draco
-// primitive is decoded once, into accessors of a new buffer laid out as an uncompressed file
+// primitive is decoded once, into accessors of new buffers laid out as an uncompressed file
 // would be (the accessor's own component type), so the rest of the loader reads it unchanged.
 #pragma once
 #include <string>
