@@ -135,6 +135,30 @@ TEST(Shader, CompileErrorInIncludeNamesIncludedFile) {
 
 // Every fragment and compute shader in shaders/ (most include the shared shaders/pass_formulas.h),
 // each fragment shader with its vertex shader: the one of the same name, else the full-screen one.
+// A uniform the program does not have is an error naming both, not a silent no-op (issue 36: a
+// misspelt name used to leave the pass running with the uniform's default).
+TEST(Shader, SettingAnUndeclaredUniformFails) {
+  test::osmesa_context();
+  const std::string frag = R"(#version 450 core
+uniform float gain;
+layout(location = 0) out vec4 color;
+void main() { color = vec4(gain); }
+)";
+  Shader vs(ShaderStage::Vertex, "fullscreen.vert", embedded_shader("fullscreen.vert"));
+  Shader fs(ShaderStage::Fragment, "gain.frag", frag);
+  Program program({&vs, &fs});
+  EXPECT_NO_THROW(program.set("gain", 2.0f));
+  try {
+    program.set("gian", 2.0f);
+    FAIL() << "a misspelt uniform was accepted";
+  } catch (const Error& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("gain.frag"), std::string::npos) << message;
+    EXPECT_NE(message.find("'gian'"), std::string::npos) << message;
+    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+  }
+}
+
 TEST(Shader, EveryEmbeddedPassCompiles) {
   test::osmesa_context();
   auto ends_with = [](const std::string& s, const std::string& end) {

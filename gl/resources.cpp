@@ -122,17 +122,25 @@ Program Program::from_embedded_compute(const std::string& compute_file) {
 
 void Program::use() const { glUseProgram(name_.id); }
 int Program::location(const char* uniform) const { return glGetUniformLocation(name_.id, uniform); }
-void Program::set(const char* u, int v) const { glProgramUniform1i(name_.id, location(u), v); }
-void Program::set(const char* u, float v) const { glProgramUniform1f(name_.id, location(u), v); }
-void Program::set(const char* u, glm::vec2 v) const { glProgramUniform2fv(name_.id, location(u), 1, glm::value_ptr(v)); }
-void Program::set(const char* u, glm::vec3 v) const { glProgramUniform3fv(name_.id, location(u), 1, glm::value_ptr(v)); }
-void Program::set(const char* u, glm::vec4 v) const { glProgramUniform4fv(name_.id, location(u), 1, glm::value_ptr(v)); }
-void Program::set(const char* u, glm::ivec2 v) const { glProgramUniform2iv(name_.id, location(u), 1, glm::value_ptr(v)); }
+// A pass that sets a uniform the program does not have (misspelt, or one the shader no longer
+// reads and the linker dropped) fails loudly, as Falcor's shader variables do: GL would ignore
+// location -1 and the pass would run with the uniform's default.
+int Program::declared_location(const char* uniform) const {
+  const int at = location(uniform);
+  if (at < 0) throw Error("shader program " + files_ + " has no active uniform '" + uniform + "'");
+  return at;
+}
+void Program::set(const char* u, int v) const { glProgramUniform1i(name_.id, declared_location(u), v); }
+void Program::set(const char* u, float v) const { glProgramUniform1f(name_.id, declared_location(u), v); }
+void Program::set(const char* u, glm::vec2 v) const { glProgramUniform2fv(name_.id, declared_location(u), 1, glm::value_ptr(v)); }
+void Program::set(const char* u, glm::vec3 v) const { glProgramUniform3fv(name_.id, declared_location(u), 1, glm::value_ptr(v)); }
+void Program::set(const char* u, glm::vec4 v) const { glProgramUniform4fv(name_.id, declared_location(u), 1, glm::value_ptr(v)); }
+void Program::set(const char* u, glm::ivec2 v) const { glProgramUniform2iv(name_.id, declared_location(u), 1, glm::value_ptr(v)); }
 void Program::set(const char* u, const glm::mat3& v) const {
-  glProgramUniformMatrix3fv(name_.id, location(u), 1, GL_FALSE, glm::value_ptr(v));
+  glProgramUniformMatrix3fv(name_.id, declared_location(u), 1, GL_FALSE, glm::value_ptr(v));
 }
 void Program::set(const char* u, const glm::mat4& v) const {
-  glProgramUniformMatrix4fv(name_.id, location(u), 1, GL_FALSE, glm::value_ptr(v));
+  glProgramUniformMatrix4fv(name_.id, declared_location(u), 1, GL_FALSE, glm::value_ptr(v));
 }
 
 // ---- Texture2D ----

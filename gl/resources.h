@@ -65,6 +65,8 @@ class Program {
   GlHandle id() const { return name_.id; }
   void use() const;
   int location(const char* uniform) const;  // -1 when absent (optimized out)
+  // set(): throws pxf::Error naming the program and the uniform when the program has no active
+  // uniform of that name.
   void set(const char* uniform, int v) const;
   void set(const char* uniform, float v) const;
   void set(const char* uniform, glm::vec2 v) const;
@@ -75,6 +77,8 @@ class Program {
   void set(const char* uniform, const glm::mat4& v) const;
 
  private:
+  int declared_location(const char* uniform) const;
+
   GlName name_;
   std::string files_;
 };
