@@ -87,6 +87,8 @@ class Bsdf {
   bool has_nondelta() const { return has_nondelta_; }
   // The probability that sample() picks a non-delta lobe (1 for a BSDF without delta lobes).
   float nondelta_probability() const { return p_diffuse_ + (glossy_delta_ ? 0.0f : p_glossy_); }
+  // The probability that sample() picks the diffuse lobe.
+  float diffuse_probability() const { return p_diffuse_; }
   // sample() reads u_lobe only when more than one lobe can be picked.
   bool has_lobe_choice() const { return (p_diffuse_ > 0.0f) + (p_glossy_ > 0.0f) + (p_glass_ > 0.0f) > 1; }
   bool is_black() const { return black_; }

@@ -494,6 +494,8 @@ glm::vec3 GuidingField::Distribution::sample(glm::vec2 u, float* pdf_out) const 
   return direction;
 }
 
+bool GuidingField::Distribution::learned() const { return tree_ && sum4((*tree_)[0].share) > 0.0; }
+
 float GuidingField::Distribution::pdf(const glm::vec3& direction) const {
   return direction_pdf(*tree_, uniform_fraction_, direction);
 }

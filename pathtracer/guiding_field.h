@@ -142,6 +142,9 @@ class GuidingField {
     // The solid-angle density of sample() for a direction of any length (0 for a zero or
     // non-finite one). Uniform (1 / 4 pi) where the leaf learned no energy.
     float pdf(const glm::vec3& direction) const;
+    // False where the leaf has learned no light: its distribution is uniform over the sphere,
+    // which guides nowhere (the renderer then samples the BSDF alone there).
+    bool learned() const;
 
    private:
     friend class GuidingField;

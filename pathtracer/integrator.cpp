@@ -533,15 +533,17 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
   if (last_vertex || bsdf.is_black()) return false;
 
   // Path guiding: once the field is trained, the BSDF-side strategy of the path's first non-delta
-  // vertex is the mixture that takes the guided direction with probability alpha (times the share
-  // of the BSDF's non-delta lobes: its delta lobes keep their samples). Deeper vertices sample the
-  // BSDF alone: most of the heavy-tailed light arrives at the first, and a guided vertex pays
-  // field lookups for its sample and every MIS weight (measured in docs/guiding.md).
+  // vertex is the mixture that takes the guided direction with probability alpha (times the
+  // BSDF's diffuse share: the field knows the incident light, not the BSDF, so it serves a diffuse
+  // lobe; glossy and delta lobes keep their samples). Deeper vertices sample the BSDF alone: most
+  // of the heavy-tailed light arrives at the first, and a guided vertex pays field lookups for its
+  // sample and every MIS weight. A leaf that learned no light (a uniform distribution) is not
+  // guided. Measured in docs/guiding.md.
   GuidingMixture mixture;
   if (guiding_ && params.guiding && s.nonspecular == 0 && bsdf.has_nondelta() && guiding_->trained()) {
-    mixture.guided = true;
     mixture.guide = guiding_->distribution(sp.position);
-    mixture.alpha = kGuidingAlpha * bsdf.nondelta_probability();
+    mixture.guided = mixture.guide.learned();
+    mixture.alpha = kGuidingAlpha * bsdf.diffuse_probability();
   }
 
   // Next event estimation (the light vertex is vertex + 1 <= max_vertices).
