@@ -13,6 +13,7 @@
 #include "app/explorer_camera.h"
 #include "app/explorer_views.h"
 #include "app/frame_budget.h"
+#include "app/pixel_probe.h"
 #include "app/preview.h"
 #include "app/render_output.h"
 #include "pathtracer/auto_camera.h"
@@ -46,15 +47,6 @@ double ms_between(Clock::time_point a, Clock::time_point b) {
   return std::chrono::duration<double, std::milli>(b - a).count();
 }
 
-// One texel of a GPU texture as RGBA floats (a 16-byte read-back; missing channels read 0, alpha 1).
-glm::vec4 read_texel(const Texture2D& texture, int x, int y) {
-  glm::vec4 v(0.0f);
-  glGetTextureSubImage(texture.id(), 0, x, y, 0, 1, 1, 1, GL_RGBA, GL_FLOAT, sizeof(v), &v.x);
-  return v;
-}
-
-float luminance(const glm::vec4& c) { return pxf::luminance(c.r, c.g, c.b); }
-
 // The default framebuffer (window plus UI) as an sRGB PNG-ready image, top row first.
 Image read_window(int width, int height) {
   std::vector<unsigned char> rgba(static_cast<size_t>(width) * height * 4);
@@ -68,37 +60,6 @@ Image read_window(int width, int height) {
       for (int c = 0; c < 3; ++c)  // GL rows go bottom-up
         image.at(x, y, c) = rgba[(static_cast<size_t>(height - 1 - y) * width + x) * 4 + c] / 255.0f;
   return image;
-}
-
-// Everything the inspector shows of one pixel.
-struct PixelProbe {
-  int x = -1, y = -1;
-  glm::vec4 final_s, lv, hv_var, filtered_var, guide;
-  float case_code = 0;
-  uint32_t n = 0;
-  float background = 0, u = 0, f = 0;
-  bool has_filtered = false;
-};
-
-PixelProbe probe_pixel(const Preview& preview, const std::vector<uint32_t>& samples, int x, int y) {
-  PixelProbe p;
-  p.x = x;
-  p.y = y;
-  p.final_s = read_texel(preview.blend().output(), x, y);
-  p.lv = read_texel(preview.inputs().lv(), x, y);
-  p.hv_var = read_texel(preview.inputs().hv(), x, y);
-  p.has_filtered = preview.has_filtered();
-  p.filtered_var = p.has_filtered ? read_texel(preview.filtered_output(), x, y) : p.hv_var;
-  p.guide = read_texel(preview.range().guide(), x, y);
-  p.case_code = read_texel(preview.blend().case_texture(), x, y).r;
-  const size_t i = static_cast<size_t>(y) * preview.width() + x;
-  p.n = i < samples.size() ? samples[i] : 0;
-  // docs/method.md section 3.1: L_b = Y(L_f) + Y(L_lv); u and f relative to it (0 where the variance is unknown).
-  p.background = luminance(p.filtered_var) + luminance(p.lv);
-  const float b2 = p.background * p.background;
-  p.u = p.hv_var.a > 0 && b2 > 0 ? p.hv_var.a / b2 : 0.0f;
-  p.f = p.has_filtered && p.filtered_var.a > 0 && b2 > 0 ? p.filtered_var.a / b2 : 0.0f;
-  return p;
 }
 
 std::string variance_text(float v) {
@@ -303,17 +264,31 @@ class Explorer {
       ImGui::Text("paths %u   next frame: %s", sampling.paths[i],
                   sampling.active.size() > i && sampling.active[i] == 0 ? "skipped" : "traced");
     ImGui::Text("final     %.4g %.4g %.4g", p.final_s.r, p.final_s.g, p.final_s.b);
-    ImGui::Text("LV        %.4g %.4g %.4g", p.lv.r, p.lv.g, p.lv.b);
-    ImGui::Text("HV L_u    %.4g %.4g %.4g", p.hv_var.r, p.hv_var.g, p.hv_var.b);
-    if (p.has_filtered) ImGui::Text("HV L_f    %.4g %.4g %.4g", p.filtered_var.r, p.filtered_var.g, p.filtered_var.b);
-    else ImGui::TextDisabled("HV L_f    (filter has not run)");
-    ImGui::Text("Var[L_u]  %s", variance_text(p.hv_var.a).c_str());
-    ImGui::Text("Var[L_f]  %s", p.has_filtered ? variance_text(p.filtered_var.a).c_str() : "-");
-    ImGui::Text("L_b %.4g   u %.4g   f %.4g   t %.4g", p.background, p.u, p.f, settings_.threshold);
-    const int code = static_cast<int>(p.case_code + 0.5f);
-    ImGui::Text("s %.4f   case %s", p.final_s.a, code >= 0 && code < kBlendCaseCount ? case_styles()[code].label : "?");
+    if (p.blended) blend_decision_lines(p.blend);
+    else ImGui::TextDisabled("(not blended yet)");
     ImGui::Text("range     %.3f %.3f %.3f   depth %.4g", p.guide.r, p.guide.g, p.guide.b, p.guide.a);
     ImGui::EndTooltip();
+  }
+
+  // The blend's inputs and decision at the pixel, as the last blend run made them (pooled u, the
+  // pixel's threshold t_n, s, f and the case: BlendPass::inspect).
+  static void blend_decision_lines(const BlendInspection& blend) {
+    const shared::BlendTexels& px = blend.texels;
+    const shared::BlendPixel& d = blend.decision;
+    ImGui::Text("LV        %.4g %.4g %.4g", px.lv.r, px.lv.g, px.lv.b);
+    ImGui::Text("HV L_u    %.4g %.4g %.4g", px.hv.r, px.hv.g, px.hv.b);
+    if (blend.switches.has_filtered) ImGui::Text("HV L_f    %.4g %.4g %.4g", px.filtered.r, px.filtered.g, px.filtered.b);
+    else ImGui::TextDisabled("HV L_f    (filter has not run)");
+    const bool compared = shared::blend_compares_variances(px, blend.switches);
+    if (compared && blend.switches.has_guide)
+      ImGui::Text("Var[L_u]  %s   pooled %s", variance_text(px.hv.a).c_str(), variance_text(d.var_u).c_str());
+    else ImGui::Text("Var[L_u]  %s", variance_text(px.hv.a).c_str());
+    ImGui::Text("Var[L_f]  %s", blend.switches.has_filtered ? variance_text(px.filtered.a).c_str() : "-");
+    if (compared) ImGui::Text("u %.4g   f %.4g   L_b %.4g", d.u, d.f, d.lb);
+    else ImGui::Text("L_b %.4g   (u, f not compared)", d.lb);
+    const int code = d.blend_case;
+    ImGui::Text("t_n %.4g   s %.4f", d.t, d.s);
+    ImGui::Text("case %s", code >= 0 && code < kBlendCaseCount ? case_styles()[code].label : "?");
   }
 
   // --- the panel ------------------------------------------------------------------------------

@@ -17,6 +17,7 @@
 #include "app/adaptive.h"
 #include "app/explorer_camera.h"
 #include "app/explorer_views.h"
+#include "app/pixel_probe.h"
 #include "app/preview.h"
 #include "gl/context.h"
 #include "image/image.h"
@@ -231,6 +232,44 @@ TEST_F(ExplorerSamplingViews, StatusLineOfAnAdaptivePreview) {
   std::snprintf(want, sizeof want, "clean (case 2): %.1f %%   paths/pixel mean %.1f (min %u, max %u)   active %.1f %%",
                 100.0 * preview_->case_counts()[kCaseUnfiltered] / (kW * kH), counts.mean, counts.min, counts.max, active);
   EXPECT_EQ(sampling_status_line(preview_->case2_share(), views_->sampling()), want);
+}
+
+// --- issue 36: the inspector shows the blend's own decision, headless ----------------------------
+
+// Cornell at 32x24, 6 frames with the default settings (variance pooling, the centre weight, the
+// bias guard): at every pixel the inspector's case is the blend pass's and its s the pass's to the
+// rounding of the C++ compilation (it sums in double; at one pixel here every known neighbour lies
+// across a range edge, where it pooled what the shader did not before kMinPooledWeight). Somewhere
+// the pooled variance, not the pixel's own, decided s (the old inspector's u), so an inspector
+// that used the own variance again would fail here.
+TEST(ExplorerInspector, ShowsTheBlendPassDecisionAtEveryPixel) {
+  headless_context();
+  static const Scene scene = load_scene("cornell");
+  constexpr int kW = 32, kH = 24, kFrames = 6;
+  Preview preview(scene, PreviewSettings{}, kW, kH);
+  for (int i = 0; i < kFrames; ++i) preview.add_frame(i + 1 == kFrames);
+  const Image s = preview.blend().s_image(), cases = preview.blend().case_image();
+  int compared = 0, decided_by_pooling = 0;
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) {
+      SCOPED_TRACE(testing::Message() << "pixel " << x << "," << y);
+      const PixelProbe probe = probe_pixel(preview, preview.pixel_samples(), x, y);
+      ASSERT_TRUE(probe.blended);
+      ASSERT_TRUE(probe.blend.switches.has_filtered && probe.blend.switches.has_guide);
+      const shared::BlendPixel& shown = probe.blend.decision;
+      EXPECT_EQ(shown.blend_case, static_cast<int>(cases.at(x, y, 0)));
+      EXPECT_NEAR(shown.s, s.at(x, y, 0), 1e-4f);
+      EXPECT_EQ(probe.final_s.a, s.at(x, y, 0));
+      if (!shared::blend_compares_variances(probe.blend.texels, probe.blend.switches)) continue;
+      ++compared;
+      shared::BlendVarianceInputs own = probe.blend.variance_inputs;
+      own.var_u_pooled = shared::clean_var(probe.blend.texels.hv.a);
+      const float s_own = shared::blend_pixel(probe.blend.texels, probe.blend.switches, own).s;
+      decided_by_pooling += std::abs(s_own - s.at(x, y, 0)) > 0.01f;
+    }
+  EXPECT_GT(compared, kW * kH / 4) << "too few pixels whose variances the blend compared";
+  EXPECT_GT(decided_by_pooling, 0) << "no pixel whose s the pooled variance changed: the test cannot tell an "
+                                      "inspector that uses the pixel's own variance";
 }
 
 // --- the explorer in a window ----------------------------------------------------------------

@@ -51,13 +51,15 @@ void BlendPass::run(const PreviewInputs& inputs, const Texture2D* filtered, cons
   timer_.begin();
   const bool guard = params.bias_guard && filtered;
   if (guard) run_bias_guard(inputs, *filtered);
-  program_.set("has_filtered", filtered ? 1 : 0);
-  program_.set("has_guide", guide ? 1 : 0);
-  program_.set("has_centre_weight", filtered && centre_weight ? 1 : 0);
+  last_ = LastRun{&inputs.hv(), &inputs.lv(), filtered, guide, filtered ? centre_weight : nullptr,
+                  shared::BlendSwitches{filtered != nullptr, guide != nullptr, guard, t}, params.range};
+  program_.set("has_filtered", last_.switches.has_filtered ? 1 : 0);
+  program_.set("has_guide", last_.switches.has_guide ? 1 : 0);
+  program_.set("has_centre_weight", last_.centre_weight ? 1 : 0);
   program_.set("k_c", params.range.k_c);
   program_.set("k_d", params.range.k_d);
   program_.set("t", t);
-  program_.set("bias_guard", guard ? 1 : 0);
+  program_.set("bias_guard", last_.switches.bias_guard ? 1 : 0);
   const std::array<uint32_t, kBlendCaseCount> zeros{};
   counts_.upload(zeros.data(), sizeof zeros);
   counts_.bind_storage(shared::kBufferCounts);
@@ -79,6 +81,40 @@ std::array<uint32_t, kBlendCaseCount> BlendPass::case_counts() const {
   std::array<uint32_t, kBlendCaseCount> counts{};
   counts_.download(counts.data(), sizeof counts);
   return counts;
+}
+
+namespace {
+
+// A texture as the shared code reads a sampler (shaders/cpu_gpu.h), one read-back per texel.
+struct TextureTexels {
+  const Texture2D* texture;
+};
+glm::vec4 texelFetch(const TextureTexels& t, glm::ivec2 p, int) { return t.texture->texel(p.x, p.y); }
+glm::ivec2 textureSize(const TextureTexels& t, int) { return {t.texture->width(), t.texture->height()}; }
+
+}  // namespace
+
+// blend.frag's reads, on the same textures.
+BlendInspection BlendPass::inspect(int x, int y) const {
+  if (!last_.hv) throw Error("blend pass: inspected before its first run");
+  const glm::ivec2 p(x, y);
+  BlendInspection i;
+  i.switches = last_.switches;
+  i.texels = {last_.hv->texel(x, y), last_.lv->texel(x, y), (last_.filtered ? last_.filtered : last_.hv)->texel(x, y),
+              last_.guide ? last_.guide->texel(x, y).a : 0.0f};
+  i.variance_inputs = shared::blend_variance_inputs_none();
+  if (shared::blend_compares_variances(i.texels, i.switches)) {
+    if (last_.guide)
+      i.variance_inputs.var_u_pooled = shared::pooled_var_u(TextureTexels{last_.hv}, TextureTexels{last_.guide}, p,
+                                                             last_.range.k_c, last_.range.k_d);
+    if (last_.centre_weight) i.variance_inputs.centre_weight = last_.centre_weight->texel(x, y).r;
+    if (last_.switches.bias_guard) {
+      const glm::vec4 g = guard_.texel(x, y);
+      i.variance_inputs.guard = {g.x, g.y};
+    }
+  }
+  i.decision = shared::blend_pixel(i.texels, i.switches, i.variance_inputs);
+  return i;
 }
 
 Image BlendPass::final_image() const { return output_.download({"R", "G", "B"}); }

@@ -6,6 +6,7 @@
 //   tonemap.run(blend.output(), tonemap_params);
 //   auto counts = blend.case_counts();  // e.g. counts[kCaseUnfiltered] == w*h: stop filtering
 //   blend.final_image(), blend.s_image(), blend.case_image(), blend.last_ms()
+//   blend.inspect(x, y).decision  // one pixel decided again as the pass did (the explorer's inspector)
 #pragma once
 #include <array>
 #include "gl/filter_pass.h"
@@ -14,6 +15,16 @@
 #include "gl/resources.h"
 
 namespace pxf {
+
+// One pixel as the last blend run decided it (BlendPass::inspect, the explorer's inspector): the
+// texels the pass read there, the run's switches, what it read where it compared variances, and
+// shared::blend_pixel on them, the shader's decision compiled as C++.
+struct BlendInspection {
+  shared::BlendTexels texels;
+  shared::BlendSwitches switches;
+  shared::BlendVarianceInputs variance_inputs;
+  shared::BlendPixel decision;
+};
 
 class BlendPass {
  public:
@@ -41,11 +52,29 @@ class BlendPass {
   Image s_image() const;      // "Y"
   Image case_image() const;   // "Y"
 
+  // Pixel (x, y) of the last run, decided again from the textures that run read, read back texel
+  // by texel (one pixel at a time): they must still hold what it read, as the preview's do until
+  // its next upload. The C++ sums in double where the shader sums in float, so s agrees with the
+  // pass to rounding.
+  BlendInspection inspect(int x, int y) const;
+  bool has_run() const { return last_.hv != nullptr; }
+
  private:
   // The bias guard's finding (bias_guard_estimate in shaders/pass_formulas.h) into guard_: a row
   // pass of 5 reads writes the row sums of three x ranges, a column pass of 5 reads of each adds
   // them into the 5x5 window and its four halves and judges them.
   void run_bias_guard(const PreviewInputs& inputs, const Texture2D& filtered);
+
+  // What the last run read and its switches (the shader's uniforms), for inspect().
+  struct LastRun {
+    const Texture2D* hv = nullptr;
+    const Texture2D* lv = nullptr;
+    const Texture2D* filtered = nullptr;
+    const Texture2D* guide = nullptr;
+    const Texture2D* centre_weight = nullptr;
+    shared::BlendSwitches switches{};
+    RangeWeights range;
+  };
 
   int width_, height_;
   Program program_;
@@ -57,6 +86,7 @@ class BlendPass {
   FullscreenPass quad_;
   StageTimer timer_;
   int guard_runs_ = 0;
+  LastRun last_;
 };
 
 }  // namespace pxf

@@ -8,8 +8,6 @@ namespace pxf {
 
 namespace {
 
-float lum(const float* c) { return luminance(c[0], c[1], c[2]); }
-
 struct Px {
   float c[3];
 };
@@ -215,46 +213,30 @@ FilterOutput cpu_filter(const Image& hv, const Image& var_u, const Image& lv, co
   return out;
 }
 
+// shared::blend_pixel on the images; the guard's finding by the definition of its windows.
 BlendOutput cpu_blend(const Image& lv, const Image& hv, const Image& var_u, const FilterOutput* filtered, float t,
                       const BlendParams& params, const Image* range_color, const Image* depth) {
   const bool pool = range_color && depth;
   const int w = hv.width, h = hv.height;
   BlendOutput out{Image::rgb(w, h), Image::gray(w, h), Image::gray(w, h)};
+  const TexelView hv_texels{&hv, &var_u};
+  const TexelView filtered_texels = filtered ? TexelView{&filtered->filtered, &filtered->variance} : hv_texels;
+  const shared::BlendSwitches on{filtered != nullptr, pool, params.bias_guard, t};
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
-      Px l = rgb_at(lv, x, y), lu = rgb_at(hv, x, y);
-      Px lf = lu;
-      BlendDecision d{1.0f, kCaseNoFiltered};
-      if (filtered) {
-        lf = rgb_at(filtered->filtered, x, y);
-        float vf_raw = filtered->variance.at(x, y, 0);
-        float vu = clean_var(var_u.at(x, y, 0));
-        if (vf_raw < kVarSkippedBelow) {
-          d = {1.0f, kCaseUnfiltered};
-        } else if (pool && lu.c[0] == 0.0f && lu.c[1] == 0.0f && lu.c[2] == 0.0f &&
-                   depth->at(x, y, 0) >= kBackgroundDistanceMin) {
-          d = {1.0f, kCaseUnfiltered};  // the background rule
-        } else if (vu < 0.0f) {
-          d = {0.0f, kCaseUnknownVar};
-        } else {
-          float vf = std::max(clean_var(vf_raw), 0.0f);  // unknown Var[L_f] (no neighbour variance known) reads as 0
-          float lb = std::max(lum(lf.c) + lum(l.c), 0.0f);
-          if (pool) vu = pooled_var_u(var_u, *range_color, *depth, x, y, params.range);
-          float u = vu > 0.0f ? relative_variance(vu, lb) : zero_variance_u(lum(lf.c), lb);
-          const float w_centre = filtered->centre_weight.pixels.empty() ? 0.0f : filtered->centre_weight.at(x, y, 0);
-          const float f = relative_variance(vf, lb);
-          d = blend_decision(u, f, shared::pixel_threshold(t, texelFetch(lv_view(lv), glm::ivec2(x, y), 0)), w_centre);
-          if (params.bias_guard)
-            d.s = shared::guarded_blend_factor(
-                shared::bias_guard_estimate_at(TexelView{&hv, &var_u},
-                                               TexelView{&filtered->filtered, &filtered->variance}, glm::ivec2(x, y)),
-                d.s, u, f, w_centre, lb, d.blend_case);
-        }
+      const glm::ivec2 p(x, y);
+      const shared::BlendTexels px{texelFetch(hv_texels, p, 0), texelFetch(lv_view(lv), p, 0),
+                                   texelFetch(filtered_texels, p, 0), pool ? depth->at(x, y, 0) : 0.0f};
+      shared::BlendVarianceInputs v = shared::blend_variance_inputs_none();
+      if (shared::blend_compares_variances(px, on)) {
+        if (pool) v.var_u_pooled = pooled_var_u(var_u, *range_color, *depth, x, y, params.range);
+        if (!filtered->centre_weight.pixels.empty()) v.centre_weight = filtered->centre_weight.at(x, y, 0);
+        if (params.bias_guard) v.guard = shared::bias_guard_estimate_at(hv_texels, filtered_texels, p);
       }
-      for (int c = 0; c < 3; ++c)
-        out.final_rgb.at(x, y, c) = clean(l.c[c] + d.s * lu.c[c] + (1.0f - d.s) * lf.c[c]);
-      out.s.at(x, y, 0) = d.s;
-      out.blend_case.at(x, y, 0) = static_cast<float>(d.blend_case);
+      const shared::BlendPixel b = shared::blend_pixel(px, on, v);
+      for (int c = 0; c < 3; ++c) out.final_rgb.at(x, y, c) = b.radiance[c];
+      out.s.at(x, y, 0) = b.s;
+      out.blend_case.at(x, y, 0) = static_cast<float>(b.blend_case);
     }
   return out;
 }

@@ -200,6 +200,12 @@ Image Texture2D::download(const std::vector<std::string>& channels) const {
   return image;
 }
 
+glm::vec4 Texture2D::texel(int x, int y) const {
+  glm::vec4 v(0.0f);
+  glGetTextureSubImage(name_.id, 0, x, y, 0, 1, 1, 1, GL_RGBA, GL_FLOAT, sizeof(v), &v.x);
+  return v;
+}
+
 void Texture2D::set_filter(bool linear, bool mipmaps) {
   GLenum min = linear ? (mipmaps ? GL_LINEAR_MIPMAP_LINEAR : GL_LINEAR) : (mipmaps ? GL_NEAREST_MIPMAP_NEAREST : GL_NEAREST);
   glTextureParameteri(name_.id, GL_TEXTURE_MIN_FILTER, min);

@@ -109,6 +109,8 @@ class Texture2D {
   void upload(const Image& image);
   // Read-back of level 0 as floats with the given channel names (1..4 of them).
   Image download(const std::vector<std::string>& channels) const;
+  // One texel of level 0 as RGBA floats (a 16-byte read-back; missing channels read 0, alpha 1).
+  glm::vec4 texel(int x, int y) const;
   void set_filter(bool linear, bool mipmaps = false);
   void set_wrap(int gl_wrap_s, int gl_wrap_t);  // GL_REPEAT, GL_CLAMP_TO_EDGE, ...
   void bind(int unit) const;

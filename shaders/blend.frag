@@ -20,46 +20,28 @@ layout(std430, binding = kBufferCounts) buffer CaseCounts { uint case_counts[kBl
 layout(location = 0) out vec4 out_final;  // rgb L, a s
 layout(location = 1) out float out_case;
 
+// The decision is shared::blend_pixel (pass_formulas.h); here only what it reads, and the
+// neighbourhoods only where it compares variances.
 void main() {
   ivec2 p = ivec2(gl_FragCoord.xy);
-  vec4 hv = texelFetch(hv_tex, p, 0);
-  vec3 lu = clean(hv.rgb);
-  vec4 lv_texel = texelFetch(lv_tex, p, 0);
-  vec3 lv = clean(lv_texel.rgb);
-  vec3 lf = lu;
-  float s = 1.0;
-  int blend_case = kCaseNoFiltered;
-  if (has_filtered != 0) {
-    vec4 fv = texelFetch(filtered_tex, p, 0);
-    lf = clean(fv.rgb);
-    float vu = clean_var(hv.a);
-    if (fv.a < kVarSkippedBelow) {
-      s = 1.0;
-      blend_case = kCaseUnfiltered;  // skipped by the filter
-    } else if (has_guide != 0 && lu == vec3(0.0) && texelFetch(guide_tex, p, 0).a >= kBackgroundDistanceMin) {
-      s = 1.0;
-      blend_case = kCaseUnfiltered;  // the background rule (kBackgroundDistanceMin): no HV light to miss
-    } else if (vu < 0.0) {
-      s = 0.0;
-      blend_case = kCaseUnknownVar;  // n < 2
-    } else {
-      float vf = max(clean_var(fv.a), 0.0);
-      float lb = max(luminance(lf) + luminance(lv), 0.0);
-      if (has_guide != 0) vu = pooled_var_u(hv_tex, guide_tex, p, k_c, k_d);
-      float u = vu > 0.0 ? relative_variance(vu, lb) : zero_variance_u(luminance(lf), lb);
-      float w = has_centre_weight != 0 ? texelFetch(centre_weight_tex, p, 0).r : 0.0;
-      float f = relative_variance(vf, lb);
-      s = blend_factor_covariance(u, f, pixel_threshold(t, lv_texel), w, blend_case);
-      if (bias_guard != 0) {
-        vec2 g = texelFetch(guard_tex, p, 0).rg;
-        BiasGuardEstimate e;
-        e.b2 = g.x;
-        e.var_u = g.y;
-        s = guarded_blend_factor(e, s, u, f, w, lb, blend_case);
-      }
+  BlendTexels px;
+  px.hv = texelFetch(hv_tex, p, 0);
+  px.lv = texelFetch(lv_tex, p, 0);
+  px.filtered = texelFetch(filtered_tex, p, 0);
+  px.guide_distance = texelFetch(guide_tex, p, 0).a;
+  BlendSwitches on = BlendSwitches(has_filtered != 0, has_guide != 0, bias_guard != 0, t);
+  BlendVarianceInputs v = blend_variance_inputs_none();
+  if (blend_compares_variances(px, on)) {
+    if (on.has_guide) v.var_u_pooled = pooled_var_u(hv_tex, guide_tex, p, k_c, k_d);
+    if (has_centre_weight != 0) v.centre_weight = texelFetch(centre_weight_tex, p, 0).r;
+    if (on.bias_guard) {
+      vec4 g = texelFetch(guard_tex, p, 0);
+      v.guard.b2 = g.x;
+      v.guard.var_u = g.y;
     }
   }
-  atomicAdd(case_counts[blend_case], 1u);
-  out_final = vec4(clean(lv + s * lu + (1.0 - s) * lf), s);
-  out_case = float(blend_case);
+  BlendPixel b = blend_pixel(px, on, v);
+  atomicAdd(case_counts[b.blend_case], 1u);
+  out_final = vec4(b.radiance, b.s);
+  out_case = float(b.blend_case);
 }

@@ -173,13 +173,22 @@ PXF_INLINE float zero_variance_u(float y_f, float lb) {
   return r * r;
 }
 
+// The least range weight a neighbour's variance is pooled with: the smallest normal float. The
+// GPU flushes a smaller weight to 0 (exp(-e) for e > 87), so the shader leaves such a neighbour
+// out; the C++ compilation, whose weights are doubles, left it in, and where every known
+// neighbour was that far across a range edge it normalized their tiny weights back to a full
+// mean: the CPU reference and the explorer's inspector pooled a variance the blend pass did not
+// (cornell 32x24 at 6 spp, 1 pixel in 768, s 0.067 against the pass's 0.056).
+PXF_CONST float kMinPooledWeight = 1.17549435e-38f;
+
 // Var[L_u] for the decisions of the blend and the filter's skipping (docs/method.md section 3.3). A
 // variance estimated from few samples is itself noisy, and far more often too low than too high:
 // path contributions are heavy-tailed, and a pixel that missed the rare bright paths looks quiet
 // (dark speckles kept by case 2). So the decision uses the larger of the pixel's own variance and
 // the range-weighted mean of the known variances in its 3x3 neighbourhood (the filter's weights).
 // Both fall as 1/n, so the bias still vanishes. Returns kVarUnknown where n < 2, and 0 where all
-// the pixel's samples were equal and no neighbour variance is known.
+// the pixel's samples were equal and no neighbour variance is known. A neighbour whose range weight
+// is below kMinPooledWeight counts as unknown.
 PXF_SAMPLER_FN float pooled_var_u(sampler2D hv, sampler2D guide, ivec2 p, float k_c, float k_d) {
   float own = clean_var(texelFetch(hv, p, 0).a);
   if (own < 0.0f) return kVarUnknown;
@@ -193,6 +202,7 @@ PXF_SAMPLER_FN float pooled_var_u(sampler2D hv, sampler2D guide, ivec2 p, float 
       float v = clean_var(texelFetch(hv, q, 0).a);
       if (!(v > 0.0f)) continue;  // unknown, or all samples equal: no evidence
       wide_float w = range_weight(g_p, texelFetch(guide, q, 0), k_c, k_d);
+      if (!(w >= kMinPooledWeight)) continue;  // across a range edge: as the GPU flushes it
       sw += w;
       swv += w * v;
     }
@@ -455,7 +465,7 @@ PXF_SAMPLER_FN BiasGuardEstimate bias_guard_estimate_at(sampler2D hv, sampler2D 
                              bias_guard_window_sums(hv, filtered, p, ivec2(0, -r), ivec2(r, r)));
 }
 
-// The guard as the blend applies it (blend.frag, cpu_blend): in cases 1 and 3 only, s and the
+// The guard as the blend applies it (blend_pixel): in cases 1 and 3 only, s and the
 // case from bias_guard_factor where the estimate holds a bias, traded against the larger of the
 // blend's u and the window's mean variance. lb: the blend's L_b; w: the filter's centre weight (0 if
 // none).
@@ -465,6 +475,98 @@ PXF_INLINE float guarded_blend_factor(BiasGuardEstimate e, float s, float u, flo
   if (!(e.b2 > 0.0f)) return s;
   float u_guard = max(u, relative_variance(e.var_u, lb));
   return bias_guard_factor(s, u_guard, f, w, relative_variance(e.b2, lb), blend_case);
+}
+
+// ---- The blend's decision per pixel (docs/method.md section 3.2) ----
+
+// Written once for the blend pass (blend.frag), the CPU reference (cpu_blend) and the explorer's
+// inspector (BlendPass::inspect), so that what the inspector shows is what made the image.
+
+// One pixel's texels as the blend pass reads them.
+struct BlendTexels {
+  vec4 hv;               // rgb L_u, a Var[L_u] of the pixel's own samples (kVarUnknown where n < 2)
+  vec4 lv;               // rgb L_lv, a the pixel's threshold factor (pixel_threshold)
+  vec4 filtered;         // rgb L_f, a Var[L_f] or a sentinel (kVarSkipped: the filter skipped the pixel)
+  float guide_distance;  // the range buffer's distance (the background rule)
+};
+
+// A blend run's settings: the pass's uniforms.
+struct BlendSwitches {
+  bool has_filtered;  // an L_f exists; without one every pixel is case 0 (s = 1)
+  bool has_guide;     // the range buffer is given: the background rule and the variance pooling apply
+  bool bias_guard;    // raise s where L_f is measurably biased (guarded_blend_factor)
+  float t;            // the run's threshold t_n; the pixel's own is pixel_threshold(t, lv)
+};
+
+// What the blend reads only where it compares variances (blend_compares_variances): the pooling
+// and the guard read whole neighbourhoods, which the pixels settled before need not pay for.
+struct BlendVarianceInputs {
+  float var_u_pooled;       // pooled_var_u at the pixel; read only with a guide (has_guide)
+  float centre_weight;      // the filter's centre weight w; 0 where none is known (no covariance term)
+  BiasGuardEstimate guard;  // the guard's finding; read only with bias_guard
+};
+PXF_INLINE BlendVarianceInputs blend_variance_inputs_none() {
+  BlendVarianceInputs v;
+  v.var_u_pooled = 0.0f;
+  v.centre_weight = 0.0f;
+  v.guard.b2 = 0.0f;
+  v.guard.var_u = 0.0f;
+  return v;
+}
+
+// The decision and the values it was made with, for the inspector to show.
+struct BlendPixel {
+  int blend_case;  // kCase*
+  float s;         // the weight of L_u: L = L_lv + s L_u + (1 - s) L_f
+  vec3 radiance;   // that L
+  float t;         // the pixel's threshold t_n (pixel_threshold)
+  float lb;        // L_b = Y(L_f) + Y(L_lv)
+  float var_u;     // the Var[L_u] u comes from: pooled with a guide, else the pixel's own
+  float u, f;      // u and f relative to L_b; 0 where the case was settled before comparing them
+};
+
+// Not a blend case: the variances decide (blend_case_before_variances).
+PXF_CONST int kCaseByVariances = -1;
+
+// The cases the blend settles before comparing variances, in its order: no L_f yet (case 0); the
+// filter skipped the pixel (case 2); the background rule (kBackgroundDistanceMin, case 2); n < 2,
+// the variance unknown (case 4). kCaseByVariances where none applies.
+PXF_INLINE int blend_case_before_variances(BlendTexels px, BlendSwitches on) {
+  if (!on.has_filtered) return kCaseNoFiltered;
+  if (px.filtered.a < kVarSkippedBelow) return kCaseUnfiltered;
+  if (on.has_guide && clean(vec3(px.hv)) == vec3(0.0f) && px.guide_distance >= kBackgroundDistanceMin)
+    return kCaseUnfiltered;
+  if (clean_var(px.hv.a) < 0.0f) return kCaseUnknownVar;
+  return kCaseByVariances;
+}
+PXF_INLINE bool blend_compares_variances(BlendTexels px, BlendSwitches on) {
+  return blend_case_before_variances(px, on) == kCaseByVariances;
+}
+
+// The blend of one pixel: the case order above, then u from the pooled variance (the pixel's own
+// without a guide; zero_variance_u where it is 0), f, the threshold, the covariance through the
+// centre weight (blend_factor_covariance) and the bias guard (guarded_blend_factor).
+PXF_INLINE BlendPixel blend_pixel(BlendTexels px, BlendSwitches on, BlendVarianceInputs v) {
+  vec3 lu = clean(vec3(px.hv));
+  vec3 lv = clean(vec3(px.lv));
+  vec3 lf = on.has_filtered ? clean(vec3(px.filtered)) : lu;
+  BlendPixel b;
+  b.t = pixel_threshold(on.t, px.lv);
+  b.lb = max(luminance(lf) + luminance(lv), 0.0f);
+  b.var_u = on.has_guide ? v.var_u_pooled : clean_var(px.hv.a);
+  b.u = 0.0f;
+  b.f = 0.0f;
+  b.blend_case = blend_case_before_variances(px, on);
+  b.s = b.blend_case == kCaseUnknownVar ? 0.0f : 1.0f;
+  if (b.blend_case == kCaseByVariances) {
+    float var_f = max(clean_var(px.filtered.a), 0.0f);  // unknown (no neighbour's variance known) reads as 0
+    b.u = b.var_u > 0.0f ? relative_variance(b.var_u, b.lb) : zero_variance_u(luminance(lf), b.lb);
+    b.f = relative_variance(var_f, b.lb);
+    b.s = blend_factor_covariance(b.u, b.f, b.t, v.centre_weight, b.blend_case);
+    if (on.bias_guard) b.s = guarded_blend_factor(v.guard, b.s, b.u, b.f, v.centre_weight, b.lb, b.blend_case);
+  }
+  b.radiance = clean(lv + b.s * lu + (1.0f - b.s) * lf);
+  return b;
 }
 
 // ---- Albedo demodulation ----
