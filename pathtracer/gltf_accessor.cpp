@@ -17,17 +17,6 @@ constexpr size_t kMaxZeroAccessorElements = size_t(1) << 26;
   throw Error(file + ": " + what + ": " + problem);
 }
 
-int component_size(int component_type) {
-  switch (component_type) {
-    case TINYGLTF_COMPONENT_TYPE_BYTE:
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return 1;
-    case TINYGLTF_COMPONENT_TYPE_SHORT:
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return 2;
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
-    case TINYGLTF_COMPONENT_TYPE_FLOAT: return 4;
-    default: return 0;
-  }
-}
 
 int type_components(int type) {
   switch (type) {
@@ -143,6 +132,18 @@ const tinygltf::Accessor& accessor_at(const tinygltf::Model& model, int index, c
 }
 
 }  // namespace
+
+int component_size(int component_type) {
+  switch (component_type) {
+    case TINYGLTF_COMPONENT_TYPE_BYTE:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return 1;
+    case TINYGLTF_COMPONENT_TYPE_SHORT:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return 2;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+    case TINYGLTF_COMPONENT_TYPE_FLOAT: return 4;
+    default: return 0;
+  }
+}
 
 ByteRange buffer_view_bytes(const tinygltf::Model& model, int view_index, const std::string& file,
                             const std::string& what) {

@@ -28,6 +28,9 @@ std::vector<glm::vec4> read_vec4(const tinygltf::Model& model, int index, const 
 // COLOR_0: vec3 (alpha = 1) or vec4.
 std::vector<glm::vec4> read_color(const tinygltf::Model& model, int index, const std::string& file,
                                   const std::string& what);
+// Bytes of one component of a glTF componentType (5120..5126); 0 for an unknown type.
+int component_size(int component_type);
+
 // Index accessor (unsigned byte/short/int scalars).
 std::vector<uint32_t> read_indices(const tinygltf::Model& model, int index, const std::string& file,
                                    const std::string& what);

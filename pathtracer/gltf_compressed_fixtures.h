@@ -17,6 +17,8 @@
 #include <string>
 #include <vector>
 
+#include "pathtracer/glb_test_util.h"
+
 namespace pxf::gltf_fixtures {
 
 using json = nlohmann::json;
@@ -67,20 +69,7 @@ struct Glb {
     }
     std::string text = d.dump();
     while (text.size() % 4) text += ' ';
-    Bytes out;
-    auto u32 = [&](uint32_t v) { for (int s = 0; s < 32; s += 8) out.push_back(static_cast<unsigned char>(v >> s)); };
-    out.insert(out.end(), {'g', 'l', 'T', 'F'});
-    u32(2);
-    u32(static_cast<uint32_t>(20 + text.size() + (payload.empty() ? 0 : 8 + payload.size())));
-    u32(static_cast<uint32_t>(text.size()));
-    u32(0x4E4F534A);  // JSON
-    out.insert(out.end(), text.begin(), text.end());
-    if (!payload.empty()) {
-      u32(static_cast<uint32_t>(payload.size()));
-      u32(0x004E4942);  // BIN
-      out.insert(out.end(), payload.begin(), payload.end());
-    }
-    return out;
+    return test::glb_container(text, payload);  // Bytes is std::vector<uint8_t>
   }
 };
 

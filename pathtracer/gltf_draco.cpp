@@ -43,18 +43,6 @@ std::unique_ptr<draco::Mesh> decode_mesh(const ByteRange& bytes, const std::stri
   }
 }
 
-int component_bytes(int component_type) {
-  switch (component_type) {
-    case TINYGLTF_COMPONENT_TYPE_BYTE:
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return 1;
-    case TINYGLTF_COMPONENT_TYPE_SHORT:
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return 2;
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
-    case TINYGLTF_COMPONENT_TYPE_FLOAT: return 4;
-    default: return 0;
-  }
-}
-
 // One point's components converted to the accessor's component type and stored at `out`.
 template <typename T>
 bool store_value(const draco::PointAttribute& attribute, draco::AttributeValueIndex index, int components,
@@ -91,7 +79,7 @@ DecodedArray decode_attribute(const draco::Mesh& mesh, const tinygltf::Accessor&
   const draco::PointAttribute* attribute = unique_id >= 0 ? mesh.GetAttributeByUniqueId(unique_id) : nullptr;
   if (!attribute) fail(file, label, "the Draco data has no attribute " + std::to_string(unique_id));
   const int components = tinygltf::GetNumComponentsInType(declared.type);
-  const int bytes_per_component = component_bytes(declared.componentType);
+  const int bytes_per_component = component_size(declared.componentType);
   if (components < 1 || components > 4 || bytes_per_component == 0)
     fail(file, label, "accessor type or componentType is not a vertex attribute's");
   if (attribute->num_components() != components)

@@ -14,6 +14,7 @@
 #include "core/json_depth.h"
 #include "image/image.h"
 #include "pathtracer/camera.h"
+#include "pathtracer/glb_test_util.h"
 #include "pathtracer/pathtracer.h"
 #include "pathtracer/texture.h"
 
@@ -198,20 +199,7 @@ class GltfBuilder {
     if (!payload.empty()) d["buffers"] = json::array({{{"byteLength", bin.size()}}});
     std::string text = d.dump();
     while (text.size() % 4) text += ' ';
-    std::vector<uint8_t> out;
-    auto u32 = [&](uint32_t v) { for (int s = 0; s < 32; s += 8) out.push_back(static_cast<uint8_t>(v >> s)); };
-    uint32_t total = 12 + 8 + static_cast<uint32_t>(text.size()) + (payload.empty() ? 0 : 8 + static_cast<uint32_t>(payload.size()));
-    out.insert(out.end(), {'g', 'l', 'T', 'F'});
-    u32(2);
-    u32(total);
-    u32(static_cast<uint32_t>(text.size()));
-    u32(0x4E4F534A);  // JSON
-    out.insert(out.end(), text.begin(), text.end());
-    if (!payload.empty()) {
-      u32(static_cast<uint32_t>(payload.size()));
-      u32(0x004E4942);  // BIN
-      out.insert(out.end(), payload.begin(), payload.end());
-    }
+    const std::vector<uint8_t> out = test::glb_container(text, payload);
     write_bytes(path, out);
     return path;
   }
