@@ -2,10 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <functional>
 #include <limits>
 
 #include "gl/cpu_reference.h"
+#include "pathtracer/pathtracer.h"
 
 namespace pxf {
 
@@ -43,31 +43,56 @@ std::vector<float> neighbourhood_need(const std::vector<float>& need, int width,
 
 namespace {
 
-// The need at which a pixel is traced every frame: full_rate_need, or the need of the pixel at the
-// top full_rate_share of `needs` where that is larger (nth_element: O(pixels)).
-float full_rate_scale(std::vector<float> needs, const AdaptiveParams& params) {
-  if (!(params.full_rate_share > 0.0f) || needs.empty()) return params.full_rate_need;
-  // The pixel with share * n - 1 pixels above it: exactly the top share is at or past it.
-  const size_t share_count = static_cast<size_t>(params.full_rate_share * static_cast<float>(needs.size()));
-  const size_t top = std::min(needs.size(), std::max<size_t>(share_count, 1)) - 1;
-  std::nth_element(needs.begin(), needs.begin() + top, needs.end(), std::greater<float>());
-  const float at_share = needs[top];
-  return std::isfinite(at_share) ? std::max(params.full_rate_need, at_share) : params.full_rate_need;
+// w_p of the goal (app/adaptive.h): s_p = sqrt(r_p n_p), the per-path relative deviation over
+// sqrt(t) (r falls as 1/n).
+float allocation_weight(float need, uint32_t paths, const AdaptiveParams& params) {
+  const float n = static_cast<float>(std::max<uint32_t>(paths, 1));
+  const bool young = paths < params.min_samples;
+  if (young) need = std::max(need, 1.0f);  // not retired on few samples
+  const float deviation = std::sqrt(need * n);  // s_p
+  if (params.goal == AdaptiveGoal::Error) return deviation;
+  return need > 1.0f || young ? deviation : 0.0f;
 }
 
 }  // namespace
 
+// The sum of the rates grows with lambda: lambda is found by bisection on its logarithm.
+std::vector<float> water_fill(const std::vector<float>& weights, double total, float floor_rate, float max_rate) {
+  auto rates_for = [&](double lambda, std::vector<float>* out) {
+    double sum = 0;
+    for (size_t p = 0; p < weights.size(); ++p) {
+      const double w = weights[p];
+      const float rate = std::isinf(w) ? max_rate : static_cast<float>(std::clamp(lambda * w, double{floor_rate}, double{max_rate}));
+      if (out) (*out)[p] = rate;
+      sum += rate;
+    }
+    return sum;
+  };
+  double lo = 1e-30, hi = 1e30;
+  for (int i = 0; i < 200 && hi / lo > 1.0 + 1e-7; ++i) {
+    const double mid = std::sqrt(lo * hi);
+    (rates_for(mid, nullptr) < total ? lo : hi) = mid;
+  }
+  std::vector<float> rates(weights.size());
+  rates_for(lo, &rates);
+  return rates;
+}
+
+std::vector<float> allocation_weights(const std::vector<float>& dilated_need, const std::vector<uint32_t>& paths,
+                                      const AdaptiveParams& params) {
+  std::vector<float> weights(dilated_need.size());
+  for (size_t p = 0; p < weights.size(); ++p) {
+    const float need = std::isnan(dilated_need[p]) ? std::numeric_limits<float>::infinity() : dilated_need[p];
+    weights[p] = allocation_weight(need, paths[p], params);
+  }
+  return weights;
+}
+
 std::vector<float> sampling_rates(const std::vector<float>& dilated_need, const std::vector<uint32_t>& paths,
                                   const AdaptiveParams& params) {
-  std::vector<float> needs(dilated_need.size());
-  for (size_t p = 0; p < needs.size(); ++p) {
-    needs[p] = std::isnan(dilated_need[p]) ? std::numeric_limits<float>::infinity() : dilated_need[p];
-    if (paths[p] < params.min_samples) needs[p] = std::max(needs[p], 1.0f);  // not retired on few samples
-  }
-  const float scale = full_rate_scale(needs, params);
-  std::vector<float> rates(needs.size());
-  for (size_t p = 0; p < rates.size(); ++p) rates[p] = std::clamp(needs[p] / scale, params.floor_rate, 1.0f);
-  return rates;
+  const std::vector<float> weights = allocation_weights(dilated_need, paths, params);
+  const double total = static_cast<double>(params.frame_paths) * static_cast<double>(weights.size());
+  return water_fill(weights, total, params.floor_rate, std::min(params.max_rate, static_cast<float>(kMaxPathsPerFrame)));
 }
 
 std::vector<uint8_t> select_active(const std::vector<float>& rates, std::vector<float>& credit) {
@@ -75,8 +100,9 @@ std::vector<uint8_t> select_active(const std::vector<float>& rates, std::vector<
   std::vector<uint8_t> active(rates.size());
   for (size_t p = 0; p < rates.size(); ++p) {
     credit[p] += rates[p];
-    active[p] = credit[p] >= 1.0f;
-    if (active[p]) credit[p] -= 1.0f;
+    const float paths = std::floor(std::min(credit[p], 255.0f));
+    active[p] = static_cast<uint8_t>(paths);
+    credit[p] -= paths;
   }
   return active;
 }

@@ -17,8 +17,9 @@ namespace pxf {
 
 namespace {
 
-PreviewSettings with_adaptive(PreviewSettings s, bool adaptive) {
+PreviewSettings with_adaptive(PreviewSettings s, bool adaptive, AdaptiveGoal goal = AdaptiveGoal::Error) {
   s.adaptive = adaptive;
+  s.adaptive_params.goal = goal;
   return s;
 }
 
@@ -200,7 +201,7 @@ void clean_over_time(const AdaptiveBenchSetup& b, double cap_ms, CleanJob (&jobs
   for (int adaptive = 0; adaptive < 2; ++adaptive) {
     const auto start = BenchClock::now();
     jobs[adaptive].preview =
-        std::make_unique<Preview>(b.scene, with_adaptive(b.settings, adaptive != 0), b.width, b.height);
+        std::make_unique<Preview>(b.scene, with_adaptive(b.settings, adaptive != 0, AdaptiveGoal::Clean), b.width, b.height);
     jobs[adaptive].ms = elapsed_ms(start);
   }
   while (!jobs[0].done || !jobs[1].done) {

@@ -1,6 +1,8 @@
 // The allocation of adaptive sampling (app/adaptive.h) under fake variance images: the need is the
-// final pixel's perceived variance over its own threshold, decided for each pixel by the others in its box; samples follow
-// it up to one per frame; the floor, the minimum and the dilation hold.
+// final pixel's perceived variance over its own threshold, decided for each pixel by the others in
+// its box; the paths follow its standard deviation (goal Error) or its variance where not yet clean
+// (goal Clean), water-filled to a uniform frame's paths; the floor, the cap, the minimum and the
+// dilation hold.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -74,81 +76,118 @@ TEST(AdaptiveNeighbourhood, EachPixelTakesTheLargestNeedOfTheOthersInItsBox) {
 }
 
 // The property that keeps adaptive means unbiased (tests/consistency_test.cpp): whatever a pixel's
-// own samples say, its rate is the same; its neighbours' rates follow it. (With full_rate_share the
-// scale is the need at the top quarter of all pixels, to which each pixel adds 1/N: off here.)
-TEST(AdaptiveNeighbourhood, APixelsOwnNeedNeverDecidesItsRate) {
+// own samples say, its weight is the same; its neighbours' weights follow it. (Its rate also
+// depends, through the water filling, on the whole image's weights, to which it adds little.)
+TEST(AdaptiveNeighbourhood, APixelsOwnNeedNeverDecidesItsWeight) {
   const int w = 7, h = 7;
-  AdaptiveParams params;
-  params.full_rate_share = 0.0f;
-  const std::vector<uint32_t> paths(w * h, 500);
-  std::vector<float> need(w * h, 0.3f);
-  need[2 * w + 2] = 6.0f;
-  const size_t centre = 3 * w + 3;
-  std::vector<std::vector<float>> rates;
-  for (float own : {0.0f, 1.0f, 50.0f, kInf}) {
-    need[centre] = own;
-    rates.push_back(sampling_rates(neighbourhood_need(need, w, h, params.dilation_radius), paths, params));
+  for (AdaptiveGoal goal : {AdaptiveGoal::Error, AdaptiveGoal::Clean}) {
+    AdaptiveParams params;
+    params.goal = goal;
+    const std::vector<uint32_t> paths(w * h, 500);
+    std::vector<float> need(w * h, 0.3f);
+    need[2 * w + 2] = 6.0f;
+    const size_t centre = 3 * w + 3;
+    std::vector<std::vector<float>> weights;
+    for (float own : {0.0f, 1.0f, 50.0f, kInf}) {
+      need[centre] = own;
+      weights.push_back(allocation_weights(neighbourhood_need(need, w, h, params.dilation_radius), paths, params));
+    }
+    for (const auto& wt : weights) EXPECT_EQ(wt[centre], weights[0][centre]);
+    EXPECT_LT(weights[0][5 * w + 5], weights[2][5 * w + 5]);  // a neighbour's weight does follow it
   }
-  for (const auto& r : rates) EXPECT_EQ(r[centre], rates[0][centre]);
-  EXPECT_LT(rates[0][5 * w + 5], rates[2][5 * w + 5]);  // a neighbour's rate does follow it
 }
 
-// Frames traced per pixel over `frames` frames of fixed rates.
+// Paths traced per pixel over `frames` frames of fixed rates.
 std::vector<int> traced_over(const std::vector<float>& rates, int frames) {
   std::vector<float> credit;
   std::vector<int> traced(rates.size(), 0);
   for (int f = 0; f < frames; ++f) {
-    const std::vector<uint8_t> active = select_active(rates, credit);
-    for (size_t p = 0; p < rates.size(); ++p) traced[p] += active[p];
+    const std::vector<uint8_t> counts = select_active(rates, credit);
+    for (size_t p = 0; p < rates.size(); ++p) traced[p] += counts[p];
   }
   return traced;
 }
 
-TEST(AdaptiveRates, SamplesFollowTheNeedUpToOnePerFrame) {
-  AdaptiveParams params;
-  params.full_rate_share = 0.0f;  // the fixed scale full_rate_need (the share: the next test)
-  const std::vector<float> need = {0.5f, 1.0f, 2.0f, 3.0f, 4.0f, 30.0f, kInf};
-  const std::vector<uint32_t> paths(need.size(), 1000);  // past the minimum
-  const std::vector<float> rates = sampling_rates(need, paths, params);
-  constexpr int kFrames = 256;
-  const std::vector<int> traced = traced_over(rates, kFrames);
-  for (size_t p = 0; p < need.size(); ++p) {
-    const double expected = kFrames * std::min(1.0, static_cast<double>(need[p] / params.full_rate_need));
-    EXPECT_NEAR(traced[p], expected, 1.0) << "need " << need[p];
-  }
-  // Proportional: twice the need, twice the samples (below a path per frame).
-  EXPECT_NEAR(static_cast<double>(traced[2]) / traced[1], 2.0, 0.02);
-  EXPECT_NEAR(static_cast<double>(traced[3]) / traced[0], 6.0, 0.1);
+double sum_of(const std::vector<float>& v) {
+  double s = 0;
+  for (float x : v) s += x;
+  return s;
 }
 
-// While most pixels are far from t, only the neediest full_rate_share of them are traced every frame
-// and the others in proportion to their need; once few are past full_rate_need, the fixed scale holds.
-TEST(AdaptiveRates, TheNeediestShareIsTracedEveryFrameTheOthersInProportion) {
-  AdaptiveParams params;  // full_rate_share 0.25
-  std::vector<float> need(100);
-  for (size_t p = 0; p < need.size(); ++p) need[p] = 10.0f + static_cast<float>(p);  // 10 .. 109, all past 4
-  const std::vector<uint32_t> paths(need.size(), 1000);
+// Goal Error: paths in proportion to the per-path standard deviation sqrt(r n) (n proportional to
+// sigma), every frame as many paths as a uniform one.
+TEST(AdaptiveRates, ForTheErrorSamplesFollowTheStandardDeviation) {
+  const AdaptiveParams params;  // goal Error
+  const std::vector<float> need = {0.25f, 1.0f, 4.0f, 9.0f, 0.25f, 1.0f, 0.0f, 16.0f};
+  std::vector<uint32_t> paths(need.size(), 1000);  // past the minimum
+  paths[4] = 4000;  // four times the paths at the same need: twice the per-path deviation
   const std::vector<float> rates = sampling_rates(need, paths, params);
-  const float scale = need[75];  // the pixel with 25 pixels above it
-  for (size_t p = 0; p < need.size(); ++p)
-    EXPECT_FLOAT_EQ(rates[p], std::min(1.0f, need[p] / scale)) << p;
-  EXPECT_EQ(std::count(rates.begin(), rates.end(), 1.0f), 25);
-  // Few pixels past full_rate_need: the scale stays full_rate_need.
-  std::vector<float> mostly_clean(100, 0.5f);
-  mostly_clean[7] = 40.0f;
-  const std::vector<float> clean_rates = sampling_rates(mostly_clean, paths, params);
-  EXPECT_EQ(clean_rates[7], 1.0f);
-  EXPECT_FLOAT_EQ(clean_rates[0], 0.5f / params.full_rate_need);
-  // Unknown variances (infinite need) are traced every frame and do not make the scale infinite.
-  std::vector<float> unknown(need);
-  for (size_t p = 0; p < 40; ++p) unknown[p] = kInf;
-  const std::vector<float> unknown_rates = sampling_rates(unknown, paths, params);
-  EXPECT_EQ(unknown_rates[0], 1.0f);
-  EXPECT_GT(unknown_rates[99], params.floor_rate);
+  EXPECT_NEAR(sum_of(rates), need.size() * params.frame_paths, 1e-3);
+  EXPECT_NEAR(rates[1] / rates[0], 2.0f, 1e-4f);
+  EXPECT_NEAR(rates[2] / rates[0], 4.0f, 1e-4f);
+  EXPECT_NEAR(rates[3] / rates[0], 6.0f, 1e-4f);
+  EXPECT_NEAR(rates[4] / rates[0], 2.0f, 1e-4f);
+  EXPECT_EQ(rates[6], params.floor_rate);  // no need: the floor
+  constexpr int kFrames = 256;
+  const std::vector<int> traced = traced_over(rates, kFrames);
+  for (size_t p = 0; p < need.size(); ++p) EXPECT_NEAR(traced[p], kFrames * rates[p], 1.0) << p;
+}
+
+// Goal Clean: paths in proportion to the standard deviation for the pixels not yet clean, the floor
+// for the others.
+TEST(AdaptiveRates, ForCleanSamplesFollowTheDeviationOfThePixelsNotYetClean) {
+  AdaptiveParams params;
+  params.goal = AdaptiveGoal::Clean;
+  const std::vector<float> need = {2.0f, 8.0f, 18.0f, 0.9f, 1.0f, 0.2f, 4.5f, 2.0f};
+  std::vector<uint32_t> paths(need.size(), 1000);
+  paths[7] = 4000;
+  const std::vector<float> rates = sampling_rates(need, paths, params);
+  EXPECT_NEAR(sum_of(rates), need.size() * params.frame_paths, 1e-3);
+  EXPECT_NEAR(rates[1] / rates[0], 2.0f, 1e-4f);
+  EXPECT_NEAR(rates[2] / rates[0], 3.0f, 1e-4f);
+  EXPECT_NEAR(rates[6] / rates[0], 1.5f, 1e-4f);
+  EXPECT_NEAR(rates[7] / rates[0], 2.0f, 1e-4f);
+  for (size_t p : {3, 4, 5}) EXPECT_EQ(rates[p], params.floor_rate) << p;  // clean: the floor only
+  // Every pixel clean: every pixel at the floor, and a frame traces only the floor's paths.
+  const std::vector<float> clean_rates = sampling_rates(std::vector<float>(8, 0.5f), paths, params);
+  for (float r : clean_rates) EXPECT_EQ(r, params.floor_rate);
+}
+
+TEST(AdaptiveRates, WaterFillingKeepsTheCapAndTheFloorAndSpendsTheBudget) {
+  std::vector<float> weights(100, 1.0f);
+  weights[0] = 1e6f;                     // would take the whole budget: the cap
+  weights[1] = kInf;                     // unknown variance: the cap
+  for (size_t p = 2; p < 12; ++p) weights[p] = 0.0f;  // nothing to gain: the floor
+  const std::vector<float> rates = water_fill(weights, 200.0, 0.0625f, 32.0f);
+  EXPECT_EQ(rates[0], 32.0f);
+  EXPECT_EQ(rates[1], 32.0f);
+  for (size_t p = 2; p < 12; ++p) EXPECT_EQ(rates[p], 0.0625f);
+  EXPECT_NEAR(sum_of(rates), 200.0, 1e-3);
+  EXPECT_NEAR(rates[50], (200.0 - 64.0 - 10 * 0.0625) / 88.0, 1e-4);
+  // A budget past every cap: every pixel at the cap; below every floor: every pixel at the floor.
+  const std::vector<float> rich = water_fill(weights, 1e6, 0.0625f, 32.0f);  // nothing to gain stays at the floor
+  for (size_t p = 0; p < rich.size(); ++p) EXPECT_EQ(rich[p], weights[p] == 0.0f ? 0.0625f : 32.0f) << p;
+  for (float r : water_fill(std::vector<float>(10, 1.0f), 1e6, 0.0625f, 32.0f)) EXPECT_EQ(r, 32.0f);
+  for (float r : water_fill(std::vector<float>(10, 1.0f), 0.1, 0.0625f, 32.0f)) EXPECT_EQ(r, 0.0625f);
+}
+
+TEST(AdaptiveRates, ARateAboveOneTracesSeveralPathsInAFrame) {
+  std::vector<float> credit;
+  const std::vector<float> rates = {2.5f, 0.25f, 40.0f};
+  int total[3] = {0, 0, 0};
+  for (int f = 0; f < 8; ++f) {
+    const std::vector<uint8_t> counts = select_active(rates, credit);
+    EXPECT_TRUE(counts[0] == 2 || counts[0] == 3) << f;
+    EXPECT_EQ(counts[2], 40);
+    for (int p = 0; p < 3; ++p) total[p] += counts[p];
+  }
+  EXPECT_EQ(total[0], 20);
+  EXPECT_EQ(total[1], 2);
 }
 
 TEST(AdaptiveRates, TheFloorRevisitsEveryPixelRegularly) {
-  const AdaptiveParams params;
+  AdaptiveParams params;
+  params.goal = AdaptiveGoal::Clean;  // every pixel clean: all at the floor
   const std::vector<float> need = {0.0f, 1e-6f, 0.05f};
   const std::vector<float> rates = sampling_rates(need, std::vector<uint32_t>(3, 1000), params);
   for (float r : rates) EXPECT_EQ(r, params.floor_rate);
@@ -169,35 +208,46 @@ TEST(AdaptiveRates, TheFloorRevisitsEveryPixelRegularly) {
 }
 
 TEST(AdaptiveRates, APixelBelowTheMinimumIsNotRetired) {
-  AdaptiveParams params;
-  params.full_rate_share = 0.0f;
-  const std::vector<float> need = {0.0f, 0.0f, 8.0f};
-  const std::vector<uint32_t> paths = {params.min_samples - 1, params.min_samples, params.min_samples - 1};
-  const std::vector<float> rates = sampling_rates(need, paths, params);
-  EXPECT_EQ(rates[0], 1.0f / params.full_rate_need);  // counts as at the threshold
-  EXPECT_EQ(rates[1], params.floor_rate);             // at the minimum: may retire
-  EXPECT_EQ(rates[2], 1.0f);                          // a larger need stays
-  params.min_samples = 0;
-  EXPECT_EQ(sampling_rates(need, paths, params)[0], params.floor_rate);
+  for (AdaptiveGoal goal : {AdaptiveGoal::Error, AdaptiveGoal::Clean}) {
+    AdaptiveParams params;
+    params.goal = goal;
+    const std::vector<float> need = {0.0f, 0.0f, 0.0f, 0.0f};
+    const std::vector<uint32_t> paths = {params.min_samples - 1, params.min_samples, params.min_samples,
+                                         params.min_samples};
+    const std::vector<float> weights = allocation_weights(need, paths, params);
+    EXPECT_GT(weights[0], 0.0f);  // counts as at the threshold
+    EXPECT_EQ(weights[1], 0.0f);  // at the minimum: may retire
+    const std::vector<float> rates = sampling_rates(need, paths, params);
+    EXPECT_GT(rates[0], params.floor_rate);
+    EXPECT_EQ(rates[1], params.floor_rate);
+  }
 }
 
 TEST(AdaptiveRates, ACausticKeepsItselfAndItsQuietNeighboursSampled) {
-  // The chain from a fake need image to the masks: a 2x2 caustic (need 40) among clean pixels (0.1)
-  // past the minimum. The caustic's pixels keep each other traced every frame, and so is every pixel
-  // within 2 of it; the rest is at the floor.
+  // The chain from a fake need image to the path counts: a 2x2 caustic (need 40) among clean
+  // pixels (0.1) past the minimum. The caustic's pixels keep each other traced, and so is every
+  // pixel within 2 of it, sqrt(400) = 20 times as often as the rest (goal Error), or every clean
+  // pixel is at the floor (goal Clean).
   const int w = 12, h = 10;
-  const AdaptiveParams params;
-  std::vector<float> need(w * h, 0.1f);
-  for (int y = 5; y <= 6; ++y)
-    for (int x = 6; x <= 7; ++x) need[y * w + x] = 40.0f;
-  const std::vector<float> rates = sampling_rates(neighbourhood_need(need, w, h, params.dilation_radius),
-                                                  std::vector<uint32_t>(w * h, 500), params);
-  const std::vector<int> traced = traced_over(rates, 32);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      const bool near = x >= 4 && x <= 9 && y >= 3 && y <= 8;
-      EXPECT_EQ(traced[y * w + x], near ? 32 : 2) << x << "," << y;
-    }
+  for (AdaptiveGoal goal : {AdaptiveGoal::Error, AdaptiveGoal::Clean}) {
+    AdaptiveParams params;
+    params.goal = goal;
+    std::vector<float> need(w * h, 0.1f);
+    for (int y = 5; y <= 6; ++y)
+      for (int x = 6; x <= 7; ++x) need[y * w + x] = 40.0f;
+    const std::vector<float> rates = sampling_rates(neighbourhood_need(need, w, h, params.dilation_radius),
+                                                    std::vector<uint32_t>(w * h, 500), params);
+    const std::vector<int> traced = traced_over(rates, 32);
+    const int near_count = 36, far_count = w * h - near_count;
+    const double far_rate = goal == AdaptiveGoal::Error ? w * h / (near_count * 20.0 + far_count) : params.floor_rate;
+    const double near_rate = goal == AdaptiveGoal::Error ? 20.0 * far_rate
+                                                          : (w * h - far_count * params.floor_rate) / near_count;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const bool near = x >= 4 && x <= 9 && y >= 3 && y <= 8;
+        EXPECT_NEAR(traced[y * w + x], 32 * (near ? near_rate : far_rate), 1.0) << x << "," << y;
+      }
+  }
 }
 
 TEST(AdaptiveCounts, MeanMinAndMax) {

@@ -58,7 +58,7 @@ FrameRange render_frame_range(const CheckpointOptions& o, int spp) {
 SampleSettings render_sample_settings(const SceneOptions& scene, const PreviewSettings& settings) {
   SampleSettings s = sample_settings(scene_content_hash(scene.scene, scene.env, scene.env_strength), scene.width,
                                      scene.height, settings.trace);
-  s.adaptive = settings.adaptive ? 1u : 0u;
+  s.adaptive = !settings.adaptive ? 0u : settings.adaptive_params.goal == AdaptiveGoal::Clean ? 2u : 1u;
   return s;
 }
 

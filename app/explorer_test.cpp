@@ -178,7 +178,8 @@ TEST_F(ExplorerSamplingViews, SamplesViewIsTheCountsOnTheLegendsLinearScale) {
   ASSERT_EQ(paths.size(), static_cast<size_t>(kW * kH));
   const SampleCounts counts = sample_counts(paths);
   ASSERT_LT(counts.min, counts.max) << "the allocation traced every pixel alike: nothing uneven to show";
-  EXPECT_EQ(counts.max, 40u);
+  EXPECT_NEAR(counts.mean, 40.0, 1.0);  // an adaptive frame traces a uniform one's paths, spread unevenly
+  EXPECT_GT(counts.max, 40u);
   const ScalarScale& s = views_->scale(BufferView::Samples);  // set by set_sampling, no update call
   EXPECT_FALSE(s.log);
   EXPECT_EQ(s.lo, float(counts.min));  // the whole range of the image
@@ -212,7 +213,7 @@ TEST_F(ExplorerSamplingViews, ActiveViewShowsTheNextMaskAndAnEmptyMaskAsEveryPix
     for (int y = 0; y < kH; ++y)
       for (int x = 0; x < kW; ++x) {
         const size_t p = static_cast<size_t>(y) * kW + x;
-        const CaseStyle& style = active_styles()[active.empty() || active[p] == 1 ? 1 : 0];
+        const CaseStyle& style = active_styles()[active.empty() || active[p] > 0 ? 1 : 0];
         const float want[3] = {style.r, style.g, style.b};
         for (int c = 0; c < 3; ++c) wrong += std::abs(image.at(x, y, c) - want[c]) > 0.6f / 255;
       }
@@ -227,7 +228,7 @@ TEST_F(ExplorerSamplingViews, ActiveViewShowsTheNextMaskAndAnEmptyMaskAsEveryPix
 TEST_F(ExplorerSamplingViews, StatusLineOfAnAdaptivePreview) {
   const SampleCounts counts = sample_counts(preview_->pixel_samples());
   const std::vector<uint8_t>& mask = preview_->next_active();
-  const double active = 100.0 * std::count(mask.begin(), mask.end(), 1) / mask.size();
+  const double active = 100.0 * (mask.size() - std::count(mask.begin(), mask.end(), 0)) / mask.size();
   char want[200];
   std::snprintf(want, sizeof want, "clean (case 2): %.1f %%   paths/pixel mean %.1f (min %u, max %u)   active %.1f %%",
                 100.0 * preview_->case_counts()[kCaseUnfiltered] / (kW * kH), counts.mean, counts.min, counts.max, active);

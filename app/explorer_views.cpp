@@ -100,7 +100,8 @@ const std::array<CaseStyle, 2>& active_styles() { return kActiveStyles; }
 
 double active_share(const std::vector<uint8_t>& active) {
   if (active.empty()) return 1.0;
-  return static_cast<double>(std::count(active.begin(), active.end(), uint8_t{1})) / static_cast<double>(active.size());
+  const auto untraced = std::count(active.begin(), active.end(), uint8_t{0});
+  return static_cast<double>(active.size() - static_cast<size_t>(untraced)) / static_cast<double>(active.size());
 }
 
 std::string sampling_status_line(double case2_share, const SamplingSnapshot& sampling) {
@@ -173,7 +174,7 @@ void ViewRenderer::upload_sampling() {
   const bool every_pixel = sampling_.active.size() != pixels;  // empty: adaptive off or still warming up
   std::vector<unsigned char> rgba(4 * pixels);
   for (size_t p = 0; p < pixels; ++p) {
-    const CaseStyle& c = kActiveStyles[every_pixel || sampling_.active[p] == 1 ? 1 : 0];
+    const CaseStyle& c = kActiveStyles[every_pixel || sampling_.active[p] > 0 ? 1 : 0];
     rgba[4 * p + 0] = static_cast<unsigned char>(std::lround(255.0f * c.r));
     rgba[4 * p + 1] = static_cast<unsigned char>(std::lround(255.0f * c.g));
     rgba[4 * p + 2] = static_cast<unsigned char>(std::lround(255.0f * c.b));

@@ -53,7 +53,7 @@ const std::array<CaseStyle, 2>& active_styles();
 // and the status line read this copy (taken after each traced frame) instead of the live vectors.
 struct SamplingSnapshot {
   std::vector<uint32_t> paths;  // Preview::pixel_samples(): paths traced into each pixel, row-major, top row first
-  std::vector<uint8_t> active;  // Preview::next_active(): 1 = the next frame traces it; empty = every pixel
+  std::vector<uint8_t> active;  // Preview::next_active(): paths the next frame traces in each pixel; empty = one in every pixel
   static SamplingSnapshot of(const Preview& preview) { return {preview.pixel_samples(), preview.next_active()}; }
 };
 // The share of the pixels the next frame traces: 1 when the mask is empty (every pixel).

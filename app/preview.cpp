@@ -89,6 +89,12 @@ void check_preview_memory(int width, int height, uint64_t available_bytes) {
 }
 
 // The memory check runs first, before any member allocates.
+namespace {
+// An adaptive frame traces up to kMaxPathsPerFrame paths per pixel: its shards of disjoint frames
+// then keep disjoint sample indices (ProgressiveRenderer::set_sample_stride).
+uint32_t sample_stride(const PreviewSettings& settings) { return settings.adaptive ? kMaxPathsPerFrame : 1u; }
+}  // namespace
+
 Preview::Preview(const Scene& scene, const PreviewSettings& settings, int width, int height)
     : width_((check_preview_memory(width, height, available_memory_bytes()), width)),
       height_(height),
@@ -103,6 +109,7 @@ Preview::Preview(const Scene& scene, const PreviewSettings& settings, int width,
   range_.set_settings(settings_.range);
   range_.set_scene(scene);
   range_.set_camera(renderer_->camera());
+  renderer_->set_sample_stride(sample_stride(settings_));
 }
 
 Preview::~Preview() = default;
@@ -149,8 +156,9 @@ void Preview::load_state(const AccumulationState& state) {
   replans_ = replan_schedule(samples());
   if (std::any_of(state.rate.begin(), state.rate.end(), [](float r) { return r > 0.0f; })) rates_ = state.rate;
   active_credit_ = state.credit;
-  const bool every_pixel = std::all_of(state.next_active.begin(), state.next_active.end(), [](uint8_t a) { return a; });
-  if (!every_pixel) next_active_ = state.next_active;
+  // One path for every pixel is the uniform frame (the same paths).
+  const bool uniform = std::all_of(state.next_active.begin(), state.next_active.end(), [](uint8_t a) { return a == 1; });
+  if (!uniform) next_active_ = state.next_active;
 }
 
 void Preview::set_camera(const Camera& camera) {
@@ -164,6 +172,7 @@ void Preview::set_settings(const PreviewSettings& settings) {
   const bool refilter = !same_filter_params(settings, settings_);
   settings_ = settings;
   range_.set_settings(settings_.range);
+  renderer_->set_sample_stride(sample_stride(settings_));
   if (retrace) {
     renderer_->set_params(settings_.trace);
     reset();
@@ -326,7 +335,7 @@ bool Preview::trace_frame() {
   const auto start = BenchClock::now();
   const bool complete = next_active_.empty() ? renderer_->add_frame() : renderer_->add_frame(next_active_);
   last_active_share_ = next_active_.empty() ? 1.0
-                       : static_cast<double>(std::count(next_active_.begin(), next_active_.end(), 1)) /
+                       : static_cast<double>(next_active_.size() - std::count(next_active_.begin(), next_active_.end(), 0)) /
                              static_cast<double>(next_active_.size());
   last_.path_tracing = elapsed_ms(start);
   uploaded_ = false;
@@ -374,7 +383,7 @@ void Preview::plan_next_frame() {
   // most 1 / floor_rate steps, when every pixel is at the floor).
   do {
     next_active_ = select_active(rates, active_credit_);
-  } while (std::find(next_active_.begin(), next_active_.end(), 1) == next_active_.end());
+  } while (std::all_of(next_active_.begin(), next_active_.end(), [](uint8_t paths) { return paths == 0; }));
 }
 
 void Preview::queue_passes(bool last_frame, bool display) {

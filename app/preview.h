@@ -144,9 +144,9 @@ class Preview {
   int height() const { return height_; }
   int samples() const { return renderer_->frames(); }  // frames traced; a pixel's own count: pixel_samples()
   const std::vector<uint32_t>& pixel_samples() const { return renderer_->pixel_frames(); }
-  // The share of the pixels the last traced frame traced (1 for a uniform frame).
+  // The share of the pixels the last frame traced at least once (1 for a uniform frame).
   double last_active_share() const { return last_active_share_; }
-  // Adaptive sampling's allocation: the next frame's mask (1 = traced; empty = every pixel) and the
+  // Adaptive sampling's allocation: the next frame's path count per pixel (empty = one in every pixel) and the
   // per-pixel credits it was selected with (empty before the first allocation; app/adaptive.h).
   const std::vector<uint8_t>& next_active() const { return next_active_; }
   const std::vector<float>& allocation_credit() const { return active_credit_; }

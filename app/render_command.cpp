@@ -122,6 +122,7 @@ int run_render(const Args& args) {
   }
   // Without a filter the blend has no case 2 to count.
   if (until_clean && !preview_settings.filtering()) throw UsageError("--until-clean needs a filter (not --filter none)");
+  if (until_clean) preview_settings.adaptive_params.goal = AdaptiveGoal::Clean;  // app/adaptive.h
 
   const FrameRange frames = render_frame_range(checkpoint_options, spp);  // a bad range before any load
 

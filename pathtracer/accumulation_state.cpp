@@ -85,6 +85,11 @@ void put_settings(ByteWriter& w, const SampleSettings& s) {
   w.put(s.guiding);
 }
 
+// The adaptive flag as a phrase (SampleSettings::adaptive).
+std::string adaptive_name(uint32_t adaptive) {
+  return adaptive == 0 ? "off" : adaptive == 1 ? "on" : "on until clean";
+}
+
 SampleSettings get_settings(ByteReader& r) {
   SampleSettings s;
   s.scene_hash = r.get<uint64_t>("header");
@@ -100,7 +105,7 @@ SampleSettings get_settings(ByteReader& r) {
   s.adaptive = r.get<uint32_t>("header");
   s.guiding = r.get<uint32_t>("header");
   if (s.all_hv > 1 || s.specular_sampling > static_cast<uint32_t>(SpecularSamplingMode::Near) || s.sampler > 1 ||
-      s.adaptive > 1 || s.guiding > 1)
+      s.adaptive > 2 || s.guiding > 1)
     throw Error("state file has an invalid setting flag (all-hv, sampler, specular sampling, adaptive or guiding)");
   if (s.replicates < 1 || s.replicates > kMaxReplicates)
     throw Error("state file has an invalid replicate count " + std::to_string(s.replicates));
@@ -139,14 +144,15 @@ void check_pixels(const AccumulationState& state) {
   const Accumulation& acc = state.acc;
   const uint32_t frames = state.frame_count();
   for (size_t i = 0; i < acc.samples.size(); ++i) {
-    // A frame traces a pixel at most once, every frame of a uniform state every pixel; non-finite
-    // samples are traced but dropped.
-    if (state.traced[i] > frames || (!state.settings.adaptive && state.traced[i] != frames))
+    // An adaptive frame traces a pixel at most kMaxPathsPerFrame times, every frame of a uniform
+    // state every pixel once; non-finite samples are traced but dropped.
+    const uint64_t most = static_cast<uint64_t>(frames) * (state.settings.adaptive ? kMaxPathsPerFrame : 1u);
+    if (state.traced[i] > most || (!state.settings.adaptive && state.traced[i] != frames))
       throw Error("state file has a traced count that does not fit its frames at pixel " + std::to_string(i));
     if (acc.samples[i] > state.traced[i]) throw Error("state file has more samples in a pixel than it traced");
     if (state.settings.adaptive &&
-        (!(state.rate[i] >= 0.0f && state.rate[i] <= 1.0f) || !(state.credit[i] >= 0.0f && state.credit[i] < 1.0f) ||
-         state.next_active[i] > 1))
+        (!(state.rate[i] >= 0.0f && state.rate[i] <= static_cast<float>(kMaxPathsPerFrame)) ||
+         !(state.credit[i] >= 0.0f && state.credit[i] < 1.0f) || state.next_active[i] > kMaxPathsPerFrame))
       throw Error("state file has an invalid adaptive allocation at pixel " + std::to_string(i));
     const glm::vec3 lv = acc.lv_mean[i], hv = acc.hv_mean[i], a = acc.albedo_mean[i];
     const bool finite = std::isfinite(lv.x) && std::isfinite(lv.y) && std::isfinite(lv.z) && std::isfinite(hv.x) &&
@@ -233,7 +239,7 @@ std::string SampleSettings::difference(const SampleSettings& o) const {
   if (sampler != o.sampler) return diff("sampler", sampler_type_names()[sampler], sampler_type_names()[o.sampler]);
   if (replicates != o.replicates) return diff("replicates", replicates, o.replicates);
   if (specular_sampling != o.specular_sampling) return diff("specular sampling", specular_sampling, o.specular_sampling);
-  if (adaptive != o.adaptive) return std::string("adaptive sampling ") + (adaptive ? "on" : "off") + " vs " + (o.adaptive ? "on" : "off");
+  if (adaptive != o.adaptive) return "adaptive sampling " + adaptive_name(adaptive) + " vs " + adaptive_name(o.adaptive);
   if (guiding != o.guiding) return std::string("guiding ") + (guiding ? "on" : "off") + " vs " + (o.guiding ? "on" : "off");
   return "";
 }

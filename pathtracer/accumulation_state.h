@@ -14,8 +14,10 @@ namespace pxf {
 
 // 2: the albedo mean; 3: sampler, replicates, specular sampling; 4: replicate sums; 5: the LV luminance Welford
 // state; 6: adaptive sampling (the flag, per-pixel traced counts, the allocation's credits and next mask) and path
-// guiding (the flag, the serialized field)
-constexpr uint32_t kStateFormatVersion = 6;
+// guiding (the flag, the serialized field); 7: adaptive frames trace up to kMaxPathsPerFrame paths per
+// pixel (counts, rates above 1, a shard's sample indices from its first frame * kMaxPathsPerFrame)
+// and the flag names the allocation's goal
+constexpr uint32_t kStateFormatVersion = 7;
 
 // Frame counts: one render traces at most kMaxRenderFrames frames (--spp, --frames, --shard); a
 // state, also a merge of many shards, holds at most kMaxStateFrames in all, the most the preview's
@@ -42,7 +44,8 @@ struct SampleSettings {
   uint32_t sampler = 0;            // SamplerType: 0 sobol, 1 independent
   uint32_t replicates = 1;         // TraceParams::replicates (which scrambled sequence frame k uses)
   uint32_t specular_sampling = 0;  // 0 none, 1 at every diffuse vertex, 2 near only (the default)
-  // 1: adaptive sampling (--adaptive on): pixels are traced unevenly, each at its own sample index.
+  // 1: adaptive sampling (--adaptive on) for the least error, 2: for clean (--until-clean; the
+  // allocation's goal, app/adaptive.h): pixels are traced unevenly, each at its own sample index.
   // Not a property of a sample, but a resume must continue the same allocation, and a merge of
   // adaptive and uniform shards would be a render neither option describes.
   uint32_t adaptive = 0;
@@ -64,7 +67,7 @@ struct AccumulationState {
   std::vector<uint32_t> traced;
   // Adaptive sampling's allocation (settings.adaptive only, else empty; app/adaptive.h): each
   // pixel's rate (paths per frame) of the last recomputation, 0 before the first; its credit after
-  // the last planned frame and that frame's mask (1 = traced next), so that a resumed render traces
+  // the last planned frame and that frame's path counts (0 = not traced next), so that a resumed render traces
   // exactly what the uninterrupted one would. A merged state keeps zeros and ones: it is not resumed
   // (its frames are not one range).
   std::vector<float> rate;

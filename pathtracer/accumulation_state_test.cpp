@@ -325,7 +325,7 @@ TEST(AccumulationState, AdaptiveAllocationRoundTripsExactly) {
 
 TEST(AccumulationState, AdaptiveCountsAndAllocationOutOfRangeAreRefused) {
   AccumulationState state = render_adaptive({0, 8});
-  state.traced[4] = 9;  // more paths than frames
+  state.traced[4] = 8 * kMaxPathsPerFrame + 1;  // more paths than frames can hold
   EXPECT_NE(decode_error(encode_state(state)).find("traced count that does not fit its frames at pixel 4"),
             std::string::npos);
   state = render_adaptive({0, 8});
@@ -338,10 +338,10 @@ TEST(AccumulationState, AdaptiveCountsAndAllocationOutOfRangeAreRefused) {
         << bad;
   }
   state = render_adaptive({0, 8});
-  state.rate[3] = 1.5f;
+  state.rate[3] = kMaxPathsPerFrame + 0.5f;
   EXPECT_NE(decode_error(encode_state(state)).find("invalid adaptive allocation at pixel 3"), std::string::npos);
   state = render_adaptive({0, 8});
-  state.next_active[1] = 2;
+  state.next_active[1] = kMaxPathsPerFrame + 1;
   EXPECT_NE(decode_error(encode_state(state)).find("invalid adaptive allocation at pixel 1"), std::string::npos);
   // A uniform state's pixels were traced in every frame.
   AccumulationState uniform = render_frames({0, 8});
@@ -349,8 +349,9 @@ TEST(AccumulationState, AdaptiveCountsAndAllocationOutOfRangeAreRefused) {
   EXPECT_NE(decode_error(encode_state(uniform)).find("traced count that does not fit"), std::string::npos);
 }
 
-// An adaptive shard of frames A:B traces pixel p at sample indices A..A + traced[p] - 1, so shards
-// of disjoint ranges hold disjoint samples and their merge is their exact sum. It is not resumed:
+// An adaptive shard of frames A:B traces pixel p at sample indices 32 A .. 32 A + traced[p] - 1
+// (ProgressiveRenderer::set_sample_stride), so shards of disjoint ranges hold disjoint samples and
+// their merge is their exact sum. It is not resumed:
 // adjacent ranges stay apart (one joined range would let a resume trace some indices twice), and
 // the allocation is cleared. Adaptive and uniform states do not merge.
 TEST(AccumulationState, AdaptiveShardsMergeAsTheirSumAndStayApart) {

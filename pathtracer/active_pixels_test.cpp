@@ -48,6 +48,15 @@ std::vector<uint8_t> varying_mask(int frame) {
   return mask;
 }
 
+// Path counts that change from frame to frame: the active pixels of varying_mask trace 1 to 3
+// paths, so that a pixel's paths of one frame straddle the 256-path batches somewhere.
+std::vector<uint8_t> varying_counts(int frame) {
+  std::vector<uint8_t> counts = varying_mask(frame);
+  for (size_t p = 0; p < counts.size(); ++p)
+    if (counts[p]) counts[p] = static_cast<uint8_t>(1 + (p + static_cast<size_t>(frame)) % 3);
+  return counts;
+}
+
 TEST(ActivePixels, EveryPixelActiveIsTheUniformFrame) {
   const Scene scene = make_cornell_box(true);
   TraceParams params;
@@ -83,10 +92,37 @@ TEST(ActivePixels, UniformFrameKIsEachPixelsSampleK) {
   expect_same_accumulation(renderer.accumulation(), expected);
 }
 
+// An adaptive shard of frames A:B starts at sample index A * kMaxPathsPerFrame (the sample stride):
+// its frames trace at most kMaxPathsPerFrame paths per pixel each, so the indices of shards of
+// disjoint frames never meet, whatever their allocations.
+TEST(ActivePixels, AShardStartsAtItsFirstFrameTimesTheStride) {
+  const Scene scene = make_cornell_box(true);
+  TraceParams params;
+  params.threads = 2;
+  ProgressiveRenderer renderer(scene, params, kWidth, kHeight);
+  renderer.set_sample_stride(kMaxPathsPerFrame);
+  renderer.set_first_frame(2);
+  const std::vector<uint8_t> counts = varying_counts(0);
+  ASSERT_TRUE(renderer.add_frame(counts));
+  PathTracer tracer(scene);
+  Accumulation expected;
+  resize_accumulation(expected, kWidth, kHeight);
+  for (int y = 0; y < kHeight; ++y)
+    for (int x = 0; x < kWidth; ++x) {
+      const size_t p = static_cast<size_t>(y) * kWidth + x;
+      for (uint32_t k = 0; k < counts[p]; ++k) {
+        const PathSample s = tracer.trace_pixel(scene.camera, kWidth, kHeight, x, y, 2 * kMaxPathsPerFrame + k, params);
+        if (s.finite()) accumulate_sample(expected, p, s.lv, s.hv, 0, s.albedo);
+      }
+    }
+  expect_same_accumulation(renderer.accumulation(), expected);
+  EXPECT_THROW(renderer.set_sample_stride(kMaxPathsPerFrame + 1), Error);
+}
+
 TEST(ActivePixels, APixelTracedNTimesHoldsTheFirstNSamplesOfItsSequence) {
-  // Pixels active in some frames only: each holds exactly the samples 0 .. n-1 of its own
-  // sequence, i.e. what a uniform render of n frames gives it, with replicates split by its own
-  // count (frame k of replicate k mod K).
+  // Pixels tracing 0 to 3 paths a frame: each holds exactly the samples 0 .. n-1 of its own
+  // sequence, i.e. what a uniform render of n frames gives it (paths of one frame or of n frames,
+  // the same bits), with replicates split by its own count (sample k in replicate k mod K).
   const Scene scene = make_cornell_box(true);
   for (int replicates : {1, 3}) {
     TraceParams params;
@@ -94,27 +130,29 @@ TEST(ActivePixels, APixelTracedNTimesHoldsTheFirstNSamplesOfItsSequence) {
     params.replicates = replicates;
     ProgressiveRenderer masked(scene, params, kWidth, kHeight);
     std::vector<uint32_t> active_frames(static_cast<size_t>(kWidth) * kHeight, 0);
-    constexpr int kFrames = 7;
+    constexpr int kFrames = 5, kMostPaths = 3 * kFrames;
     for (int f = 0; f < kFrames; ++f) {
-      const std::vector<uint8_t> mask = varying_mask(f);
+      const std::vector<uint8_t> mask = varying_counts(f);
       ASSERT_TRUE(masked.add_frame(mask));
       for (size_t p = 0; p < mask.size(); ++p) active_frames[p] += mask[p];
     }
     EXPECT_EQ(masked.pixel_frames(), active_frames);
     EXPECT_EQ(masked.frames(), kFrames);
-    std::vector<std::unique_ptr<ProgressiveRenderer>> owned;  // uniform renders of n = 0 .. kFrames frames
-    for (int n = 0; n <= kFrames; ++n) {
+    std::vector<std::unique_ptr<ProgressiveRenderer>> owned;  // uniform renders of n = 0 .. kMostPaths frames
+    for (int n = 0; n <= kMostPaths; ++n) {
       owned.push_back(std::make_unique<ProgressiveRenderer>(scene, params, kWidth, kHeight));
       for (int f = 0; f < n; ++f) ASSERT_TRUE(owned.back()->add_frame());
     }
-    bool some_pixel_skipped_frames = false;
+    bool some_pixel_skipped_frames = false, some_pixel_traced_more = false;
     for (size_t p = 0; p < active_frames.size(); ++p) {
       const uint32_t n = active_frames[p];
       some_pixel_skipped_frames |= n < kFrames;
+      some_pixel_traced_more |= n > kFrames;
       ASSERT_EQ(pixel_bytes(masked.accumulation(), p), pixel_bytes(owned[n]->accumulation(), p))
           << "pixel " << p << ", " << n << " paths, " << replicates << " replicates";
     }
     EXPECT_TRUE(some_pixel_skipped_frames);
+    EXPECT_TRUE(some_pixel_traced_more);
   }
 }
 
@@ -125,7 +163,11 @@ TEST(ActivePixels, ResultsDoNotDependOnTheThreadCount) {
     TraceParams params;
     params.threads = threads;
     renders.push_back(std::make_unique<ProgressiveRenderer>(scene, params, kWidth, kHeight));
-    for (int f = 0; f < 5; ++f) ASSERT_TRUE(renders.back()->add_frame(varying_mask(f)));
+    for (int f = 0; f < 5; ++f) {
+      std::vector<uint8_t> counts = varying_counts(f);
+      counts[300] = kMaxPathsPerFrame;  // the batches around it are cut short
+      ASSERT_TRUE(renders.back()->add_frame(counts));
+    }
   }
   expect_same_accumulation(renders[0]->accumulation(), renders[1]->accumulation());
   expect_same_accumulation(renders[0]->accumulation(), renders[2]->accumulation());
@@ -148,6 +190,9 @@ TEST(ActivePixels, AnInactivePixelIsUntouchedAndAResetClearsTheCounts) {
   renderer.reset();
   for (uint32_t n : renderer.pixel_frames()) EXPECT_EQ(n, 0u);
   EXPECT_THROW(renderer.add_frame(std::vector<uint8_t>(3, 1)), Error);
+  std::vector<uint8_t> too_many(static_cast<size_t>(kWidth) * kHeight, 1);
+  too_many[5] = kMaxPathsPerFrame + 1;
+  EXPECT_THROW(renderer.add_frame(too_many), Error);
 }
 
 TEST(ActivePixels, RestoredFramesCountForEveryPixel) {

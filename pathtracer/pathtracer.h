@@ -182,7 +182,10 @@ struct TraceStats {
 
 class PathTracer;  // Embree scene, light and environment samplers (pathtracer internals)
 
-// The progressive state: one path per pixel (or per active pixel) per add_frame().
+// The most paths one pixel traces in one frame (adaptive sampling's counts).
+constexpr uint32_t kMaxPathsPerFrame = 32;
+
+// The progressive state: one path per pixel (or a count per pixel) per add_frame().
 class ProgressiveRenderer {
  public:
   // The renderer keeps a reference to `scene`, not a copy: the scene must outlive the renderer and
@@ -196,26 +199,32 @@ class ProgressiveRenderer {
   void reset();                          // clears accumulation (camera, scene or params changed)
   void set_camera(const Camera& camera); // resets
   void set_params(const TraceParams& params);  // resets
-  // Traces one path per pixel, each at its own sample index first_frame() + pixel_frames()[p]
-  // (first_frame() + frames() while every frame traced every pixel). Returns false when
+  // Traces one path per pixel, each at its own sample index first_frame() * the sample stride +
+  // pixel_frames()[p] (first_frame() + frames() while every frame traced every pixel). Returns false when
   // cancel_frame() stopped it: the frame is then incomplete and the accumulation is reset.
   bool add_frame();
-  // The same for the pixels whose `active` entry is nonzero only (width x height entries, row-major;
-  // adaptive sampling, docs/sampling.md): they are compacted into full batches, and each traces the
-  // next sample of its own sequence, so the result does not depend on the thread count. Throws
-  // pxf::Error when the mask's size is not the image's.
-  bool add_frame(const std::vector<uint8_t>& active);
+  // The same with `counts[p]` paths for pixel p (width x height entries, row-major, 0 = none;
+  // adaptive sampling, docs/sampling.md): the paths are compacted into full batches, and pixel p
+  // traces the next counts[p] samples of its own sequence, so the result does not depend on the
+  // thread count nor on how the paths were spread over frames. Throws pxf::Error when the counts'
+  // size is not the image's or a count is over kMaxPathsPerFrame.
+  bool add_frame(const std::vector<uint8_t>& counts);
   // Thread-safe: a running add_frame() (on another thread) stops after the tiles in flight. For a
   // caller about to reset anyway (the explorer's camera moves), so that it need not wait a frame.
   void cancel_frame();
   int frames() const;                    // frames traced (or restored) since the last reset
   // Paths traced into each pixel since the last reset (restored frames included), dropped
-  // non-finite ones too: the pixel's next sample index is first_frame() + this. Accumulation::samples
+  // non-finite ones too: the pixel's next sample index is first_frame() * stride + this. Accumulation::samples
   // counts the accepted ones only.
   const std::vector<uint32_t>& pixel_frames() const;
   // Where the frame sequence starts (a shard of frames A:B starts at A); resets.
   void set_first_frame(uint32_t first);
   uint32_t first_frame() const;
+  // Frame f's first sample index is f * stride (default 1; from the next frame on, which matters
+  // only where first_frame() > 0). Adaptive sampling, which traces
+  // up to kMaxPathsPerFrame paths per pixel a frame, sets kMaxPathsPerFrame, so that shards of
+  // disjoint frames keep disjoint sample indices however their allocations spread the paths.
+  void set_sample_stride(uint32_t stride);
   // Continues from a saved accumulation holding the frames [first, first + frames) (checkpoint
   // resume, merged shards). `traced`: each pixel's traced paths (pixel_frames(); an adaptive
   // render's), empty = `frames` for every pixel. Throws pxf::Error when a size differs from the

@@ -18,6 +18,7 @@ namespace pxf {
 namespace {
 
 constexpr int kTileSize = 16;
+constexpr int kChunk = kTileSize * kTileSize;  // jobs per batch that one thread traces
 
 // Path guiding's training (docs/guiding.md, measured there): after each frame, a quarter of a
 // photon per pixel, but at least kGuidingMinPhotonsPerFrame (the field's resolution depends on the
@@ -69,8 +70,10 @@ struct ProgressiveRenderer::Impl {
   TraceStats stats;
   std::atomic<int> frames{0};  // read by the explorer's UI thread while a worker traces
   uint32_t first_frame = 0;
+  uint32_t sample_stride = 1;  // frame f's first sample index is f * sample_stride
   std::vector<uint32_t> pixel_frames;  // paths traced into each pixel since the reset
   std::vector<PixelSampleJob> jobs;    // the frame's paths (build_jobs), kept to reuse the memory
+  std::vector<size_t> chunk_starts;    // where each batch of at most kChunk jobs starts, then the end
   // Path guiding (params.guiding): learned since the last reset, read by the tracing threads.
   std::unique_ptr<GuidingField> guiding;
 
@@ -117,35 +120,44 @@ struct ProgressiveRenderer::Impl {
     arena = std::make_unique<tbb::task_arena>(threads);
   }
 
-  // The pixels a frame traces, as jobs in tile order (16x16 tiles, row-major inside each): with
+  // The paths a frame traces, as jobs in tile order (16x16 tiles, row-major inside each): with
   // every pixel active a chunk of kChunk jobs is one tile, as the camera rays' coherence wants; with
-  // a mask the active pixels are compacted, so that every chunk but the last is a full batch.
+  // a mask the active pixels' paths are compacted, so that chunks are nearly full batches. A pixel
+  // with count k traces k consecutive jobs, the next k indices of its sequence, all in one chunk:
+  // one thread then adds them in index order, so the sums do not depend on the thread count.
   // Each job's sample index is the pixel's own count, so a pixel's samples do not depend on which
   // other pixels a frame traces, nor on the chunking or the thread.
-  void build_jobs(const uint8_t* active) {
+  uint32_t first_sample() const { return first_frame * sample_stride; }
+
+  void build_jobs(const uint8_t* counts) {
     jobs.clear();
+    chunk_starts.assign(1, 0);
     const int tiles_x = (width + kTileSize - 1) / kTileSize, tiles_y = (height + kTileSize - 1) / kTileSize;
     for (int ty = 0; ty < tiles_y; ++ty)
       for (int tx = 0; tx < tiles_x; ++tx)
         for (int y = ty * kTileSize; y < std::min((ty + 1) * kTileSize, height); ++y)
           for (int x = tx * kTileSize; x < std::min((tx + 1) * kTileSize, width); ++x) {
             const size_t p = static_cast<size_t>(y) * width + x;
-            if (active && !active[p]) continue;
-            jobs.push_back(PixelSampleJob{x, y, first_frame + pixel_frames[p]});
+            const uint32_t k = counts ? counts[p] : 1u;
+            if (k == 0) continue;
+            if (k > kMaxPathsPerFrame) throw Error("a pixel's path count of " + std::to_string(k) + " is over " +
+                                                   std::to_string(kMaxPathsPerFrame) + " a frame");
+            if (jobs.size() - chunk_starts.back() + k > static_cast<size_t>(kChunk)) chunk_starts.push_back(jobs.size());
+            for (uint32_t i = 0; i < k; ++i) jobs.push_back(PixelSampleJob{x, y, first_sample() + pixel_frames[p] + i});
           }
+    chunk_starts.push_back(jobs.size());
   }
 
   void render_frame() {
-    constexpr int kChunk = kTileSize * kTileSize;
-    const int chunks = static_cast<int>((jobs.size() + kChunk - 1) / kChunk);
+    const int chunks = static_cast<int>(chunk_starts.size()) - 1;
     const uint32_t replicates = static_cast<uint32_t>(acc.replicates);
     std::atomic<uint64_t> rays{0}, paths{0}, dropped{0};
     auto render_chunks = [&](const tbb::blocked_range<int>& range) {
       uint64_t chunk_rays = 0, chunk_paths = 0, chunk_dropped = 0;
       for (int chunk = range.begin(); chunk != range.end(); ++chunk) {
         if (cancel.load(std::memory_order_relaxed)) break;
-        const size_t first = static_cast<size_t>(chunk) * kChunk;
-        const int count = static_cast<int>(std::min<size_t>(kChunk, jobs.size() - first));
+        const size_t first = chunk_starts[chunk];
+        const int count = static_cast<int>(chunk_starts[chunk + 1] - first);
         PathSample samples[kChunk];
         tracer->trace_jobs(camera, width, height, &jobs[first], count, params, samples);
         for (int i = 0; i < count; ++i) {
@@ -213,7 +225,7 @@ bool ProgressiveRenderer::add_frame() { return add_frame_of(nullptr); }
 
 bool ProgressiveRenderer::add_frame(const std::vector<uint8_t>& active) {
   if (active.size() != impl_->pixel_frames.size())
-    throw Error("active mask has " + std::to_string(active.size()) + " entries, the image " +
+    throw Error("path counts have " + std::to_string(active.size()) + " entries, the image " +
                 std::to_string(impl_->pixel_frames.size()) + " pixels");
   return add_frame_of(active.data());
 }
@@ -245,6 +257,11 @@ uint32_t ProgressiveRenderer::first_frame() const { return impl_->first_frame; }
 void ProgressiveRenderer::set_first_frame(uint32_t first) {
   impl_->first_frame = first;
   reset();
+}
+
+void ProgressiveRenderer::set_sample_stride(uint32_t stride) {
+  if (stride < 1 || stride > kMaxPathsPerFrame) throw Error("sample stride " + std::to_string(stride) + " out of range");
+  impl_->sample_stride = stride;
 }
 
 void ProgressiveRenderer::restore(const Accumulation& acc, uint32_t first, int frames,

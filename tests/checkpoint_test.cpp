@@ -153,7 +153,7 @@ TEST(Checkpoint, AdaptiveResumeAfterSigkillIsBitIdentical) {
 }
 
 // An adaptive shard (--frames A:B or --shard i/n with --adaptive on) is an adaptive render of B - A
-// frames whose pixel p takes the sample indices A, A + 1, ... as far as its allocation goes, so
+// frames whose pixel p takes the sample indices 32 A, 32 A + 1, ... as far as its allocation goes, so
 // shards hold disjoint samples and their merge is their exact sum: counts add, means are the
 // sample-weighted means. A merged adaptive state is not resumed, and an adaptive and a uniform
 // state do not merge.

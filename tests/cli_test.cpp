@@ -197,9 +197,12 @@ TEST(Cli, AdaptiveRenderRecordsItsPixelCounts) {
   ASSERT_EQ(r.code, 0) << r.err;
   const auto adaptive = nlohmann::json::parse(slurp(out + "/stats.json"));
   EXPECT_EQ(adaptive["settings"]["adaptive"], true);
-  EXPECT_EQ(adaptive["samples_per_pixel"]["max"], 48);
+  // A frame traces as many paths as a uniform one, placed where they are needed: the mean stays at
+  // the frames, the counts part from the warm-up's 16 on, down to the floor's and up past the frames.
+  EXPECT_NEAR(adaptive["samples_per_pixel"]["mean"].get<double>(), 48.0, 1.0);
+  EXPECT_GT(adaptive["samples_per_pixel"]["max"].get<int>(), 48);
   EXPECT_GE(adaptive["samples_per_pixel"]["min"].get<int>(), 16 + (48 - 16) / 16);  // warm-up, then the floor
-  EXPECT_LT(adaptive["samples_per_pixel"]["mean"].get<double>(), 48.0);
+  EXPECT_LT(adaptive["samples_per_pixel"]["min"].get<int>(), 48);
   // The whole adaptive render (allocation, its guide, the masked frames) does not depend on the
   // thread count: the same samples, bit for bit, with one thread and with two.
   std::vector<Layer> by_threads[2];
