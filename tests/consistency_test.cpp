@@ -128,7 +128,8 @@ TEST(Consistency, AdaptiveUnfilteredMeanHasNoBiasFromStopping) {
   }
   // Goal error; goal clean weights the same neighbourhood need (the weights' independence of the
   // pixel's own need, both goals: AdaptiveNeighbourhood.APixelsOwnNeedNeverDecidesItsWeight).
-  for (AdaptiveGoal goal : {AdaptiveGoal::Error}) {
+  {
+    const AdaptiveGoal goal = AdaptiveGoal::Error;
     std::vector<std::vector<double>> adaptive;
     double spread = 0;  // the mean over seeds of the most paths a pixel got over the mean
     for (int seed = 1; seed <= 32; ++seed) {
