@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "pathtracer/ggx_albedo.h"
 #include "pathtracer/texture.h"
 
 namespace pxf {
@@ -58,10 +59,14 @@ bool material_is_perfect_mirror(const Material& m) {
   return constant(m.metallic_roughness_texture) && m.roughness < kDeltaRoughness && m.metallic >= 1.0f - 1e-3f;
 }
 
+// Exactly the materials whose BSDF has delta lobes only (a constant-factor mirror or glass), so
+// that the specular chains, the range buffer and the LV/HV split agree about every surface.
 bool material_is_perfect_specular(const Material& m) {
-  if (!constant(m.metallic_roughness_texture) || m.roughness >= kDeltaRoughness) return false;
-  bool glass = constant(m.transmission_texture) && m.transmission >= 1.0f - 1e-3f && m.metallic <= 1e-3f;
-  return material_is_perfect_mirror(m) || glass;
+  if (!constant(m.metallic_roughness_texture)) return false;
+  if (material_is_perfect_mirror(m)) return true;
+  // Glass is smooth below the delta roughness, or at any roughness without refraction (ior 1).
+  const bool smooth = m.roughness < kDeltaRoughness || std::abs(m.ior - 1.0f) < 1e-3f;
+  return smooth && constant(m.transmission_texture) && m.transmission >= 1.0f - 1e-3f && m.metallic <= 1e-3f;
 }
 
 float ggx_d(glm::vec3 h, float alpha) {
@@ -103,6 +108,12 @@ float fresnel_dielectric(float cos_i, float eta) {
   return 0.5f * (rs * rs + rp * rp);
 }
 
+float ggx_vndf_pdf(glm::vec3 wo, glm::vec3 h, float alpha) {
+  const float cos_oh = glm::dot(wo, h);
+  if (!(cos_oh > 0.0f) || !(wo.z > 0.0f)) return 0.0f;
+  return ggx_d(h, alpha) * cos_oh / ((1.0f + ggx_lambda(wo, alpha)) * wo.z);
+}
+
 BsdfMaterial bsdf_material(const BsdfParams& params) {
   BsdfMaterial k;
   k.params = params;
@@ -110,6 +121,9 @@ BsdfMaterial bsdf_material(const BsdfParams& params) {
   const float c_diffuse = (1.0f - m) * (1.0f - t);
   k.c_glass = (1.0f - m) * t;
   k.glossy_delta = params.roughness < kDeltaRoughness;
+  // An interface without refraction has no half vector for its transmission: it passes light
+  // straight through, a delta lobe whatever the roughness (pbrt does the same).
+  k.glass_delta = k.glossy_delta || std::abs(params.ior - 1.0f) < 1e-3f;
   k.alpha = std::max(params.roughness * params.roughness, kMinAlpha);
   const float r0 = (params.ior - 1.0f) / (params.ior + 1.0f);
   k.f0_dielectric = glm::min(glm::vec3(r0 * r0) * params.specular_color, glm::vec3(1.0f)) * params.specular;
@@ -126,6 +140,7 @@ Bsdf::Bsdf(const BsdfMaterial& k, glm::vec3 shading_normal, glm::vec3 geometric_
       ior_(k.params.ior),
       alpha_(k.alpha),
       glossy_delta_(k.glossy_delta),
+      glass_delta_(k.glass_delta),
       front_face_(front_face),
       c_glass_(k.c_glass),
       fresnel_at_0_(k.fresnel_at_0),
@@ -138,12 +153,20 @@ Bsdf::Bsdf(const BsdfMaterial& k, glm::vec3 shading_normal, glm::vec3 geometric_
   wo_local_ = frame_.to_local(wo);
   wo_local_.z = std::max(wo_local_.z, 1e-6f);
   lambda_o_ = ggx_lambda(wo_local_, alpha_);
+  g1_o_ = 1.0f / (1.0f + lambda_o_);
 
-  float cos_o = wo_local_.z;
-  glm::vec3 fd_o = schlick(k.f0_dielectric, k.f90_dielectric, cos_o);
-  diffuse_factor_ = k.diffuse_albedo * (glm::vec3(1.0f) - fd_o);
+  const float cos_o = wo_local_.z;
+  // The single-scattering GGX albedo at wo; a delta mirror reflects everything, with Schlick's weight.
+  const GgxAlbedo e = glossy_delta_ ? GgxAlbedo{1.0f, schlick_weight(cos_o)} : ggx_albedo(cos_o, alpha_);
+  const float missing = 1.0f / std::max(e.total, 1e-2f) - 1.0f;  // 1 / E - 1: the multiple-scattering share
+  glossy_compensation_ = glm::vec3(1.0f) + fresnel_at_0_ * missing;
+  const glm::vec3 glossy_albedo = (fresnel_at_0_ * e.total + fresnel_slope_ * e.schlick) * glossy_compensation_;
+  // The Lambert layer gets what the dielectric specular layer (compensated the same way) leaves.
+  const glm::vec3 specular_albedo = (k.f0_dielectric * e.total + (glm::vec3(k.f90_dielectric) - k.f0_dielectric) * e.schlick) *
+                                    (glm::vec3(1.0f) + k.f0_dielectric * missing);
+  diffuse_factor_ = k.diffuse_albedo * glm::max(glm::vec3(1.0f) - specular_albedo, glm::vec3(0.0f));
   float w_diffuse = std::max(0.0f, luminance(diffuse_factor_) * kPi);
-  float w_glossy = std::max(0.0f, luminance(glossy_fresnel(cos_o)));
+  float w_glossy = std::max(0.0f, luminance(glossy_albedo));
   float w_glass = std::max(0.0f, c_glass_);
   float total = w_diffuse + w_glossy + w_glass;
   black_ = !(total > 0.0f);
@@ -151,9 +174,9 @@ Bsdf::Bsdf(const BsdfMaterial& k, glm::vec3 shading_normal, glm::vec3 geometric_
   p_diffuse_ = w_diffuse / total;
   p_glossy_ = w_glossy / total;
   p_glass_ = w_glass / total;
-  has_nondelta_ = p_diffuse_ > 0.0f || (p_glossy_ > 0.0f && !glossy_delta_);
+  has_nondelta_ = p_diffuse_ > 0.0f || (p_glossy_ > 0.0f && !glossy_delta_) || (p_glass_ > 0.0f && !glass_delta_);
   inv_4cos_o_ = 1.0f / (4.0f * cos_o);
-  glossy_pdf_scale_ = p_glossy_ * inv_4cos_o_ / (1.0f + lambda_o_);
+  glossy_pdf_scale_ = p_glossy_ * inv_4cos_o_ * g1_o_;
 }
 
 // Fresnel of the GGX layer: the conductor and the dielectric specular share one microfacet lobe.
@@ -163,24 +186,61 @@ glm::vec3 Bsdf::glossy_fresnel(float cos_oh) const {
 
 glm::vec3 Bsdf::eval_local(glm::vec3 wi, float* pdf) const {
   *pdf = 0.0f;
-  if (wi.z <= 0.0f) return glm::vec3(0.0f);
+  if (wi.z < 0.0f) return p_glass_ > 0.0f && !glass_delta_ ? eval_glass_transmission(wi, pdf) : glm::vec3(0.0f);
+  if (wi.z == 0.0f) return glm::vec3(0.0f);
   glm::vec3 f = diffuse_factor_ * wi.z;
   *pdf = p_diffuse_ * wi.z * kInvPi;
-  if (p_glossy_ > 0.0f && !glossy_delta_) {
+  const bool glossy = p_glossy_ > 0.0f && !glossy_delta_, glass = p_glass_ > 0.0f && !glass_delta_;
+  if (glossy || glass) {  // the GGX reflection lobes share the half vector
     glm::vec3 h = glm::normalize(wo_local_ + wi);
     float d = ggx_d(h, alpha_);
     float g2 = 1.0f / (1.0f + lambda_o_ + ggx_lambda(wi, alpha_));
     float spec = d * g2 * inv_4cos_o_;  // D G2 / (4 cos_o cos_i), times cos_i
-    f += glossy_fresnel(std::max(0.0f, glm::dot(wo_local_, h))) * spec;
-    *pdf += glossy_pdf_scale_ * d;  // VNDF: G1(wo) D / (4 cos_o)
+    float cos_oh = std::max(0.0f, glm::dot(wo_local_, h));
+    if (glossy) {
+      f += glossy_fresnel(cos_oh) * glossy_compensation_ * spec;
+      *pdf += glossy_pdf_scale_ * d;  // VNDF: G1(wo) D / (4 cos_o)
+    }
+    if (glass) {  // reflected with probability F(wo.h) of the sampled microfacet
+      float fresnel = fresnel_dielectric(cos_oh, eta());
+      f += glm::vec3(c_glass_ * fresnel * spec);
+      *pdf += p_glass_ * fresnel * g1_o_ * d * inv_4cos_o_;
+    }
   }
   return f;
 }
 
+// Walter et al. 2007's refraction through a GGX microfacet (pbrt-v4's DielectricBxDF), tinted by
+// the base color and compressed by eta^2 like the smooth glass's.
+glm::vec3 Bsdf::eval_glass_transmission(glm::vec3 wi, float* pdf) const {
+  const float eta = this->eta();
+  glm::vec3 h = wo_local_ + wi * eta;  // the generalized half vector
+  const float length2 = glm::dot(h, h);
+  if (!(length2 > 1e-12f)) return glm::vec3(0.0f);
+  h *= 1.0f / std::sqrt(length2);
+  if (h.z < 0.0f) h = -h;
+  const float cos_oh = glm::dot(wo_local_, h), cos_ih = glm::dot(wi, h);
+  if (cos_oh <= 0.0f || cos_ih >= 0.0f) return glm::vec3(0.0f);  // a microfacet seen from its back
+  const float transmitted = 1.0f - fresnel_dielectric(cos_oh, eta);
+  const float denom = cos_ih + cos_oh / eta;
+  const float jacobian = -cos_ih / (denom * denom);  // d omega_h / d omega_i
+  if (!(transmitted > 0.0f) || !std::isfinite(jacobian)) return glm::vec3(0.0f);
+  const float d = ggx_d(h, alpha_);
+  const float g2 = 1.0f / (1.0f + lambda_o_ + ggx_lambda(wi, alpha_));
+  const float cos_o = wo_local_.z;
+  *pdf = p_glass_ * transmitted * g1_o_ * d * cos_oh / cos_o * jacobian;
+  return base_color_ * (c_glass_ * transmitted * d * g2 * cos_oh * jacobian / (cos_o * eta * eta));
+}
+
 glm::vec3 Bsdf::eval(glm::vec3 wi, float* pdf) const {
   *pdf = 0.0f;
-  if (black_ || glm::dot(wi, ng_) <= 0.0f) return glm::vec3(0.0f);  // no light through opaque faces
-  return eval_local(frame_.to_local(wi), pdf);
+  if (black_) return glm::vec3(0.0f);
+  // Reflection stays on wo's side of the face, transmission crosses it: light never passes through
+  // an opaque face, and the shading normal may not disagree with the face about the side.
+  const glm::vec3 local = frame_.to_local(wi);
+  const float side = glm::dot(wi, ng_);
+  if ((local.z > 0.0f && side > 0.0f) || (local.z < 0.0f && side < 0.0f)) return eval_local(local, pdf);
+  return glm::vec3(0.0f);
 }
 
 glm::vec3 Bsdf::eval(glm::vec3 wi) const {
@@ -194,12 +254,22 @@ float Bsdf::pdf(glm::vec3 wi) const {
   return pdf;
 }
 
+bool Bsdf::finish_nondelta_sample(glm::vec3 wi_local, bool transmitted, BsdfSample* out) const {
+  out->wi = frame_.to_world(wi_local);
+  glm::vec3 f = eval(out->wi, &out->pdf);
+  if (!(out->pdf > 0.0f)) return false;
+  out->weight = f / out->pdf;
+  out->delta = false;
+  out->transmitted = transmitted;
+  return true;
+}
+
 bool Bsdf::sample(float u_lobe, glm::vec2 u, BsdfSample* out) const {
   if (black_) return false;
   const glm::vec3& wo = wo_local_;
+  if (u_lobe < p_diffuse_) return finish_nondelta_sample(sample_cosine_hemisphere(u), false, out);
   if (u_lobe < p_diffuse_ + p_glossy_) {
-    bool diffuse = u_lobe < p_diffuse_;
-    if (!diffuse && glossy_delta_) {  // perfect mirror branch
+    if (glossy_delta_) {  // perfect mirror branch
       glm::vec3 wi(-wo.x, -wo.y, wo.z);
       out->wi = frame_.to_world(wi);
       out->weight = glossy_fresnel(wo.z) / p_glossy_;
@@ -208,25 +278,38 @@ bool Bsdf::sample(float u_lobe, glm::vec2 u, BsdfSample* out) const {
       out->transmitted = false;
       return glm::dot(out->wi, ng_) > 0.0f;
     }
-    glm::vec3 wi;
-    if (diffuse) {
-      wi = sample_cosine_hemisphere(u);
-    } else {
-      glm::vec3 h = ggx_sample_vndf(wo, alpha_, u);
-      wi = glm::reflect(-wo, h);
-    }
-    if (wi.z <= 0.0f) return false;
-    out->wi = frame_.to_world(wi);
-    if (glm::dot(out->wi, ng_) <= 0.0f) return false;
-    glm::vec3 f = eval_local(wi, &out->pdf);
-    if (!(out->pdf > 0.0f)) return false;
-    out->weight = f / out->pdf;
-    out->delta = false;
-    out->transmitted = false;
-    return true;
+    glm::vec3 wi = glm::reflect(-wo, ggx_sample_vndf(wo, alpha_, u));
+    return wi.z > 0.0f && finish_nondelta_sample(wi, false, out);
   }
-  // Smooth dielectric: reflect with probability F, else refract (tinted by the base color).
-  float eta = front_face_ ? ior_ : 1.0f / ior_;  // eta_t / eta_i
+  if (!(p_glass_ > 0.0f)) return false;
+  if (glass_delta_) return sample_smooth_glass(u, out);
+  // The rest of u_lobe's interval picks reflection or refraction.
+  const float u_choice = std::min((u_lobe - p_diffuse_ - p_glossy_) / p_glass_, 0x1.fffffep-1f);
+  return sample_rough_glass(u_choice, u, out);
+}
+
+// A visible microfacet normal, then reflection with probability F(wo.h), else refraction through it.
+bool Bsdf::sample_rough_glass(float u_choice, glm::vec2 u, BsdfSample* out) const {
+  const glm::vec3& wo = wo_local_;
+  const glm::vec3 h = ggx_sample_vndf(wo, alpha_, u);
+  const float cos_oh = glm::dot(wo, h);
+  if (!(cos_oh > 0.0f)) return false;
+  const float eta = this->eta();
+  if (u_choice < fresnel_dielectric(cos_oh, eta)) {
+    const glm::vec3 wi = glm::reflect(-wo, h);
+    return wi.z > 0.0f && finish_nondelta_sample(wi, false, out);
+  }
+  const float sin2_t = (1.0f - cos_oh * cos_oh) / (eta * eta);
+  if (sin2_t >= 1.0f) return false;  // total internal reflection (F = 1: not reached)
+  const float cos_t = std::sqrt(1.0f - sin2_t);
+  const glm::vec3 wi = glm::normalize(-wo / eta + (cos_oh / eta - cos_t) * h);
+  return wi.z < 0.0f && finish_nondelta_sample(wi, true, out);
+}
+
+// Reflect with probability F, else refract (tinted by the base color).
+bool Bsdf::sample_smooth_glass(glm::vec2 u, BsdfSample* out) const {
+  const glm::vec3& wo = wo_local_;
+  float eta = this->eta();
   float cos_i = wo.z;
   float fresnel = fresnel_dielectric(cos_i, eta);
   glm::vec3 wi;

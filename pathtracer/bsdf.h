@@ -1,10 +1,13 @@
 // Materials as BSDFs (glTF metallic-roughness + transmission, ior, specular):
 //   metallic * GGX conductor (Schlick, F0 = base color)
 // + (1 - metallic) * (1 - transmission) * (GGX dielectric specular (F0 from ior and KHR specular)
-//                                        + (1 - F) * Lambert(base color))
-// + (1 - metallic) * transmission * smooth dielectric (exact Fresnel, transmission tinted by base).
-// Roughness below kDeltaRoughness makes the GGX lobe a perfect mirror. Lobes are picked
-// stochastically by an estimate of their weight; pdf() is the combined pdf of the non-delta lobes.
+//                                        + (1 - E_specular(cos_o)) * Lambert(base color))
+// + (1 - metallic) * transmission * GGX dielectric (Walter 2007: exact Fresnel, reflection and
+//                                     refraction, the refraction tinted by the base color).
+// The GGX reflection lobes are energy-compensated (Turquin 2019: scaled by 1 + F0 (1 / E - 1), E
+// the single-scattering albedo, ggx_albedo.h). Roughness below kDeltaRoughness makes the GGX lobes
+// delta lobes (a mirror, smooth glass). Lobes are picked stochastically by their albedo at wo;
+// pdf() is the combined pdf of the non-delta lobes.
 #pragma once
 #include <glm/glm.hpp>
 #include "pathtracer/sampling.h"
@@ -48,6 +51,7 @@ struct BsdfMaterial {
   BsdfParams params;
   float c_glass = 0.0f;                    // the glass lobe's mixing coefficient
   bool glossy_delta = false;               // roughness below kDeltaRoughness: a mirror lobe
+  bool glass_delta = false;                // the same, or ior ~ 1 (no refraction): smooth glass
   float alpha = 1.0f;                      // GGX alpha
   glm::vec3 f0_dielectric{0.0f};           // the dielectric specular's Schlick terms
   float f90_dielectric = 1.0f;
@@ -77,7 +81,7 @@ class Bsdf {
        bool front_face)
       : Bsdf(bsdf_material(params), shading_normal, geometric_normal, wo, front_face) {}
 
-  glm::vec3 eval(glm::vec3 wi) const;  // f(wo, wi) |cos(wi)| of the non-delta lobes
+  glm::vec3 eval(glm::vec3 wi) const;  // f(wo, wi) |cos(wi)| of the non-delta lobes (wi on either side)
   float pdf(glm::vec3 wi) const;       // combined pdf of the non-delta lobes
   glm::vec3 eval(glm::vec3 wi, float* pdf) const;  // both at once (shares the half-vector work)
   // u_lobe picks the lobe, u the direction. Returns false when no valid direction was drawn.
@@ -86,17 +90,28 @@ class Bsdf {
   bool is_perfectly_specular() const { return !has_nondelta_; }
   bool has_nondelta() const { return has_nondelta_; }
   // The probability that sample() picks a non-delta lobe (1 for a BSDF without delta lobes).
-  float nondelta_probability() const { return p_diffuse_ + (glossy_delta_ ? 0.0f : p_glossy_); }
+  float nondelta_probability() const {
+    return p_diffuse_ + (glossy_delta_ ? 0.0f : p_glossy_) + (glass_delta_ ? 0.0f : p_glass_);
+  }
   // The probability that sample() picks the diffuse lobe.
   float diffuse_probability() const { return p_diffuse_; }
-  // sample() reads u_lobe only when more than one lobe can be picked.
-  bool has_lobe_choice() const { return (p_diffuse_ > 0.0f) + (p_glossy_ > 0.0f) + (p_glass_ > 0.0f) > 1; }
+  // sample() reads u_lobe only when more than one lobe can be picked, or when the rough glass lobe
+  // (which picks reflection or refraction with it) can be.
+  bool has_lobe_choice() const {
+    return (p_diffuse_ > 0.0f) + (p_glossy_ > 0.0f) + (p_glass_ > 0.0f) > 1 || (p_glass_ > 0.0f && !glass_delta_);
+  }
   bool is_black() const { return black_; }
   glm::vec3 shading_normal() const { return frame_.n; }
 
  private:
   glm::vec3 eval_local(glm::vec3 wi, float* pdf) const;
+  glm::vec3 eval_glass_reflection(glm::vec3 wi, float* pdf) const;
+  glm::vec3 eval_glass_transmission(glm::vec3 wi, float* pdf) const;
   glm::vec3 glossy_fresnel(float cos_oh) const;
+  bool sample_smooth_glass(glm::vec2 u, BsdfSample* out) const;
+  bool sample_rough_glass(float u_choice, glm::vec2 u, BsdfSample* out) const;
+  bool finish_nondelta_sample(glm::vec3 wi_local, bool transmitted, BsdfSample* out) const;
+  float eta() const { return front_face_ ? ior_ : 1.0f / ior_; }  // eta_t / eta_i across the surface
 
   Frame frame_{};
   glm::vec3 ng_{0.0f};      // geometric normal on wo's side
@@ -108,10 +123,13 @@ class Bsdf {
   // Fixed per shading point, so eval_local() divides once per BSDF instead of once per call:
   float inv_4cos_o_ = 0.0f;         // 1 / (4 cos_o)
   float glossy_pdf_scale_ = 0.0f;   // p_glossy G1(wo) / (4 cos_o): the glossy pdf is this times D(h)
+  float g1_o_ = 1.0f;               // Smith G1(wo)
   bool glossy_delta_ = false;
+  bool glass_delta_ = false;
   bool front_face_ = true;
   float c_glass_ = 0.0f;  // the glass lobe's mixing coefficient
   glm::vec3 fresnel_at_0_{0.0f}, fresnel_slope_{0.0f};  // BsdfMaterial's
+  glm::vec3 glossy_compensation_{1.0f};  // Turquin's 1 + F0 (1 / E(cos_o) - 1) of the GGX reflection lobe
   glm::vec3 diffuse_factor_{0.0f};  // c_diffuse * base / pi * (1 - F_dielectric(cos_o))
   float p_diffuse_ = 0.0f, p_glossy_ = 0.0f, p_glass_ = 0.0f;  // lobe selection probabilities
   bool has_nondelta_ = false;
@@ -123,5 +141,7 @@ float ggx_d(glm::vec3 h, float alpha);
 float ggx_lambda(glm::vec3 w, float alpha);
 glm::vec3 ggx_sample_vndf(glm::vec3 wo, float alpha, glm::vec2 u);
 float fresnel_dielectric(float cos_i, float eta);  // eta = eta_t / eta_i, cos_i >= 0
+// Visible-normal pdf of h seen from wo: G1(wo) max(0, wo.h) D(h) / cos_o.
+float ggx_vndf_pdf(glm::vec3 wo, glm::vec3 h, float alpha);
 
 }  // namespace pxf
