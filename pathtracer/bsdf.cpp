@@ -17,6 +17,8 @@ inline float schlick_weight(float cos_theta) {
   return m2 * m2 * m;
 }
 
+constexpr float kCoatF0 = 0.04f;  // KHR_materials_clearcoat: ior 1.5, ((1.5 - 1) / (1.5 + 1))^2
+
 inline glm::vec3 schlick(glm::vec3 f0, float f90, float cos_theta) {
   return f0 + (glm::vec3(f90) - f0) * schlick_weight(cos_theta);
 }
@@ -38,12 +40,15 @@ BsdfParams eval_material(const Scene& scene, const Material& m, glm::vec2 uv0, g
   p.ior = m.ior >= 1.0f ? m.ior : 1.5f;  // glTF allows ior 0 (= "no refraction"); keep it sane
   p.specular = saturate(m.specular * eval_texture(scene, m.specular_texture, uv0, uv1).a);
   p.specular_color = m.specular_color * glm::vec3(eval_texture(scene, m.specular_color_texture, uv0, uv1));
+  p.clearcoat = saturate(m.clearcoat * eval_texture(scene, m.clearcoat_texture, uv0, uv1).r);
+  p.clearcoat_roughness = saturate(m.clearcoat_roughness * eval_texture(scene, m.clearcoat_roughness_texture, uv0, uv1).g);
   return p;
 }
 
 bool eval_material_is_constant(const Material& m) {  // the textures eval_material() reads
   return constant(m.base_color_texture) && constant(m.metallic_roughness_texture) && constant(m.transmission_texture) &&
-         constant(m.specular_texture) && constant(m.specular_color_texture);
+         constant(m.specular_texture) && constant(m.specular_color_texture) && constant(m.clearcoat_texture) &&
+         constant(m.clearcoat_roughness_texture);
 }
 
 glm::vec3 eval_emission(const Scene& scene, const Material& m, glm::vec2 uv0, glm::vec2 uv1) {
@@ -55,8 +60,14 @@ float eval_opacity(const Scene& scene, const Material& m, glm::vec2 uv0, glm::ve
   return m.base_color.a * eval_texture(scene, m.base_color_texture, uv0, uv1).a * vertex_alpha;
 }
 
+// No clearcoat, or a smooth one (a delta lobe).
+static bool coat_is_delta_or_absent(const Material& m) {
+  return !(m.clearcoat > 0.0f) || (constant(m.clearcoat_roughness_texture) && m.clearcoat_roughness < kDeltaRoughness);
+}
+
 bool material_is_perfect_mirror(const Material& m) {
-  return constant(m.metallic_roughness_texture) && m.roughness < kDeltaRoughness && m.metallic >= 1.0f - 1e-3f;
+  return constant(m.metallic_roughness_texture) && m.roughness < kDeltaRoughness && m.metallic >= 1.0f - 1e-3f &&
+         coat_is_delta_or_absent(m);
 }
 
 // Exactly the materials whose BSDF has delta lobes only (a constant-factor mirror or glass), so
@@ -66,7 +77,8 @@ bool material_is_perfect_specular(const Material& m) {
   if (material_is_perfect_mirror(m)) return true;
   // Glass is smooth below the delta roughness, or at any roughness without refraction (ior 1).
   const bool smooth = m.roughness < kDeltaRoughness || std::abs(m.ior - 1.0f) < 1e-3f;
-  return smooth && constant(m.transmission_texture) && m.transmission >= 1.0f - 1e-3f && m.metallic <= 1e-3f;
+  return smooth && constant(m.transmission_texture) && m.transmission >= 1.0f - 1e-3f && m.metallic <= 1e-3f &&
+         coat_is_delta_or_absent(m);
 }
 
 float ggx_d(glm::vec3 h, float alpha) {
@@ -132,10 +144,14 @@ BsdfMaterial bsdf_material(const BsdfParams& params) {
   k.fresnel_at_0 = m * params.base_color + c_diffuse * k.f0_dielectric;
   k.fresnel_slope = m * (glm::vec3(1.0f) - params.base_color) + c_diffuse * (glm::vec3(k.f90_dielectric) - k.f0_dielectric);
   k.diffuse_albedo = c_diffuse * params.base_color * kInvPi;
+  k.clearcoat = params.clearcoat;
+  k.coat_delta = params.clearcoat_roughness < kDeltaRoughness;
+  k.coat_alpha = std::max(params.clearcoat_roughness * params.clearcoat_roughness, kMinAlpha);
   return k;
 }
 
-Bsdf::Bsdf(const BsdfMaterial& k, glm::vec3 shading_normal, glm::vec3 geometric_normal, glm::vec3 wo, bool front_face)
+Bsdf::Bsdf(const BsdfMaterial& k, glm::vec3 shading_normal, glm::vec3 geometric_normal, glm::vec3 wo, bool front_face,
+           glm::vec3 coat_normal)
     : base_color_(k.params.base_color),
       ior_(k.params.ior),
       alpha_(k.alpha),
@@ -154,29 +170,54 @@ Bsdf::Bsdf(const BsdfMaterial& k, glm::vec3 shading_normal, glm::vec3 geometric_
   wo_local_.z = std::max(wo_local_.z, 1e-6f);
   lambda_o_ = ggx_lambda(wo_local_, alpha_);
   g1_o_ = 1.0f / (1.0f + lambda_o_);
+  // The coat reflects clearcoat * E_coat of the light; the base below gets the rest.
+  const float coat_albedo = set_up_coat(k, glm::dot(coat_normal, coat_normal) > 0.0f ? coat_normal : ns, wo);
+  const float base_share = 1.0f - clearcoat_ * coat_albedo;
 
   const float cos_o = wo_local_.z;
   // The single-scattering GGX albedo at wo; a delta mirror reflects everything, with Schlick's weight.
   const GgxAlbedo e = glossy_delta_ ? GgxAlbedo{1.0f, schlick_weight(cos_o)} : ggx_albedo(cos_o, alpha_);
   const float missing = 1.0f / std::max(e.total, 1e-2f) - 1.0f;  // 1 / E - 1: the multiple-scattering share
-  glossy_compensation_ = glm::vec3(1.0f) + fresnel_at_0_ * missing;
+  glossy_compensation_ = (glm::vec3(1.0f) + fresnel_at_0_ * missing) * base_share;
   const glm::vec3 glossy_albedo = (fresnel_at_0_ * e.total + fresnel_slope_ * e.schlick) * glossy_compensation_;
   // The Lambert layer gets what the dielectric specular layer (compensated the same way) leaves.
   const glm::vec3 specular_albedo = (k.f0_dielectric * e.total + (glm::vec3(k.f90_dielectric) - k.f0_dielectric) * e.schlick) *
                                     (glm::vec3(1.0f) + k.f0_dielectric * missing);
-  diffuse_factor_ = k.diffuse_albedo * glm::max(glm::vec3(1.0f) - specular_albedo, glm::vec3(0.0f));
+  diffuse_factor_ = k.diffuse_albedo * glm::max(glm::vec3(1.0f) - specular_albedo, glm::vec3(0.0f)) * base_share;
+  c_glass_ *= base_share;
   float w_diffuse = std::max(0.0f, luminance(diffuse_factor_) * kPi);
   float w_glossy = std::max(0.0f, luminance(glossy_albedo));
+  float w_coat = std::max(0.0f, clearcoat_ * coat_albedo);
   float w_glass = std::max(0.0f, c_glass_);
-  float total = w_diffuse + w_glossy + w_glass;
+  float total = w_diffuse + w_glossy + w_coat + w_glass;
   black_ = !(total > 0.0f);
   if (black_) return;
   p_diffuse_ = w_diffuse / total;
   p_glossy_ = w_glossy / total;
+  p_coat_ = w_coat / total;
   p_glass_ = w_glass / total;
-  has_nondelta_ = p_diffuse_ > 0.0f || (p_glossy_ > 0.0f && !glossy_delta_) || (p_glass_ > 0.0f && !glass_delta_);
+  has_nondelta_ = p_diffuse_ > 0.0f || (p_glossy_ > 0.0f && !glossy_delta_) || (p_coat_ > 0.0f && !coat_delta_) ||
+                  (p_glass_ > 0.0f && !glass_delta_);
   inv_4cos_o_ = 1.0f / (4.0f * cos_o);
   glossy_pdf_scale_ = p_glossy_ * inv_4cos_o_ * g1_o_;
+}
+
+// The coat's frame at wo and its compensated albedo (F0 0.04, ior 1.5); 0 without a coat.
+float Bsdf::set_up_coat(const BsdfMaterial& k, glm::vec3 coat_normal, glm::vec3 wo) {
+  clearcoat_ = k.clearcoat;
+  if (!(clearcoat_ > 0.0f)) return 0.0f;
+  coat_alpha_ = k.coat_alpha;
+  coat_delta_ = k.coat_delta;
+  glm::vec3 nc = glm::dot(coat_normal, ng_) >= 0.0f ? coat_normal : -coat_normal;
+  if (!(glm::dot(wo, nc) > 1e-4f)) nc = ng_;
+  coat_frame_ = Frame::from_normal(nc);
+  coat_wo_local_ = coat_frame_.to_local(wo);
+  coat_wo_local_.z = std::max(coat_wo_local_.z, 1e-6f);
+  coat_lambda_o_ = ggx_lambda(coat_wo_local_, coat_alpha_);
+  const float cos_o = coat_wo_local_.z;
+  const GgxAlbedo e = coat_delta_ ? GgxAlbedo{1.0f, schlick_weight(cos_o)} : ggx_albedo(cos_o, coat_alpha_);
+  coat_compensation_ = 1.0f + kCoatF0 * (1.0f / std::max(e.total, 1e-2f) - 1.0f);
+  return (kCoatF0 * e.total + (1.0f - kCoatF0) * e.schlick) * coat_compensation_;
 }
 
 // Fresnel of the GGX layer: the conductor and the dielectric specular share one microfacet lobe.
@@ -239,8 +280,22 @@ glm::vec3 Bsdf::eval(glm::vec3 wi, float* pdf) const {
   // an opaque face, and the shading normal may not disagree with the face about the side.
   const glm::vec3 local = frame_.to_local(wi);
   const float side = glm::dot(wi, ng_);
-  if ((local.z > 0.0f && side > 0.0f) || (local.z < 0.0f && side < 0.0f)) return eval_local(local, pdf);
-  return glm::vec3(0.0f);
+  glm::vec3 f(0.0f);
+  if ((local.z > 0.0f && side > 0.0f) || (local.z < 0.0f && side < 0.0f)) f = eval_local(local, pdf);
+  if (p_coat_ > 0.0f && !coat_delta_ && side > 0.0f) f += eval_coat(coat_frame_.to_local(wi), pdf);
+  return f;
+}
+
+glm::vec3 Bsdf::eval_coat(glm::vec3 wi, float* pdf) const {
+  if (wi.z <= 0.0f) return glm::vec3(0.0f);
+  const glm::vec3& wo = coat_wo_local_;
+  const glm::vec3 h = glm::normalize(wo + wi);
+  const float d = ggx_d(h, coat_alpha_);
+  const float g2 = 1.0f / (1.0f + coat_lambda_o_ + ggx_lambda(wi, coat_alpha_));
+  const float inv_4cos_o = 1.0f / (4.0f * wo.z);
+  const float fresnel = kCoatF0 + (1.0f - kCoatF0) * schlick_weight(std::max(0.0f, glm::dot(wo, h)));
+  *pdf += p_coat_ * d * inv_4cos_o / (1.0f + coat_lambda_o_);  // VNDF: G1(wo) D / (4 cos_o)
+  return glm::vec3(clearcoat_ * coat_compensation_ * fresnel * d * g2 * inv_4cos_o);
 }
 
 glm::vec3 Bsdf::eval(glm::vec3 wi) const {
@@ -254,8 +309,8 @@ float Bsdf::pdf(glm::vec3 wi) const {
   return pdf;
 }
 
-bool Bsdf::finish_nondelta_sample(glm::vec3 wi_local, bool transmitted, BsdfSample* out) const {
-  out->wi = frame_.to_world(wi_local);
+bool Bsdf::finish_nondelta_sample(glm::vec3 wi, bool transmitted, BsdfSample* out) const {
+  out->wi = wi;
   glm::vec3 f = eval(out->wi, &out->pdf);
   if (!(out->pdf > 0.0f)) return false;
   out->weight = f / out->pdf;
@@ -267,25 +322,40 @@ bool Bsdf::finish_nondelta_sample(glm::vec3 wi_local, bool transmitted, BsdfSamp
 bool Bsdf::sample(float u_lobe, glm::vec2 u, BsdfSample* out) const {
   if (black_) return false;
   const glm::vec3& wo = wo_local_;
-  if (u_lobe < p_diffuse_) return finish_nondelta_sample(sample_cosine_hemisphere(u), false, out);
+  if (u_lobe < p_diffuse_) return finish_nondelta_sample(frame_.to_world(sample_cosine_hemisphere(u)), false, out);
   if (u_lobe < p_diffuse_ + p_glossy_) {
     if (glossy_delta_) {  // perfect mirror branch
       glm::vec3 wi(-wo.x, -wo.y, wo.z);
       out->wi = frame_.to_world(wi);
-      out->weight = glossy_fresnel(wo.z) / p_glossy_;
+      out->weight = glossy_fresnel(wo.z) * glossy_compensation_ / p_glossy_;  // compensation 1 x the base's share
       out->pdf = 0.0f;
       out->delta = true;
       out->transmitted = false;
       return glm::dot(out->wi, ng_) > 0.0f;
     }
     glm::vec3 wi = glm::reflect(-wo, ggx_sample_vndf(wo, alpha_, u));
-    return wi.z > 0.0f && finish_nondelta_sample(wi, false, out);
+    return wi.z > 0.0f && finish_nondelta_sample(frame_.to_world(wi), false, out);
   }
+  if (u_lobe < p_diffuse_ + p_glossy_ + p_coat_) return sample_coat(u, out);
   if (!(p_glass_ > 0.0f)) return false;
   if (glass_delta_) return sample_smooth_glass(u, out);
   // The rest of u_lobe's interval picks reflection or refraction.
-  const float u_choice = std::min((u_lobe - p_diffuse_ - p_glossy_) / p_glass_, 0x1.fffffep-1f);
+  const float u_choice = std::min((u_lobe - p_diffuse_ - p_glossy_ - p_coat_) / p_glass_, 0x1.fffffep-1f);
   return sample_rough_glass(u_choice, u, out);
+}
+
+bool Bsdf::sample_coat(glm::vec2 u, BsdfSample* out) const {
+  const glm::vec3& wo = coat_wo_local_;
+  if (coat_delta_) {  // a mirror coat
+    out->wi = coat_frame_.to_world(glm::vec3(-wo.x, -wo.y, wo.z));
+    out->weight = glm::vec3(clearcoat_ * (kCoatF0 + (1.0f - kCoatF0) * schlick_weight(wo.z)) / p_coat_);
+    out->pdf = 0.0f;
+    out->delta = true;
+    out->transmitted = false;
+    return glm::dot(out->wi, ng_) > 0.0f;
+  }
+  const glm::vec3 wi = glm::reflect(-wo, ggx_sample_vndf(wo, coat_alpha_, u));
+  return wi.z > 0.0f && finish_nondelta_sample(coat_frame_.to_world(wi), false, out);
 }
 
 // A visible microfacet normal, then reflection with probability F(wo.h), else refraction through it.
@@ -297,13 +367,13 @@ bool Bsdf::sample_rough_glass(float u_choice, glm::vec2 u, BsdfSample* out) cons
   const float eta = this->eta();
   if (u_choice < fresnel_dielectric(cos_oh, eta)) {
     const glm::vec3 wi = glm::reflect(-wo, h);
-    return wi.z > 0.0f && finish_nondelta_sample(wi, false, out);
+    return wi.z > 0.0f && finish_nondelta_sample(frame_.to_world(wi), false, out);
   }
   const float sin2_t = (1.0f - cos_oh * cos_oh) / (eta * eta);
   if (sin2_t >= 1.0f) return false;  // total internal reflection (F = 1: not reached)
   const float cos_t = std::sqrt(1.0f - sin2_t);
   const glm::vec3 wi = glm::normalize(-wo / eta + (cos_oh / eta - cos_t) * h);
-  return wi.z < 0.0f && finish_nondelta_sample(wi, true, out);
+  return wi.z < 0.0f && finish_nondelta_sample(frame_.to_world(wi), true, out);
 }
 
 // Reflect with probability F, else refract (tinted by the base color).

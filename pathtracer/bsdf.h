@@ -1,4 +1,6 @@
-// Materials as BSDFs (glTF metallic-roughness + transmission, ior, specular):
+// Materials as BSDFs (glTF metallic-roughness + transmission, ior, specular, clearcoat):
+//   clearcoat * GGX coat (Schlick, F0 = 0.04, own roughness and normal)
+// + (1 - clearcoat * E_coat(cos_o)) * the base:
 //   metallic * GGX conductor (Schlick, F0 = base color)
 // + (1 - metallic) * (1 - transmission) * (GGX dielectric specular (F0 from ior and KHR specular)
 //                                        + (1 - E_specular(cos_o)) * Lambert(base color))
@@ -27,6 +29,8 @@ struct BsdfParams {
   float ior = 1.5f;
   float specular = 1.0f;
   glm::vec3 specular_color{1.0f};
+  float clearcoat = 0.0f;  // KHR_materials_clearcoat
+  float clearcoat_roughness = 0.0f;
 };
 
 // The material evaluated at a surface point: base color x texture x vertex color, etc.
@@ -59,6 +63,9 @@ struct BsdfMaterial {
   // Schlick terms share the power, so their sum is one line.
   glm::vec3 fresnel_at_0{0.0f}, fresnel_slope{0.0f};
   glm::vec3 diffuse_albedo{0.0f};  // c_diffuse * base / pi, c_diffuse = (1 - metallic)(1 - transmission)
+  float clearcoat = 0.0f;          // the coat's weight
+  bool coat_delta = true;          // clearcoat roughness below kDeltaRoughness: a mirror coat
+  float coat_alpha = kMinAlpha;    // the coat's GGX alpha
 };
 BsdfMaterial bsdf_material(const BsdfParams& params);
 
@@ -74,12 +81,13 @@ class Bsdf {
  public:
   Bsdf() = default;
   // shading_normal and geometric_normal: unit, any orientation (flipped to wo's side here);
-  // front_face: wo is on the side the geometric normal points to (outside of a dielectric).
+  // front_face: wo is on the side the geometric normal points to (outside of a dielectric);
+  // coat_normal: the clearcoat's shading normal (zero: shading_normal).
   Bsdf(const BsdfMaterial& material, glm::vec3 shading_normal, glm::vec3 geometric_normal, glm::vec3 wo,
-       bool front_face);
+       bool front_face, glm::vec3 coat_normal = glm::vec3(0.0f));
   Bsdf(const BsdfParams& params, glm::vec3 shading_normal, glm::vec3 geometric_normal, glm::vec3 wo,
-       bool front_face)
-      : Bsdf(bsdf_material(params), shading_normal, geometric_normal, wo, front_face) {}
+       bool front_face, glm::vec3 coat_normal = glm::vec3(0.0f))
+      : Bsdf(bsdf_material(params), shading_normal, geometric_normal, wo, front_face, coat_normal) {}
 
   glm::vec3 eval(glm::vec3 wi) const;  // f(wo, wi) |cos(wi)| of the non-delta lobes (wi on either side)
   float pdf(glm::vec3 wi) const;       // combined pdf of the non-delta lobes
@@ -91,14 +99,16 @@ class Bsdf {
   bool has_nondelta() const { return has_nondelta_; }
   // The probability that sample() picks a non-delta lobe (1 for a BSDF without delta lobes).
   float nondelta_probability() const {
-    return p_diffuse_ + (glossy_delta_ ? 0.0f : p_glossy_) + (glass_delta_ ? 0.0f : p_glass_);
+    return p_diffuse_ + (glossy_delta_ ? 0.0f : p_glossy_) + (coat_delta_ ? 0.0f : p_coat_) +
+           (glass_delta_ ? 0.0f : p_glass_);
   }
   // The probability that sample() picks the diffuse lobe.
   float diffuse_probability() const { return p_diffuse_; }
   // sample() reads u_lobe only when more than one lobe can be picked, or when the rough glass lobe
   // (which picks reflection or refraction with it) can be.
   bool has_lobe_choice() const {
-    return (p_diffuse_ > 0.0f) + (p_glossy_ > 0.0f) + (p_glass_ > 0.0f) > 1 || (p_glass_ > 0.0f && !glass_delta_);
+    return (p_diffuse_ > 0.0f) + (p_glossy_ > 0.0f) + (p_coat_ > 0.0f) + (p_glass_ > 0.0f) > 1 ||
+           (p_glass_ > 0.0f && !glass_delta_);
   }
   bool is_black() const { return black_; }
   glm::vec3 shading_normal() const { return frame_.n; }
@@ -107,10 +117,13 @@ class Bsdf {
   glm::vec3 eval_local(glm::vec3 wi, float* pdf) const;
   glm::vec3 eval_glass_reflection(glm::vec3 wi, float* pdf) const;
   glm::vec3 eval_glass_transmission(glm::vec3 wi, float* pdf) const;
+  glm::vec3 eval_coat(glm::vec3 wi_coat, float* pdf) const;  // adds the coat's pdf to *pdf
+  float set_up_coat(const BsdfMaterial& material, glm::vec3 coat_normal, glm::vec3 wo);
+  bool sample_coat(glm::vec2 u, BsdfSample* out) const;
   glm::vec3 glossy_fresnel(float cos_oh) const;
   bool sample_smooth_glass(glm::vec2 u, BsdfSample* out) const;
   bool sample_rough_glass(float u_choice, glm::vec2 u, BsdfSample* out) const;
-  bool finish_nondelta_sample(glm::vec3 wi_local, bool transmitted, BsdfSample* out) const;
+  bool finish_nondelta_sample(glm::vec3 wi, bool transmitted, BsdfSample* out) const;
   float eta() const { return front_face_ ? ior_ : 1.0f / ior_; }  // eta_t / eta_i across the surface
 
   Frame frame_{};
@@ -131,7 +144,16 @@ class Bsdf {
   glm::vec3 fresnel_at_0_{0.0f}, fresnel_slope_{0.0f};  // BsdfMaterial's
   glm::vec3 glossy_compensation_{1.0f};  // Turquin's 1 + F0 (1 / E(cos_o) - 1) of the GGX reflection lobe
   glm::vec3 diffuse_factor_{0.0f};  // c_diffuse * base / pi * (1 - F_dielectric(cos_o))
-  float p_diffuse_ = 0.0f, p_glossy_ = 0.0f, p_glass_ = 0.0f;  // lobe selection probabilities
+  // The clearcoat: its own frame (its normal map) and GGX lobe, F = Schlick(0.04, 1).
+  Frame coat_frame_{};
+  glm::vec3 coat_wo_local_{0.0f};
+  float clearcoat_ = 0.0f;
+  float coat_alpha_ = 1.0f;
+  bool coat_delta_ = false;
+  float coat_lambda_o_ = 0.0f;
+  float coat_compensation_ = 1.0f;  // Turquin's factor of the coat lobe
+  // Lobe selection probabilities; sample() reads u_lobe in this order.
+  float p_diffuse_ = 0.0f, p_glossy_ = 0.0f, p_coat_ = 0.0f, p_glass_ = 0.0f;
   bool has_nondelta_ = false;
   bool black_ = true;
 };

@@ -57,6 +57,12 @@ BsdfParams rough_glass(float roughness, glm::vec3 tint = glm::vec3(1.0f)) {
   return p;
 }
 
+BsdfParams coated(BsdfParams base, float clearcoat, float coat_roughness) {
+  base.clearcoat = clearcoat;
+  base.clearcoat_roughness = coat_roughness;
+  return base;
+}
+
 // Diffuse, glossy and rough glass lobes at once.
 BsdfParams half_glass() {
   BsdfParams p = plastic(glm::vec3(0.6f, 0.7f, 0.8f), 0.5f);
@@ -111,6 +117,10 @@ TEST(Bsdf, SamplingMatchesPdfChiSquare) {
       {"rough glass inside r0.3 20deg", rough_glass(0.3f), 20.0f, false},
       {"rough glass inside r0.5 40deg", rough_glass(0.5f), 40.0f, false},
       {"rough glass inside r0.8 70deg", rough_glass(0.8f), 70.0f, false},
+      {"coat r0.2 over plastic r0.6 30deg", coated(plastic(glm::vec3(0.6f, 0.3f, 0.2f), 0.6f), 1.0f, 0.2f), 30.0f},
+      {"coat r0.5 over metal r0.3 70deg", coated(conductor(glm::vec3(0.9f, 0.6f, 0.3f), 0.3f), 0.7f, 0.5f), 70.0f},
+      {"coat r0.3 over rough glass 45deg", coated(rough_glass(0.5f), 1.0f, 0.3f), 45.0f},
+      {"smooth coat over plastic r0.5 20deg", coated(plastic(glm::vec3(0.5f), 0.5f), 1.0f, 0.0f), 20.0f},
   };
   const double alpha = 0.01 / cases.size();  // Bonferroni
   for (const Case& c : cases) {
@@ -348,6 +358,39 @@ TEST(Bsdf, CompensatedWhiteLobesKeepAllTheEnergy) {
       }
 }
 
+// The clearcoat over white bases keeps all the light: the coat reflects clearcoat E_coat(cos_o)
+// (compensated), the base gets the rest. At several coat and base roughnesses, smooth coat included.
+TEST(Bsdf, ClearcoatOverWhiteKeepsAllTheEnergy) {
+  for (float coat_roughness : {0.0f, 0.3f, 1.0f})
+    for (float metallic : {1.0f, 0.0f})
+      for (float mu : {1.0f, 0.5f, 0.15f}) {
+        const glm::vec3 n(0, 0, 1), wo(std::sqrt(1.0f - mu * mu), 0.0f, mu);
+        const Bsdf bsdf(coated(plastic(glm::vec3(1.0f), 0.6f, metallic), 1.0f, coat_roughness), n, n, wo, true);
+        EXPECT_NEAR(stratified_albedo(bsdf), 1.0, 0.01) << "coat roughness " << coat_roughness << " metallic " << metallic
+                                                         << " mu " << mu;
+      }
+}
+
+// The coat has its own normal (its normal map): a coat over a black base is the coat lobe alone,
+// and it is symmetric about the coat normal, not the base's.
+TEST(Bsdf, ClearcoatReflectsAboutItsOwnNormal) {
+  const glm::vec3 n(0, 0, 1), coat_n = glm::normalize(glm::vec3(0.3f, 0.0f, 1.0f));
+  const glm::vec3 wo = glm::normalize(glm::vec3(-0.2f, 0.1f, 1.0f));
+  BsdfParams black = plastic(glm::vec3(0.0f), 0.5f);
+  black.specular = 0.0f;
+  const Bsdf bsdf(coated(black, 1.0f, 0.2f), n, n, wo, true, coat_n);
+  const glm::vec3 mirror = glm::reflect(-wo, coat_n), base_mirror = glm::reflect(-wo, n);
+  EXPECT_GT(bsdf.eval(mirror).x / mirror.z, 10.0f * bsdf.eval(base_mirror).x / base_mirror.z);
+  const float fresnel = 0.04f + 0.96f * std::pow(1.0f - glm::dot(wo, coat_n), 5.0f);
+  const float alpha = 0.04f;  // 0.2^2
+  const float lambda_o = ggx_lambda(glm::vec3(0, 0, glm::dot(wo, coat_n)), alpha);
+  const float cos_o = glm::dot(wo, coat_n);
+  // At the mirror direction h is the coat normal: F D(1) G2 / (4 cos_o cos_i) cos_i, times Turquin's factor.
+  const float expected = fresnel * ggx_d(glm::vec3(0, 0, 1), alpha) / (1.0f + 2.0f * lambda_o) / (4.0f * cos_o) *
+                         (1.0f + 0.04f * (1.0f / ggx_albedo(cos_o, alpha).total - 1.0f));
+  EXPECT_NEAR(bsdf.eval(mirror).x, expected, 2e-3f * expected);
+}
+
 // Walter's BTDF obeys the reciprocity of refraction (Veach 1997, eq. 5.14): f(wo, wi) / eta_i^2 =
 // f(wi, wo) / eta_o^2, eta the index on each direction's side: from inside it is ior^2 times
 // the one from outside. Reflection on either side is symmetric.
@@ -410,7 +453,12 @@ TEST(Bsdf, PerfectlySpecularMaterialsAreThoseWithOnlyDeltaLobes) {
   nearly_metal.metallic = 0.99f;
   Material nearly_glass = make_glass();
   nearly_glass.transmission = 0.99f;
-  materials.insert(materials.end(), {frosted, no_refraction, nearly_metal, nearly_glass});
+  Material rough_coat_mirror = make_mirror();
+  rough_coat_mirror.clearcoat = 1.0f;
+  rough_coat_mirror.clearcoat_roughness = 0.3f;
+  Material smooth_coat_glass = make_glass();
+  smooth_coat_glass.clearcoat = 1.0f;
+  materials.insert(materials.end(), {frosted, no_refraction, nearly_metal, nearly_glass, rough_coat_mirror, smooth_coat_glass});
   const Scene scene;
   const glm::vec3 n(0, 0, 1);
   for (size_t i = 0; i < materials.size(); ++i) {
@@ -444,12 +492,16 @@ TEST(Bsdf, ConstantMaterialIsOneWhoseParametersDoNotVaryOverTheSurface) {
   TextureRef Material::*const slots[] = {&Material::base_color_texture, &Material::metallic_roughness_texture,
                                          &Material::normal_texture,     &Material::emissive_texture,
                                          &Material::transmission_texture, &Material::specular_texture,
-                                         &Material::specular_color_texture};
+                                         &Material::specular_color_texture, &Material::clearcoat_texture,
+                                         &Material::clearcoat_roughness_texture, &Material::clearcoat_normal_texture};
   const glm::vec2 left(0.25f, 0.5f), right(0.75f, 0.5f);
+  base.clearcoat = 0.5f;
+  base.clearcoat_roughness = 0.5f;
   auto same = [](const BsdfParams& a, const BsdfParams& b) {
     return a.base_color == b.base_color && a.metallic == b.metallic && a.roughness == b.roughness &&
            a.transmission == b.transmission && a.ior == b.ior && a.specular == b.specular &&
-           a.specular_color == b.specular_color;
+           a.specular_color == b.specular_color && a.clearcoat == b.clearcoat &&
+           a.clearcoat_roughness == b.clearcoat_roughness;
   };
   for (size_t i = 0; i < std::size(slots); ++i) {
     Material m = base;

@@ -191,6 +191,24 @@ float EmbreeScene::triangle_area(unsigned mesh, unsigned prim) const {
   return 0.5f * glm::length(glm::cross(m.positions[tri.y] - m.positions[tri.x], m.positions[tri.z] - m.positions[tri.x]));
 }
 
+// A tangent-space normal map (glTF: +Y green up) applied to the vertex normal; *normal is left as
+// it is where the tangent frame or the mapped normal degenerates.
+void EmbreeScene::map_normal(const TextureRef& map, float scale, glm::vec4 tangent, const SurfacePoint& sp,
+                             glm::vec3* normal) const {
+  glm::vec3 t = glm::vec3(tangent) - sp.vertex_normal * glm::dot(glm::vec3(tangent), sp.vertex_normal);
+  const float tl = glm::length(t);
+  if (!(tl > 1e-8f)) return;
+  t /= tl;
+  const glm::vec3 b = glm::cross(sp.vertex_normal, t) * (tangent.w < 0.0f ? -1.0f : 1.0f);
+  glm::vec3 m = glm::vec3(eval_texture(scene_, map, sp.uv0, sp.uv1, glm::vec4(0.5f, 0.5f, 1.0f, 1.0f)));
+  m = m * 2.0f - 1.0f;
+  m.x *= scale;
+  m.y *= scale;
+  const glm::vec3 mapped = t * m.x + b * m.y + sp.vertex_normal * m.z;
+  const float ml = glm::length(mapped);
+  if (ml > 1e-8f && std::isfinite(ml)) *normal = mapped / ml;
+}
+
 SurfacePoint EmbreeScene::surface_point(const Hit& hit, const Ray& ray) const {
   const Mesh& mesh = scene_.meshes[hit.mesh];
   const glm::uvec3& tri = mesh.triangles[hit.prim];
@@ -207,21 +225,12 @@ SurfacePoint EmbreeScene::surface_point(const Hit& hit, const Ray& ray) const {
   sp.uv1 = interpolate_uv(mesh.uv1, tri, hit.u, hit.v);
   if (!mesh.colors.empty()) sp.color = interpolate(mesh.colors, tri, hit.u, hit.v);
   const Material& mat = *sp.material;
-  if (mat.normal_texture.valid() && !mesh.tangents.empty()) {
-    glm::vec4 t4 = interpolate(mesh.tangents, tri, hit.u, hit.v);
-    glm::vec3 t = glm::vec3(t4) - sp.vertex_normal * glm::dot(glm::vec3(t4), sp.vertex_normal);
-    float tl = glm::length(t);
-    if (tl > 1e-8f) {
-      t /= tl;
-      glm::vec3 b = glm::cross(sp.vertex_normal, t) * (t4.w < 0.0f ? -1.0f : 1.0f);
-      glm::vec3 m = glm::vec3(eval_texture(scene_, mat.normal_texture, sp.uv0, sp.uv1, glm::vec4(0.5f, 0.5f, 1.0f, 1.0f)));
-      m = m * 2.0f - 1.0f;
-      m.x *= mat.normal_scale;
-      m.y *= mat.normal_scale;
-      glm::vec3 mapped = t * m.x + b * m.y + sp.vertex_normal * m.z;
-      float ml = glm::length(mapped);
-      if (ml > 1e-8f && std::isfinite(ml)) sp.shading_normal = mapped / ml;
-    }
+  sp.clearcoat_normal = sp.vertex_normal;
+  if (!mesh.tangents.empty()) {
+    const glm::vec4 tangent = interpolate(mesh.tangents, tri, hit.u, hit.v);
+    if (mat.normal_texture.valid()) map_normal(mat.normal_texture, mat.normal_scale, tangent, sp, &sp.shading_normal);
+    if (mat.clearcoat_normal_texture.valid())
+      map_normal(mat.clearcoat_normal_texture, mat.clearcoat_normal_scale, tangent, sp, &sp.clearcoat_normal);
   }
   return sp;
 }

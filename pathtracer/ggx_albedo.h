@@ -1,6 +1,6 @@
 // Directional albedo of the single-scattering GGX lobe (height-correlated Smith G2), tabulated over
 // (cos theta_o, perceptual roughness) for the energy compensation of the rough lobes (Turquin 2019,
-// docs/materials.md). The table (ggx_albedo_table.inc) is written by tools/make_ggx_albedo_table.cpp
+// docs/materials.md). The table (ggx_albedo_table.inc) is written by tools/make_albedo_table.cpp ggx
 // from ggx_albedo_quadrature(); regenerate it with the command in docs/materials.md.
 #pragma once
 

@@ -11,7 +11,7 @@
 namespace pxf {
 namespace {
 
-constexpr int kGeneratorQuadrature = 1024;  // make_ggx_albedo_table's
+constexpr int kGeneratorQuadrature = 1024;  // make_albedo_table's
 
 float grid_cos(int j) {
   const float s = static_cast<float>(j) / (kGgxAlbedoSize - 1);
