@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "pathtracer/ggx_albedo.h"
+#include "pathtracer/sheen.h"
 #include "pathtracer/texture.h"
 
 namespace pxf {
@@ -42,13 +43,15 @@ BsdfParams eval_material(const Scene& scene, const Material& m, glm::vec2 uv0, g
   p.specular_color = m.specular_color * glm::vec3(eval_texture(scene, m.specular_color_texture, uv0, uv1));
   p.clearcoat = saturate(m.clearcoat * eval_texture(scene, m.clearcoat_texture, uv0, uv1).r);
   p.clearcoat_roughness = saturate(m.clearcoat_roughness * eval_texture(scene, m.clearcoat_roughness_texture, uv0, uv1).g);
+  p.sheen_color = m.sheen_color * glm::vec3(eval_texture(scene, m.sheen_color_texture, uv0, uv1));
+  p.sheen_roughness = saturate(m.sheen_roughness * eval_texture(scene, m.sheen_roughness_texture, uv0, uv1).a);
   return p;
 }
 
 bool eval_material_is_constant(const Material& m) {  // the textures eval_material() reads
   return constant(m.base_color_texture) && constant(m.metallic_roughness_texture) && constant(m.transmission_texture) &&
          constant(m.specular_texture) && constant(m.specular_color_texture) && constant(m.clearcoat_texture) &&
-         constant(m.clearcoat_roughness_texture);
+         constant(m.clearcoat_roughness_texture) && constant(m.sheen_color_texture) && constant(m.sheen_roughness_texture);
 }
 
 glm::vec3 eval_emission(const Scene& scene, const Material& m, glm::vec2 uv0, glm::vec2 uv1) {
@@ -65,9 +68,12 @@ static bool coat_is_delta_or_absent(const Material& m) {
   return !(m.clearcoat > 0.0f) || (constant(m.clearcoat_roughness_texture) && m.clearcoat_roughness < kDeltaRoughness);
 }
 
+// A sheen is never a delta lobe.
+static bool has_sheen(const Material& m) { return max_component(m.sheen_color) > 0.0f; }
+
 bool material_is_perfect_mirror(const Material& m) {
   return constant(m.metallic_roughness_texture) && m.roughness < kDeltaRoughness && m.metallic >= 1.0f - 1e-3f &&
-         coat_is_delta_or_absent(m);
+         coat_is_delta_or_absent(m) && !has_sheen(m);
 }
 
 // Exactly the materials whose BSDF has delta lobes only (a constant-factor mirror or glass), so
@@ -78,7 +84,7 @@ bool material_is_perfect_specular(const Material& m) {
   // Glass is smooth below the delta roughness, or at any roughness without refraction (ior 1).
   const bool smooth = m.roughness < kDeltaRoughness || std::abs(m.ior - 1.0f) < 1e-3f;
   return smooth && constant(m.transmission_texture) && m.transmission >= 1.0f - 1e-3f && m.metallic <= 1e-3f &&
-         coat_is_delta_or_absent(m);
+         coat_is_delta_or_absent(m) && !has_sheen(m);
 }
 
 float ggx_d(glm::vec3 h, float alpha) {
@@ -147,6 +153,8 @@ BsdfMaterial bsdf_material(const BsdfParams& params) {
   k.clearcoat = params.clearcoat;
   k.coat_delta = params.clearcoat_roughness < kDeltaRoughness;
   k.coat_alpha = std::max(params.clearcoat_roughness * params.clearcoat_roughness, kMinAlpha);
+  k.sheen_color = glm::max(params.sheen_color, glm::vec3(0.0f));
+  k.sheen_alpha = sheen_alpha(params.sheen_roughness);
   return k;
 }
 
@@ -172,9 +180,20 @@ Bsdf::Bsdf(const BsdfMaterial& k, glm::vec3 shading_normal, glm::vec3 geometric_
   g1_o_ = 1.0f / (1.0f + lambda_o_);
   // The coat reflects clearcoat * E_coat of the light; the base below gets the rest.
   const float coat_albedo = set_up_coat(k, glm::dot(coat_normal, coat_normal) > 0.0f ? coat_normal : ns, wo);
-  const float base_share = 1.0f - clearcoat_ * coat_albedo;
-
+  const float coat_share = 1.0f - clearcoat_ * coat_albedo;
   const float cos_o = wo_local_.z;
+  // The sheen reflects sheen_color E_sheen; the extension scales the base by 1 - max(sheen_color) E_sheen.
+  float sheen_albedo_o = 0.0f;
+  if (max_component(k.sheen_color) > 0.0f) {
+    sheen_alpha_ = k.sheen_alpha;
+    // Near grazing at sheen roughness below ~0.2 the lobe's albedo exceeds 1 (up to 1.41, the
+    // visibility's fit): scaled down there, so that it never reflects more than it receives.
+    const float albedo = sheen_albedo(cos_o, sheen_alpha_);
+    sheen_albedo_o = std::min(albedo, 1.0f);
+    sheen_factor_ = k.sheen_color * (albedo > 1.0f ? coat_share / albedo : coat_share);
+  }
+  const float base_share = coat_share * std::max(0.0f, 1.0f - max_component(k.sheen_color) * sheen_albedo_o);
+
   // The single-scattering GGX albedo at wo; a delta mirror reflects everything, with Schlick's weight.
   const GgxAlbedo e = glossy_delta_ ? GgxAlbedo{1.0f, schlick_weight(cos_o)} : ggx_albedo(cos_o, alpha_);
   const float missing = 1.0f / std::max(e.total, 1e-2f) - 1.0f;  // 1 / E - 1: the multiple-scattering share
@@ -187,16 +206,20 @@ Bsdf::Bsdf(const BsdfMaterial& k, glm::vec3 shading_normal, glm::vec3 geometric_
   c_glass_ *= base_share;
   float w_diffuse = std::max(0.0f, luminance(diffuse_factor_) * kPi);
   float w_glossy = std::max(0.0f, luminance(glossy_albedo));
+  // Never 0 where the sheen is evaluated (its albedo vanishes at normal incidence for low roughness),
+  // so that the directions it reflects into can be sampled.
+  float w_sheen = std::max(0.0f, luminance(sheen_factor_) * std::max(sheen_albedo_o, 1e-3f));
   float w_coat = std::max(0.0f, clearcoat_ * coat_albedo);
   float w_glass = std::max(0.0f, c_glass_);
-  float total = w_diffuse + w_glossy + w_coat + w_glass;
+  float total = w_diffuse + w_glossy + w_sheen + w_coat + w_glass;
   black_ = !(total > 0.0f);
   if (black_) return;
   p_diffuse_ = w_diffuse / total;
   p_glossy_ = w_glossy / total;
+  p_sheen_ = w_sheen / total;
   p_coat_ = w_coat / total;
   p_glass_ = w_glass / total;
-  has_nondelta_ = p_diffuse_ > 0.0f || (p_glossy_ > 0.0f && !glossy_delta_) || (p_coat_ > 0.0f && !coat_delta_) ||
+  has_nondelta_ = p_diffuse_ > 0.0f || p_sheen_ > 0.0f || (p_glossy_ > 0.0f && !glossy_delta_) || (p_coat_ > 0.0f && !coat_delta_) ||
                   (p_glass_ > 0.0f && !glass_delta_);
   inv_4cos_o_ = 1.0f / (4.0f * cos_o);
   glossy_pdf_scale_ = p_glossy_ * inv_4cos_o_ * g1_o_;
@@ -230,7 +253,8 @@ glm::vec3 Bsdf::eval_local(glm::vec3 wi, float* pdf) const {
   if (wi.z < 0.0f) return p_glass_ > 0.0f && !glass_delta_ ? eval_glass_transmission(wi, pdf) : glm::vec3(0.0f);
   if (wi.z == 0.0f) return glm::vec3(0.0f);
   glm::vec3 f = diffuse_factor_ * wi.z;
-  *pdf = p_diffuse_ * wi.z * kInvPi;
+  *pdf = (p_diffuse_ + p_sheen_) * wi.z * kInvPi;  // the sheen is cosine-sampled too
+  if (p_sheen_ > 0.0f) f += eval_sheen(wi);
   const bool glossy = p_glossy_ > 0.0f && !glossy_delta_, glass = p_glass_ > 0.0f && !glass_delta_;
   if (glossy || glass) {  // the GGX reflection lobes share the half vector
     glm::vec3 h = glm::normalize(wo_local_ + wi);
@@ -286,6 +310,11 @@ glm::vec3 Bsdf::eval(glm::vec3 wi, float* pdf) const {
   return f;
 }
 
+glm::vec3 Bsdf::eval_sheen(glm::vec3 wi) const {
+  const glm::vec3 h = glm::normalize(wo_local_ + wi);
+  return sheen_factor_ * (charlie_d(h.z, sheen_alpha_) * sheen_visibility(wo_local_.z, wi.z, sheen_alpha_) * wi.z);
+}
+
 glm::vec3 Bsdf::eval_coat(glm::vec3 wi, float* pdf) const {
   if (wi.z <= 0.0f) return glm::vec3(0.0f);
   const glm::vec3& wo = coat_wo_local_;
@@ -336,11 +365,14 @@ bool Bsdf::sample(float u_lobe, glm::vec2 u, BsdfSample* out) const {
     glm::vec3 wi = glm::reflect(-wo, ggx_sample_vndf(wo, alpha_, u));
     return wi.z > 0.0f && finish_nondelta_sample(frame_.to_world(wi), false, out);
   }
-  if (u_lobe < p_diffuse_ + p_glossy_ + p_coat_) return sample_coat(u, out);
+  // The sheen is broad (its D peaks at grazing half vectors): cosine sampling, like the diffuse lobe.
+  if (u_lobe < p_diffuse_ + p_glossy_ + p_sheen_)
+    return finish_nondelta_sample(frame_.to_world(sample_cosine_hemisphere(u)), false, out);
+  if (u_lobe < p_diffuse_ + p_glossy_ + p_sheen_ + p_coat_) return sample_coat(u, out);
   if (!(p_glass_ > 0.0f)) return false;
   if (glass_delta_) return sample_smooth_glass(u, out);
   // The rest of u_lobe's interval picks reflection or refraction.
-  const float u_choice = std::min((u_lobe - p_diffuse_ - p_glossy_ - p_coat_) / p_glass_, 0x1.fffffep-1f);
+  const float u_choice = std::min((u_lobe - p_diffuse_ - p_glossy_ - p_sheen_ - p_coat_) / p_glass_, 0x1.fffffep-1f);
   return sample_rough_glass(u_choice, u, out);
 }
 

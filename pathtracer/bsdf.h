@@ -1,6 +1,7 @@
 // Materials as BSDFs (glTF metallic-roughness + transmission, ior, specular, clearcoat):
 //   clearcoat * GGX coat (Schlick, F0 = 0.04, own roughness and normal)
-// + (1 - clearcoat * E_coat(cos_o)) * the base:
+// + (1 - clearcoat * E_coat(cos_o)) * (sheen color * Charlie sheen
+//                                       + (1 - max(sheen color) E_sheen(cos_o)) * the base):
 //   metallic * GGX conductor (Schlick, F0 = base color)
 // + (1 - metallic) * (1 - transmission) * (GGX dielectric specular (F0 from ior and KHR specular)
 //                                        + (1 - E_specular(cos_o)) * Lambert(base color))
@@ -31,6 +32,8 @@ struct BsdfParams {
   glm::vec3 specular_color{1.0f};
   float clearcoat = 0.0f;  // KHR_materials_clearcoat
   float clearcoat_roughness = 0.0f;
+  glm::vec3 sheen_color{0.0f};  // KHR_materials_sheen
+  float sheen_roughness = 0.0f;
 };
 
 // The material evaluated at a surface point: base color x texture x vertex color, etc.
@@ -66,6 +69,8 @@ struct BsdfMaterial {
   float clearcoat = 0.0f;          // the coat's weight
   bool coat_delta = true;          // clearcoat roughness below kDeltaRoughness: a mirror coat
   float coat_alpha = kMinAlpha;    // the coat's GGX alpha
+  glm::vec3 sheen_color{0.0f};
+  float sheen_alpha = 1.0f;        // the Charlie distribution's
 };
 BsdfMaterial bsdf_material(const BsdfParams& params);
 
@@ -99,7 +104,7 @@ class Bsdf {
   bool has_nondelta() const { return has_nondelta_; }
   // The probability that sample() picks a non-delta lobe (1 for a BSDF without delta lobes).
   float nondelta_probability() const {
-    return p_diffuse_ + (glossy_delta_ ? 0.0f : p_glossy_) + (coat_delta_ ? 0.0f : p_coat_) +
+    return p_diffuse_ + (glossy_delta_ ? 0.0f : p_glossy_) + p_sheen_ + (coat_delta_ ? 0.0f : p_coat_) +
            (glass_delta_ ? 0.0f : p_glass_);
   }
   // The probability that sample() picks the diffuse lobe.
@@ -107,7 +112,7 @@ class Bsdf {
   // sample() reads u_lobe only when more than one lobe can be picked, or when the rough glass lobe
   // (which picks reflection or refraction with it) can be.
   bool has_lobe_choice() const {
-    return (p_diffuse_ > 0.0f) + (p_glossy_ > 0.0f) + (p_coat_ > 0.0f) + (p_glass_ > 0.0f) > 1 ||
+    return (p_diffuse_ > 0.0f) + (p_glossy_ > 0.0f) + (p_sheen_ > 0.0f) + (p_coat_ > 0.0f) + (p_glass_ > 0.0f) > 1 ||
            (p_glass_ > 0.0f && !glass_delta_);
   }
   bool is_black() const { return black_; }
@@ -119,6 +124,7 @@ class Bsdf {
   glm::vec3 eval_glass_transmission(glm::vec3 wi, float* pdf) const;
   glm::vec3 eval_coat(glm::vec3 wi_coat, float* pdf) const;  // adds the coat's pdf to *pdf
   float set_up_coat(const BsdfMaterial& material, glm::vec3 coat_normal, glm::vec3 wo);
+  glm::vec3 eval_sheen(glm::vec3 wi) const;  // f cos of the sheen lobe (local, wi.z > 0)
   bool sample_coat(glm::vec2 u, BsdfSample* out) const;
   glm::vec3 glossy_fresnel(float cos_oh) const;
   bool sample_smooth_glass(glm::vec2 u, BsdfSample* out) const;
@@ -152,8 +158,11 @@ class Bsdf {
   bool coat_delta_ = false;
   float coat_lambda_o_ = 0.0f;
   float coat_compensation_ = 1.0f;  // Turquin's factor of the coat lobe
+  // The sheen: color x Charlie D x Neubelt-Pettineo V, under the coat (times its share).
+  glm::vec3 sheen_factor_{0.0f};
+  float sheen_alpha_ = 1.0f;
   // Lobe selection probabilities; sample() reads u_lobe in this order.
-  float p_diffuse_ = 0.0f, p_glossy_ = 0.0f, p_coat_ = 0.0f, p_glass_ = 0.0f;
+  float p_diffuse_ = 0.0f, p_glossy_ = 0.0f, p_sheen_ = 0.0f, p_coat_ = 0.0f, p_glass_ = 0.0f;
   bool has_nondelta_ = false;
   bool black_ = true;
 };

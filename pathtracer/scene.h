@@ -55,7 +55,7 @@ struct TextureRef {
 
 enum class AlphaMode { Opaque, Mask, Blend };
 
-// glTF metallic-roughness material (+ emissive_strength, transmission, ior, specular, clearcoat).
+// glTF metallic-roughness material (+ emissive_strength, transmission, ior, specular, clearcoat, sheen).
 struct Material {
   std::string name;
   glm::vec4 base_color{1.0f};
@@ -80,6 +80,10 @@ struct Material {
   TextureRef clearcoat_roughness_texture;  // G
   TextureRef clearcoat_normal_texture;
   float clearcoat_normal_scale = 1.0f;
+  glm::vec3 sheen_color{0.0f};          // KHR_materials_sheen
+  TextureRef sheen_color_texture;       // RGB (sRGB)
+  float sheen_roughness = 0.0f;
+  TextureRef sheen_roughness_texture;   // A
   // KHR_materials_volume: absorption coefficient per scene unit, -ln(attenuationColor) /
   // attenuationDistance; 0 = clear or thin-walled (thicknessFactor 0). The medium is the inside
   // of the closed mesh, entered through its front faces.

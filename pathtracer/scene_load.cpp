@@ -59,6 +59,7 @@ const std::set<std::string>& supported_extensions() {
       "KHR_lights_punctual",      "KHR_texture_transform", "KHR_materials_emissive_strength",
       "KHR_materials_transmission", "KHR_materials_ior",   "KHR_materials_specular",
       "KHR_materials_volume",     "KHR_materials_pbrSpecularGlossiness", "KHR_materials_clearcoat",
+      "KHR_materials_sheen",
       "KHR_mesh_quantization",    "KHR_draco_mesh_compression", "EXT_meshopt_compression",
       "EXT_texture_webp",         "EXT_mesh_gpu_instancing"};
   return names;
@@ -617,7 +618,8 @@ class GltfLoader {
     for (Material& m : scene_.materials)
       for (TextureRef* ref : {&m.base_color_texture, &m.metallic_roughness_texture, &m.normal_texture, &m.emissive_texture,
                               &m.transmission_texture, &m.specular_texture, &m.specular_color_texture,
-                              &m.clearcoat_texture, &m.clearcoat_roughness_texture, &m.clearcoat_normal_texture})
+                              &m.clearcoat_texture, &m.clearcoat_roughness_texture, &m.clearcoat_normal_texture,
+                              &m.sheen_color_texture, &m.sheen_roughness_texture})
         if (ref->texture >= 0) {
           ref->texture = renumber[ref->texture];
           if (ref->texture < 0) *ref = TextureRef{};
@@ -678,6 +680,12 @@ class GltfLoader {
     }
     if (const tinygltf::Value* ext = find_extension(gm.extensions, "KHR_materials_volume")) read_volume(*ext, m);
     if (const tinygltf::Value* ext = find_extension(gm.extensions, "KHR_materials_clearcoat")) read_clearcoat(*ext, m);
+    if (const tinygltf::Value* ext = find_extension(gm.extensions, "KHR_materials_sheen")) {
+      m.sheen_color = glm::clamp(value_vec3_or(ext->Get("sheenColorFactor"), glm::vec3(0.0f)), glm::vec3(0.0f), glm::vec3(1.0f));
+      m.sheen_color_texture = texture_ref(info_of(ext->Get("sheenColorTexture")), true, m.name, "sheen color");
+      m.sheen_roughness = clamp01(number_or(ext->Get("sheenRoughnessFactor"), 0.0), 0.0f);
+      m.sheen_roughness_texture = texture_ref(info_of(ext->Get("sheenRoughnessTexture")), false, m.name, "sheen roughness");
+    }
     if (gm.alphaMode == "MASK") m.alpha_mode = AlphaMode::Mask;
     else if (gm.alphaMode == "BLEND") m.alpha_mode = AlphaMode::Blend;
     m.alpha_cutoff = std::max(finite_or(gm.alphaCutoff, 0.5f), 0.0f);

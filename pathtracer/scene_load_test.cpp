@@ -1343,6 +1343,26 @@ TEST(SceneLoadMaterial, KhrMaterialsVolumeGivesTheBeerLambertCoefficient) {
   EXPECT_FALSE(any_warning_contains(scene, "KHR_materials_volume")) << warnings_of(scene);
 }
 
+TEST(SceneLoadMaterial, KhrMaterialsSheenReadsItsFactorsAndTextures) {
+  std::string dir = temp_dir();
+  GltfBuilder b;
+  b.doc["extensionsUsed"] = {"KHR_materials_sheen"};
+  const int white = b.texture(b.image(encode_png(1, 1, 4, 8, {255, 255, 255, 255})));
+  const int velvet = b.material({{"extensions",
+                                  {{"KHR_materials_sheen",
+                                    {{"sheenColorFactor", {0.9, 0.5, 0.25}},
+                                     {"sheenColorTexture", {{"index", white}}},
+                                     {"sheenRoughnessFactor", 0.4},
+                                     {"sheenRoughnessTexture", {{"index", white}}}}}}}});
+  b.add_quad_scene(velvet);
+  Scene scene = load_scene(b.write_gltf(dir + "/sheen.gltf"));
+  EXPECT_FALSE(any_warning_contains(scene, "sheen")) << warnings_of(scene);
+  const Material& m = scene.materials[velvet];
+  expect_vec3_near(m.sheen_color, {0.9f, 0.5f, 0.25f});
+  EXPECT_FLOAT_EQ(m.sheen_roughness, 0.4f);
+  EXPECT_TRUE(m.sheen_color_texture.valid() && m.sheen_roughness_texture.valid());
+}
+
 TEST(SceneLoadMaterial, KhrMaterialsClearcoatReadsItsFactorsTexturesAndNormalMap) {
   std::string dir = temp_dir();
   GltfBuilder b;

@@ -64,10 +64,16 @@ float sheen_albedo_quadrature(float cos_o, float alpha, int n) {
 
 float sheen_albedo_table_entry(int roughness_index, int cos_index) { return kTable[roughness_index][cos_index]; }
 
+float sheen_table_roughness(int row) {
+  const float lowest = std::sqrt(kMinSheenAlpha);
+  return lowest + (1.0f - lowest) * static_cast<float>(row) / (kSheenAlbedoSize - 1);
+}
+
 float sheen_albedo(float cos_o, float alpha) {
   constexpr float last = kSheenAlbedoSize - 1;
   const float x = std::sqrt(std::clamp(cos_o, 0.0f, 1.0f)) * last;
-  const float y = std::clamp(std::sqrt(std::max(alpha, 0.0f)), 0.0f, 1.0f) * last;
+  const float lowest = std::sqrt(kMinSheenAlpha);
+  const float y = std::clamp((std::sqrt(std::max(alpha, 0.0f)) - lowest) / (1.0f - lowest), 0.0f, 1.0f) * last;
   const int x0 = std::min(static_cast<int>(x), kSheenAlbedoSize - 2), y0 = std::min(static_cast<int>(y), kSheenAlbedoSize - 2);
   const float fx = x - x0, fy = y - y0;
   const float low = kTable[y0][x0] * (1.0f - fx) + kTable[y0][x0 + 1] * fx;

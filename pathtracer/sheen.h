@@ -27,7 +27,11 @@ float sheen_visibility(float cos_o, float cos_i, float alpha);
 // The albedo of f = D V (color 1) at cos_o: a midpoint grid of n x n/2 over the hemisphere (cos
 // theta x phi, phi over [0, pi] by symmetry). The generator's.
 float sheen_albedo_quadrature(float cos_o, float alpha, int n);
-// Bilinear lookup in the generated table (grid as ggx_albedo.h's: sqrt(cos) and roughness).
+// The table's grid: column j at cos theta_o = (j / (kSheenAlbedoSize - 1))^2 (as ggx_albedo.h's),
+// row i at sheen roughness sqrt(kMinSheenAlpha) + (1 - sqrt(kMinSheenAlpha)) i / (kSheenAlbedoSize - 1),
+// so that the first row is the floor and no two rows share an alpha.
+float sheen_table_roughness(int row);
+// Bilinear lookup in the generated table.
 float sheen_albedo(float cos_o, float alpha);
 float sheen_albedo_table_entry(int roughness_index, int cos_index);
 

@@ -11,7 +11,7 @@
 namespace pxf {
 namespace {
 
-constexpr int kGeneratorQuadrature = 512;  // make_albedo_table sheen's
+constexpr int kGeneratorQuadrature = 1024;  // make_albedo_table sheen's
 
 TEST(Sheen, CharlieDistributionIsNormalized) {
   for (float alpha : {kMinSheenAlpha, 0.25f, 1.0f}) {
@@ -27,7 +27,7 @@ TEST(Sheen, CharlieDistributionIsNormalized) {
 
 TEST(Sheen, TableIsTheGeneratorsOutput) {
   for (auto [i, j] : {std::pair{0, 31}, {8, 3}, {20, 17}, {31, 0}, {31, 31}}) {
-    const float r = static_cast<float>(i) / (kSheenAlbedoSize - 1), s = static_cast<float>(j) / (kSheenAlbedoSize - 1);
+    const float r = sheen_table_roughness(i), s = static_cast<float>(j) / (kSheenAlbedoSize - 1);
     const float fresh = sheen_albedo_quadrature(s * s, sheen_alpha(r), kGeneratorQuadrature);
     EXPECT_NEAR(sheen_albedo_table_entry(i, j), fresh, 2e-6f) << i << ", " << j;
   }
@@ -39,11 +39,11 @@ TEST(Sheen, LookupInterpolatesTheAlbedo) {
   EXPECT_LT(sheen_albedo(0.1f, sheen_alpha(0.1f)), 1.0f);
   EXPECT_LT(sheen_albedo(0.004f, sheen_alpha(0.2f)), 1.0f);
   // Within 0.005 above sheen roughness 0.2 and 6 degrees from grazing, where the albedo is smooth;
-  // within 0.02 at the steep grazing and low-roughness end.
+  // within 0.025 at the steep grazing and low-roughness end.
   float worst = 0.0f, worst_steep = 0.0f;
-  for (int i = 3; i + 1 < kSheenAlbedoSize; i += 3)
+  for (int i = 0; i + 1 < kSheenAlbedoSize; i += 3)
     for (int j = 0; j + 1 < kSheenAlbedoSize; j += 3) {
-      const float r = (i + 0.5f) / (kSheenAlbedoSize - 1), s = (j + 0.5f) / (kSheenAlbedoSize - 1);
+      const float r = 0.5f * (sheen_table_roughness(i) + sheen_table_roughness(i + 1)), s = (j + 0.5f) / (kSheenAlbedoSize - 1);
       const float exact = sheen_albedo_quadrature(s * s, sheen_alpha(r), 128);
       const float error = std::abs(sheen_albedo(s * s, sheen_alpha(r)) - exact);
       float& bucket = r > 0.2f && s * s > 0.1f ? worst : worst_steep;
@@ -51,7 +51,7 @@ TEST(Sheen, LookupInterpolatesTheAlbedo) {
     }
   std::printf("largest absolute interpolation error of E_sheen: %.5f (steep end %.5f)\n", worst, worst_steep);
   EXPECT_LT(worst, 5e-3f);
-  EXPECT_LT(worst_steep, 2e-2f);
+  EXPECT_LT(worst_steep, 2.5e-2f);
 }
 
 }  // namespace
