@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <string>
 
@@ -22,8 +23,33 @@ glm::vec2 interpolate_uv(const std::vector<glm::vec2>& uv, const glm::uvec3& tri
   return uv.empty() ? glm::vec2(0.0f) : interpolate(uv, tri, u, v);
 }
 
-// Embree filter: rejects hits whose opacity is below the material's alpha cutoff.
-void alpha_mask_filter(const RTCFilterFunctionNArguments* args) {
+// splitmix64's finalizer: every input bit flips about half of the output bits.
+uint64_t mix_bits(uint64_t h) {
+  h = (h ^ (h >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  h = (h ^ (h >> 27)) * 0x94d049bb133111ebULL;
+  return h ^ (h >> 31);
+}
+
+// A uniform number in [0, 1) fixed by the ray (origin and direction) and the triangle it hits:
+// Embree may report one hit more than once, and every report must be decided alike; different
+// rays (other pixels, jitters, bounces, shadow rays) decide independently.
+float hit_random(const RTCFilterFunctionNArguments* args, unsigned i, unsigned prim) {
+  const unsigned n = args->N;
+  const float parts[] = {RTCRayN_org_x(args->ray, n, i), RTCRayN_org_y(args->ray, n, i), RTCRayN_org_z(args->ray, n, i),
+                         RTCRayN_dir_x(args->ray, n, i), RTCRayN_dir_y(args->ray, n, i), RTCRayN_dir_z(args->ray, n, i)};
+  uint64_t h = mix_bits(static_cast<uint64_t>(prim) + 0x9e3779b97f4a7c15ULL * (RTCHitN_geomID(args->hit, n, i) + 1));
+  for (float part : parts) {
+    uint32_t bits;
+    std::memcpy(&bits, &part, sizeof(bits));
+    h = mix_bits(h ^ bits);
+  }
+  return static_cast<float>(h >> 40) * 0x1p-24f;
+}
+
+// Embree filter for MASK and BLEND materials, on camera, bounce and shadow rays alike: MASK
+// rejects hits whose opacity is below the alpha cutoff; BLEND keeps a hit with probability equal
+// to its opacity (stochastic transparency: in expectation the surface is blended over what is behind).
+void alpha_filter(const RTCFilterFunctionNArguments* args) {
   const auto* data = static_cast<const EmbreeScene::MaskData*>(args->geometryUserPtr);
   for (unsigned i = 0; i < args->N; ++i) {
     if (args->valid[i] == 0) continue;
@@ -34,7 +60,9 @@ void alpha_mask_filter(const RTCFilterFunctionNArguments* args) {
     glm::vec2 uv1 = interpolate_uv(data->mesh->uv1, tri, u, v);
     float vertex_alpha = data->mesh->colors.empty() ? 1.0f : interpolate(data->mesh->colors, tri, u, v).a;
     float opacity = eval_opacity(*data->scene, *data->material, uv0, uv1, vertex_alpha);
-    if (!(opacity >= data->material->alpha_cutoff)) args->valid[i] = 0;
+    const bool kept = data->material->alpha_mode == AlphaMode::Mask ? opacity >= data->material->alpha_cutoff
+                                                                      : hit_random(args, i, prim) < opacity;
+    if (!kept) args->valid[i] = 0;
   }
 }
 
@@ -72,11 +100,11 @@ EmbreeScene::EmbreeScene(const Scene& scene) : scene_(scene) {
                                                                    3 * sizeof(unsigned), mesh.triangles.size()));
     if (!mesh.triangles.empty()) std::memcpy(indices, mesh.triangles.data(), mesh.triangles.size() * sizeof(glm::uvec3));
     const Material& material = scene.materials[mesh.material];
-    if (material.alpha_mode == AlphaMode::Mask) {
+    if (material.alpha_mode != AlphaMode::Opaque) {
       mask_data_.push_back({&scene_, &mesh, &material});
       rtcSetGeometryUserData(geom, &mask_data_.back());
-      rtcSetGeometryIntersectFilterFunction(geom, alpha_mask_filter);
-      rtcSetGeometryOccludedFilterFunction(geom, alpha_mask_filter);
+      rtcSetGeometryIntersectFilterFunction(geom, alpha_filter);
+      rtcSetGeometryOccludedFilterFunction(geom, alpha_filter);
     }
     rtcCommitGeometry(geom);
     unsigned id = rtcAttachGeometry(rtc_scene_, geom);  // ids are sequential: id == mesh index

@@ -67,7 +67,7 @@ class EmbreeScene {
   float triangle_area(unsigned mesh, unsigned prim) const;
   glm::vec3 face_normal(unsigned mesh, unsigned prim) const { return face_normals_[mesh][prim]; }
 
-  // Alpha-mask data handed to Embree's filter functions (one per mesh with a MASK material).
+  // Alpha data handed to Embree's filter functions (one per mesh with a MASK or BLEND material).
   struct MaskData {
     const Scene* scene;
     const Mesh* mesh;

@@ -310,6 +310,54 @@ TEST(MaterialMapping, SheenOverWhiteConservesEnergy) {
   EXPECT_NEAR(r.mean, 1.0, 0.01);
 }
 
+// A black, specular-free sphere with base alpha `alpha` in `mode` ("BLEND" or "MASK", cutoff 0.5).
+std::string cutout_material(float alpha, const char* mode) {
+  std::ostringstream m;
+  m << R"({"pbrMetallicRoughness":{"baseColorFactor":[0,0,0,)" << alpha
+    << R"(],"metallicFactor":0,"roughnessFactor":1},"alphaMode":")" << mode
+    << R"(","extensions":{"KHR_materials_specular":{"specularFactor":0}}})";
+  return m.str();
+}
+
+TEST(MaterialMapping, BlendIsStochasticTransparencyConsistentWithMask) {
+  // Every camera ray crosses the sphere twice (front face, back face): with BLEND each crossing
+  // passes with probability 1 - alpha, so the white environment shows through (1 - alpha)^2 of
+  // the time and the black surface the rest. MASK is the same surface thresholded at the cutoff.
+  struct Case {
+    float alpha;
+    const char* mode;
+    double expected;
+  };
+  for (const Case& c : {Case{0.3f, "BLEND", 0.49}, Case{1.0f, "BLEND", 0.0}, Case{0.0f, "BLEND", 1.0},
+                        Case{0.3f, "MASK", 1.0}, Case{0.8f, "MASK", 0.0}}) {
+    Scene scene = load_furnace(cutout_material(c.alpha, c.mode), R"("KHR_materials_specular")");
+    RenderResult r = render(scene, furnace_params(), 64);
+    std::printf("%s alpha %.1f: mean %.5f (expected %.2f)\n", c.mode, c.alpha, r.mean, c.expected);
+    EXPECT_NEAR(r.mean, c.expected, 0.015) << c.mode << " " << c.alpha;  // 5 sigma of 36864 Bernoulli samples
+  }
+}
+
+TEST(MaterialMapping, BlendShadowRaysAgreeWithCameraRays) {
+  // Shadow rays see a BLEND surface exactly when a ray along the same line hits it (both filters
+  // draw the same number for the same ray and triangle), and pass it with probability 1 - alpha.
+  Scene scene = load_furnace(cutout_material(0.25f, "BLEND"), R"("KHR_materials_specular")");
+  PathTracer tracer(scene);
+  int passed = 0, disagreements = 0;
+  const int rays = 4000;
+  for (int i = 0; i < rays; ++i) {
+    const glm::vec3 origin(-0.4f + 0.8f * ((i % 63) + 0.5f) / 63.0f, -0.4f + 0.8f * ((i / 63) + 0.5f) / 64.0f, 3.0f);
+    const Ray ray{origin, glm::vec3(0.0f, 0.0f, -1.0f)};
+    const bool hit = tracer.geometry().intersect(ray).valid();
+    const bool occluded = tracer.geometry().occluded(origin, ray.direction, 10.0f);
+    disagreements += hit != occluded;
+    passed += !occluded;
+  }
+  const double p = 0.75 * 0.75, sigma = std::sqrt(p * (1.0 - p) / rays);
+  std::printf("BLEND 0.25: %.4f of the shadow rays pass (expected %.4f)\n", static_cast<double>(passed) / rays, p);
+  EXPECT_EQ(disagreements, 0);
+  EXPECT_NEAR(static_cast<double>(passed) / rays, p, 4.0 * sigma);
+}
+
 TEST(MaterialMapping, RoughnessIsSquaredIntoGgxAlpha) {
   // Perceptual roughness r maps to alpha = r^2: a metal at roughness 0.5 must equal the same
   // Bsdf with roughness 0.5 (alpha 0.25), and differ from a Bsdf with alpha 0.5 (roughness 0.707).
