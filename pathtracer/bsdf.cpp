@@ -178,40 +178,57 @@ Bsdf::Bsdf(const BsdfMaterial& k, glm::vec3 shading_normal, glm::vec3 geometric_
   wo_local_.z = std::max(wo_local_.z, 1e-6f);
   lambda_o_ = ggx_lambda(wo_local_, alpha_);
   g1_o_ = 1.0f / (1.0f + lambda_o_);
-  // The coat reflects clearcoat * E_coat of the light; the base below gets the rest.
+  // The coat reflects clearcoat * E_coat of the light, the sheen below it sheen_color * E_sheen of
+  // the rest (scaling what is below by 1 - max(sheen_color) E_sheen), and the base gets the rest.
   const float coat_albedo = set_up_coat(k, glm::dot(coat_normal, coat_normal) > 0.0f ? coat_normal : ns, wo);
   const float coat_share = 1.0f - clearcoat_ * coat_albedo;
-  const float cos_o = wo_local_.z;
-  // The sheen reflects sheen_color E_sheen; the extension scales the base by 1 - max(sheen_color) E_sheen.
-  float sheen_albedo_o = 0.0f;
-  if (max_component(k.sheen_color) > 0.0f) {
-    sheen_alpha_ = k.sheen_alpha;
-    // Near grazing at sheen roughness below ~0.2 the lobe's albedo exceeds 1 (up to 1.41, the
-    // visibility's fit): scaled down there, so that it never reflects more than it receives.
-    const float albedo = sheen_albedo(cos_o, sheen_alpha_);
-    sheen_albedo_o = std::min(albedo, 1.0f);
-    sheen_factor_ = k.sheen_color * (albedo > 1.0f ? coat_share / albedo : coat_share);
-  }
+  const float sheen_albedo_o = set_up_sheen(k, coat_share);
   const float base_share = coat_share * std::max(0.0f, 1.0f - max_component(k.sheen_color) * sheen_albedo_o);
+  const glm::vec3 glossy_albedo = set_up_base(k, base_share);
+  // Never 0 where the sheen is evaluated (its albedo vanishes at normal incidence for low roughness),
+  // so that the directions it reflects into can be sampled.
+  const float w_sheen = luminance(sheen_factor_) * std::max(sheen_albedo_o, 1e-3f);
+  choose_lobes(luminance(diffuse_factor_) * kPi, luminance(glossy_albedo), w_sheen, clearcoat_ * coat_albedo, c_glass_);
+  if (black_) return;
+  inv_4cos_o_ = 1.0f / (4.0f * wo_local_.z);
+  glossy_pdf_scale_ = p_glossy_ * inv_4cos_o_ * g1_o_;
+}
 
+// The sheen under the coat: its albedo at wo (at most 1); 0 without a sheen.
+float Bsdf::set_up_sheen(const BsdfMaterial& k, float coat_share) {
+  if (!(max_component(k.sheen_color) > 0.0f)) return 0.0f;
+  sheen_alpha_ = k.sheen_alpha;
+  // Near grazing at sheen roughness below ~0.2 the lobe's albedo exceeds 1 (up to 1.41, the
+  // visibility's fit): scaled down there, so that it never reflects more than it receives.
+  const float albedo = sheen_albedo(wo_local_.z, sheen_alpha_);
+  sheen_factor_ = k.sheen_color * (albedo > 1.0f ? coat_share / albedo : coat_share);
+  return std::min(albedo, 1.0f);
+}
+
+// The base's lobes, scaled by the share of the light the layers above leave them. Returns the
+// albedo of the (compensated) GGX reflection lobe.
+glm::vec3 Bsdf::set_up_base(const BsdfMaterial& k, float base_share) {
+  const float cos_o = wo_local_.z;
   // The single-scattering GGX albedo at wo; a delta mirror reflects everything, with Schlick's weight.
   const GgxAlbedo e = glossy_delta_ ? GgxAlbedo{1.0f, schlick_weight(cos_o)} : ggx_albedo(cos_o, alpha_);
   const float missing = 1.0f / std::max(e.total, 1e-2f) - 1.0f;  // 1 / E - 1: the multiple-scattering share
   glossy_compensation_ = (glm::vec3(1.0f) + fresnel_at_0_ * missing) * base_share;
-  const glm::vec3 glossy_albedo = (fresnel_at_0_ * e.total + fresnel_slope_ * e.schlick) * glossy_compensation_;
   // The Lambert layer gets what the dielectric specular layer (compensated the same way) leaves.
   const glm::vec3 specular_albedo = (k.f0_dielectric * e.total + (glm::vec3(k.f90_dielectric) - k.f0_dielectric) * e.schlick) *
                                     (glm::vec3(1.0f) + k.f0_dielectric * missing);
   diffuse_factor_ = k.diffuse_albedo * glm::max(glm::vec3(1.0f) - specular_albedo, glm::vec3(0.0f)) * base_share;
   c_glass_ *= base_share;
-  float w_diffuse = std::max(0.0f, luminance(diffuse_factor_) * kPi);
-  float w_glossy = std::max(0.0f, luminance(glossy_albedo));
-  // Never 0 where the sheen is evaluated (its albedo vanishes at normal incidence for low roughness),
-  // so that the directions it reflects into can be sampled.
-  float w_sheen = std::max(0.0f, luminance(sheen_factor_) * std::max(sheen_albedo_o, 1e-3f));
-  float w_coat = std::max(0.0f, clearcoat_ * coat_albedo);
-  float w_glass = std::max(0.0f, c_glass_);
-  float total = w_diffuse + w_glossy + w_sheen + w_coat + w_glass;
+  return (fresnel_at_0_ * e.total + fresnel_slope_ * e.schlick) * glossy_compensation_;
+}
+
+// Lobe selection probabilities in proportion to the lobes' weights (their albedos at wo).
+void Bsdf::choose_lobes(float w_diffuse, float w_glossy, float w_sheen, float w_coat, float w_glass) {
+  w_diffuse = std::max(0.0f, w_diffuse);
+  w_glossy = std::max(0.0f, w_glossy);
+  w_sheen = std::max(0.0f, w_sheen);
+  w_coat = std::max(0.0f, w_coat);
+  w_glass = std::max(0.0f, w_glass);
+  const float total = w_diffuse + w_glossy + w_sheen + w_coat + w_glass;
   black_ = !(total > 0.0f);
   if (black_) return;
   p_diffuse_ = w_diffuse / total;
@@ -219,10 +236,8 @@ Bsdf::Bsdf(const BsdfMaterial& k, glm::vec3 shading_normal, glm::vec3 geometric_
   p_sheen_ = w_sheen / total;
   p_coat_ = w_coat / total;
   p_glass_ = w_glass / total;
-  has_nondelta_ = p_diffuse_ > 0.0f || p_sheen_ > 0.0f || (p_glossy_ > 0.0f && !glossy_delta_) || (p_coat_ > 0.0f && !coat_delta_) ||
-                  (p_glass_ > 0.0f && !glass_delta_);
-  inv_4cos_o_ = 1.0f / (4.0f * cos_o);
-  glossy_pdf_scale_ = p_glossy_ * inv_4cos_o_ * g1_o_;
+  has_nondelta_ = p_diffuse_ > 0.0f || p_sheen_ > 0.0f || (p_glossy_ > 0.0f && !glossy_delta_) ||
+                  (p_coat_ > 0.0f && !coat_delta_) || (p_glass_ > 0.0f && !glass_delta_);
 }
 
 // The coat's frame at wo and its compensated albedo (F0 0.04, ior 1.5); 0 without a coat.

@@ -125,6 +125,9 @@ class Bsdf {
   glm::vec3 eval_coat(glm::vec3 wi_coat, float* pdf) const;  // adds the coat's pdf to *pdf
   float set_up_coat(const BsdfMaterial& material, glm::vec3 coat_normal, glm::vec3 wo);
   glm::vec3 eval_sheen(glm::vec3 wi) const;  // f cos of the sheen lobe (local, wi.z > 0)
+  float set_up_sheen(const BsdfMaterial& material, float coat_share);
+  glm::vec3 set_up_base(const BsdfMaterial& material, float base_share);
+  void choose_lobes(float w_diffuse, float w_glossy, float w_sheen, float w_coat, float w_glass);
   bool sample_coat(glm::vec2 u, BsdfSample* out) const;
   glm::vec3 glossy_fresnel(float cos_oh) const;
   bool sample_smooth_glass(glm::vec2 u, BsdfSample* out) const;
