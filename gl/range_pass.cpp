@@ -183,8 +183,10 @@ void RangePass::draw_scene(glm::vec2 jitter) {
     raster_.set("base_color", m.base_color);
     raster_.set("texcoord", ref.texcoord);
     raster_.set("uv_transform", ref.transform);
-    raster_.set("alpha_mask", m.alpha_mode == AlphaMode::Mask ? 1 : 0);
-    raster_.set("alpha_cutoff", m.alpha_cutoff);
+    // The guide is deterministic: it sees a BLEND surface where its opacity is at least one half
+    // (where the path tracer's stochastic transparency keeps most hits).
+    raster_.set("alpha_mask", m.alpha_mode != AlphaMode::Opaque ? 1 : 0);
+    raster_.set("alpha_cutoff", m.alpha_mode == AlphaMode::Blend ? 0.5f : m.alpha_cutoff);
     raster_.set("double_sided", m.double_sided ? 1 : 0);
     raster_.set("specular", material_is_perfect_specular(m) ? 1.0f : 0.0f);
     g.vao.bind();

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "pathtracer/ggx_albedo.h"
+#include "pathtracer/sheen.h"
 #include "pathtracer/texture.h"
 
 namespace pxf {
@@ -15,6 +17,8 @@ inline float schlick_weight(float cos_theta) {
   const float m = saturate(1.0f - cos_theta), m2 = m * m;
   return m2 * m2 * m;
 }
+
+constexpr float kCoatF0 = 0.04f;  // KHR_materials_clearcoat: ior 1.5, ((1.5 - 1) / (1.5 + 1))^2
 
 inline glm::vec3 schlick(glm::vec3 f0, float f90, float cos_theta) {
   return f0 + (glm::vec3(f90) - f0) * schlick_weight(cos_theta);
@@ -37,12 +41,17 @@ BsdfParams eval_material(const Scene& scene, const Material& m, glm::vec2 uv0, g
   p.ior = m.ior >= 1.0f ? m.ior : 1.5f;  // glTF allows ior 0 (= "no refraction"); keep it sane
   p.specular = saturate(m.specular * eval_texture(scene, m.specular_texture, uv0, uv1).a);
   p.specular_color = m.specular_color * glm::vec3(eval_texture(scene, m.specular_color_texture, uv0, uv1));
+  p.clearcoat = saturate(m.clearcoat * eval_texture(scene, m.clearcoat_texture, uv0, uv1).r);
+  p.clearcoat_roughness = saturate(m.clearcoat_roughness * eval_texture(scene, m.clearcoat_roughness_texture, uv0, uv1).g);
+  p.sheen_color = m.sheen_color * glm::vec3(eval_texture(scene, m.sheen_color_texture, uv0, uv1));
+  p.sheen_roughness = saturate(m.sheen_roughness * eval_texture(scene, m.sheen_roughness_texture, uv0, uv1).a);
   return p;
 }
 
 bool eval_material_is_constant(const Material& m) {  // the textures eval_material() reads
   return constant(m.base_color_texture) && constant(m.metallic_roughness_texture) && constant(m.transmission_texture) &&
-         constant(m.specular_texture) && constant(m.specular_color_texture);
+         constant(m.specular_texture) && constant(m.specular_color_texture) && constant(m.clearcoat_texture) &&
+         constant(m.clearcoat_roughness_texture) && constant(m.sheen_color_texture) && constant(m.sheen_roughness_texture);
 }
 
 glm::vec3 eval_emission(const Scene& scene, const Material& m, glm::vec2 uv0, glm::vec2 uv1) {
@@ -54,14 +63,28 @@ float eval_opacity(const Scene& scene, const Material& m, glm::vec2 uv0, glm::ve
   return m.base_color.a * eval_texture(scene, m.base_color_texture, uv0, uv1).a * vertex_alpha;
 }
 
-bool material_is_perfect_mirror(const Material& m) {
-  return constant(m.metallic_roughness_texture) && m.roughness < kDeltaRoughness && m.metallic >= 1.0f - 1e-3f;
+// No clearcoat, or a smooth one (a delta lobe).
+static bool coat_is_delta_or_absent(const Material& m) {
+  return !(m.clearcoat > 0.0f) || (constant(m.clearcoat_roughness_texture) && m.clearcoat_roughness < kDeltaRoughness);
 }
 
+// A sheen is never a delta lobe.
+static bool has_sheen(const Material& m) { return max_component(m.sheen_color) > 0.0f; }
+
+bool material_is_perfect_mirror(const Material& m) {
+  return constant(m.metallic_roughness_texture) && m.roughness < kDeltaRoughness && m.metallic >= 1.0f - 1e-3f &&
+         coat_is_delta_or_absent(m) && !has_sheen(m);
+}
+
+// Exactly the materials whose BSDF has delta lobes only (a constant-factor mirror or glass), so
+// that the specular chains, the range buffer and the LV/HV split agree about every surface.
 bool material_is_perfect_specular(const Material& m) {
-  if (!constant(m.metallic_roughness_texture) || m.roughness >= kDeltaRoughness) return false;
-  bool glass = constant(m.transmission_texture) && m.transmission >= 1.0f - 1e-3f && m.metallic <= 1e-3f;
-  return material_is_perfect_mirror(m) || glass;
+  if (!constant(m.metallic_roughness_texture)) return false;
+  if (material_is_perfect_mirror(m)) return true;
+  // Glass is smooth below the delta roughness, or at any roughness without refraction (ior 1).
+  const bool smooth = m.roughness < kDeltaRoughness || std::abs(m.ior - 1.0f) < 1e-3f;
+  return smooth && constant(m.transmission_texture) && m.transmission >= 1.0f - 1e-3f && m.metallic <= 1e-3f &&
+         coat_is_delta_or_absent(m) && !has_sheen(m);
 }
 
 float ggx_d(glm::vec3 h, float alpha) {
@@ -103,6 +126,12 @@ float fresnel_dielectric(float cos_i, float eta) {
   return 0.5f * (rs * rs + rp * rp);
 }
 
+float ggx_vndf_pdf(glm::vec3 wo, glm::vec3 h, float alpha) {
+  const float cos_oh = glm::dot(wo, h);
+  if (!(cos_oh > 0.0f) || !(wo.z > 0.0f)) return 0.0f;
+  return ggx_d(h, alpha) * cos_oh / ((1.0f + ggx_lambda(wo, alpha)) * wo.z);
+}
+
 BsdfMaterial bsdf_material(const BsdfParams& params) {
   BsdfMaterial k;
   k.params = params;
@@ -110,6 +139,9 @@ BsdfMaterial bsdf_material(const BsdfParams& params) {
   const float c_diffuse = (1.0f - m) * (1.0f - t);
   k.c_glass = (1.0f - m) * t;
   k.glossy_delta = params.roughness < kDeltaRoughness;
+  // An interface without refraction has no half vector for its transmission: it passes light
+  // straight through, a delta lobe whatever the roughness (pbrt does the same).
+  k.glass_delta = k.glossy_delta || std::abs(params.ior - 1.0f) < 1e-3f;
   k.alpha = std::max(params.roughness * params.roughness, kMinAlpha);
   const float r0 = (params.ior - 1.0f) / (params.ior + 1.0f);
   k.f0_dielectric = glm::min(glm::vec3(r0 * r0) * params.specular_color, glm::vec3(1.0f)) * params.specular;
@@ -118,14 +150,21 @@ BsdfMaterial bsdf_material(const BsdfParams& params) {
   k.fresnel_at_0 = m * params.base_color + c_diffuse * k.f0_dielectric;
   k.fresnel_slope = m * (glm::vec3(1.0f) - params.base_color) + c_diffuse * (glm::vec3(k.f90_dielectric) - k.f0_dielectric);
   k.diffuse_albedo = c_diffuse * params.base_color * kInvPi;
+  k.clearcoat = params.clearcoat;
+  k.coat_delta = params.clearcoat_roughness < kDeltaRoughness;
+  k.coat_alpha = std::max(params.clearcoat_roughness * params.clearcoat_roughness, kMinAlpha);
+  k.sheen_color = glm::max(params.sheen_color, glm::vec3(0.0f));
+  k.sheen_alpha = sheen_alpha(params.sheen_roughness);
   return k;
 }
 
-Bsdf::Bsdf(const BsdfMaterial& k, glm::vec3 shading_normal, glm::vec3 geometric_normal, glm::vec3 wo, bool front_face)
+Bsdf::Bsdf(const BsdfMaterial& k, glm::vec3 shading_normal, glm::vec3 geometric_normal, glm::vec3 wo, bool front_face,
+           glm::vec3 coat_normal)
     : base_color_(k.params.base_color),
       ior_(k.params.ior),
       alpha_(k.alpha),
       glossy_delta_(k.glossy_delta),
+      glass_delta_(k.glass_delta),
       front_face_(front_face),
       c_glass_(k.c_glass),
       fresnel_at_0_(k.fresnel_at_0),
@@ -138,22 +177,85 @@ Bsdf::Bsdf(const BsdfMaterial& k, glm::vec3 shading_normal, glm::vec3 geometric_
   wo_local_ = frame_.to_local(wo);
   wo_local_.z = std::max(wo_local_.z, 1e-6f);
   lambda_o_ = ggx_lambda(wo_local_, alpha_);
+  g1_o_ = 1.0f / (1.0f + lambda_o_);
+  // The coat reflects clearcoat * E_coat of the light, the sheen below it sheen_color * E_sheen of
+  // the rest (scaling what is below by 1 - max(sheen_color) E_sheen), and the base gets the rest.
+  const float coat_albedo = set_up_coat(k, glm::dot(coat_normal, coat_normal) > 0.0f ? coat_normal : ns, wo);
+  const float coat_share = 1.0f - clearcoat_ * coat_albedo;
+  const float sheen_albedo_o = set_up_sheen(k, coat_share);
+  const float base_share = coat_share * std::max(0.0f, 1.0f - max_component(k.sheen_color) * sheen_albedo_o);
+  const glm::vec3 glossy_albedo = set_up_base(k, base_share);
+  // Never 0 where the sheen is evaluated (its albedo vanishes at normal incidence for low roughness),
+  // so that the directions it reflects into can be sampled.
+  const float w_sheen = luminance(sheen_factor_) * std::max(sheen_albedo_o, 1e-3f);
+  choose_lobes(luminance(diffuse_factor_) * kPi, luminance(glossy_albedo), w_sheen, clearcoat_ * coat_albedo, c_glass_);
+  if (black_) return;
+  inv_4cos_o_ = 1.0f / (4.0f * wo_local_.z);
+  glossy_pdf_scale_ = p_glossy_ * inv_4cos_o_ * g1_o_;
+}
 
-  float cos_o = wo_local_.z;
-  glm::vec3 fd_o = schlick(k.f0_dielectric, k.f90_dielectric, cos_o);
-  diffuse_factor_ = k.diffuse_albedo * (glm::vec3(1.0f) - fd_o);
-  float w_diffuse = std::max(0.0f, luminance(diffuse_factor_) * kPi);
-  float w_glossy = std::max(0.0f, luminance(glossy_fresnel(cos_o)));
-  float w_glass = std::max(0.0f, c_glass_);
-  float total = w_diffuse + w_glossy + w_glass;
+// The sheen under the coat: its albedo at wo (at most 1); 0 without a sheen.
+float Bsdf::set_up_sheen(const BsdfMaterial& k, float coat_share) {
+  if (!(max_component(k.sheen_color) > 0.0f)) return 0.0f;
+  sheen_alpha_ = k.sheen_alpha;
+  // Near grazing at sheen roughness below ~0.2 the lobe's albedo exceeds 1 (up to 1.41, the
+  // visibility's fit): scaled down there, so that it never reflects more than it receives.
+  const float albedo = sheen_albedo(wo_local_.z, sheen_alpha_);
+  sheen_factor_ = k.sheen_color * (albedo > 1.0f ? coat_share / albedo : coat_share);
+  return std::min(albedo, 1.0f);
+}
+
+// The base's lobes, scaled by the share of the light the layers above leave them. Returns the
+// albedo of the (compensated) GGX reflection lobe.
+glm::vec3 Bsdf::set_up_base(const BsdfMaterial& k, float base_share) {
+  const float cos_o = wo_local_.z;
+  // The single-scattering GGX albedo at wo; a delta mirror reflects everything, with Schlick's weight.
+  const GgxAlbedo e = glossy_delta_ ? GgxAlbedo{1.0f, schlick_weight(cos_o)} : ggx_albedo(cos_o, alpha_);
+  const float missing = 1.0f / std::max(e.total, 1e-2f) - 1.0f;  // 1 / E - 1: the multiple-scattering share
+  glossy_compensation_ = (glm::vec3(1.0f) + fresnel_at_0_ * missing) * base_share;
+  // The Lambert layer gets what the dielectric specular layer (compensated the same way) leaves.
+  const glm::vec3 specular_albedo = (k.f0_dielectric * e.total + (glm::vec3(k.f90_dielectric) - k.f0_dielectric) * e.schlick) *
+                                    (glm::vec3(1.0f) + k.f0_dielectric * missing);
+  diffuse_factor_ = k.diffuse_albedo * glm::max(glm::vec3(1.0f) - specular_albedo, glm::vec3(0.0f)) * base_share;
+  c_glass_ *= base_share;
+  return (fresnel_at_0_ * e.total + fresnel_slope_ * e.schlick) * glossy_compensation_;
+}
+
+// Lobe selection probabilities in proportion to the lobes' weights (their albedos at wo).
+void Bsdf::choose_lobes(float w_diffuse, float w_glossy, float w_sheen, float w_coat, float w_glass) {
+  w_diffuse = std::max(0.0f, w_diffuse);
+  w_glossy = std::max(0.0f, w_glossy);
+  w_sheen = std::max(0.0f, w_sheen);
+  w_coat = std::max(0.0f, w_coat);
+  w_glass = std::max(0.0f, w_glass);
+  const float total = w_diffuse + w_glossy + w_sheen + w_coat + w_glass;
   black_ = !(total > 0.0f);
   if (black_) return;
   p_diffuse_ = w_diffuse / total;
   p_glossy_ = w_glossy / total;
+  p_sheen_ = w_sheen / total;
+  p_coat_ = w_coat / total;
   p_glass_ = w_glass / total;
-  has_nondelta_ = p_diffuse_ > 0.0f || (p_glossy_ > 0.0f && !glossy_delta_);
-  inv_4cos_o_ = 1.0f / (4.0f * cos_o);
-  glossy_pdf_scale_ = p_glossy_ * inv_4cos_o_ / (1.0f + lambda_o_);
+  has_nondelta_ = p_diffuse_ > 0.0f || p_sheen_ > 0.0f || (p_glossy_ > 0.0f && !glossy_delta_) ||
+                  (p_coat_ > 0.0f && !coat_delta_) || (p_glass_ > 0.0f && !glass_delta_);
+}
+
+// The coat's frame at wo and its compensated albedo (F0 0.04, ior 1.5); 0 without a coat.
+float Bsdf::set_up_coat(const BsdfMaterial& k, glm::vec3 coat_normal, glm::vec3 wo) {
+  clearcoat_ = k.clearcoat;
+  if (!(clearcoat_ > 0.0f)) return 0.0f;
+  coat_alpha_ = k.coat_alpha;
+  coat_delta_ = k.coat_delta;
+  glm::vec3 nc = glm::dot(coat_normal, ng_) >= 0.0f ? coat_normal : -coat_normal;
+  if (!(glm::dot(wo, nc) > 1e-4f)) nc = ng_;
+  coat_frame_ = Frame::from_normal(nc);
+  coat_wo_local_ = coat_frame_.to_local(wo);
+  coat_wo_local_.z = std::max(coat_wo_local_.z, 1e-6f);
+  coat_lambda_o_ = ggx_lambda(coat_wo_local_, coat_alpha_);
+  const float cos_o = coat_wo_local_.z;
+  const GgxAlbedo e = coat_delta_ ? GgxAlbedo{1.0f, schlick_weight(cos_o)} : ggx_albedo(cos_o, coat_alpha_);
+  coat_compensation_ = 1.0f + kCoatF0 * (1.0f / std::max(e.total, 1e-2f) - 1.0f);
+  return (kCoatF0 * e.total + (1.0f - kCoatF0) * e.schlick) * coat_compensation_;
 }
 
 // Fresnel of the GGX layer: the conductor and the dielectric specular share one microfacet lobe.
@@ -163,24 +265,81 @@ glm::vec3 Bsdf::glossy_fresnel(float cos_oh) const {
 
 glm::vec3 Bsdf::eval_local(glm::vec3 wi, float* pdf) const {
   *pdf = 0.0f;
-  if (wi.z <= 0.0f) return glm::vec3(0.0f);
+  if (wi.z < 0.0f) return p_glass_ > 0.0f && !glass_delta_ ? eval_glass_transmission(wi, pdf) : glm::vec3(0.0f);
+  if (wi.z == 0.0f) return glm::vec3(0.0f);
   glm::vec3 f = diffuse_factor_ * wi.z;
-  *pdf = p_diffuse_ * wi.z * kInvPi;
-  if (p_glossy_ > 0.0f && !glossy_delta_) {
+  *pdf = (p_diffuse_ + p_sheen_) * wi.z * kInvPi;  // the sheen is cosine-sampled too
+  if (p_sheen_ > 0.0f) f += eval_sheen(wi);
+  const bool glossy = p_glossy_ > 0.0f && !glossy_delta_, glass = p_glass_ > 0.0f && !glass_delta_;
+  if (glossy || glass) {  // the GGX reflection lobes share the half vector
     glm::vec3 h = glm::normalize(wo_local_ + wi);
     float d = ggx_d(h, alpha_);
     float g2 = 1.0f / (1.0f + lambda_o_ + ggx_lambda(wi, alpha_));
     float spec = d * g2 * inv_4cos_o_;  // D G2 / (4 cos_o cos_i), times cos_i
-    f += glossy_fresnel(std::max(0.0f, glm::dot(wo_local_, h))) * spec;
-    *pdf += glossy_pdf_scale_ * d;  // VNDF: G1(wo) D / (4 cos_o)
+    float cos_oh = std::max(0.0f, glm::dot(wo_local_, h));
+    if (glossy) {
+      f += glossy_fresnel(cos_oh) * glossy_compensation_ * spec;
+      *pdf += glossy_pdf_scale_ * d;  // VNDF: G1(wo) D / (4 cos_o)
+    }
+    if (glass) {  // reflected with probability F(wo.h) of the sampled microfacet
+      float fresnel = fresnel_dielectric(cos_oh, eta());
+      f += glm::vec3(c_glass_ * fresnel * spec);
+      *pdf += p_glass_ * fresnel * g1_o_ * d * inv_4cos_o_;
+    }
   }
   return f;
 }
 
+// Walter et al. 2007's refraction through a GGX microfacet (pbrt-v4's DielectricBxDF), tinted by
+// the base color and compressed by eta^2 like the smooth glass's.
+glm::vec3 Bsdf::eval_glass_transmission(glm::vec3 wi, float* pdf) const {
+  const float eta = this->eta();
+  glm::vec3 h = wo_local_ + wi * eta;  // the generalized half vector
+  const float length2 = glm::dot(h, h);
+  if (!(length2 > 1e-12f)) return glm::vec3(0.0f);
+  h *= 1.0f / std::sqrt(length2);
+  if (h.z < 0.0f) h = -h;
+  const float cos_oh = glm::dot(wo_local_, h), cos_ih = glm::dot(wi, h);
+  if (cos_oh <= 0.0f || cos_ih >= 0.0f) return glm::vec3(0.0f);  // a microfacet seen from its back
+  const float transmitted = 1.0f - fresnel_dielectric(cos_oh, eta);
+  const float denom = cos_ih + cos_oh / eta;
+  const float jacobian = -cos_ih / (denom * denom);  // d omega_h / d omega_i
+  if (!(transmitted > 0.0f) || !std::isfinite(jacobian)) return glm::vec3(0.0f);
+  const float d = ggx_d(h, alpha_);
+  const float g2 = 1.0f / (1.0f + lambda_o_ + ggx_lambda(wi, alpha_));
+  const float cos_o = wo_local_.z;
+  *pdf = p_glass_ * transmitted * g1_o_ * d * cos_oh / cos_o * jacobian;
+  return base_color_ * (c_glass_ * transmitted * d * g2 * cos_oh * jacobian / (cos_o * eta * eta));
+}
+
 glm::vec3 Bsdf::eval(glm::vec3 wi, float* pdf) const {
   *pdf = 0.0f;
-  if (black_ || glm::dot(wi, ng_) <= 0.0f) return glm::vec3(0.0f);  // no light through opaque faces
-  return eval_local(frame_.to_local(wi), pdf);
+  if (black_) return glm::vec3(0.0f);
+  // Reflection stays on wo's side of the face, transmission crosses it: light never passes through
+  // an opaque face, and the shading normal may not disagree with the face about the side.
+  const glm::vec3 local = frame_.to_local(wi);
+  const float side = glm::dot(wi, ng_);
+  glm::vec3 f(0.0f);
+  if ((local.z > 0.0f && side > 0.0f) || (local.z < 0.0f && side < 0.0f)) f = eval_local(local, pdf);
+  if (p_coat_ > 0.0f && !coat_delta_ && side > 0.0f) f += eval_coat(coat_frame_.to_local(wi), pdf);
+  return f;
+}
+
+glm::vec3 Bsdf::eval_sheen(glm::vec3 wi) const {
+  const glm::vec3 h = glm::normalize(wo_local_ + wi);
+  return sheen_factor_ * (charlie_d(h.z, sheen_alpha_) * sheen_visibility(wo_local_.z, wi.z, sheen_alpha_) * wi.z);
+}
+
+glm::vec3 Bsdf::eval_coat(glm::vec3 wi, float* pdf) const {
+  if (wi.z <= 0.0f) return glm::vec3(0.0f);
+  const glm::vec3& wo = coat_wo_local_;
+  const glm::vec3 h = glm::normalize(wo + wi);
+  const float d = ggx_d(h, coat_alpha_);
+  const float g2 = 1.0f / (1.0f + coat_lambda_o_ + ggx_lambda(wi, coat_alpha_));
+  const float inv_4cos_o = 1.0f / (4.0f * wo.z);
+  const float fresnel = kCoatF0 + (1.0f - kCoatF0) * schlick_weight(std::max(0.0f, glm::dot(wo, h)));
+  *pdf += p_coat_ * d * inv_4cos_o / (1.0f + coat_lambda_o_);  // VNDF: G1(wo) D / (4 cos_o)
+  return glm::vec3(clearcoat_ * coat_compensation_ * fresnel * d * g2 * inv_4cos_o);
 }
 
 glm::vec3 Bsdf::eval(glm::vec3 wi) const {
@@ -194,39 +353,80 @@ float Bsdf::pdf(glm::vec3 wi) const {
   return pdf;
 }
 
+bool Bsdf::finish_nondelta_sample(glm::vec3 wi, bool transmitted, BsdfSample* out) const {
+  out->wi = wi;
+  glm::vec3 f = eval(out->wi, &out->pdf);
+  if (!(out->pdf > 0.0f)) return false;
+  out->weight = f / out->pdf;
+  out->delta = false;
+  out->transmitted = transmitted;
+  return true;
+}
+
 bool Bsdf::sample(float u_lobe, glm::vec2 u, BsdfSample* out) const {
   if (black_) return false;
   const glm::vec3& wo = wo_local_;
+  if (u_lobe < p_diffuse_) return finish_nondelta_sample(frame_.to_world(sample_cosine_hemisphere(u)), false, out);
   if (u_lobe < p_diffuse_ + p_glossy_) {
-    bool diffuse = u_lobe < p_diffuse_;
-    if (!diffuse && glossy_delta_) {  // perfect mirror branch
+    if (glossy_delta_) {  // perfect mirror branch
       glm::vec3 wi(-wo.x, -wo.y, wo.z);
       out->wi = frame_.to_world(wi);
-      out->weight = glossy_fresnel(wo.z) / p_glossy_;
+      out->weight = glossy_fresnel(wo.z) * glossy_compensation_ / p_glossy_;  // compensation 1 x the base's share
       out->pdf = 0.0f;
       out->delta = true;
       out->transmitted = false;
       return glm::dot(out->wi, ng_) > 0.0f;
     }
-    glm::vec3 wi;
-    if (diffuse) {
-      wi = sample_cosine_hemisphere(u);
-    } else {
-      glm::vec3 h = ggx_sample_vndf(wo, alpha_, u);
-      wi = glm::reflect(-wo, h);
-    }
-    if (wi.z <= 0.0f) return false;
-    out->wi = frame_.to_world(wi);
-    if (glm::dot(out->wi, ng_) <= 0.0f) return false;
-    glm::vec3 f = eval_local(wi, &out->pdf);
-    if (!(out->pdf > 0.0f)) return false;
-    out->weight = f / out->pdf;
-    out->delta = false;
-    out->transmitted = false;
-    return true;
+    glm::vec3 wi = glm::reflect(-wo, ggx_sample_vndf(wo, alpha_, u));
+    return wi.z > 0.0f && finish_nondelta_sample(frame_.to_world(wi), false, out);
   }
-  // Smooth dielectric: reflect with probability F, else refract (tinted by the base color).
-  float eta = front_face_ ? ior_ : 1.0f / ior_;  // eta_t / eta_i
+  // The sheen is broad (its D peaks at grazing half vectors): cosine sampling, like the diffuse lobe.
+  if (u_lobe < p_diffuse_ + p_glossy_ + p_sheen_)
+    return finish_nondelta_sample(frame_.to_world(sample_cosine_hemisphere(u)), false, out);
+  if (u_lobe < p_diffuse_ + p_glossy_ + p_sheen_ + p_coat_) return sample_coat(u, out);
+  if (!(p_glass_ > 0.0f)) return false;
+  if (glass_delta_) return sample_smooth_glass(u, out);
+  // The rest of u_lobe's interval picks reflection or refraction.
+  const float u_choice = std::min((u_lobe - p_diffuse_ - p_glossy_ - p_sheen_ - p_coat_) / p_glass_, 0x1.fffffep-1f);
+  return sample_rough_glass(u_choice, u, out);
+}
+
+bool Bsdf::sample_coat(glm::vec2 u, BsdfSample* out) const {
+  const glm::vec3& wo = coat_wo_local_;
+  if (coat_delta_) {  // a mirror coat
+    out->wi = coat_frame_.to_world(glm::vec3(-wo.x, -wo.y, wo.z));
+    out->weight = glm::vec3(clearcoat_ * (kCoatF0 + (1.0f - kCoatF0) * schlick_weight(wo.z)) / p_coat_);
+    out->pdf = 0.0f;
+    out->delta = true;
+    out->transmitted = false;
+    return glm::dot(out->wi, ng_) > 0.0f;
+  }
+  const glm::vec3 wi = glm::reflect(-wo, ggx_sample_vndf(wo, coat_alpha_, u));
+  return wi.z > 0.0f && finish_nondelta_sample(coat_frame_.to_world(wi), false, out);
+}
+
+// A visible microfacet normal, then reflection with probability F(wo.h), else refraction through it.
+bool Bsdf::sample_rough_glass(float u_choice, glm::vec2 u, BsdfSample* out) const {
+  const glm::vec3& wo = wo_local_;
+  const glm::vec3 h = ggx_sample_vndf(wo, alpha_, u);
+  const float cos_oh = glm::dot(wo, h);
+  if (!(cos_oh > 0.0f)) return false;
+  const float eta = this->eta();
+  if (u_choice < fresnel_dielectric(cos_oh, eta)) {
+    const glm::vec3 wi = glm::reflect(-wo, h);
+    return wi.z > 0.0f && finish_nondelta_sample(frame_.to_world(wi), false, out);
+  }
+  const float sin2_t = (1.0f - cos_oh * cos_oh) / (eta * eta);
+  if (sin2_t >= 1.0f) return false;  // total internal reflection (F = 1: not reached)
+  const float cos_t = std::sqrt(1.0f - sin2_t);
+  const glm::vec3 wi = glm::normalize(-wo / eta + (cos_oh / eta - cos_t) * h);
+  return wi.z < 0.0f && finish_nondelta_sample(frame_.to_world(wi), true, out);
+}
+
+// Reflect with probability F, else refract (tinted by the base color).
+bool Bsdf::sample_smooth_glass(glm::vec2 u, BsdfSample* out) const {
+  const glm::vec3& wo = wo_local_;
+  float eta = this->eta();
   float cos_i = wo.z;
   float fresnel = fresnel_dielectric(cos_i, eta);
   glm::vec3 wi;

@@ -1,10 +1,16 @@
-// Materials as BSDFs (glTF metallic-roughness + transmission, ior, specular):
+// Materials as BSDFs (glTF metallic-roughness + transmission, ior, specular, clearcoat):
+//   clearcoat * GGX coat (Schlick, F0 = 0.04, own roughness and normal)
+// + (1 - clearcoat * E_coat(cos_o)) * (sheen color * Charlie sheen
+//                                       + (1 - max(sheen color) E_sheen(cos_o)) * the base):
 //   metallic * GGX conductor (Schlick, F0 = base color)
 // + (1 - metallic) * (1 - transmission) * (GGX dielectric specular (F0 from ior and KHR specular)
-//                                        + (1 - F) * Lambert(base color))
-// + (1 - metallic) * transmission * smooth dielectric (exact Fresnel, transmission tinted by base).
-// Roughness below kDeltaRoughness makes the GGX lobe a perfect mirror. Lobes are picked
-// stochastically by an estimate of their weight; pdf() is the combined pdf of the non-delta lobes.
+//                                        + (1 - E_specular(cos_o)) * Lambert(base color))
+// + (1 - metallic) * transmission * GGX dielectric (Walter 2007: exact Fresnel, reflection and
+//                                     refraction, the refraction tinted by the base color).
+// The GGX reflection lobes are energy-compensated (Turquin 2019: scaled by 1 + F0 (1 / E - 1), E
+// the single-scattering albedo, ggx_albedo.h). Roughness below kDeltaRoughness makes the GGX lobes
+// delta lobes (a mirror, smooth glass). Lobes are picked stochastically by their albedo at wo;
+// pdf() is the combined pdf of the non-delta lobes.
 #pragma once
 #include <glm/glm.hpp>
 #include "pathtracer/sampling.h"
@@ -24,6 +30,10 @@ struct BsdfParams {
   float ior = 1.5f;
   float specular = 1.0f;
   glm::vec3 specular_color{1.0f};
+  float clearcoat = 0.0f;  // KHR_materials_clearcoat
+  float clearcoat_roughness = 0.0f;
+  glm::vec3 sheen_color{0.0f};  // KHR_materials_sheen
+  float sheen_roughness = 0.0f;
 };
 
 // The material evaluated at a surface point: base color x texture x vertex color, etc.
@@ -48,6 +58,7 @@ struct BsdfMaterial {
   BsdfParams params;
   float c_glass = 0.0f;                    // the glass lobe's mixing coefficient
   bool glossy_delta = false;               // roughness below kDeltaRoughness: a mirror lobe
+  bool glass_delta = false;                // the same, or ior ~ 1 (no refraction): smooth glass
   float alpha = 1.0f;                      // GGX alpha
   glm::vec3 f0_dielectric{0.0f};           // the dielectric specular's Schlick terms
   float f90_dielectric = 1.0f;
@@ -55,6 +66,11 @@ struct BsdfMaterial {
   // Schlick terms share the power, so their sum is one line.
   glm::vec3 fresnel_at_0{0.0f}, fresnel_slope{0.0f};
   glm::vec3 diffuse_albedo{0.0f};  // c_diffuse * base / pi, c_diffuse = (1 - metallic)(1 - transmission)
+  float clearcoat = 0.0f;          // the coat's weight
+  bool coat_delta = true;          // clearcoat roughness below kDeltaRoughness: a mirror coat
+  float coat_alpha = kMinAlpha;    // the coat's GGX alpha
+  glm::vec3 sheen_color{0.0f};
+  float sheen_alpha = 1.0f;        // the Charlie distribution's
 };
 BsdfMaterial bsdf_material(const BsdfParams& params);
 
@@ -70,14 +86,15 @@ class Bsdf {
  public:
   Bsdf() = default;
   // shading_normal and geometric_normal: unit, any orientation (flipped to wo's side here);
-  // front_face: wo is on the side the geometric normal points to (outside of a dielectric).
+  // front_face: wo is on the side the geometric normal points to (outside of a dielectric);
+  // coat_normal: the clearcoat's shading normal (zero: shading_normal).
   Bsdf(const BsdfMaterial& material, glm::vec3 shading_normal, glm::vec3 geometric_normal, glm::vec3 wo,
-       bool front_face);
+       bool front_face, glm::vec3 coat_normal = glm::vec3(0.0f));
   Bsdf(const BsdfParams& params, glm::vec3 shading_normal, glm::vec3 geometric_normal, glm::vec3 wo,
-       bool front_face)
-      : Bsdf(bsdf_material(params), shading_normal, geometric_normal, wo, front_face) {}
+       bool front_face, glm::vec3 coat_normal = glm::vec3(0.0f))
+      : Bsdf(bsdf_material(params), shading_normal, geometric_normal, wo, front_face, coat_normal) {}
 
-  glm::vec3 eval(glm::vec3 wi) const;  // f(wo, wi) |cos(wi)| of the non-delta lobes
+  glm::vec3 eval(glm::vec3 wi) const;  // f(wo, wi) |cos(wi)| of the non-delta lobes (wi on either side)
   float pdf(glm::vec3 wi) const;       // combined pdf of the non-delta lobes
   glm::vec3 eval(glm::vec3 wi, float* pdf) const;  // both at once (shares the half-vector work)
   // u_lobe picks the lobe, u the direction. Returns false when no valid direction was drawn.
@@ -86,17 +103,37 @@ class Bsdf {
   bool is_perfectly_specular() const { return !has_nondelta_; }
   bool has_nondelta() const { return has_nondelta_; }
   // The probability that sample() picks a non-delta lobe (1 for a BSDF without delta lobes).
-  float nondelta_probability() const { return p_diffuse_ + (glossy_delta_ ? 0.0f : p_glossy_); }
+  float nondelta_probability() const {
+    return p_diffuse_ + (glossy_delta_ ? 0.0f : p_glossy_) + p_sheen_ + (coat_delta_ ? 0.0f : p_coat_) +
+           (glass_delta_ ? 0.0f : p_glass_);
+  }
   // The probability that sample() picks the diffuse lobe.
   float diffuse_probability() const { return p_diffuse_; }
-  // sample() reads u_lobe only when more than one lobe can be picked.
-  bool has_lobe_choice() const { return (p_diffuse_ > 0.0f) + (p_glossy_ > 0.0f) + (p_glass_ > 0.0f) > 1; }
+  // sample() reads u_lobe only when more than one lobe can be picked, or when the rough glass lobe
+  // (which picks reflection or refraction with it) can be.
+  bool has_lobe_choice() const {
+    return (p_diffuse_ > 0.0f) + (p_glossy_ > 0.0f) + (p_sheen_ > 0.0f) + (p_coat_ > 0.0f) + (p_glass_ > 0.0f) > 1 ||
+           (p_glass_ > 0.0f && !glass_delta_);
+  }
   bool is_black() const { return black_; }
   glm::vec3 shading_normal() const { return frame_.n; }
 
  private:
   glm::vec3 eval_local(glm::vec3 wi, float* pdf) const;
+  glm::vec3 eval_glass_reflection(glm::vec3 wi, float* pdf) const;
+  glm::vec3 eval_glass_transmission(glm::vec3 wi, float* pdf) const;
+  glm::vec3 eval_coat(glm::vec3 wi_coat, float* pdf) const;  // adds the coat's pdf to *pdf
+  float set_up_coat(const BsdfMaterial& material, glm::vec3 coat_normal, glm::vec3 wo);
+  glm::vec3 eval_sheen(glm::vec3 wi) const;  // f cos of the sheen lobe (local, wi.z > 0)
+  float set_up_sheen(const BsdfMaterial& material, float coat_share);
+  glm::vec3 set_up_base(const BsdfMaterial& material, float base_share);
+  void choose_lobes(float w_diffuse, float w_glossy, float w_sheen, float w_coat, float w_glass);
+  bool sample_coat(glm::vec2 u, BsdfSample* out) const;
   glm::vec3 glossy_fresnel(float cos_oh) const;
+  bool sample_smooth_glass(glm::vec2 u, BsdfSample* out) const;
+  bool sample_rough_glass(float u_choice, glm::vec2 u, BsdfSample* out) const;
+  bool finish_nondelta_sample(glm::vec3 wi, bool transmitted, BsdfSample* out) const;
+  float eta() const { return front_face_ ? ior_ : 1.0f / ior_; }  // eta_t / eta_i across the surface
 
   Frame frame_{};
   glm::vec3 ng_{0.0f};      // geometric normal on wo's side
@@ -108,12 +145,27 @@ class Bsdf {
   // Fixed per shading point, so eval_local() divides once per BSDF instead of once per call:
   float inv_4cos_o_ = 0.0f;         // 1 / (4 cos_o)
   float glossy_pdf_scale_ = 0.0f;   // p_glossy G1(wo) / (4 cos_o): the glossy pdf is this times D(h)
+  float g1_o_ = 1.0f;               // Smith G1(wo)
   bool glossy_delta_ = false;
+  bool glass_delta_ = false;
   bool front_face_ = true;
   float c_glass_ = 0.0f;  // the glass lobe's mixing coefficient
   glm::vec3 fresnel_at_0_{0.0f}, fresnel_slope_{0.0f};  // BsdfMaterial's
+  glm::vec3 glossy_compensation_{1.0f};  // Turquin's 1 + F0 (1 / E(cos_o) - 1) of the GGX reflection lobe
   glm::vec3 diffuse_factor_{0.0f};  // c_diffuse * base / pi * (1 - F_dielectric(cos_o))
-  float p_diffuse_ = 0.0f, p_glossy_ = 0.0f, p_glass_ = 0.0f;  // lobe selection probabilities
+  // The clearcoat: its own frame (its normal map) and GGX lobe, F = Schlick(0.04, 1).
+  Frame coat_frame_{};
+  glm::vec3 coat_wo_local_{0.0f};
+  float clearcoat_ = 0.0f;
+  float coat_alpha_ = 1.0f;
+  bool coat_delta_ = false;
+  float coat_lambda_o_ = 0.0f;
+  float coat_compensation_ = 1.0f;  // Turquin's factor of the coat lobe
+  // The sheen: color x Charlie D x Neubelt-Pettineo V, under the coat (times its share).
+  glm::vec3 sheen_factor_{0.0f};
+  float sheen_alpha_ = 1.0f;
+  // Lobe selection probabilities; sample() reads u_lobe in this order.
+  float p_diffuse_ = 0.0f, p_glossy_ = 0.0f, p_sheen_ = 0.0f, p_coat_ = 0.0f, p_glass_ = 0.0f;
   bool has_nondelta_ = false;
   bool black_ = true;
 };
@@ -123,5 +175,7 @@ float ggx_d(glm::vec3 h, float alpha);
 float ggx_lambda(glm::vec3 w, float alpha);
 glm::vec3 ggx_sample_vndf(glm::vec3 wo, float alpha, glm::vec2 u);
 float fresnel_dielectric(float cos_i, float eta);  // eta = eta_t / eta_i, cos_i >= 0
+// Visible-normal pdf of h seen from wo: G1(wo) max(0, wo.h) D(h) / cos_o.
+float ggx_vndf_pdf(glm::vec3 wo, glm::vec3 h, float alpha);
 
 }  // namespace pxf

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <string>
 
@@ -22,8 +23,33 @@ glm::vec2 interpolate_uv(const std::vector<glm::vec2>& uv, const glm::uvec3& tri
   return uv.empty() ? glm::vec2(0.0f) : interpolate(uv, tri, u, v);
 }
 
-// Embree filter: rejects hits whose opacity is below the material's alpha cutoff.
-void alpha_mask_filter(const RTCFilterFunctionNArguments* args) {
+// splitmix64's finalizer: every input bit flips about half of the output bits.
+uint64_t mix_bits(uint64_t h) {
+  h = (h ^ (h >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  h = (h ^ (h >> 27)) * 0x94d049bb133111ebULL;
+  return h ^ (h >> 31);
+}
+
+// A uniform number in [0, 1) fixed by the ray (origin and direction) and the triangle it hits:
+// Embree may report one hit more than once, and every report must be decided alike; different
+// rays (other pixels, jitters, bounces, shadow rays) decide independently.
+float hit_random(const RTCFilterFunctionNArguments* args, unsigned i, unsigned prim) {
+  const unsigned n = args->N;
+  const float parts[] = {RTCRayN_org_x(args->ray, n, i), RTCRayN_org_y(args->ray, n, i), RTCRayN_org_z(args->ray, n, i),
+                         RTCRayN_dir_x(args->ray, n, i), RTCRayN_dir_y(args->ray, n, i), RTCRayN_dir_z(args->ray, n, i)};
+  uint64_t h = mix_bits(static_cast<uint64_t>(prim) + 0x9e3779b97f4a7c15ULL * (RTCHitN_geomID(args->hit, n, i) + 1));
+  for (float part : parts) {
+    uint32_t bits;
+    std::memcpy(&bits, &part, sizeof(bits));
+    h = mix_bits(h ^ bits);
+  }
+  return static_cast<float>(h >> 40) * 0x1p-24f;
+}
+
+// Embree filter for MASK and BLEND materials, on camera, bounce and shadow rays alike: MASK
+// rejects hits whose opacity is below the alpha cutoff; BLEND keeps a hit with probability equal
+// to its opacity (stochastic transparency: in expectation the surface is blended over what is behind).
+void alpha_filter(const RTCFilterFunctionNArguments* args) {
   const auto* data = static_cast<const EmbreeScene::MaskData*>(args->geometryUserPtr);
   for (unsigned i = 0; i < args->N; ++i) {
     if (args->valid[i] == 0) continue;
@@ -34,7 +60,9 @@ void alpha_mask_filter(const RTCFilterFunctionNArguments* args) {
     glm::vec2 uv1 = interpolate_uv(data->mesh->uv1, tri, u, v);
     float vertex_alpha = data->mesh->colors.empty() ? 1.0f : interpolate(data->mesh->colors, tri, u, v).a;
     float opacity = eval_opacity(*data->scene, *data->material, uv0, uv1, vertex_alpha);
-    if (!(opacity >= data->material->alpha_cutoff)) args->valid[i] = 0;
+    const bool kept = data->material->alpha_mode == AlphaMode::Mask ? opacity >= data->material->alpha_cutoff
+                                                                      : hit_random(args, i, prim) < opacity;
+    if (!kept) args->valid[i] = 0;
   }
 }
 
@@ -72,11 +100,11 @@ EmbreeScene::EmbreeScene(const Scene& scene) : scene_(scene) {
                                                                    3 * sizeof(unsigned), mesh.triangles.size()));
     if (!mesh.triangles.empty()) std::memcpy(indices, mesh.triangles.data(), mesh.triangles.size() * sizeof(glm::uvec3));
     const Material& material = scene.materials[mesh.material];
-    if (material.alpha_mode == AlphaMode::Mask) {
+    if (material.alpha_mode != AlphaMode::Opaque) {
       mask_data_.push_back({&scene_, &mesh, &material});
       rtcSetGeometryUserData(geom, &mask_data_.back());
-      rtcSetGeometryIntersectFilterFunction(geom, alpha_mask_filter);
-      rtcSetGeometryOccludedFilterFunction(geom, alpha_mask_filter);
+      rtcSetGeometryIntersectFilterFunction(geom, alpha_filter);
+      rtcSetGeometryOccludedFilterFunction(geom, alpha_filter);
     }
     rtcCommitGeometry(geom);
     unsigned id = rtcAttachGeometry(rtc_scene_, geom);  // ids are sequential: id == mesh index
@@ -191,6 +219,24 @@ float EmbreeScene::triangle_area(unsigned mesh, unsigned prim) const {
   return 0.5f * glm::length(glm::cross(m.positions[tri.y] - m.positions[tri.x], m.positions[tri.z] - m.positions[tri.x]));
 }
 
+// A tangent-space normal map (glTF: +Y green up) applied to the vertex normal; *normal is left as
+// it is where the tangent frame or the mapped normal degenerates.
+void EmbreeScene::map_normal(const TextureRef& map, float scale, glm::vec4 tangent, const SurfacePoint& sp,
+                             glm::vec3* normal) const {
+  glm::vec3 t = glm::vec3(tangent) - sp.vertex_normal * glm::dot(glm::vec3(tangent), sp.vertex_normal);
+  const float tl = glm::length(t);
+  if (!(tl > 1e-8f)) return;
+  t /= tl;
+  const glm::vec3 b = glm::cross(sp.vertex_normal, t) * (tangent.w < 0.0f ? -1.0f : 1.0f);
+  glm::vec3 m = glm::vec3(eval_texture(scene_, map, sp.uv0, sp.uv1, glm::vec4(0.5f, 0.5f, 1.0f, 1.0f)));
+  m = m * 2.0f - 1.0f;
+  m.x *= scale;
+  m.y *= scale;
+  const glm::vec3 mapped = t * m.x + b * m.y + sp.vertex_normal * m.z;
+  const float ml = glm::length(mapped);
+  if (ml > 1e-8f && std::isfinite(ml)) *normal = mapped / ml;
+}
+
 SurfacePoint EmbreeScene::surface_point(const Hit& hit, const Ray& ray) const {
   const Mesh& mesh = scene_.meshes[hit.mesh];
   const glm::uvec3& tri = mesh.triangles[hit.prim];
@@ -207,21 +253,12 @@ SurfacePoint EmbreeScene::surface_point(const Hit& hit, const Ray& ray) const {
   sp.uv1 = interpolate_uv(mesh.uv1, tri, hit.u, hit.v);
   if (!mesh.colors.empty()) sp.color = interpolate(mesh.colors, tri, hit.u, hit.v);
   const Material& mat = *sp.material;
-  if (mat.normal_texture.valid() && !mesh.tangents.empty()) {
-    glm::vec4 t4 = interpolate(mesh.tangents, tri, hit.u, hit.v);
-    glm::vec3 t = glm::vec3(t4) - sp.vertex_normal * glm::dot(glm::vec3(t4), sp.vertex_normal);
-    float tl = glm::length(t);
-    if (tl > 1e-8f) {
-      t /= tl;
-      glm::vec3 b = glm::cross(sp.vertex_normal, t) * (t4.w < 0.0f ? -1.0f : 1.0f);
-      glm::vec3 m = glm::vec3(eval_texture(scene_, mat.normal_texture, sp.uv0, sp.uv1, glm::vec4(0.5f, 0.5f, 1.0f, 1.0f)));
-      m = m * 2.0f - 1.0f;
-      m.x *= mat.normal_scale;
-      m.y *= mat.normal_scale;
-      glm::vec3 mapped = t * m.x + b * m.y + sp.vertex_normal * m.z;
-      float ml = glm::length(mapped);
-      if (ml > 1e-8f && std::isfinite(ml)) sp.shading_normal = mapped / ml;
-    }
+  sp.clearcoat_normal = sp.vertex_normal;
+  if (!mesh.tangents.empty()) {
+    const glm::vec4 tangent = interpolate(mesh.tangents, tri, hit.u, hit.v);
+    if (mat.normal_texture.valid()) map_normal(mat.normal_texture, mat.normal_scale, tangent, sp, &sp.shading_normal);
+    if (mat.clearcoat_normal_texture.valid())
+      map_normal(mat.clearcoat_normal_texture, mat.clearcoat_normal_scale, tangent, sp, &sp.clearcoat_normal);
   }
   return sp;
 }

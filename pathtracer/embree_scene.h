@@ -38,6 +38,7 @@ struct SurfacePoint {
   glm::vec3 geometric_normal{0.0f};  // unit, the triangle's winding orientation
   glm::vec3 vertex_normal{0.0f};     // interpolated vertex normal, unit, no normal map
   glm::vec3 shading_normal{0.0f};    // vertex normal with the normal map applied
+  glm::vec3 clearcoat_normal{0.0f};  // vertex normal with the clearcoat's normal map applied
   glm::vec2 uv0{0.0f}, uv1{0.0f};
   glm::vec4 color{1.0f};             // COLOR_0
   const Material* material = nullptr;
@@ -66,7 +67,7 @@ class EmbreeScene {
   float triangle_area(unsigned mesh, unsigned prim) const;
   glm::vec3 face_normal(unsigned mesh, unsigned prim) const { return face_normals_[mesh][prim]; }
 
-  // Alpha-mask data handed to Embree's filter functions (one per mesh with a MASK material).
+  // Alpha data handed to Embree's filter functions (one per mesh with a MASK or BLEND material).
   struct MaskData {
     const Scene* scene;
     const Mesh* mesh;
@@ -74,6 +75,8 @@ class EmbreeScene {
   };
 
  private:
+  void map_normal(const TextureRef& map, float scale, glm::vec4 tangent, const SurfacePoint& sp, glm::vec3* normal) const;
+
   const Scene& scene_;
   RTCDevice device_ = nullptr;
   RTCScene rtc_scene_ = nullptr;

@@ -310,7 +310,7 @@ glm::vec3 PathTracer::specular_chain_light(const SurfacePoint& sp, const Bsdf& b
     BsdfMaterial scratch;
     const BsdfMaterial& lobes = bsdf_material_at(q, &scratch);
     const BsdfParams& p = lobes.params;
-    const Bsdf chain_bsdf(lobes, q.shading_normal, q.geometric_normal, -ray.direction, q.front_face);
+    const Bsdf chain_bsdf(lobes, q.shading_normal, q.geometric_normal, -ray.direction, q.front_face, q.clearcoat_normal);
     if (chain_bsdf.is_black()) break;
     float u_lobe;
     glm::vec2 u_dir;
@@ -460,7 +460,8 @@ void PathTracer::trace_guiding_photon(uint32_t frame, uint32_t index, const Trac
     const SurfacePoint sp = geometry_.surface_point(hit, ray);
     if (!sp.front_face && sp.material->has_volume()) flux *= volume_transmittance(*sp.material, hit.t);
     BsdfMaterial scratch;
-    const Bsdf bsdf(bsdf_material_at(sp, &scratch), sp.shading_normal, sp.geometric_normal, -ray.direction, sp.front_face);
+    const Bsdf bsdf(bsdf_material_at(sp, &scratch), sp.shading_normal, sp.geometric_normal, -ray.direction, sp.front_face,
+                    sp.clearcoat_normal);
     if (bsdf.is_black()) return;
     if (surface > 0 && bsdf.has_nondelta())
       guiding_->record(key + static_cast<uint64_t>(surface), sp.position, -ray.direction, luminance(flux), 1.0f);
@@ -525,7 +526,7 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
   BsdfMaterial scratch;
   const BsdfMaterial& lobes = bsdf_material_at(sp, &scratch);
   const BsdfParams& bsdf_params = lobes.params;
-  Bsdf bsdf(lobes, sp.shading_normal, sp.geometric_normal, wo, sp.front_face);
+  Bsdf bsdf(lobes, sp.shading_normal, sp.geometric_normal, wo, sp.front_face, sp.clearcoat_normal);
   if (!s.albedo_set && (bsdf.has_nondelta() || bsdf.is_black())) {
     out.albedo = bsdf_params.base_color;
     s.albedo_set = true;

@@ -22,6 +22,7 @@
 #include "image/image.h"
 #include "pathtracer/bsdf.h"
 #include "pathtracer/camera.h"
+#include "pathtracer/ggx_albedo.h"
 #include "pathtracer/integrator.h"
 #include "pathtracer/pathtracer.h"
 #include "pathtracer/shapes.h"
@@ -175,7 +176,8 @@ double predicted_albedo(const Scene& scene, int samples_per_pixel, double* min_p
 
 // An independent prediction for GGX-based opaque materials: the directional albedo by quadrature
 // over the hemisphere (cos-theta x phi grid), with the formulas written out here rather than taken
-// from bsdf.cpp: height-correlated Smith G2, Schlick F on wo.h, plus `lambert` x (1 - Schlick(cos_o)).
+// from bsdf.cpp: height-correlated Smith G2, Schlick F on wo.h, Turquin's compensation 1 + f0 (1/E - 1)
+// with E the same quadrature's albedo at F = 1, plus `lambert` x (1 - the compensated specular albedo).
 double quadrature_albedo(double mu, double alpha, double f0, double f90, double lambert) {
   const double pi = 3.14159265358979323846;
   auto lambda = [alpha](double z) {
@@ -185,7 +187,7 @@ double quadrature_albedo(double mu, double alpha, double f0, double f90, double 
   auto schlick = [f0, f90](double c) { return f0 + (f90 - f0) * std::pow(std::max(0.0, 1.0 - c), 5.0); };
   glm::dvec3 wo(std::sqrt(std::max(0.0, 1.0 - mu * mu)), 0.0, mu);
   const int n_theta = 192, n_phi = 96;  // phi over [0, pi], doubled by symmetry
-  double sum = 0;
+  double with_fresnel = 0, white = 0;
   for (int i = 0; i < n_theta; ++i) {
     double ct = (i + 0.5) / n_theta, st = std::sqrt(1.0 - ct * ct);
     for (int j = 0; j < n_phi; ++j) {
@@ -195,11 +197,13 @@ double quadrature_albedo(double mu, double alpha, double f0, double f90, double 
       double a2 = alpha * alpha, t = h.z * h.z * (a2 - 1.0) + 1.0;
       double d = a2 / (pi * t * t);
       double g2 = 1.0 / (1.0 + lambda(mu) + lambda(ct));
-      sum += schlick(glm::dot(wo, h)) * d * g2 / (4.0 * mu);
+      white += d * g2 / (4.0 * mu);
+      with_fresnel += schlick(glm::dot(wo, h)) * d * g2 / (4.0 * mu);
     }
   }
-  double specular = sum * (1.0 / n_theta) * (2.0 * pi / n_phi);
-  return specular + lambert * (1.0 - schlick(mu));
+  const double cell = (1.0 / n_theta) * (2.0 * pi / n_phi);
+  const double specular = with_fresnel * cell * (1.0 + f0 * (1.0 / (white * cell) - 1.0));
+  return specular + lambert * (1.0 - specular);
 }
 
 // The same prediction averaged over the image: per pixel center, the view cosine on the ideal unit
@@ -241,15 +245,13 @@ TEST(MaterialMapping, WhiteDiffuseWithoutSpecularLayerConservesEnergy) {
   for (double v : r.pixels) ASSERT_NEAR(v, 1.0, 0.08);
 }
 
-TEST(MaterialMapping, WhiteDielectricDefaultSpecularLayer) {
-  // glTF's default dielectric: Lambert x (1 - F_schlick(cos_o)) + GGX specular (F0 0.04, F90 1,
-  // alpha 1). The diffuse weight uses the view angle only and the GGX lobe is single scattering, so
-  // this is not exactly energy conserving (~3% short over this image, ~8% at the grazing corners).
-  // Required: render = independent quadrature of that model (0.5%), = the loaded Bsdf's own albedo
-  // (0.5%), and within [0.96, 1.005] of the ideal 1 (no energy gain; a loss bound that fails if
-  // e.g. the diffuse or the specular term went missing).
+TEST(MaterialMapping, WhiteDielectricOverWhiteLambertConservesEnergy) {
+  // glTF's default dielectric at roughness 1: Lambert x (1 - E_specular(cos_o)) + the compensated
+  // GGX specular (F0 0.04, F90 1, alpha 1), E_specular the specular layer's own albedo: all the
+  // light is reflected. Required: render = independent quadrature of that model (0.5%), = the
+  // loaded Bsdf's own albedo (0.5%), and within 1% of 1.
   Scene scene = load_furnace(material(1.0f, 0.0f, 1.0f));
-  double min_pixel;
+  double min_pixel = 0;
   double predicted = predicted_albedo(scene, 4000, &min_pixel);
   double quadrature = quadrature_image_mean(scene, 1.0, 0.04, 1.0, 1.0);
   RenderResult r = render(scene, furnace_params(), 256);
@@ -257,26 +259,103 @@ TEST(MaterialMapping, WhiteDielectricDefaultSpecularLayer) {
               predicted, quadrature, min_pixel);
   EXPECT_NEAR(r.mean, quadrature, 0.005);
   EXPECT_NEAR(r.mean, predicted, 0.005);
-  EXPECT_GE(r.mean, 0.96);
-  EXPECT_LE(r.mean, 1.005);
+  EXPECT_NEAR(r.mean, 1.0, 0.01);
 }
 
-TEST(MaterialMapping, RoughWhiteMetalLosesOnlyMultipleScatteringEnergy) {
-  // metallic 1, roughness 0.5 (GGX alpha = 0.25), base color 1: Schlick F = 1 everywhere, so the only
-  // loss is single-scattering GGX's missing bounces between microfacets. By quadrature that is 8.4%
-  // at normal incidence and 11-16% at 45-75 degrees, ~10% over this image. Required: render =
-  // independent quadrature (0.5%) = the loaded Bsdf's albedo (0.5%), and in [0.88, 1.005] (no gain;
-  // the lower bound is the single-scattering loss plus margin, not an energy-conservation claim).
-  Scene scene = load_furnace(material(1.0f, 1.0f, 0.5f));
-  double predicted = predicted_albedo(scene, 4000);
-  double quadrature = quadrature_image_mean(scene, 0.25, 1.0, 1.0, 0.0);
-  RenderResult r = render(scene, furnace_params(), 128);
-  std::printf("rough metal: mean %.5f Bsdf %.5f quadrature %.5f (normal incidence %.5f)\n", r.mean, predicted,
-              quadrature, quadrature_albedo(1.0, 0.25, 1.0, 1.0, 0.0));
-  EXPECT_NEAR(r.mean, quadrature, 0.005);
+TEST(MaterialMapping, RoughWhiteMetalConservesEnergy) {
+  // metallic 1, base color 1: Schlick F = 1 everywhere, and the single-scattering GGX lobe's loss
+  // between microfacets (8.4% at normal incidence for roughness 0.5, 67% for roughness 1) is given
+  // back by the compensation. Required at roughness 0.5, 0.7 and 1 (alpha 0.25, 0.49, 1): the
+  // render within 1% of 1, and of the loaded Bsdf's albedo (0.5%).
+  for (float roughness : {0.5f, 0.7f, 1.0f}) {
+    Scene scene = load_furnace(material(1.0f, 1.0f, roughness));
+    double predicted = predicted_albedo(scene, 1000);
+    RenderResult r = render(scene, furnace_params(), 64);
+    std::printf("rough metal %.1f: mean %.5f Bsdf %.5f (uncompensated at normal incidence %.5f)\n", roughness, r.mean,
+                predicted, ggx_albedo(1.0f, roughness * roughness).total);
+    EXPECT_NEAR(r.mean, predicted, 0.005) << roughness;
+    EXPECT_NEAR(r.mean, 1.0, 0.01) << roughness;
+  }
+}
+
+TEST(MaterialMapping, ClearcoatOverWhiteConservesEnergy) {
+  // KHR_materials_clearcoat 1 (F0 0.04, compensated GGX) over the white dielectric at roughness 1:
+  // the coat reflects E_coat(cos_o) and the base, which keeps all it gets, the rest. Required: the
+  // render within 1% of 1 and of the loaded Bsdf's albedo (0.5%), with a rough and a smooth coat.
+  for (float coat_roughness : {0.3f, 0.0f}) {
+    std::ostringstream ext;
+    ext << R"("KHR_materials_clearcoat":{"clearcoatFactor":1,"clearcoatRoughnessFactor":)" << coat_roughness << "}";
+    Scene scene = load_furnace(material(1.0f, 0.0f, 1.0f, ext.str()), R"("KHR_materials_clearcoat")");
+    EXPECT_FLOAT_EQ(scene.materials[0].clearcoat, 1.0f);
+    double predicted = predicted_albedo(scene, 1000);
+    RenderResult r = render(scene, furnace_params(), 64);
+    std::printf("clearcoat %.1f over white: mean %.5f Bsdf %.5f\n", coat_roughness, r.mean, predicted);
+    EXPECT_NEAR(r.mean, predicted, 0.005) << coat_roughness;
+    EXPECT_NEAR(r.mean, 1.0, 0.01) << coat_roughness;
+  }
+}
+
+TEST(MaterialMapping, SheenOverWhiteConservesEnergy) {
+  // KHR_materials_sheen, white sheen color, over the white dielectric at roughness 1: the sheen
+  // reflects E_sheen(cos_o), the base (which keeps all it gets) is scaled by 1 - E_sheen(cos_o), the
+  // extension's energy bound for a white sheen being 1. Required: within 1% of 1 and of the
+  // loaded Bsdf's albedo (0.5%).
+  const std::string ext = R"("KHR_materials_sheen":{"sheenColorFactor":[1,1,1],"sheenRoughnessFactor":0.5})";
+  Scene scene = load_furnace(material(1.0f, 0.0f, 1.0f, ext), R"("KHR_materials_sheen")");
+  EXPECT_FLOAT_EQ(scene.materials[0].sheen_roughness, 0.5f);
+  double predicted = predicted_albedo(scene, 1000);
+  RenderResult r = render(scene, furnace_params(), 64);
+  std::printf("sheen over white: mean %.5f Bsdf %.5f\n", r.mean, predicted);
   EXPECT_NEAR(r.mean, predicted, 0.005);
-  EXPECT_GE(r.mean, 0.88);
-  EXPECT_LE(r.mean, 1.005);
+  EXPECT_NEAR(r.mean, 1.0, 0.01);
+}
+
+// A black, specular-free sphere with base alpha `alpha` in `mode` ("BLEND" or "MASK", cutoff 0.5).
+std::string cutout_material(float alpha, const char* mode) {
+  std::ostringstream m;
+  m << R"({"pbrMetallicRoughness":{"baseColorFactor":[0,0,0,)" << alpha
+    << R"(],"metallicFactor":0,"roughnessFactor":1},"alphaMode":")" << mode
+    << R"(","extensions":{"KHR_materials_specular":{"specularFactor":0}}})";
+  return m.str();
+}
+
+TEST(MaterialMapping, BlendIsStochasticTransparencyConsistentWithMask) {
+  // Every camera ray crosses the sphere twice (front face, back face): with BLEND each crossing
+  // passes with probability 1 - alpha, so the white environment shows through (1 - alpha)^2 of
+  // the time and the black surface the rest. MASK is the same surface thresholded at the cutoff.
+  struct Case {
+    float alpha;
+    const char* mode;
+    double expected;
+  };
+  for (const Case& c : {Case{0.3f, "BLEND", 0.49}, Case{1.0f, "BLEND", 0.0}, Case{0.0f, "BLEND", 1.0},
+                        Case{0.3f, "MASK", 1.0}, Case{0.8f, "MASK", 0.0}}) {
+    Scene scene = load_furnace(cutout_material(c.alpha, c.mode), R"("KHR_materials_specular")");
+    RenderResult r = render(scene, furnace_params(), 64);
+    std::printf("%s alpha %.1f: mean %.5f (expected %.2f)\n", c.mode, c.alpha, r.mean, c.expected);
+    EXPECT_NEAR(r.mean, c.expected, 0.015) << c.mode << " " << c.alpha;  // 5 sigma of 36864 Bernoulli samples
+  }
+}
+
+TEST(MaterialMapping, BlendShadowRaysAgreeWithCameraRays) {
+  // Shadow rays see a BLEND surface exactly when a ray along the same line hits it (both filters
+  // draw the same number for the same ray and triangle), and pass it with probability 1 - alpha.
+  Scene scene = load_furnace(cutout_material(0.25f, "BLEND"), R"("KHR_materials_specular")");
+  PathTracer tracer(scene);
+  int passed = 0, disagreements = 0;
+  const int rays = 4000;
+  for (int i = 0; i < rays; ++i) {
+    const glm::vec3 origin(-0.4f + 0.8f * ((i % 63) + 0.5f) / 63.0f, -0.4f + 0.8f * ((i / 63) + 0.5f) / 64.0f, 3.0f);
+    const Ray ray{origin, glm::vec3(0.0f, 0.0f, -1.0f)};
+    const bool hit = tracer.geometry().intersect(ray).valid();
+    const bool occluded = tracer.geometry().occluded(origin, ray.direction, 10.0f);
+    disagreements += hit != occluded;
+    passed += !occluded;
+  }
+  const double p = 0.75 * 0.75, sigma = std::sqrt(p * (1.0 - p) / rays);
+  std::printf("BLEND 0.25: %.4f of the shadow rays pass (expected %.4f)\n", static_cast<double>(passed) / rays, p);
+  EXPECT_EQ(disagreements, 0);
+  EXPECT_NEAR(static_cast<double>(passed) / rays, p, 4.0 * sigma);
 }
 
 TEST(MaterialMapping, RoughnessIsSquaredIntoGgxAlpha) {
@@ -293,9 +372,11 @@ TEST(MaterialMapping, RoughnessIsSquaredIntoGgxAlpha) {
   glm::vec3 wi = glm::normalize(glm::vec3(-0.9f, 0.0f, 0.3f));  // mirror direction
   glm::vec3 h = glm::normalize(wo + wi);
   float g = 1.0f / (1.0f + ggx_lambda(wo, 0.25f) + ggx_lambda(wi, 0.25f));
-  float expected = ggx_d(h, 0.25f) * g / (4.0f * wo.z);  // F = 1 for a white metal
+  // F = 1 for a white metal, and the compensation 1 / E(cos_o).
+  float expected = ggx_d(h, 0.25f) * g / (4.0f * wo.z) / ggx_albedo(wo.z, 0.25f).total;
   EXPECT_NEAR(bsdf.eval(wi).x, expected, 1e-3f * expected);
-  float other = ggx_d(h, 0.5f) / (1.0f + ggx_lambda(wo, 0.5f) + ggx_lambda(wi, 0.5f)) / (4.0f * wo.z);
+  float other = ggx_d(h, 0.5f) / (1.0f + ggx_lambda(wo, 0.5f) + ggx_lambda(wi, 0.5f)) / (4.0f * wo.z) /
+                ggx_albedo(wo.z, 0.5f).total;
   EXPECT_GT(std::abs(bsdf.eval(wi).x - other), 0.1f * expected);
 }
 
@@ -336,18 +417,54 @@ TEST(MaterialMapping, SmoothGlassIsEnergyConservingInTheWhiteFurnace) {
   EXPECT_NEAR(r.mean, 1.0, 0.01);
 }
 
-TEST(MaterialMapping, RoughTransmissionRendersAsSmoothGlass) {
-  // Rough transmission is not modelled: transmission 1 with roughness 0.6 is still a smooth
-  // dielectric (and has no separate rough reflection lobe), so the image equals the smooth one.
+TEST(MaterialMapping, RoughGlassLosesOnlySingleScatteringEnergy) {
+  // transmission 1 above the delta roughness: Walter's rough dielectric, reflecting and refracting
+  // at every crossing. White, it keeps all the light but what single scattering loses (no
+  // compensation of the glass lobe): a little at roughness 0.3, a quarter at 0.6, where light
+  // crosses the rough interface many times inside the sphere (bsdf_test.cpp measures one crossing).
+  // Its image is not the smooth glass's.
   const std::string ext = R"("KHR_materials_transmission":{"transmissionFactor":1},"KHR_materials_ior":{"ior":1.5})";
   const std::string used = R"("KHR_materials_transmission","KHR_materials_ior")";
-  Scene rough = load_furnace(material(0.8f, 0.0f, 0.6f, ext), used);
-  Scene smooth = load_furnace(material(0.8f, 0.0f, 0.0f, ext), used);
-  TraceParams params = furnace_params();
-  RenderResult a = render(rough, params, 32), b = render(smooth, params, 32);
-  std::printf("glass tint 0.8: rough %.5f smooth %.5f\n", a.mean, b.mean);
-  for (size_t i = 0; i < a.pixels.size(); ++i) ASSERT_NEAR(a.pixels[i], b.pixels[i], 1e-5) << i;
-  EXPECT_LT(a.mean, 0.95);  // the base color tints transmission (0.8 per crossing)
+  Scene smooth = load_furnace(material(1.0f, 0.0f, 0.0f, ext), used);
+  const RenderResult reference = render(smooth, furnace_params(), 32);
+  struct Bound {
+    float roughness, lowest;
+  };
+  for (const Bound& b : {Bound{0.3f, 0.96f}, Bound{0.6f, 0.7f}}) {  // measured 0.976, 0.730 (64 spp)
+    Scene rough = load_furnace(material(1.0f, 0.0f, b.roughness, ext), used);
+    EXPECT_FALSE(material_is_perfect_specular(rough.materials[0]));
+    RenderResult r = render(rough, furnace_params(), 64);
+    double largest_difference = 0;
+    for (size_t i = 0; i < r.pixels.size(); ++i)
+      largest_difference = std::max(largest_difference, std::abs(r.pixels[i] - reference.pixels[i]));
+    std::printf("white rough glass %.1f: mean %.5f (smooth %.5f), largest pixel difference %.4f\n", b.roughness,
+                r.mean, reference.mean, largest_difference);
+    EXPECT_GE(r.mean, b.lowest) << b.roughness;
+    EXPECT_LE(r.mean, 1.005) << b.roughness;
+    EXPECT_GT(largest_difference, 0.02) << b.roughness;
+  }
+}
+
+TEST(MaterialMapping, RoughGlassKeepsTheVolumeAbsorption) {
+  // KHR_materials_volume on rough glass: Beer-Lambert on the segments inside, as for smooth glass.
+  // Paths through a slightly rough sphere are about as long as through a smooth one, so absorption
+  // darkens both by about the same factor.
+  auto glass = [](float roughness, bool absorbing) {
+    std::string ext = R"("KHR_materials_transmission":{"transmissionFactor":1})";
+    if (absorbing) ext += R"(,"KHR_materials_volume":{"thicknessFactor":1,"attenuationDistance":1,"attenuationColor":[0.5,0.5,0.5]})";
+    return material(1.0f, 0.0f, roughness, ext);
+  };
+  const std::string used = R"("KHR_materials_transmission","KHR_materials_volume")";
+  double ratio[2];
+  for (int rough = 0; rough < 2; ++rough) {
+    const float roughness = rough ? 0.2f : 0.0f;
+    const double clear = render(load_furnace(glass(roughness, false), used), furnace_params(), 32).mean;
+    const double absorbing = render(load_furnace(glass(roughness, true), used), furnace_params(), 32).mean;
+    ratio[rough] = absorbing / clear;
+    std::printf("glass roughness %.1f: clear %.5f absorbing %.5f\n", roughness, clear, absorbing);
+  }
+  EXPECT_LT(ratio[1], 0.8);  // absorbed
+  EXPECT_NEAR(ratio[1], ratio[0], 0.05);
 }
 
 TEST(MaterialMapping, SpecularFactorZeroMakesADielectricPurelyDiffuse) {

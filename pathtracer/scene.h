@@ -55,7 +55,7 @@ struct TextureRef {
 
 enum class AlphaMode { Opaque, Mask, Blend };
 
-// glTF metallic-roughness material (+ emissive_strength, transmission, ior, specular).
+// glTF metallic-roughness material (+ emissive_strength, transmission, ior, specular, clearcoat, sheen).
 struct Material {
   std::string name;
   glm::vec4 base_color{1.0f};
@@ -74,6 +74,16 @@ struct Material {
   TextureRef specular_texture;          // A
   glm::vec3 specular_color{1.0f};
   TextureRef specular_color_texture;    // RGB
+  float clearcoat = 0.0f;               // KHR_materials_clearcoat
+  TextureRef clearcoat_texture;         // R
+  float clearcoat_roughness = 0.0f;
+  TextureRef clearcoat_roughness_texture;  // G
+  TextureRef clearcoat_normal_texture;
+  float clearcoat_normal_scale = 1.0f;
+  glm::vec3 sheen_color{0.0f};          // KHR_materials_sheen
+  TextureRef sheen_color_texture;       // RGB (sRGB)
+  float sheen_roughness = 0.0f;
+  TextureRef sheen_roughness_texture;   // A
   // KHR_materials_volume: absorption coefficient per scene unit, -ln(attenuationColor) /
   // attenuationDistance; 0 = clear or thin-walled (thicknessFactor 0). The medium is the inside
   // of the closed mesh, entered through its front faces.
@@ -86,10 +96,10 @@ struct Material {
   bool has_volume() const { return attenuation.x > 0 || attenuation.y > 0 || attenuation.z > 0; }
 };
 
-// Material-level classification (factors only, a texture on metallic/roughness/transmission
-// disqualifies): a perfect mirror or a smooth dielectric, i.e. every interaction is a delta. The
-// path tracer follows such surfaces as specular chains, and the range pass marks them for it
-// (implemented in pathtracer/bsdf.cpp).
+// Material-level classification (factors only, a texture on metallic/roughness/transmission or
+// clearcoat roughness disqualifies): a perfect mirror or a smooth dielectric, with no clearcoat or
+// a smooth one, i.e. every interaction is a delta. The path tracer follows such surfaces as
+// specular chains, and the range pass marks them for it (implemented in pathtracer/bsdf.cpp).
 bool material_is_perfect_specular(const Material& material);
 bool material_is_perfect_mirror(const Material& material);
 

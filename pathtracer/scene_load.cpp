@@ -58,7 +58,8 @@ const std::set<std::string>& supported_extensions() {
   static const std::set<std::string> names = {
       "KHR_lights_punctual",      "KHR_texture_transform", "KHR_materials_emissive_strength",
       "KHR_materials_transmission", "KHR_materials_ior",   "KHR_materials_specular",
-      "KHR_materials_volume",     "KHR_materials_pbrSpecularGlossiness",
+      "KHR_materials_volume",     "KHR_materials_pbrSpecularGlossiness", "KHR_materials_clearcoat",
+      "KHR_materials_sheen",
       "KHR_mesh_quantization",    "KHR_draco_mesh_compression", "EXT_meshopt_compression",
       "EXT_texture_webp",         "EXT_mesh_gpu_instancing"};
   return names;
@@ -616,7 +617,9 @@ class GltfLoader {
     pending_.clear();
     for (Material& m : scene_.materials)
       for (TextureRef* ref : {&m.base_color_texture, &m.metallic_roughness_texture, &m.normal_texture, &m.emissive_texture,
-                              &m.transmission_texture, &m.specular_texture, &m.specular_color_texture})
+                              &m.transmission_texture, &m.specular_texture, &m.specular_color_texture,
+                              &m.clearcoat_texture, &m.clearcoat_roughness_texture, &m.clearcoat_normal_texture,
+                              &m.sheen_color_texture, &m.sheen_roughness_texture})
         if (ref->texture >= 0) {
           ref->texture = renumber[ref->texture];
           if (ref->texture < 0) *ref = TextureRef{};
@@ -676,11 +679,29 @@ class GltfLoader {
       m.specular_color_texture = texture_ref(info_of(ext->Get("specularColorTexture")), true, m.name, "specular color");
     }
     if (const tinygltf::Value* ext = find_extension(gm.extensions, "KHR_materials_volume")) read_volume(*ext, m);
+    if (const tinygltf::Value* ext = find_extension(gm.extensions, "KHR_materials_clearcoat")) read_clearcoat(*ext, m);
+    if (const tinygltf::Value* ext = find_extension(gm.extensions, "KHR_materials_sheen")) {
+      m.sheen_color = glm::clamp(value_vec3_or(ext->Get("sheenColorFactor"), glm::vec3(0.0f)), glm::vec3(0.0f), glm::vec3(1.0f));
+      m.sheen_color_texture = texture_ref(info_of(ext->Get("sheenColorTexture")), true, m.name, "sheen color");
+      m.sheen_roughness = clamp01(number_or(ext->Get("sheenRoughnessFactor"), 0.0), 0.0f);
+      m.sheen_roughness_texture = texture_ref(info_of(ext->Get("sheenRoughnessTexture")), false, m.name, "sheen roughness");
+    }
     if (gm.alphaMode == "MASK") m.alpha_mode = AlphaMode::Mask;
     else if (gm.alphaMode == "BLEND") m.alpha_mode = AlphaMode::Blend;
     m.alpha_cutoff = std::max(finite_or(gm.alphaCutoff, 0.5f), 0.0f);
     m.double_sided = gm.doubleSided;
     return m;
+  }
+
+  void read_clearcoat(const tinygltf::Value& ext, Material& m) {
+    m.clearcoat = clamp01(number_or(ext.Get("clearcoatFactor"), 0.0), 0.0f);
+    m.clearcoat_texture = texture_ref(info_of(ext.Get("clearcoatTexture")), false, m.name, "clearcoat");
+    m.clearcoat_roughness = clamp01(number_or(ext.Get("clearcoatRoughnessFactor"), 0.0), 0.0f);
+    m.clearcoat_roughness_texture =
+        texture_ref(info_of(ext.Get("clearcoatRoughnessTexture")), false, m.name, "clearcoat roughness");
+    const tinygltf::Value& normal = ext.Get("clearcoatNormalTexture");
+    m.clearcoat_normal_texture = texture_ref(info_of(normal), false, m.name, "clearcoat normal");
+    m.clearcoat_normal_scale = finite_or(number_or(member(normal, "scale"), 1.0), 1.0f);
   }
 
   // KHR_materials_pbrSpecularGlossiness: the factors are converted here; the diffuse and
@@ -1148,12 +1169,14 @@ class GltfLoader {
     for (glm::vec4& c : mesh.colors) c = gltf::is_finite(c) ? glm::clamp(c, glm::vec4(0.0f), glm::vec4(1.0f)) : glm::vec4(1.0f);
 
     const Material& material = scene_.materials[mesh.material];
-    if (!material.normal_texture.valid()) {
+    // Tangents for the normal map, else for the clearcoat's (from its UV set when there is only that).
+    const TextureRef& normal_map = material.normal_texture.valid() ? material.normal_texture : material.clearcoat_normal_texture;
+    if (!normal_map.valid()) {
       if (!mesh.tangents.empty()) gltf::sanitize_tangents(mesh);
       return;
     }
     if (mesh.tangents.empty()) {
-      const std::vector<glm::vec2>& uvs = material.normal_texture.texcoord == 1 ? mesh.uv1 : mesh.uv0;
+      const std::vector<glm::vec2>& uvs = normal_map.texcoord == 1 ? mesh.uv1 : mesh.uv0;
       if (uvs.empty()) warn(what + " has a normal map but no texture coordinates; its tangents are arbitrary");
       mesh.tangents = gltf::compute_tangents(mesh, uvs);
     }

@@ -14,6 +14,7 @@
 #include "core/json_depth.h"
 #include "image/image.h"
 #include "pathtracer/camera.h"
+#include "pathtracer/embree_scene.h"
 #include "pathtracer/glb_test_util.h"
 #include "pathtracer/pathtracer.h"
 #include "pathtracer/texture.h"
@@ -1340,6 +1341,60 @@ TEST(SceneLoadMaterial, KhrMaterialsVolumeGivesTheBeerLambertCoefficient) {
   EXPECT_FALSE(scene.materials[thin].has_volume());
   EXPECT_FALSE(scene.materials[clear].has_volume());
   EXPECT_FALSE(any_warning_contains(scene, "KHR_materials_volume")) << warnings_of(scene);
+}
+
+TEST(SceneLoadMaterial, KhrMaterialsSheenReadsItsFactorsAndTextures) {
+  std::string dir = temp_dir();
+  GltfBuilder b;
+  b.doc["extensionsUsed"] = {"KHR_materials_sheen"};
+  const int white = b.texture(b.image(encode_png(1, 1, 4, 8, {255, 255, 255, 255})));
+  const int velvet = b.material({{"extensions",
+                                  {{"KHR_materials_sheen",
+                                    {{"sheenColorFactor", {0.9, 0.5, 0.25}},
+                                     {"sheenColorTexture", {{"index", white}}},
+                                     {"sheenRoughnessFactor", 0.4},
+                                     {"sheenRoughnessTexture", {{"index", white}}}}}}}});
+  b.add_quad_scene(velvet);
+  Scene scene = load_scene(b.write_gltf(dir + "/sheen.gltf"));
+  EXPECT_FALSE(any_warning_contains(scene, "sheen")) << warnings_of(scene);
+  const Material& m = scene.materials[velvet];
+  expect_vec3_near(m.sheen_color, {0.9f, 0.5f, 0.25f});
+  EXPECT_FLOAT_EQ(m.sheen_roughness, 0.4f);
+  EXPECT_TRUE(m.sheen_color_texture.valid() && m.sheen_roughness_texture.valid());
+}
+
+TEST(SceneLoadMaterial, KhrMaterialsClearcoatReadsItsFactorsTexturesAndNormalMap) {
+  std::string dir = temp_dir();
+  GltfBuilder b;
+  b.doc["extensionsUsed"] = {"KHR_materials_clearcoat"};
+  const int grey = b.texture(b.image(encode_png(1, 1, 3, 8, {128, 128, 128})));
+  // A normal map tilted towards +T (tangent +X on this quad): n = normalize(T + N) at scale 1.
+  const int tilted = b.texture(b.image(encode_png(1, 1, 3, 8, {255, 128, 255})));
+  const int coated = b.material({{"extensions",
+                                  {{"KHR_materials_clearcoat",
+                                    {{"clearcoatFactor", 0.8},
+                                     {"clearcoatTexture", {{"index", grey}}},
+                                     {"clearcoatRoughnessFactor", 0.3},
+                                     {"clearcoatRoughnessTexture", {{"index", grey}}},
+                                     {"clearcoatNormalTexture", {{"index", tilted}, {"scale", 1.0}}}}}}}});
+  b.add_quad_scene(coated);
+  Scene scene = load_scene(b.write_gltf(dir + "/coat.gltf"));
+  EXPECT_FALSE(any_warning_contains(scene, "clearcoat")) << warnings_of(scene);
+  const Material& m = scene.materials[coated];
+  EXPECT_FLOAT_EQ(m.clearcoat, 0.8f);
+  EXPECT_FLOAT_EQ(m.clearcoat_roughness, 0.3f);
+  EXPECT_TRUE(m.clearcoat_texture.valid() && m.clearcoat_roughness_texture.valid() && m.clearcoat_normal_texture.valid());
+  EXPECT_FLOAT_EQ(m.clearcoat_normal_scale, 1.0f);
+  ASSERT_EQ(scene.meshes[0].tangents.size(), scene.meshes[0].positions.size());  // for the coat's normal map
+  // The coat's normal is mapped, the base's (no normalTexture) is the vertex normal.
+  EmbreeScene geometry(scene);
+  const Ray ray{glm::vec3(0.5f, 0.5f, 1.0f), glm::vec3(0.0f, 0.0f, -1.0f)};
+  const Hit hit = geometry.intersect(ray);
+  ASSERT_TRUE(hit.valid());
+  const SurfacePoint sp = geometry.surface_point(hit, ray);
+  expect_vec3_near(sp.shading_normal, {0, 0, 1});
+  EXPECT_NEAR(sp.clearcoat_normal.z, std::sqrt(0.5f), 0.01f);
+  EXPECT_NEAR(std::abs(sp.clearcoat_normal.x), std::sqrt(0.5f), 0.01f);
 }
 
 // ----------------------------------------------------------------------------------------------
