@@ -180,6 +180,40 @@ TEST(HistoryPass, ASurfaceTheCardHidBeforeIsRejected) {
   EXPECT_GT(hidden, 20);
 }
 
+// The card alone, the same color on both sides, before an empty background.
+Image card_guide(const Camera& camera) {
+  Image g = Image::rgba(W, H);
+  const shared::ViewCamera v = view_camera(camera, W, H);
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      const glm::vec3 o = v.origin, d = shared::view_point(v, {x + 0.5f, y + 0.5f}, 1.0f) - o;
+      const float t = (-3.0f - o.z) / d.z;
+      const glm::vec3 hit = o + t * d;
+      const bool card = t > 0 && std::abs(hit.x) <= 0.5f && std::abs(hit.y) <= 0.5f;
+      for (int c = 0; c < 3; ++c) g.at(x, y, c) = card ? 0.3f : 0.0f;
+      g.at(x, y, 3) = card ? t : shared::kBackgroundDepth;
+    }
+  return g;
+}
+
+// A thin card seen from its other side: the same distance and range color, but it faces away.
+TEST(HistoryPass, TheOtherSideOfAThinCardIsRejected) {
+  const Camera before = test_camera({0.0f, 0.0f, 0.0f}, 0.0f);
+  const Camera behind = test_camera({0.0f, 0.0f, -6.0f}, 180.0f);
+  const Image guide_before = card_guide(before), guide_behind = card_guide(behind);
+  const FreshSamples s = random_samples(5);
+  const HistoryCombination kept = cpu_combine_history(s.lv, s.hv, 3.0f, nullptr);
+  const HistoryReprojection r = cpu_reproject_history(kept.state, kept.hv, guide_before, before, guide_behind, behind);
+  int card = 0;
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      if (guide_behind.at(x, y, 3) >= shared::kBackgroundDistanceMin) continue;
+      ++card;
+      EXPECT_EQ(r.outcome.at(x, y, 0), shared::kHistoryDisoccluded) << x << "," << y;
+    }
+  EXPECT_GT(card, 50);
+}
+
 // The history is a biased estimate: its weight falls with the fresh samples and is exactly 0 from
 // kHistoryFadeSamples on, where the fresh samples pass through unchanged.
 TEST(HistoryPass, TheHistorysWeightFallsToZeroAndTheFreshSamplesPassThrough) {

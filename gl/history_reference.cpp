@@ -41,7 +41,7 @@ HistoryReprojection cpu_reproject_history(const Image& previous_lv, const Image&
       const glm::ivec2 p(x, y);
       const shared::HistorySample s =
           shared::reproject_history(RgbaTexels{&previous_lv}, RgbaTexels{&previous_hv}, RgbaTexels{&previous_guide},
-                                    texelFetch(RgbaTexels{&guide}, p, 0), p, now, before);
+                                    RgbaTexels{&guide}, p, now, before);
       put(out.lv, x, y, glm::vec4(s.lv, s.count));
       put(out.hv, x, y, glm::vec4(s.hv, s.var));
       out.outcome.at(x, y, 0) = static_cast<float>(s.outcome);

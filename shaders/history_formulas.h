@@ -23,6 +23,10 @@ PXF_CONST float kHistoryDepthTolerance = 0.05f;
 // color's shading term changes with the viewing direction; 0.8 of the albedo over a full turn).
 PXF_CONST float kHistoryColorTolerance = 0.05f;
 PXF_CONST float kHistoryColorRelTolerance = 0.25f;
+// ... and the surface normals the two guides' distances give, each turned towards its own camera,
+// at most about 37 degrees apart (a thin wall seen from its other side agrees in distance and,
+// near grazing, in range color: only its facing tells).
+PXF_CONST float kHistoryNormalAgreement = 0.8f;
 
 // Texture units of the history passes (beyond the pass shaders' kUnit* of pass_formulas.h).
 PXF_CONST int kUnitHistoryLv = 10;     // rgb L_lv, a the sample count it holds
@@ -76,6 +80,42 @@ PXF_INLINE bool view_project(ViewCamera c, vec3 x, PXF_OUT(vec2) pixel, PXF_OUT(
 
 // ---- Reprojection ----
 
+// The step from pixel p's surface point to its neighbour's along `axis`, towards +axis: on the side
+// whose distance is closer to p's (so that an edge on one side does not tilt the normal).
+PXF_SAMPLER_FN vec3 guide_step(sampler2D guide, ivec2 p, ivec2 axis, ViewCamera c, vec3 point, float d) {
+  ivec2 size = textureSize(guide, 0);
+  ivec2 ahead = p + axis, behind = p - axis;
+  bool has_ahead = all(lessThan(ahead, size));
+  bool has_behind = all(greaterThanEqual(behind, ivec2(0)));
+  float d_ahead = has_ahead ? clean(texelFetch(guide, ahead, 0).a) : 0.0f;
+  float d_behind = has_behind ? clean(texelFetch(guide, behind, 0).a) : 0.0f;
+  if (has_ahead && (!has_behind || abs(d_ahead - d) <= abs(d_behind - d)))
+    return view_point(c, vec2(ahead) + vec2(0.5f), d_ahead) - point;
+  if (has_behind) return point - view_point(c, vec2(behind) + vec2(0.5f), d_behind);
+  return vec3(0.0f);
+}
+
+// The unit normal of the surface a guide shows at pixel p, from the distances of p and its
+// neighbours, turned towards the camera; vec3(0) where it cannot be told (the background, a
+// one-pixel image, a degenerate step).
+PXF_SAMPLER_FN vec3 guide_normal(sampler2D guide, ivec2 p, ViewCamera c) {
+  float d = clean(texelFetch(guide, p, 0).a);
+  if (!(d < kBackgroundDistanceMin)) return vec3(0.0f);
+  vec3 point = view_point(c, vec2(p) + vec2(0.5f), d);
+  vec3 n = cross(guide_step(guide, p, ivec2(1, 0), c, point, d), guide_step(guide, p, ivec2(0, 1), c, point, d));
+  float len = length(n);
+  if (!(len > 0.0f)) return vec3(0.0f);
+  n = n / len;
+  vec3 to_camera = c.orthographic ? c.basis * vec3(0.0f, 0.0f, 1.0f) : c.origin - point;
+  return dot(n, to_camera) < 0.0f ? -n : n;
+}
+
+// Whether two such normals allow the same surface (either unknown: no evidence against it).
+PXF_INLINE bool history_normals_agree(vec3 a, vec3 b) {
+  if (dot(a, a) == 0.0f || dot(b, b) == 0.0f) return true;
+  return dot(a, b) >= kHistoryNormalAgreement;
+}
+
 PXF_INLINE float max_component(vec3 v) { return max(v.x, max(v.y, v.z)); }
 
 // Whether a texel of the previous guide shows the surface the new pixel shows: its distance is the
@@ -109,16 +149,18 @@ PXF_INLINE HistorySample history_none(int outcome) {
 
 // The previous view's estimate at new pixel p: the surface point the new guide shows at the pixel
 // center, projected into the previous view, read there bilinearly from the texels that still show
-// that surface (history_tap_agrees), their weights renormalized. The taps are independent pixel
+// that surface (history_tap_agrees, history_normals_agree), their weights renormalized. The taps are independent pixel
 // means: the variance is sum w^2 Var / (sum w)^2, a tap of unknown variance counted with the
 // weighted mean of the known ones (as the filter does, method.md 2.3); unknown if none is known.
 PXF_SAMPLER_FN HistorySample reproject_history(sampler2D previous_lv, sampler2D previous_hv, sampler2D previous_guide,
-                                               vec4 new_guide, ivec2 p, ViewCamera now, ViewCamera before) {
+                                               sampler2D new_guide_tex, ivec2 p, ViewCamera now, ViewCamera before) {
+  vec4 new_guide = texelFetch(new_guide_tex, p, 0);
   vec3 x = view_point(now, vec2(p) + vec2(0.5f), clean(new_guide.a));
   vec2 q;
   float expected;
   if (!view_project(before, x, q, expected)) return history_none(kHistoryOutside);
   ivec2 size = textureSize(previous_guide, 0);
+  vec3 normal = guide_normal(new_guide_tex, p, now);
   if (!(q.x >= 0.0f && q.y >= 0.0f && q.x <= float(size.x) && q.y <= float(size.y)))
     return history_none(kHistoryOutside);
   vec2 corner = q - vec2(0.5f);
@@ -133,6 +175,7 @@ PXF_SAMPLER_FN HistorySample reproject_history(sampler2D previous_lv, sampler2D 
     if (any(lessThan(t, ivec2(0))) || any(greaterThanEqual(t, size))) continue;
     wide_float w = wide_float((o.x == 1 ? f.x : 1.0f - f.x) * (o.y == 1 ? f.y : 1.0f - f.y));
     if (!(w > 0.0f) || !history_tap_agrees(texelFetch(previous_guide, t, 0), vec3(new_guide), expected)) continue;
+    if (!history_normals_agree(normal, guide_normal(previous_guide, t, before))) continue;
     vec4 lv = texelFetch(previous_lv, t, 0);
     vec4 hv = texelFetch(previous_hv, t, 0);
     float m = clean(lv.a);

@@ -29,8 +29,7 @@ void main() {
   ViewCamera now = ViewCamera(now_origin, now_basis, now_half_height, now_aspect, size, now_orthographic != 0);
   ViewCamera before = ViewCamera(before_origin, before_basis, before_half_height, before_aspect, size,
                                  before_orthographic != 0);
-  HistorySample h = reproject_history(previous_lv_tex, previous_hv_tex, previous_guide_tex, texelFetch(guide_tex, p, 0),
-                                      p, now, before);
+  HistorySample h = reproject_history(previous_lv_tex, previous_hv_tex, previous_guide_tex, guide_tex, p, now, before);
   out_lv = vec4(h.lv, h.count);
   out_hv = vec4(h.hv, h.var);
   out_outcome = float(h.outcome);
