@@ -81,6 +81,7 @@ void HistoryPass::reproject(const Texture2D& guide, const Camera& camera) {
   guide.bind(shared::kUnitGuide);
   quad_.draw(reproject_fbo_, width_, height_);
   last_ms_ = timer_.end();
+  total_ms_ += last_ms_;
   check_gl_error("history reprojection");
   reprojected_ = true;
   combined_since_reprojection_ = false;
@@ -99,6 +100,7 @@ void HistoryPass::run_combine(const PreviewInputs& fresh, float samples, bool wi
   history_hv_.bind(shared::kUnitHistoryHv);
   quad_.draw(combine_fbo_, width_, height_);
   last_ms_ = timer_.end();
+  total_ms_ += last_ms_;
   check_gl_error("history combination");
 }
 
@@ -114,5 +116,16 @@ Image HistoryPass::outcome_image() const { return outcome_.download({"Y"}); }
 Image HistoryPass::weight_image() const { return weight_.download({"Y"}); }
 Image HistoryPass::history_lv_image() const { return history_lv_.download({"R", "G", "B", "A"}); }
 Image HistoryPass::history_hv_image() const { return history_hv_.download({"R", "G", "B", "A"}); }
+
+Image history_outcome_colors(const Image& outcome) {
+  Image colors = Image::rgb(outcome.width, outcome.height);
+  for (size_t p = 0; p < outcome.pixels.size(); ++p) {
+    const int o = static_cast<int>(outcome.pixels[p]);
+    colors.pixels[3 * p + 0] = o == shared::kHistoryDisoccluded ? 1.0f : 0.0f;
+    colors.pixels[3 * p + 1] = o == shared::kHistoryKept ? 0.8f : 0.0f;
+    colors.pixels[3 * p + 2] = o == shared::kHistoryOutside ? 1.0f : 0.0f;
+  }
+  return colors;
+}
 
 }  // namespace pxf

@@ -22,6 +22,10 @@ namespace pxf {
 // A camera as the history formulas see it (camera_ray's terms) for an image of width x height.
 shared::ViewCamera view_camera(const Camera& camera, int width, int height);
 
+// The reprojection's outcome (HistoryPass::outcome_image) as colors: kept green, disoccluded red,
+// outside the previous view blue, no history black.
+Image history_outcome_colors(const Image& outcome);
+
 class HistoryPass {
  public:
   HistoryPass(int width, int height);
@@ -44,7 +48,8 @@ class HistoryPass {
   bool has_combination() const { return combined_since_reprojection_; }
   // Forgets everything (a new scene, new path-tracing settings: the history is another render's).
   void drop();
-  double last_ms() const { return last_ms_; }  // the last reprojection or combination
+  double last_ms() const { return last_ms_; }    // the last keep, reprojection or combination
+  double total_ms() const { return total_ms_; }  // all of them since construction
 
   // For the views and tests: per pixel the reprojection's outcome (kHistory*, "Y"), the history's
   // weight in the last combination ("Y"), and the reprojected history (rgba L_lv + count, L_u + Var).
@@ -71,7 +76,7 @@ class HistoryPass {
   FullscreenPass quad_;
   StageTimer timer_;
   bool has_kept_ = false, reprojected_ = false, combined_since_reprojection_ = false;
-  double last_ms_ = 0;
+  double last_ms_ = 0, total_ms_ = 0;
 };
 
 }  // namespace pxf

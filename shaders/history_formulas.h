@@ -27,6 +27,10 @@ PXF_CONST float kHistoryColorRelTolerance = 0.25f;
 // at most about 37 degrees apart (a thin wall seen from its other side agrees in distance and,
 // near grazing, in range color: only its facing tells).
 PXF_CONST float kHistoryNormalAgreement = 0.8f;
+// A pixel whose neighbours on both sides along an axis lie more than this share of its distance
+// away is on a silhouette: no normal, and no history (an edge's antialiased guide mixes surfaces,
+// and history taken there smeared the inside of a wall onto its outside in a cornell orbit).
+PXF_CONST float kHistoryEdgeDepthJump = 0.2f;
 
 // Texture units of the history passes (beyond the pass shaders' kUnit* of pass_formulas.h).
 PXF_CONST int kUnitHistoryLv = 10;     // rgb L_lv, a the sample count it holds
@@ -81,7 +85,8 @@ PXF_INLINE bool view_project(ViewCamera c, vec3 x, PXF_OUT(vec2) pixel, PXF_OUT(
 // ---- Reprojection ----
 
 // The step from pixel p's surface point to its neighbour's along `axis`, towards +axis: on the side
-// whose distance is closer to p's (so that an edge on one side does not tilt the normal).
+// whose distance is closer to p's (so that an edge on one side does not tilt the normal); vec3(0)
+// where both sides jump by more than kHistoryEdgeDepthJump (a silhouette) or there is no neighbour.
 PXF_SAMPLER_FN vec3 guide_step(sampler2D guide, ivec2 p, ivec2 axis, ViewCamera c, vec3 point, float d) {
   ivec2 size = textureSize(guide, 0);
   ivec2 ahead = p + axis, behind = p - axis;
@@ -89,31 +94,34 @@ PXF_SAMPLER_FN vec3 guide_step(sampler2D guide, ivec2 p, ivec2 axis, ViewCamera 
   bool has_behind = all(greaterThanEqual(behind, ivec2(0)));
   float d_ahead = has_ahead ? clean(texelFetch(guide, ahead, 0).a) : 0.0f;
   float d_behind = has_behind ? clean(texelFetch(guide, behind, 0).a) : 0.0f;
-  if (has_ahead && (!has_behind || abs(d_ahead - d) <= abs(d_behind - d)))
-    return view_point(c, vec2(ahead) + vec2(0.5f), d_ahead) - point;
-  if (has_behind) return point - view_point(c, vec2(behind) + vec2(0.5f), d_behind);
-  return vec3(0.0f);
+  bool use_ahead = has_ahead && (!has_behind || abs(d_ahead - d) <= abs(d_behind - d));
+  float d_next = use_ahead ? d_ahead : d_behind;
+  if (!(has_ahead || has_behind) || !(abs(d_next - d) <= kHistoryEdgeDepthJump * d)) return vec3(0.0f);
+  if (use_ahead) return view_point(c, vec2(ahead) + vec2(0.5f), d_ahead) - point;
+  return point - view_point(c, vec2(behind) + vec2(0.5f), d_behind);
 }
 
 // The unit normal of the surface a guide shows at pixel p, from the distances of p and its
-// neighbours, turned towards the camera; vec3(0) where it cannot be told (the background, a
-// one-pixel image, a degenerate step).
-PXF_SAMPLER_FN vec3 guide_normal(sampler2D guide, ivec2 p, ViewCamera c) {
+// neighbours, turned towards the camera, in xyz; w = 1 where known, 0 on the background (no
+// evidence either way), -1 where it cannot be told (a silhouette, a degenerate step).
+PXF_SAMPLER_FN vec4 guide_normal(sampler2D guide, ivec2 p, ViewCamera c) {
   float d = clean(texelFetch(guide, p, 0).a);
-  if (!(d < kBackgroundDistanceMin)) return vec3(0.0f);
+  if (!(d < kBackgroundDistanceMin)) return vec4(0.0f);
   vec3 point = view_point(c, vec2(p) + vec2(0.5f), d);
   vec3 n = cross(guide_step(guide, p, ivec2(1, 0), c, point, d), guide_step(guide, p, ivec2(0, 1), c, point, d));
   float len = length(n);
-  if (!(len > 0.0f)) return vec3(0.0f);
+  if (!(len > 0.0f)) return vec4(0.0f, 0.0f, 0.0f, -1.0f);
   n = n / len;
   vec3 to_camera = c.orthographic ? c.basis * vec3(0.0f, 0.0f, 1.0f) : c.origin - point;
-  return dot(n, to_camera) < 0.0f ? -n : n;
+  return vec4(dot(n, to_camera) < 0.0f ? -n : n, 1.0f);
 }
 
-// Whether two such normals allow the same surface (either unknown: no evidence against it).
-PXF_INLINE bool history_normals_agree(vec3 a, vec3 b) {
-  if (dot(a, a) == 0.0f || dot(b, b) == 0.0f) return true;
-  return dot(a, b) >= kHistoryNormalAgreement;
+// Whether two such normals allow the same surface: no silhouette on either side, and where both
+// are known, close enough.
+PXF_INLINE bool history_normals_agree(vec4 a, vec4 b) {
+  if (a.w < 0.0f || b.w < 0.0f) return false;
+  if (a.w == 0.0f || b.w == 0.0f) return true;
+  return dot(vec3(a), vec3(b)) >= kHistoryNormalAgreement;
 }
 
 PXF_INLINE float max_component(vec3 v) { return max(v.x, max(v.y, v.z)); }
@@ -160,7 +168,7 @@ PXF_SAMPLER_FN HistorySample reproject_history(sampler2D previous_lv, sampler2D 
   float expected;
   if (!view_project(before, x, q, expected)) return history_none(kHistoryOutside);
   ivec2 size = textureSize(previous_guide, 0);
-  vec3 normal = guide_normal(new_guide_tex, p, now);
+  vec4 normal = guide_normal(new_guide_tex, p, now);
   if (!(q.x >= 0.0f && q.y >= 0.0f && q.x <= float(size.x) && q.y <= float(size.y)))
     return history_none(kHistoryOutside);
   vec2 corner = q - vec2(0.5f);
