@@ -383,6 +383,15 @@ class Explorer {
         ImGui::TextDisabled(settings_.adaptive ? "uniform warm-up: every pixel is traced" : "adaptive sampling off (--adaptive on)");
       return;
     }
+    if (view == BufferView::History) {
+      for (const CaseStyle& style : history_styles()) {
+        ImGui::ColorButton(style.label, ImVec4(style.r, style.g, style.b, 1), ImGuiColorEditFlags_NoTooltip, ImVec2(14, 14));
+        ImGui::SameLine();
+        ImGui::TextUnformatted(style.label);
+      }
+      if (!preview_->history_active()) ImGui::TextDisabled("no history with weight (the camera rests, or --motion-history off)");
+      return;
+    }
     if (!is_scalar_view(view)) return;
     ScalarScale& s = views_->scale(view);
     ImGui::TextUnformatted(buffer_view_label(view) + 3);

@@ -39,11 +39,17 @@ HistoryPass::HistoryPass(int width, int height)
     : width_(width), height_(height),
       reproject_program_(Program::from_embedded("fullscreen.vert", "history_reproject.frag")),
       combine_program_(Program::from_embedded("fullscreen.vert", "history_combine.frag")),
+      normals_program_(Program::from_embedded("fullscreen.vert", "history_normals.frag")),
       kept_lv_(width, height, TextureFormat::RGBA32F), kept_hv_(width, height, TextureFormat::RGBA32F),
-      kept_guide_(width, height, TextureFormat::RGBA32F), history_lv_(width, height, TextureFormat::RGBA32F),
+      kept_guide_(width, height, TextureFormat::RGBA32F), kept_normals_(width, height, TextureFormat::RGBA32F),
+      normals_(width, height, TextureFormat::RGBA32F), history_lv_(width, height, TextureFormat::RGBA32F),
       history_hv_(width, height, TextureFormat::RGBA32F), outcome_(width, height, TextureFormat::R32F),
       combined_(width, height), state_(width, height, TextureFormat::RGBA32F),
       weight_(width, height, TextureFormat::R32F) {
+  kept_normals_fbo_.attach(0, kept_normals_);
+  kept_normals_fbo_.check("history normals");
+  normals_fbo_.attach(0, normals_);
+  normals_fbo_.check("history normals");
   reproject_fbo_.attach(0, history_lv_);
   reproject_fbo_.attach(1, history_hv_);
   reproject_fbo_.attach(2, outcome_);
@@ -59,11 +65,15 @@ void HistoryPass::keep(const PreviewInputs& fresh, float samples, const Texture2
   if (fresh.width() != width_ || fresh.height() != height_ || guide.width() != width_ || guide.height() != height_)
     throw Error("history pass: input size differs from the pass size");
   if (!(active(samples) && combined_since_reprojection_)) run_combine(fresh, samples, false);
+  timer_.begin();
   copy_texture(state_, kept_lv_);
   copy_texture(combined_.hv(), kept_hv_);
   copy_texture(guide, kept_guide_);
+  compute_normals(kept_guide_, camera, kept_normals_fbo_);
   kept_camera_ = camera;
   has_kept_ = true;
+  last_ms_ = timer_.end();
+  total_ms_ += last_ms_;
   check_gl_error("history keep");
 }
 
@@ -72,19 +82,29 @@ void HistoryPass::reproject(const Texture2D& guide, const Camera& camera) {
   if (guide.width() != width_ || guide.height() != height_)
     throw Error("history pass: guide size differs from the pass size");
   timer_.begin();
+  compute_normals(guide, camera, normals_fbo_);
   reproject_program_.use();
   set_camera_uniforms(reproject_program_, "now", view_camera(camera, width_, height_));
   set_camera_uniforms(reproject_program_, "before", view_camera(kept_camera_, width_, height_));
   kept_lv_.bind(shared::kUnitHistoryLv);
   kept_hv_.bind(shared::kUnitHistoryHv);
   kept_guide_.bind(shared::kUnitHistoryGuide);
+  kept_normals_.bind(shared::kUnitHistoryNormals);
   guide.bind(shared::kUnitGuide);
+  normals_.bind(shared::kUnitNormals);
   quad_.draw(reproject_fbo_, width_, height_);
   last_ms_ = timer_.end();
   total_ms_ += last_ms_;
   check_gl_error("history reprojection");
   reprojected_ = true;
   combined_since_reprojection_ = false;
+}
+
+void HistoryPass::compute_normals(const Texture2D& guide, const Camera& camera, const Framebuffer& target) {
+  normals_program_.use();
+  set_camera_uniforms(normals_program_, "cam", view_camera(camera, width_, height_));
+  guide.bind(shared::kUnitGuide);
+  quad_.draw(target, width_, height_);
 }
 
 void HistoryPass::run_combine(const PreviewInputs& fresh, float samples, bool with_history) {

@@ -63,9 +63,13 @@ class HistoryPass {
   void run_combine(const PreviewInputs& fresh, float samples, bool with_history);
 
   int width_, height_;
-  Program reproject_program_, combine_program_;
+  // guide_normal of `guide` seen by `camera` into `normals`.
+  void compute_normals(const Texture2D& guide, const Camera& camera, const Framebuffer& target);
+
+  Program reproject_program_, combine_program_, normals_program_;
   // The kept view: its state (rgb L_lv, a count), L_u + Var, guide, camera.
-  Texture2D kept_lv_, kept_hv_, kept_guide_;
+  Texture2D kept_lv_, kept_hv_, kept_guide_, kept_normals_, normals_;
+  Framebuffer kept_normals_fbo_, normals_fbo_;
   Camera kept_camera_;
   // The reprojected history in the new view, and what the reprojection found.
   Texture2D history_lv_, history_hv_, outcome_;

@@ -24,6 +24,14 @@ void put(Image& image, int x, int y, glm::vec4 v) {
   for (int c = 0; c < 4; ++c) image.at(x, y, c) = v[c];
 }
 
+// shared::guide_normal per pixel ("R,G,B,A"), as history_normals.frag computes it.
+Image guide_normals(const Image& guide, const shared::ViewCamera& camera) {
+  Image normals = Image::rgba(guide.width, guide.height);
+  for (int y = 0; y < guide.height; ++y)
+    for (int x = 0; x < guide.width; ++x) put(normals, x, y, shared::guide_normal(RgbaTexels{&guide}, {x, y}, camera));
+  return normals;
+}
+
 }  // namespace
 
 HistoryReprojection cpu_reproject_history(const Image& previous_lv, const Image& previous_hv,
@@ -36,12 +44,14 @@ HistoryReprojection cpu_reproject_history(const Image& previous_lv, const Image&
   check_rgba(previous_guide, w, h, "the previous guide");
   const shared::ViewCamera now = view_camera(camera, w, h), before = view_camera(previous_camera, w, h);
   HistoryReprojection out{Image(w, h, {"R", "G", "B", "A"}), Image(w, h, {"R", "G", "B", "A"}), Image::gray(w, h)};
+  const Image previous_normals = guide_normals(previous_guide, before), normals = guide_normals(guide, now);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
       const glm::ivec2 p(x, y);
       const shared::HistorySample s =
           shared::reproject_history(RgbaTexels{&previous_lv}, RgbaTexels{&previous_hv}, RgbaTexels{&previous_guide},
-                                    RgbaTexels{&guide}, p, now, before);
+                                    RgbaTexels{&previous_normals}, RgbaTexels{&guide}, RgbaTexels{&normals}, p, now,
+                                    before);
       put(out.lv, x, y, glm::vec4(s.lv, s.count));
       put(out.hv, x, y, glm::vec4(s.hv, s.var));
       out.outcome.at(x, y, 0) = static_cast<float>(s.outcome);

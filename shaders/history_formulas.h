@@ -37,6 +37,8 @@ PXF_CONST float kHistoryEdgeDepthJump = 0.2f;
 PXF_CONST int kUnitHistoryLv = 10;     // rgb L_lv, a the sample count it holds
 PXF_CONST int kUnitHistoryHv = 11;     // rgb L_u, a Var[L_u]
 PXF_CONST int kUnitHistoryGuide = 12;  // the previous view's guide (rgb range color, a distance)
+PXF_CONST int kUnitHistoryNormals = 13;  // the previous view's guide_normal per pixel
+PXF_CONST int kUnitNormals = 14;         // the new view's guide_normal per pixel
 
 // What the reprojection found per pixel (the "history" view of the explorer).
 PXF_CONST int kHistoryNone = 0;        // no history (the camera did not move, or no previous samples)
@@ -161,15 +163,17 @@ PXF_INLINE HistorySample history_none(int outcome) {
 // that surface (history_tap_agrees, history_normals_agree), their weights renormalized. The taps are independent pixel
 // means: the variance is sum w^2 Var / (sum w)^2, a tap of unknown variance counted with the
 // weighted mean of the known ones (as the filter does, method.md 2.3); unknown if none is known.
+// The normals (guide_normal) of both guides come computed, one texel a pixel.
 PXF_SAMPLER_FN HistorySample reproject_history(sampler2D previous_lv, sampler2D previous_hv, sampler2D previous_guide,
-                                               sampler2D new_guide_tex, ivec2 p, ViewCamera now, ViewCamera before) {
+                                               sampler2D previous_normals, sampler2D new_guide_tex,
+                                               sampler2D new_normals, ivec2 p, ViewCamera now, ViewCamera before) {
   vec4 new_guide = texelFetch(new_guide_tex, p, 0);
   vec3 x = view_point(now, vec2(p) + vec2(0.5f), clean(new_guide.a));
   vec2 q;
   float expected;
   if (!view_project(before, x, q, expected)) return history_none(kHistoryOutside);
   ivec2 size = textureSize(previous_guide, 0);
-  vec4 normal = guide_normal(new_guide_tex, p, now);
+  vec4 normal = texelFetch(new_normals, p, 0);
   if (!(q.x >= 0.0f && q.y >= 0.0f && q.x <= float(size.x) && q.y <= float(size.y)))
     return history_none(kHistoryOutside);
   vec2 corner = q - vec2(0.5f);
@@ -184,7 +188,7 @@ PXF_SAMPLER_FN HistorySample reproject_history(sampler2D previous_lv, sampler2D 
     if (any(lessThan(t, ivec2(0))) || any(greaterThanEqual(t, size))) continue;
     wide_float w = wide_float((o.x == 1 ? f.x : 1.0f - f.x) * (o.y == 1 ? f.y : 1.0f - f.y));
     if (!(w > 0.0f) || !history_tap_agrees(texelFetch(previous_guide, t, 0), vec3(new_guide), expected)) continue;
-    if (!history_normals_agree(normal, guide_normal(previous_guide, t, before))) continue;
+    if (!history_normals_agree(normal, texelFetch(previous_normals, t, 0))) continue;
     vec4 lv = texelFetch(previous_lv, t, 0);
     vec4 hv = texelFetch(previous_hv, t, 0);
     float m = clean(lv.a);
