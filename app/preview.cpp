@@ -178,13 +178,13 @@ void Preview::keep_history() {
   if (!history_) history_ = std::make_unique<HistoryPass>(width_, height_);
   if (range_.frames() == 0) step_range_buffer();
   if (samples() > 0) upload();
-  history_->keep(inputs_, static_cast<float>(samples()), range_.guide(), renderer_->camera());
+  history_->keep(inputs_, static_cast<float>(samples()), range_.guide(), range_.frame_color(), renderer_->camera());
 }
 
 void Preview::reproject_history(const Camera& camera) {
   if (!history_ || !history_->has_kept()) return;
   step_range_buffer();  // the new view's distances
-  history_->reproject(range_.guide(), camera);
+  history_->reproject(range_.guide(), range_.frame_color(), camera);
   last_.range += history_->last_ms();
 }
 

@@ -61,7 +61,8 @@ HistoryPass::HistoryPass(int width, int height)
   combine_fbo_.check("history combination");
 }
 
-void HistoryPass::keep(const PreviewInputs& fresh, float samples, const Texture2D& guide, const Camera& camera) {
+void HistoryPass::keep(const PreviewInputs& fresh, float samples, const Texture2D& guide,
+                       const Texture2D& specular_flags, const Camera& camera) {
   if (fresh.width() != width_ || fresh.height() != height_ || guide.width() != width_ || guide.height() != height_)
     throw Error("history pass: input size differs from the pass size");
   if (!(active(samples) && combined_since_reprojection_)) run_combine(fresh, samples, false);
@@ -69,7 +70,7 @@ void HistoryPass::keep(const PreviewInputs& fresh, float samples, const Texture2
   copy_texture(state_, kept_lv_);
   copy_texture(combined_.hv(), kept_hv_);
   copy_texture(guide, kept_guide_);
-  compute_normals(kept_guide_, camera, kept_normals_fbo_);
+  compute_normals(kept_guide_, specular_flags, camera, kept_normals_fbo_);
   kept_camera_ = camera;
   has_kept_ = true;
   last_ms_ = timer_.end();
@@ -77,12 +78,12 @@ void HistoryPass::keep(const PreviewInputs& fresh, float samples, const Texture2
   check_gl_error("history keep");
 }
 
-void HistoryPass::reproject(const Texture2D& guide, const Camera& camera) {
+void HistoryPass::reproject(const Texture2D& guide, const Texture2D& specular_flags, const Camera& camera) {
   if (!has_kept_) return;
   if (guide.width() != width_ || guide.height() != height_)
     throw Error("history pass: guide size differs from the pass size");
   timer_.begin();
-  compute_normals(guide, camera, normals_fbo_);
+  compute_normals(guide, specular_flags, camera, normals_fbo_);
   reproject_program_.use();
   set_camera_uniforms(reproject_program_, "now", view_camera(camera, width_, height_));
   set_camera_uniforms(reproject_program_, "before", view_camera(kept_camera_, width_, height_));
@@ -100,10 +101,14 @@ void HistoryPass::reproject(const Texture2D& guide, const Camera& camera) {
   combined_since_reprojection_ = false;
 }
 
-void HistoryPass::compute_normals(const Texture2D& guide, const Camera& camera, const Framebuffer& target) {
+void HistoryPass::compute_normals(const Texture2D& guide, const Texture2D& specular_flags, const Camera& camera,
+                                  const Framebuffer& target) {
+  if (specular_flags.width() != width_ || specular_flags.height() != height_)
+    throw Error("history pass: specular flags' size differs from the pass size");
   normals_program_.use();
   set_camera_uniforms(normals_program_, "cam", view_camera(camera, width_, height_));
   guide.bind(shared::kUnitGuide);
+  specular_flags.bind(shared::kUnitSignal);
   quad_.draw(target, width_, height_);
 }
 

@@ -6,9 +6,9 @@
 // accumulate (shared::combine_history).
 // Usage:
 //   HistoryPass history(w, h);
-//   history.keep(inputs_now, n, range.guide(), old_camera);    // before the camera changes
+//   history.keep(inputs_now, n, range.guide(), range.frame_color(), old_camera);  // before the camera changes
 //   ... new camera, range.step() ...
-//   history.reproject(range.guide(), new_camera);
+//   history.reproject(range.guide(), range.frame_color(), new_camera);
 //   after each upload of the fresh inputs (n samples):
 //   const PreviewInputs& in = history.active(n) ? history.combine(fresh, n) : fresh;
 #pragma once
@@ -34,10 +34,12 @@ class HistoryPass {
   // there were any since the last reprojection, else `fresh` itself with `samples` samples per pixel.
   // guide: that view's range buffer; camera: its camera. A view that was never kept leaves the
   // previous one kept (a camera that moves on before a frame was traced).
-  void keep(const PreviewInputs& fresh, float samples, const Texture2D& guide, const Camera& camera);
+  // specular_flags: the view's newest raster frame (RangePass::frame_color, a the specular flag).
+  void keep(const PreviewInputs& fresh, float samples, const Texture2D& guide, const Texture2D& specular_flags,
+            const Camera& camera);
   bool has_kept() const { return has_kept_; }
   // Reprojects the kept view into `camera`'s, whose range buffer is `guide`.
-  void reproject(const Texture2D& guide, const Camera& camera);
+  void reproject(const Texture2D& guide, const Texture2D& specular_flags, const Camera& camera);
   // Whether a reprojected history still has weight after `samples` fresh samples.
   bool active(float samples) const { return reprojected_ && shared::history_count_kept(1.0f, samples) > 0.0f; }
   // The fresh inputs with the history beside them (shared::combine_history), for the filter and blend.
@@ -64,7 +66,8 @@ class HistoryPass {
 
   int width_, height_;
   // guide_normal of `guide` seen by `camera` into `normals`.
-  void compute_normals(const Texture2D& guide, const Camera& camera, const Framebuffer& target);
+  void compute_normals(const Texture2D& guide, const Texture2D& specular_flags, const Camera& camera,
+                       const Framebuffer& target);
 
   Program reproject_program_, combine_program_, normals_program_;
   // The kept view: its state (rgb L_lv, a count), L_u + Var, guide, camera.

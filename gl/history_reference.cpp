@@ -24,11 +24,14 @@ void put(Image& image, int x, int y, glm::vec4 v) {
   for (int c = 0; c < 4; ++c) image.at(x, y, c) = v[c];
 }
 
-// shared::guide_normal per pixel ("R,G,B,A"), as history_normals.frag computes it.
-Image guide_normals(const Image& guide, const shared::ViewCamera& camera) {
+// shared::history_normal per pixel ("R,G,B,A"), as history_normals.frag computes it.
+Image guide_normals(const Image& guide, const Image* specular, const shared::ViewCamera& camera) {
   Image normals = Image::rgba(guide.width, guide.height);
   for (int y = 0; y < guide.height; ++y)
-    for (int x = 0; x < guide.width; ++x) put(normals, x, y, shared::guide_normal(RgbaTexels{&guide}, {x, y}, camera));
+    for (int x = 0; x < guide.width; ++x) {
+      const float flag = specular ? specular->at(x, y, 0) : 0.0f;
+      put(normals, x, y, shared::history_normal(RgbaTexels{&guide}, flag, {x, y}, camera));
+    }
   return normals;
 }
 
@@ -36,7 +39,8 @@ Image guide_normals(const Image& guide, const shared::ViewCamera& camera) {
 
 HistoryReprojection cpu_reproject_history(const Image& previous_lv, const Image& previous_hv,
                                           const Image& previous_guide, const Camera& previous_camera,
-                                          const Image& guide, const Camera& camera) {
+                                          const Image& guide, const Camera& camera, const Image* previous_specular,
+                                          const Image* specular) {
   const int w = guide.width, h = guide.height;
   check_rgba(guide, w, h, "the guide");
   check_rgba(previous_lv, w, h, "the previous L_lv");
@@ -44,7 +48,8 @@ HistoryReprojection cpu_reproject_history(const Image& previous_lv, const Image&
   check_rgba(previous_guide, w, h, "the previous guide");
   const shared::ViewCamera now = view_camera(camera, w, h), before = view_camera(previous_camera, w, h);
   HistoryReprojection out{Image(w, h, {"R", "G", "B", "A"}), Image(w, h, {"R", "G", "B", "A"}), Image::gray(w, h)};
-  const Image previous_normals = guide_normals(previous_guide, before), normals = guide_normals(guide, now);
+  const Image previous_normals = guide_normals(previous_guide, previous_specular, before),
+              normals = guide_normals(guide, specular, now);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
       const glm::ivec2 p(x, y);

@@ -13,9 +13,11 @@ struct HistoryReprojection {
   Image hv;       // "R,G,B,A": L_u, Var[L_u]
   Image outcome;  // "Y": kHistory*
 };
+// previous_specular, specular: "Y" 1 where the view's surface is perfectly specular (nullptr: none).
 HistoryReprojection cpu_reproject_history(const Image& previous_lv, const Image& previous_hv,
                                           const Image& previous_guide, const Camera& previous_camera,
-                                          const Image& guide, const Camera& camera);
+                                          const Image& guide, const Camera& camera,
+                                          const Image* previous_specular = nullptr, const Image* specular = nullptr);
 
 struct HistoryCombination {
   Image lv;      // "R,G,B,A": the L_lv the passes read, the fresh threshold factor

@@ -28,9 +28,10 @@ PXF_CONST float kHistoryColorRelTolerance = 0.25f;
 // at most about 37 degrees apart (a thin wall seen from its other side agrees in distance and,
 // near grazing, in range color: only its facing tells).
 PXF_CONST float kHistoryNormalAgreement = 0.8f;
-// A pixel whose neighbours on both sides along an axis lie more than this share of its distance
-// away is on a silhouette: no normal, and no history (an edge's antialiased guide mixes surfaces,
-// and history taken there smeared the inside of a wall onto its outside in a cornell orbit).
+// A pixel with a neighbour more than this share of its distance nearer or farther is on a
+// silhouette: no normal, and it neither gives nor takes history. Its samples mix the surfaces on
+// both sides (the path tracer's pixel footprint); reprojected as the surface of its center they
+// smeared a mirror sphere's reflections along the wall beside it in a cornell orbit.
 PXF_CONST float kHistoryEdgeDepthJump = 0.2f;
 
 // Texture units of the history passes (beyond the pass shaders' kUnit* of pass_formulas.h).
@@ -87,20 +88,19 @@ PXF_INLINE bool view_project(ViewCamera c, vec3 x, PXF_OUT(vec2) pixel, PXF_OUT(
 
 // ---- Reprojection ----
 
-// The step from pixel p's surface point to its neighbour's along `axis`, towards +axis: on the side
-// whose distance is closer to p's (so that an edge on one side does not tilt the normal); vec3(0)
-// where both sides jump by more than kHistoryEdgeDepthJump (a silhouette) or there is no neighbour.
+// The step from pixel p's surface point to its neighbour's along `axis`, towards +axis; vec3(0)
+// where a neighbour on either side jumps by more than kHistoryEdgeDepthJump (a silhouette) or
+// there is no neighbour.
 PXF_SAMPLER_FN vec3 guide_step(sampler2D guide, ivec2 p, ivec2 axis, ViewCamera c, vec3 point, float d) {
   ivec2 size = textureSize(guide, 0);
   ivec2 ahead = p + axis, behind = p - axis;
   bool has_ahead = all(lessThan(ahead, size));
   bool has_behind = all(greaterThanEqual(behind, ivec2(0)));
-  float d_ahead = has_ahead ? clean(texelFetch(guide, ahead, 0).a) : 0.0f;
-  float d_behind = has_behind ? clean(texelFetch(guide, behind, 0).a) : 0.0f;
-  bool use_ahead = has_ahead && (!has_behind || abs(d_ahead - d) <= abs(d_behind - d));
-  float d_next = use_ahead ? d_ahead : d_behind;
-  if (!(has_ahead || has_behind) || !(abs(d_next - d) <= kHistoryEdgeDepthJump * d)) return vec3(0.0f);
-  if (use_ahead) return view_point(c, vec2(ahead) + vec2(0.5f), d_ahead) - point;
+  float d_ahead = has_ahead ? clean(texelFetch(guide, ahead, 0).a) : d;
+  float d_behind = has_behind ? clean(texelFetch(guide, behind, 0).a) : d;
+  bool no_jump = abs(d_ahead - d) <= kHistoryEdgeDepthJump * d && abs(d_behind - d) <= kHistoryEdgeDepthJump * d;
+  if (!(has_ahead || has_behind) || !no_jump) return vec3(0.0f);
+  if (has_ahead) return view_point(c, vec2(ahead) + vec2(0.5f), d_ahead) - point;
   return point - view_point(c, vec2(behind) + vec2(0.5f), d_behind);
 }
 
@@ -119,8 +119,16 @@ PXF_SAMPLER_FN vec4 guide_normal(sampler2D guide, ivec2 p, ViewCamera c) {
   return vec4(dot(n, to_camera) < 0.0f ? -n : n, 1.0f);
 }
 
-// Whether two such normals allow the same surface: no silhouette on either side, and where both
-// are known, close enough.
+// guide_normal where the newest raster frame's surface is not perfectly specular; w = -2 where it
+// is: its guide distance is a specular chain's, no point on the camera ray, and a mirror pixel's
+// history reprojected through it put the mirror's reflections onto the wall beside it.
+PXF_SAMPLER_FN vec4 history_normal(sampler2D guide, float specular_flag, ivec2 p, ViewCamera c) {
+  if (specular_flag > 0.5f) return vec4(0.0f, 0.0f, 0.0f, -2.0f);
+  return guide_normal(guide, p, c);
+}
+
+// Whether two such normals allow the same surface: no silhouette or specular chain on either
+// side, and where both are known, close enough.
 PXF_INLINE bool history_normals_agree(vec4 a, vec4 b) {
   if (a.w < 0.0f || b.w < 0.0f) return false;
   if (a.w == 0.0f || b.w == 0.0f) return true;
@@ -160,7 +168,8 @@ PXF_INLINE HistorySample history_none(int outcome) {
 
 // The previous view's estimate at new pixel p: the surface point the new guide shows at the pixel
 // center, projected into the previous view, read there bilinearly from the texels that still show
-// that surface (history_tap_agrees, history_normals_agree), their weights renormalized. The taps are independent pixel
+// that surface (history_tap_agrees, history_normals_agree), their weights renormalized for the
+// values; the count is the taps' weighted sum (the share of the footprint that agrees). The taps are independent pixel
 // means: the variance is sum w^2 Var / (sum w)^2, a tap of unknown variance counted with the
 // weighted mean of the known ones (as the filter does, method.md 2.3); unknown if none is known.
 // The normals (guide_normal) of both guides come computed, one texel a pixel.
@@ -211,7 +220,9 @@ PXF_SAMPLER_FN HistorySample reproject_history(sampler2D previous_lv, sampler2D 
   h.lv = vec3(slv / sw);
   h.hv = vec3(shv / sw);
   h.var = sw_known > 0.0f ? float((sw2v_known + swv_known / sw_known * sw2_unknown) / (sw * sw)) : kVarUnknown;
-  h.count = float(swm / sw);
+  // Not renormalized: a pixel that only a corner of the taps supports gets that share of their
+  // samples (a history renormalized from a tap of weight 0.05 smeared streaks along the motion).
+  h.count = float(swm);
   h.outcome = kHistoryKept;
   return h;
 }
