@@ -6,6 +6,7 @@
 #include "app/explorer_camera.h"
 #include "app/preview.h"
 #include "app/render_output.h"
+#include "image/metrics.h"
 #include "tests/test_support.h"
 
 using namespace pxf;
@@ -82,9 +83,12 @@ TEST(MotionHistory, ASmallMoveKeepsMostOfTheImage) {
   restart.set_camera(now);
   const std::vector<Layer> one = render_at(restart, 1);
   const Image target = unfiltered_image(converged);
-  const double with_history = compare_images(preview.final_image(), target).nrmse_percent;
-  const double restarted = compare_images(unfiltered_image(one), target).nrmse_percent;
-  std::printf("1 spp after a move: NRMSE %.1f %% with the history, %.1f %% restarted\n", with_history, restarted);
+  // On display values, as pxf bench --motion measures: the HDR NRMSE is the fireflies' of the
+  // pixels that take no history (the glass and mirror spheres, silhouettes) in both.
+  const double with_history = compare_display(preview.final_image(), target).display_nrmse_percent;
+  const double restarted = compare_display(unfiltered_image(one), target).display_nrmse_percent;
+  std::printf("1 spp after a move: display NRMSE %.1f %% with the history, %.1f %% restarted\n", with_history,
+              restarted);
   EXPECT_LT(with_history, 0.5 * restarted);
 }
 
