@@ -18,6 +18,7 @@
 #include "app/adaptive_bench.h"
 #include "app/guiding_bench.h"
 #include "app/bench_runs.h"
+#include "app/motion_bench.h"
 #include "app/commands.h"
 #include "app/options.h"
 #include "app/plot.h"
@@ -443,7 +444,9 @@ int run_bench(const Args& args) {
   PreviewSettings preview_settings;
   bool pathtracer = false, variants = false, stage_table = false, sampler_error = false, variance_ratio = false;
   bool demodulation_ab = false, guiding_ab = false;
-  bool threshold_fidelity = false, adaptive = false;
+  bool threshold_fidelity = false, adaptive = false, motion = false;
+  int motion_frames = 60;
+  double orbit_degrees = 90;
   double clean_cap_s = 300;
   int variant_spp = 4, variant_rounds = 5;
   std::string extra_taps_text;
@@ -475,6 +478,12 @@ int run_bench(const Args& args) {
            "--rounds, default 3), starved dark pixels, and the clean share over time up to --clean-cap");
   cli.option("--clean-cap", &clean_cap_s, "seconds of each until-clean run of --adaptive (default 300; 0: none)", 0.0,
              1e6);
+  cli.flag("--motion", &motion,
+           "a camera orbit of --motion-frames frames over --orbit-degrees, one path per pixel per frame, with the\n"
+           "reprojected history and the filter every frame against restart + unfiltered at equal frame time:\n"
+           "error, flicker, disocclusions, frame times (references: --reference-spp, default 1024, per frame)");
+  cli.option("--motion-frames", &motion_frames, "frames of the --motion orbit (default 60)", 2, 100000);
+  cli.option("--orbit-degrees", &orbit_degrees, "the whole --motion orbit in degrees (default 90)", 0.0, 3600.0);
   cli.flag("--variants", &variants, "the filter variant table (time vs HV-only NRMSE)");
   cli.option("--variant-spp", &variant_spp, "spp of the --variants HV buffer (default 4)", 1, 1 << 16);
   cli.option("--variant-rounds", &variant_rounds, "timed rounds of --variants (default 5, after a warm-up)", 1, 1000);
@@ -552,6 +561,14 @@ int run_bench(const Args& args) {
   }
 
   auto context = create_gl_context(parse_gl_backend(scene_options.gl));
+  if (motion) {
+    MotionBenchSetup mb{b.scene, scene_options.scene, b.filtered, b.width, b.height, out};
+    mb.frames = motion_frames;
+    mb.orbit_degrees = static_cast<float>(orbit_degrees);
+    mb.reference_spp = cli.given("--reference-spp") ? reference_spp : 1024;
+    run_motion_bench(mb);
+    return 0;
+  }
   std::printf("bench: %s %dx%d, t=%g, filter %s, sigma_s=%g sigma_c=%g sigma_d=%g, GL %s (%s)\n",
               scene_options.scene.c_str(), b.width, b.height, b.filtered.threshold,
               filter_kind_name(b.filtered.filter.kind), b.filtered.filter.sigma_s, b.filtered.filter.sigma_c,

@@ -29,7 +29,11 @@ int run_explore(const Args& args) {
   cli.option("--frames", &o.frames, "quit after N displayed frames, with --spp or --time not before they are reached (testing)", 0, 1 << 30);
   cli.option("--screenshot", &o.screenshot, "FILE.png", "save the whole window (UI included) before quitting");
   cli.flag("--capture", &o.capture_on_exit, "capture into --out before quitting (with --frames)");
+  cli.option("--camera-path", &o.camera_path, "FILE.json|turntable:N",
+             "play a camera path (as `pxf render --camera-path`), then hold its last frame");
+  cli.option("--spp-per-frame", &o.spp_per_frame, "with --camera-path: samples per path frame (default 1)", 1, 1 << 24);
   if (!cli.parse(args)) return 0;
+  if (o.camera_path.empty() && cli.given("--spp-per-frame")) throw UsageError("--spp-per-frame needs --camera-path");
   if (!inspect.empty() && std::sscanf(inspect.c_str(), "%d,%d", &o.inspect_x, &o.inspect_y) != 2)
     throw UsageError("--inspect wants X,Y, got '" + inspect + "'");
   if (print_scene_list_if_asked(o.scene)) return 0;

@@ -10,6 +10,7 @@
 #include <memory>
 #include <vector>
 
+#include "app/camera_path.h"
 #include "app/explorer_camera.h"
 #include "app/explorer_views.h"
 #include "app/frame_budget.h"
@@ -120,7 +121,7 @@ class Explorer {
       if (last) finish_run();
       // The longest display frame before the swap (which may wait for vsync), from the third
       // traced frame on: the first runs of each pass include compiling its shaders.
-      if (preview_->samples() > 2) longest_frame_ms_ = std::max(longest_frame_ms_, ms_between(frame_start, Clock::now()));
+      if (frames_traced_ > 2) longest_frame_ms_ = std::max(longest_frame_ms_, ms_between(frame_start, Clock::now()));
       context_.present();
       if (last) break;
     }
@@ -142,6 +143,11 @@ class Explorer {
       if (scene->automatic_camera) scene->camera = frame_scene(*scene, static_cast<float>(width_) / height_);
       auto preview = std::make_unique<Preview>(*scene, settings_, width_, height_);
       controller_ = std::make_unique<CameraController>(scene->camera, scene_bounds(*scene));
+      if (first && !options_.camera_path.empty()) {
+        path_ = camera_path_for(options_.camera_path, *scene);
+        path_frame_ = 0;
+        playing_path_ = camera_changed_ = true;
+      }
       preview_ = std::move(preview);  // the old preview goes before its scene
       scene_ = std::move(scene);
       options_.scene.scene = path;
@@ -377,6 +383,15 @@ class Explorer {
         ImGui::TextDisabled(settings_.adaptive ? "uniform warm-up: every pixel is traced" : "adaptive sampling off (--adaptive on)");
       return;
     }
+    if (view == BufferView::History) {
+      for (const CaseStyle& style : history_styles()) {
+        ImGui::ColorButton(style.label, ImVec4(style.r, style.g, style.b, 1), ImGuiColorEditFlags_NoTooltip, ImVec2(14, 14));
+        ImGui::SameLine();
+        ImGui::TextUnformatted(style.label);
+      }
+      if (!preview_->history_active()) ImGui::TextDisabled("no history with weight (the camera rests, or --motion-history off)");
+      return;
+    }
     if (!is_scalar_view(view)) return;
     ScalarScale& s = views_->scale(view);
     ImGui::TextUnformatted(buffer_view_label(view) + 3);
@@ -491,6 +506,8 @@ class Explorer {
                        "(Shift: faster)   R: reset");
     if (ImGui::Button("reset camera (R)")) reset_camera();
     ImGui::SameLine();
+    if (ImGui::Checkbox("reproject history", &settings_.motion_history)) settings_changed_ = true;
+    ImGui::SameLine();
     ImGui::Checkbox("skip filter while moving", &fast_while_moving_);
   }
 
@@ -536,17 +553,19 @@ class Explorer {
     camera_changed_ = true;
   }
 
-  // Camera moves reset the accumulation; while moving the filter is skipped so the preview keeps
-  // up, and it runs again on the current samples as soon as the camera rests. A camera move
-  // cancels the frame being traced (it would be discarded anyway); other changes wait for it, and
-  // for the queued passes, without blocking.
+  // Camera moves reset the accumulation. With the reprojected history (docs/method.md 4.1) the
+  // view keeps what it showed and the filter keeps running; a move waits for the frame being
+  // traced, whose samples the history then carries into the new view. Without it a move cancels
+  // that frame (it would be discarded anyway), and "skip filter while moving" leaves the filter out
+  // until the camera rests. Other changes wait for the frame and the queued passes, without blocking.
   void apply_changes() {
-    if (camera_changed_ && tracing_) stop_tracing(/*cancel=*/true);
+    if (camera_changed_ && tracing_ && !settings_.motion_history) stop_tracing(/*cancel=*/true);
     if (tracing_ || preview_->passes_pending()) return;
     const bool camera = camera_changed_;
-    if (camera_changed_) preview_->set_camera(controller_->camera());
+    if (camera_changed_)
+      preview_->set_camera(playing_path_ ? camera_on_path(path_, path_frame_, scene_->camera) : controller_->camera());
     camera_changed_ = false;
-    const bool moving = fast_while_moving_ && (dragging_camera_ || flying_);
+    const bool moving = fast_while_moving_ && (dragging_camera_ || flying_ || playing_path_);
     const bool settings = settings_changed_ || moving != applied_moving_;
     if (settings) {
       PreviewSettings effective = settings_;
@@ -586,6 +605,7 @@ class Explorer {
   }
 
   void frame_traced() {
+    ++frames_traced_;
     const int samples = preview_->samples();
     const bool last = options_.spp > 0 && samples == options_.spp;
     preview_->queue_passes(last, /*display=*/true);
@@ -627,6 +647,7 @@ class Explorer {
       if (preview_->passes_pending()) break;
       if (frame_stats_pending_) average_stage_times(preview_->last_times()), frame_stats_pending_ = false;
       if (camera_changed_ || settings_changed_) break;
+      if (advance_path()) break;
       if (preview_->samples() == 0) accumulation_start_ = Clock::now();  // --time counts from here
       if (paused_ || spp_reached()) {
         if (!finished_ && spp_reached()) preview_->finish(), finished_ = true;
@@ -645,6 +666,19 @@ class Explorer {
       frames_since_display_ = 0;
     }
     last_samples_ = preview_->samples();
+  }
+
+  // --camera-path: once the path frame holds its samples, the next path frame's camera (applied by
+  // apply_changes, as a move of the mouse is); the last frame then stays and accumulates.
+  bool advance_path() {
+    if (!playing_path_ || preview_->samples() < options_.spp_per_frame) return false;
+    if (path_frame_ + 1 >= path_.frame_count()) {
+      playing_path_ = false;
+      return false;
+    }
+    ++path_frame_;
+    camera_changed_ = true;
+    return true;
   }
 
   void average_stage_times(const StageTimes& t) {
@@ -725,7 +759,7 @@ class Explorer {
   bool split_ = false, inspector_ = true, paused_ = false, finished_ = false;
   float divider_ = 0.0f;
   bool dragging_divider_ = false, dragging_camera_ = false, flying_ = false;
-  bool camera_changed_ = false, settings_changed_ = false, applied_moving_ = false, fast_while_moving_ = true;
+  bool camera_changed_ = false, settings_changed_ = false, applied_moving_ = false, fast_while_moving_ = false;
   StageTimes stage_ms_;
   double paths_per_second_ = 0;
   std::deque<float> history_;
@@ -734,6 +768,10 @@ class Explorer {
   bool frame_stats_pending_ = false;
   std::future<bool> trace_result_;
   std::vector<uint32_t> samples_snapshot_;  // per-pixel n for the inspector (the worker writes n)
+  CameraPath path_;                  // --camera-path
+  int path_frame_ = 0;
+  bool playing_path_ = false;
+  long frames_traced_ = 0;             // in all, camera moves included
   double longest_frame_ms_ = 0;        // longest display frame (the UI budget, kUiBudgetMs)
   std::string out_dir_, scene_path_, scene_error_, status_message_;
   Clock::time_point started_;

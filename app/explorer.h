@@ -24,6 +24,8 @@ struct ExploreOptions {
   bool capture_on_exit = false;
   std::string split;          // split view: the --view buffer left, this one right ("" = no split)
   int inspect_x = -1, inspect_y = -1;  // show the pixel inspector at this pixel (screenshots, tests)
+  std::string camera_path;    // play this path (app/camera_path.h: FILE.json or turntable:N), then hold its last frame
+  int spp_per_frame = 1;      // traced frames per path frame
 };
 
 // Opens the window and runs until it is closed (or options.frames have been shown). Throws

@@ -386,5 +386,22 @@ TEST_F(ExplorerWindow, CapturedBuffersEqualPxfRender) {
   EXPECT_TRUE(std::filesystem::exists(dir_ / "explore" / "view-final.png"));
 }
 
+// The history view (issue 37): a kept pixel is green, brighter with more weight; disoccluded red,
+// outside blue, no history grey.
+TEST(ExplorerViews, HistoryViewColorsShowOutcomeAndWeight) {
+  Image outcome = Image::gray(5, 1), weight = Image::gray(5, 1);
+  const int codes[5] = {shared::kHistoryNone, shared::kHistoryKept, shared::kHistoryKept, shared::kHistoryDisoccluded,
+                          shared::kHistoryOutside};
+  for (int i = 0; i < 5; ++i) outcome.pixels[i] = static_cast<float>(codes[i]);
+  weight.pixels[1] = 0.1f;
+  weight.pixels[2] = 0.9f;
+  const Image c = history_view_colors(outcome, weight);
+  EXPECT_FLOAT_EQ(c.at(0, 0, 0), c.at(0, 0, 1));  // grey
+  EXPECT_GT(c.at(1, 0, 1), c.at(1, 0, 0));        // green
+  EXPECT_GT(c.at(2, 0, 1), c.at(1, 0, 1));        // more weight, brighter
+  EXPECT_GT(c.at(3, 0, 0), c.at(3, 0, 1));        // red
+  EXPECT_GT(c.at(4, 0, 2), c.at(4, 0, 0));        // blue
+}
+
 }  // namespace
 }  // namespace pxf

@@ -32,6 +32,7 @@ const ViewInfo kViews[kBufferViewCount] = {
     {BufferView::Unfiltered, "unfiltered", "   unfiltered L_lv + L_u"},
     {BufferView::Samples, "samples", "   paths per pixel"},
     {BufferView::Active, "active", "   next frame's active pixels"},
+    {BufferView::History, "history", "   reprojected history"},
 };
 
 // The legend's colors are the case view's (shared::case_color, shaders/view_case.frag).
@@ -98,6 +99,27 @@ bool is_scalar_view(BufferView v) {
 const std::array<CaseStyle, kBlendCaseCount>& case_styles() { return kCaseStyles; }
 const std::array<CaseStyle, 2>& active_styles() { return kActiveStyles; }
 
+const std::array<CaseStyle, 4>& history_styles() {
+  static const std::array<CaseStyle, 4> styles = {CaseStyle{"no history", 0.25f, 0.25f, 0.25f},
+                                                  CaseStyle{"kept (weight: brighter)", 0.15f, 0.85f, 0.15f},
+                                                  CaseStyle{"disoccluded", 0.95f, 0.20f, 0.15f},
+                                                  CaseStyle{"outside the last view", 0.20f, 0.40f, 0.95f}};
+  return styles;
+}
+
+Image history_view_colors(const Image& outcome, const Image& weight) {
+  Image colors = Image::rgb(outcome.width, outcome.height);
+  for (size_t p = 0; p < outcome.pixel_count(); ++p) {
+    const int o = std::clamp(static_cast<int>(outcome.pixels[p]), 0, 3);
+    const CaseStyle& c = history_styles()[o];
+    const float shade = o == shared::kHistoryKept ? 0.25f + 0.75f * std::clamp(weight.pixels[p], 0.0f, 1.0f) : 1.0f;
+    colors.pixels[3 * p + 0] = shade * c.r;
+    colors.pixels[3 * p + 1] = shade * c.g;
+    colors.pixels[3 * p + 2] = shade * c.b;
+  }
+  return colors;
+}
+
 double active_share(const std::vector<uint8_t>& active) {
   if (active.empty()) return 1.0;
   const auto untraced = std::count(active.begin(), active.end(), uint8_t{0});
@@ -125,7 +147,7 @@ ViewRenderer::ViewRenderer(int width, int height)
       hdr_tonemap_(width, height),
       unfiltered_(width, height),
       samples_(width, height, TextureFormat::R32F),
-      active_(width, height, TextureFormat::RGBA8) {
+      active_(width, height, TextureFormat::RGBA8), history_(width, height, TextureFormat::RGBA32F) {
   for (int i = 0; i < 3; ++i) {
     outputs_[i] = Texture2D(width, height, TextureFormat::RGBA8);
     outputs_[i].set_filter(false);  // magnified views show pixels, not blur
@@ -261,6 +283,15 @@ const Texture2D& ViewRenderer::render(BufferView view, Preview& preview, int slo
       upload_sampling();
       draw_display(active_, false, slot);
       break;
+    case BufferView::History: {  // colors made on the CPU from two read-backs
+      const HistoryPass* history = preview.history();
+      const bool shown = history && history->reprojected() && preview.history_active();
+      const Image colors = shown ? history_view_colors(history->outcome_image(), history->weight_image())
+                                 : Image::rgb(width_, height_, history_styles()[0].r);
+      history_.upload(colors);
+      draw_display(history_, false, slot);
+      break;
+    }
   }
   check_gl_error("explorer view");
   return outputs_[slot];

@@ -19,12 +19,14 @@
 namespace pxf {
 
 // In the order of the number keys 1..9, 0; Unfiltered (L_lv + L_u), Samples (paths traced into
-// each pixel) and Active (the next frame's adaptive mask, issue 33) have no key.
-enum class BufferView { Final, Lv, Hv, HvFiltered, RangeColor, Depth, VarU, VarF, Blend, Case, Unfiltered, Samples, Active };
-constexpr int kBufferViewCount = 13;
+// each pixel), Active (the next frame's adaptive mask, issue 33) and History (the reprojected
+// history after a camera move: kept with its weight, disoccluded, outside; issue 37) have no key.
+enum class BufferView { Final, Lv, Hv, HvFiltered, RangeColor, Depth, VarU, VarF, Blend, Case, Unfiltered, Samples, Active,
+                        History };
+constexpr int kBufferViewCount = 14;
 
 // Command-line names ("final", "lv", "hv", "hv-filtered", "range", "depth", "var-u", "var-f",
-// "blend", "case", "unfiltered", "samples", "active") and UI labels.
+// "blend", "case", "unfiltered", "samples", "active", "history") and UI labels.
 const std::vector<std::string>& buffer_view_names();
 const char* buffer_view_label(BufferView view);
 BufferView parse_buffer_view(const std::string& name);  // throws pxf::Error listing the names
@@ -47,6 +49,11 @@ struct CaseStyle {
 const std::array<CaseStyle, kBlendCaseCount>& case_styles();
 // Colors of the active view, also for its legend: [0] skipped by the next frame, [1] traced.
 const std::array<CaseStyle, 2>& active_styles();
+// Colors of the history view, also for its legend: index = kHistory* (shaders/history_formulas.h);
+// a kept pixel's green is darker where the history's weight in the shown image is lower.
+const std::array<CaseStyle, 4>& history_styles();
+// The history view's colors ("R,G,B") from HistoryPass::outcome_image and weight_image.
+Image history_view_colors(const Image& outcome, const Image& weight);
 
 // Adaptive sampling per pixel (issue 33), copied from the preview while it is not tracing: the
 // explorer's worker writes the per-pixel counts during a frame, so the samples and active views
@@ -117,6 +124,7 @@ class ViewRenderer {
   bool sampling_uploaded_ = false;
   Texture2D samples_;  // R32F: paths per pixel as floats (exact below 2^24)
   Texture2D active_;   // RGBA8: active_styles() colors, drawn as they are
+  Texture2D history_;  // RGBA32F: history_view_colors, drawn as they are
 };
 
 }  // namespace pxf

@@ -51,6 +51,10 @@ void add_preview_options(CommandLine& cli, PreviewSettings& s, bool adaptive_opt
              "shrink the filter's sigma_s as samples accumulate: --sigma-s up to 4 spp, then\n"
              "sigma_s sqrt(4 / spp), at least 2 px (default off: --sigma-s for every filter run; on lowers\n"
              "the error but mixed pixels keep more noise than t, docs/method.md 2.5)");
+  cli.choice("--motion-history", &s.motion_history, {"off", "on"},
+             "after a camera move, reproject what the view showed into the new view beside the fresh samples,\n"
+             "its weight falling to 0 over 16 samples (default on; off: a move restarts from nothing;\n"
+             "docs/method.md 4.1)");
   if (adaptive_option)
     cli.choice("--adaptive", &s.adaptive, {"off", "on"},
                "adaptive sampling: after 16 uniform frames each frame traces the pixels whose final pixel is\n"

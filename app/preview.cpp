@@ -115,7 +115,13 @@ Preview::Preview(const Scene& scene, const PreviewSettings& settings, int width,
 Preview::~Preview() = default;
 
 void Preview::reset() {
+  restart_samples();
+  if (history_) history_->drop();
+}
+
+void Preview::restart_samples() {
   renderer_->reset();
+  combined_now_ = false;
   // The newest run's cost stays a valid prediction (same size): the share bound then also holds
   // right after a camera change.
   const double last_run_ms = schedule_.last_run_ms;
@@ -162,9 +168,32 @@ void Preview::load_state(const AccumulationState& state) {
 }
 
 void Preview::set_camera(const Camera& camera) {
+  if (settings_.motion_history) keep_history();
   renderer_->set_camera(camera);
   range_.set_camera(camera);
-  reset();
+  restart_samples();
+  if (settings_.motion_history) reproject_history(camera);
+  else if (history_) history_->drop();
+}
+
+bool Preview::history_active() const { return history_ && history_->active(static_cast<float>(samples())); }
+
+// What the view shows now: its samples (with the history they were combined with), or, when the
+// frame in flight was cancelled, the last combination, which is still this view's. Nothing new to
+// keep leaves the view kept before it, which then reprojects into the new camera.
+void Preview::keep_history() {
+  if (samples() == 0 && !(history_ && history_->has_combination())) return;
+  if (!history_) history_ = std::make_unique<HistoryPass>(width_, height_);
+  if (range_.frames() == 0) step_range_buffer();
+  if (samples() > 0) upload();
+  history_->keep(inputs_, static_cast<float>(samples()), range_.guide(), range_.frame_color(), renderer_->camera());
+}
+
+void Preview::reproject_history(const Camera& camera) {
+  if (!history_ || !history_->has_kept()) return;
+  step_range_buffer();  // the new view's distances
+  history_->reproject(range_.guide(), range_.frame_color(), camera);
+  last_.range += history_->last_ms();
 }
 
 void Preview::set_settings(const PreviewSettings& settings) {
@@ -173,6 +202,7 @@ void Preview::set_settings(const PreviewSettings& settings) {
   settings_ = settings;
   range_.set_settings(settings_.range);
   renderer_->set_sample_stride(sample_stride(settings_));
+  if (!settings_.motion_history && history_) history_->drop();
   if (retrace) {
     renderer_->set_params(settings_.trace);
     reset();
@@ -207,6 +237,8 @@ void Preview::upload() {
     }
     inputs_.upload_packed_with_threshold(lv_packed_.data(), hv_packed_.data());
   }
+  combined_now_ = history_active();
+  if (combined_now_) history_->combine(inputs_, static_cast<float>(samples()));
   last_.upload += elapsed_ms(start);
   uploaded_ = true;
 }
@@ -252,13 +284,14 @@ void Preview::run_filter() {
   if (settings_.demodulate) {
     const auto start = BenchClock::now();
     if (!demod_) demod_ = std::make_unique<Demodulation>(width_, height_);
-    inputs_.upload_albedo(&renderer_->accumulation().albedo_mean[0].x);
-    demod_->demodulate(inputs_, range_.guide(), params, threshold_now());
+    PreviewInputs& in = pass_inputs();
+    in.upload_albedo(&renderer_->accumulation().albedo_mean[0].x);
+    demod_->demodulate(in, range_.guide(), params, threshold_now());
     filter_.run(demod_->filter_inputs(), range_.guide(), params, threshold_now());
-    demod_->remodulate(filter_.output(), inputs_);
+    demod_->remodulate(filter_.output(), in);
     filter_ms = elapsed_ms(start);
   } else {
-    filter_.run(inputs_, range_.guide(), params, threshold_now());
+    filter_.run(inputs(), range_.guide(), params, threshold_now());
     filter_ms = filter_.last_ms();
   }
   last_.filter += filter_ms;
@@ -312,7 +345,7 @@ void Preview::blend_and_tonemap() {
   // Once a filter run skipped every pixel, its L_f marks every pixel case 2 and the guard, which
   // acts in cases 1 and 3 only, would change nothing: its passes are left out (the same image).
   const bool guard = settings_.bias_guard && !schedule_.all_pixels_case2;
-  blend_.run(inputs_, have_filtered_ ? &filtered_output() : nullptr, &range_.guide(), threshold_now(),
+  blend_.run(inputs(), have_filtered_ ? &filtered_output() : nullptr, &range_.guide(), threshold_now(),
              BlendParams{range_weights(settings_.filter), guard}, have_filtered_ ? filter_.centre_weight() : nullptr);
   last_.blend += blend_.last_ms();
   tonemap_.run(blend_.output(), settings_.tonemap);
@@ -388,6 +421,7 @@ void Preview::plan_next_frame() {
 
 void Preview::queue_passes(bool last_frame, bool display) {
   update_hv_empty();
+  schedule_.history_active = history_active();
   plan_next_frame();
   pending_last_frame_ = last_frame;
   pending_ = {PassStep::RangeFrame, PassStep::Filter};

@@ -19,6 +19,7 @@
 #include "gl/blend_pass.h"
 #include "gl/demodulation.h"
 #include "gl/filter_pass.h"
+#include "gl/history_pass.h"
 #include "gl/inputs.h"
 #include "gl/pass_params.h"
 #include "gl/range_pass.h"
@@ -59,6 +60,11 @@ struct PreviewSettings {
   FilterSchedule schedule = FilterSchedule::Budget;
   TonemapParams tonemap;
   RangeSettings range;
+  // Reprojected history (docs/method.md section 4.1): a camera move keeps what the view showed and
+  // reprojects it into the new view, beside the fresh samples, with a weight that falls to 0 after
+  // kHistoryFadeSamples samples. Acts only on a camera change after traced samples (the explorer,
+  // camera paths); a render that never moves is unchanged.
+  bool motion_history = true;
   bool filtering() const { return filter.kind != FilterKind::None; }
 };
 
@@ -176,7 +182,13 @@ class Preview {
   const std::array<uint32_t, kBlendCaseCount>& case_counts() const { return case_counts_; }
 
   // GPU results for the explorer's views.
-  const PreviewInputs& inputs() const { return inputs_; }
+  // The inputs the filter and blend read: the fresh samples, or with the reprojected history
+  // beside them while it has weight (HistoryPass::combine).
+  const PreviewInputs& inputs() const { return combined_now_ ? history_->combined() : inputs_; }
+  // The reprojected history (nullptr before the first camera move with motion_history on).
+  const HistoryPass* history() const { return history_.get(); }
+  // Whether the history still has weight in the current samples.
+  bool history_active() const;
   const RangePass& range() const { return range_; }
   const FilterPass& filter() const { return filter_; }
   const BlendPass& blend() const { return blend_; }
@@ -197,6 +209,12 @@ class Preview {
 
  private:
   void upload();
+  PreviewInputs& pass_inputs() { return combined_now_ ? history_->combined() : inputs_; }
+  // reset() without forgetting the history (a camera move keeps it).
+  void restart_samples();
+  // Keeps the current view for the history before the camera changes to `camera`, then reprojects.
+  void keep_history();
+  void reproject_history(const Camera& camera);
   void run_filter();
   bool filter_worthwhile();  // HV's energy share reaches kMinHvShare (else counts a skip)
   bool step_range_buffer();     // one antialiasing frame of the range pass; false once converged
@@ -220,6 +238,8 @@ class Preview {
   RangePass range_;
   FilterPass filter_;
   std::unique_ptr<Demodulation> demod_;  // created on first use
+  std::unique_ptr<HistoryPass> history_;  // created at the first camera move with motion_history
+  bool combined_now_ = false;             // the passes read history_->combined() for the current samples
   bool filtered_demodulated_ = false;    // the newest L_f went through demod_
   BlendPass blend_;
   TonemapPass tonemap_;

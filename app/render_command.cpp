@@ -7,6 +7,7 @@
 #include <iterator>
 #include <unistd.h>
 
+#include "app/camera_path_render.h"
 #include "app/checkpoint.h"
 #include "app/commands.h"
 #include "app/first_frame.h"
@@ -113,8 +114,35 @@ int run_render(const Args& args) {
            "or earlier at --spp (unbounded without it), --time or Ctrl-C");
   CheckpointOptions checkpoint_options;
   add_checkpoint_options(cli, checkpoint_options);
+  std::string camera_path;
+  PathRenderOptions path_options;
+  cli.option("--camera-path", &camera_path, "FILE.json|turntable:N",
+             "render a numbered frame sequence DIR/frame-NNNN.png along a camera path (docs/explorer.md), "
+             "the history reprojected from frame to frame");
+  cli.option("--spp-per-frame", &path_options.spp_per_frame, "with --camera-path: samples per frame (default 1)", 1,
+             static_cast<int>(kMaxRenderFrames));
+  cli.option("--time-per-frame", &path_options.time_per_frame_s,
+             "with --camera-path: seconds per frame instead of --spp-per-frame", 0.001, 1e7);
   if (!cli.parse(args)) return 0;
   if (print_scene_list_if_asked(scene_options)) return 0;
+  if (camera_path.empty()) {
+    for (const char* flag : {"--spp-per-frame", "--time-per-frame"})
+      if (cli.given(flag)) throw UsageError(std::string(flag) + " needs --camera-path");
+  } else {
+    for (const char* flag : {"--spp", "--time", "--until-clean", "--reference"})
+      if (cli.given(flag)) throw UsageError(std::string(flag) + " does not go with --camera-path (use --spp-per-frame or --time-per-frame)");
+    if (cli.given("--spp-per-frame") && cli.given("--time-per-frame"))
+      throw UsageError("--spp-per-frame and --time-per-frame exclude each other");
+    if (uses_state(checkpoint_options)) throw UsageError("checkpoints do not go with --camera-path");
+    path_options.out = out;
+    path_options.quiet = quiet;
+    Scene scene = load_scene_for(scene_options, preview_settings, cli);
+    const CameraPath path = camera_path_for(camera_path, scene);
+    set_gl_timing(scene_options.stage_timing);
+    auto context = create_gl_context(parse_gl_backend(scene_options.gl));
+    return run_camera_path_render(scene, scene_options.scene, preview_settings, scene_options.width,
+                                  scene_options.height, path, path_options);
+  }
   const double budget_ms = time_s * 1000.0;
   if ((budget_ms > 0 || until_clean) && !cli.given("--spp")) {
     spp = static_cast<int>(kMaxRenderFrames);

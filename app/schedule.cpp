@@ -31,7 +31,7 @@ bool run_fits_share(const ScheduleState& s) {
 
 bool filter_due(FilterSchedule schedule, int samples, bool last_frame, const ScheduleState& state) {
   if (samples < 1 || state.hv_empty || state.all_pixels_case2) return false;
-  if (last_frame || schedule == FilterSchedule::EveryFrame) return true;
+  if (last_frame || schedule == FilterSchedule::EveryFrame || state.history_active) return true;
   if (!is_power_of_two(samples)) return false;
   return schedule == FilterSchedule::PowersOfTwo || run_fits_share(state);
 }

@@ -21,6 +21,9 @@ struct ScheduleState {
   bool hv_empty = true;          // no HV radiance yet anywhere (e.g. a scene lit only directly)
   bool all_pixels_case2 = false; // every pixel already meets the threshold unfiltered
   bool have_filtered = false;    // an L_f exists from an earlier run
+  // A reprojected history still has weight (a moving camera, docs/method.md 4.1): the filter runs
+  // on every frame, as the history makes a few fresh samples worth filtering.
+  bool history_active = false;
   // Measured since the last reset (ms), for the budget schedule.
   double tracing_ms = 0;   // path tracing
   double pass_ms = 0;      // filter + range runs

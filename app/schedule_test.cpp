@@ -177,3 +177,19 @@ TEST(TimeBudget, NoBudgetNeverStops) {
   t.next_frame_ms = 1e9;
   EXPECT_TRUE(next_frame_fits(t));
 }
+
+// While a reprojected history has weight (a moving camera, docs/method.md 4.1) the filter runs on
+// every frame, also where the budget would leave it out; once the history is gone, the budget again.
+TEST(FilterSchedule, RunsEveryFrameWhileTheHistoryHasWeight) {
+  ScheduleState state;
+  state.hv_empty = false;
+  state.last_run_ms = 50;  // far beyond 10 % of the tracing so far
+  state.tracing_ms = 100;
+  for (int samples : {1, 3, 5})
+    EXPECT_FALSE(filter_due(FilterSchedule::Budget, samples, false, state)) << samples;
+  state.history_active = true;
+  for (int samples : {1, 3, 5})
+    EXPECT_TRUE(filter_due(FilterSchedule::Budget, samples, false, state)) << samples;
+  state.all_pixels_case2 = true;  // nothing to filter: not even with a history
+  EXPECT_FALSE(filter_due(FilterSchedule::Budget, 3, false, state));
+}

@@ -60,6 +60,9 @@ class RangePass {
   void end_frame();                      // accumulates, updates converged()
 
   const Texture2D& guide() const;        // rgb range color, a distance (antialiased)
+  // The newest frame's raster output: rgb its range color, a 1 where its surface is perfectly
+  // specular (the guide's distance there is a specular chain's, not the distance to a surface).
+  const Texture2D& frame_color() const { return frame_color_; }
   Image range_color_image() const;       // "R,G,B"
   Image depth_image() const;             // "Y": distance
   Image frame_color_image() const;       // the current (single) frame, "R,G,B"

@@ -1,6 +1,9 @@
 // The formulas and constants of the preview passes (docs/method.md sections 2-4) that the shaders
 // and the CPU reference (gl/cpu_reference.cpp, gl/grid_reference.cpp) both compute: one source,
 // valid GLSL and C++ (shaders/cpu_gpu.h). The gl_tests compare the two compilations of it.
+#ifdef __cplusplus
+#pragma once  // also included by shaders/history_formulas.h
+#endif
 #include "cpu_gpu.h"
 
 PXF_SHARED_BEGIN

@@ -1,0 +1,95 @@
+// The reprojected history of a moving camera (issue 37, docs/method.md 4.1) in the preview core:
+// once the camera rests, the history's weight falls to 0 and the render converges to the one that
+// never moved; while it moves, the history stands beside the fresh samples.
+#include <gtest/gtest.h>
+
+#include "app/explorer_camera.h"
+#include "app/preview.h"
+#include "app/render_output.h"
+#include "image/metrics.h"
+#include "tests/test_support.h"
+
+using namespace pxf;
+
+namespace {
+
+constexpr int kSize = 32;
+
+Camera orbited(const Scene& scene, float dx) {
+  CameraController control(scene.camera, scene_bounds(scene));
+  control.orbit(dx, 0.0f);
+  return control.camera();
+}
+
+std::vector<Layer> render_at(Preview& preview, int spp) {
+  for (int i = 0; i < spp; ++i) preview.add_frame(i + 1 == spp, false);
+  return preview.buffers();
+}
+
+// 64 spp after a move against 64 spp of a camera that never moved: the same fresh samples, and a
+// final image within the tolerance of the consistency test's last checkpoint (the filtered image
+// 4 % NRMSE from the unfiltered one there; here both filter the same samples).
+TEST(MotionHistory, AfterTheCameraRestsTheRenderConvergesToTheStaticOne) {
+  test_support::headless_context();
+  Scene scene = load_scene("cornell");
+  PreviewSettings settings;
+  Preview still(scene, settings, kSize, kSize);
+  still.converge_range_buffer();
+  const std::vector<Layer> reference = render_at(still, 64);
+
+  Preview moved(scene, settings, kSize, kSize);
+  moved.set_camera(orbited(scene, 40.0f));
+  render_at(moved, 4);
+  moved.set_camera(scene.camera);
+  ASSERT_TRUE(moved.history() && moved.history()->reprojected());
+  moved.add_frame(false, false);
+  EXPECT_TRUE(moved.history_active());
+  moved.converge_range_buffer();
+  const std::vector<Layer> after = render_at(moved, 63);
+  EXPECT_FALSE(moved.history_active());
+  for (const char* name : {"lv", "hv"})
+    EXPECT_EQ(layer_image(after, name).pixels, layer_image(reference, name).pixels) << name;
+  // The passes read the fresh samples again, exactly.
+  EXPECT_EQ(moved.inputs().hv_image().pixels, layer_image(reference, "hv").pixels);
+  const double nrmse = compare_images(layer_image(after, "final"), layer_image(reference, "final")).nrmse_percent;
+  EXPECT_LT(nrmse, 1.0);
+}
+
+// One frame after a small orbit, the history counts: most pixels reprojected, their weight high,
+// and the final image closer to a converged render than the one frame alone.
+TEST(MotionHistory, ASmallMoveKeepsMostOfTheImage) {
+  test_support::headless_context();
+  Scene scene = load_scene("cornell");
+  PreviewSettings settings;
+  Preview preview(scene, settings, kSize, kSize);
+  render_at(preview, 16);
+  const Camera now = orbited(scene, 6.0f);
+  preview.set_camera(now);
+  preview.add_frame(false, true);
+  ASSERT_TRUE(preview.history_active());
+  const Image outcome = preview.history()->outcome_image();
+  int kept = 0;
+  for (float o : outcome.pixels) kept += o == shared::kHistoryKept;
+  EXPECT_GT(kept, kSize * kSize * 3 / 4);
+  const Image weight = preview.history()->weight_image();
+  double mean_weight = 0;
+  for (float w : weight.pixels) mean_weight += w / weight.pixels.size();
+  EXPECT_GT(mean_weight, 0.6);
+
+  Preview reference(scene, settings, kSize, kSize);
+  reference.set_camera(now);
+  const std::vector<Layer> converged = render_at(reference, 256);
+  Preview restart(scene, settings, kSize, kSize);
+  restart.set_camera(now);
+  const std::vector<Layer> one = render_at(restart, 1);
+  const Image target = unfiltered_image(converged);
+  // On display values, as pxf bench --motion measures: the HDR NRMSE is the fireflies' of the
+  // pixels that take no history (the glass and mirror spheres, silhouettes) in both.
+  const double with_history = compare_display(preview.final_image(), target).display_nrmse_percent;
+  const double restarted = compare_display(unfiltered_image(one), target).display_nrmse_percent;
+  std::printf("1 spp after a move: display NRMSE %.1f %% with the history, %.1f %% restarted\n", with_history,
+              restarted);
+  EXPECT_LT(with_history, 0.5 * restarted);
+}
+
+}  // namespace
