@@ -174,7 +174,9 @@ TEST(HistoryPass, AnUnmovedCameraReprojectsEveryPixelOntoItself) {
       for (int c = 0; c < 4; ++c) EXPECT_NEAR(r.lv.at(x, y, c), kept.state.at(x, y, c), 1e-4f) << x << "," << y;
       for (int c = 0; c < 3; ++c) EXPECT_NEAR(r.hv.at(x, y, c), kept.hv.at(x, y, c), 1e-4f) << x << "," << y;
       // An unknown variance may be taken from a neighbour whose bilinear weight is a rounding error.
-      if (kept.hv.at(x, y, 3) >= 0.0f) EXPECT_NEAR(r.hv.at(x, y, 3), kept.hv.at(x, y, 3), 1e-4f) << x << "," << y;
+      if (kept.hv.at(x, y, 3) >= 0.0f) {
+        EXPECT_NEAR(r.hv.at(x, y, 3), kept.hv.at(x, y, 3), 1e-4f) << x << "," << y;
+      }
     }
   EXPECT_GT(edges, 10);
 }
