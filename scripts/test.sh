@@ -2,7 +2,7 @@
 # Sets up and builds pxf, then runs the whole test suite with ctest. Afterwards it builds the
 # core libraries' unit tests (image, pathtracer) with AddressSanitizer + UndefinedBehaviorSanitizer
 # in build-asan/ and runs them (skip with PXF_SKIP_SANITIZERS=1). Last, a short libFuzzer run of each
-# harness in fuzz/ (PXF_FUZZ_SECONDS per harness, default 20; skip with PXF_SKIP_FUZZ=1) where clang++
+# harness in fuzz/ (PXF_FUZZ_SECONDS per harness, default 10; skip with PXF_SKIP_FUZZ=1) where clang++
 # and libFuzzer work; any crash, leak, sanitizer report or timeout fails the script.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -20,8 +20,8 @@ fi
 
 if [ "${PXF_SKIP_FUZZ:-0}" != "1" ]; then
   if scripts/fuzz.sh --available; then
-    echo "== libFuzzer harnesses, ${PXF_FUZZ_SECONDS:-20} s each (scripts/fuzz.sh)"
-    scripts/fuzz.sh "${PXF_FUZZ_SECONDS:-20}"
+    echo "== libFuzzer harnesses, ${PXF_FUZZ_SECONDS:-10} s each (scripts/fuzz.sh)"
+    scripts/fuzz.sh "${PXF_FUZZ_SECONDS:-10}"
   else
     echo "== libFuzzer harnesses skipped: clang++ with libFuzzer not available (scripts/setup.sh installs it)"
   fi

@@ -1,7 +1,7 @@
 // Issue 38 items 1-4, end to end: pxf keeps the user's files, and a stop signal, a kill or a second
 // render at any moment of the output write leaves the old set or the new one, whole, never neither
 // and never a mix; a reader that closes the pipe does not kill the render.
-// PXF_STRESS_TRIALS (default 70) and PXF_STRESS_PAIRS (default 70) set the trial counts; the
+// PXF_STRESS_TRIALS (default 70) and PXF_STRESS_PAIRS (default 35) set the trial counts; the
 // figures in docs/robustness.md were taken with 1000 and 200.
 #include <gtest/gtest.h>
 
@@ -193,7 +193,7 @@ TEST(OutputSet, SignalsDuringTheWriteLeaveOneWholeSet) {
 // set of one of them, whole.
 TEST(OutputSet, ConcurrentRendersIntoOneFolderNeverMix) {
   const std::string out = test_support::temp_dir("output_set", "pairs");
-  const int pairs = env_count("PXF_STRESS_PAIRS", 70);
+  const int pairs = env_count("PXF_STRESS_PAIRS", 35);
   std::map<int, int> winners;
   for (int pair = 0; pair < pairs; ++pair) {
     const pid_t a = start_render(out, 16), b = start_render(out, 20);
