@@ -513,7 +513,7 @@ TEST(Cli, DiffSecondReferenceTakesOutTheReferencesNoise) {
   const std::string a = temp_dir("noise_a"), b = temp_dir("noise_b"), test = temp_dir("noise_test"),
                     other = temp_dir("noise_other");
   for (const auto& [dir, seed] : {std::pair{a, 9}, {b, 10}, {test, 11}})
-    ASSERT_EQ(run("render --size 40x40 --spp 16 --filter none --quiet --seed " + std::to_string(seed) + " --out " + dir)
+    ASSERT_EQ(run("render --size 40x40 --spp 64 --filter none --quiet --seed " + std::to_string(seed) + " --out " + dir)
                   .code,
               0);
   const Result r = run("diff " + test + "/final.exr " + a + "/final.exr --second-reference " + b + "/final.exr");
