@@ -16,19 +16,8 @@ using namespace pxf;
 
 namespace {
 
-struct Result {
-  int code = -1;
-  std::string out, err;
-};
-
-Result run(const std::string& args) {
-  const std::string base = test_support::temp_dir("camera_path", "io");
-  fs::create_directories(base);
-  const std::string cmd = std::string(PXF_EXECUTABLE) + " " + args + " >" + base + "/out 2>" + base + "/err";
-  const int status = std::system(cmd.c_str());
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, test_support::slurp(base + "/out"),
-          test_support::slurp(base + "/err")};
-}
+using Result = test_support::PxfResult;
+Result run(const std::string& args) { return test_support::run_pxf(args, "camera_path"); }
 
 std::string write_path_file(const std::string& text) {
   const std::string dir = test_support::temp_dir("camera_path", "files");

@@ -32,21 +32,12 @@ using namespace pxf;
 
 namespace {
 
-struct Result {
-  int code = -1;
-  std::string out, err;
-};
+using Result = test_support::PxfResult;
 
 std::string temp_dir(const std::string& name) { return test_support::temp_dir("cli", name); }
 using test_support::slurp;
 
-Result run(const std::string& args) {
-  const std::string base = temp_dir("io");
-  fs::create_directories(base);
-  const std::string cmd = std::string(PXF_EXECUTABLE) + " " + args + " >" + base + "/out 2>" + base + "/err";
-  const int status = std::system(cmd.c_str());
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(base + "/out"), slurp(base + "/err")};
-}
+Result run(const std::string& args) { return test_support::run_pxf(args, "cli"); }
 
 size_t lines(const std::string& text) { return std::count(text.begin(), text.end(), '\n'); }
 

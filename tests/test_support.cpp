@@ -1,6 +1,7 @@
 #include "tests/test_support.h"
 
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -51,6 +52,14 @@ std::string temp_dir(const std::string& suite, const std::string& name) {
 std::string slurp(const std::string& path) {
   std::ifstream in(path);
   return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+PxfResult run_pxf(const std::string& args, const std::string& suite) {
+  const std::string base = temp_dir(suite, "io");
+  std::filesystem::create_directories(base);
+  const std::string cmd = std::string(PXF_EXECUTABLE) + " " + args + " >" + base + "/out 2>" + base + "/err";
+  const int status = std::system(cmd.c_str());
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(base + "/out"), slurp(base + "/err")};
 }
 
 void expect_merge_close(const Image& merged, const Image& single, const std::string& what) {

@@ -23,6 +23,14 @@ std::string temp_dir(const std::string& suite, const std::string& name);
 // The whole file as text ("" if it cannot be read).
 std::string slurp(const std::string& path);
 
+// `pxf ARGS` run to its end: the exit code (-1 if it did not exit) and what it printed, kept in a
+// folder of `suite`'s.
+struct PxfResult {
+  int code = -1;
+  std::string out, err;
+};
+PxfResult run_pxf(const std::string& args, const std::string& suite);
+
 // A merge of accumulation states against one render of the same samples: shard means are combined
 // as n-weighted means in double and rounded to float once, where the single render rounds its
 // running float mean at every sample, so values may differ by a few float ulps of the radiance
