@@ -146,7 +146,7 @@ void print_perfect_filter(const std::string& test_path, const std::string& refer
   perfect.filtered = ref_hv;
   perfect.variance = Image::gray(hv.width, hv.height);
   const BlendOutput blended =
-      cpu_blend(lv, hv, layer_of(test, "var_u", test_path), &perfect, t, BlendParams{range_weights(settings.filter)},
+      cpu_blend(lv, hv, layer_of(test, "var_u", test_path), &perfect, t, BlendParams{range_weights(settings.filter), false, spp},
                 &layer_of(test, "range_color", test_path), &layer_of(test, "depth", test_path));
   std::printf("perfect filter: t %g (%g at %.0f spp), sigma_c %g, sigma_d %g from %s\n", settings.threshold, t, spp,
               settings.filter.sigma_c, settings.filter.sigma_d, settings.source.c_str());

@@ -226,8 +226,8 @@ TEST(BlendFactorShader, MatchesCpuOnGridAndBoundaries) {
     EXPECT_EQ(count_nonfinite(final_rgb), 0u);
     for (int y = 0; y < w; ++y)
       for (int x = 0; x < w; ++x) {
-        // L_b = Y(L_f) = 1 here; Var[L_u] = 0 means all samples equal: u = zero_variance_u(1, 1) = 1.
-        float u = mags[y] > 0.0f ? mags[y] : zero_variance_u(1.0f, 1.0f), f = mags[x];
+        // L_b = Y(L_f) = 1 here; Var[L_u] = 0 means all samples equal: u = zero_variance_u(1, 1, n) = 1 (n unknown).
+        float u = mags[y] > 0.0f ? mags[y] : zero_variance_u(1.0f, 1.0f, 0.0f), f = mags[x];
         BlendDecision ref = blend_decision(u, f, t);
         BlendDecision gpu{s.at(x, y, 0), static_cast<int>(cases.at(x, y, 0))};
         check_decision(u, f, t, gpu);
@@ -306,6 +306,36 @@ TEST(PooledVariance, QuietPixelTakesTheMeanOfItsRangeNeighbours) {
   // All samples equal and no neighbour variance known: 0 (the blend then uses zero_variance_u).
   for (float& v : p.var.pixels) v = 0.0f;
   EXPECT_EQ(pooled_var_u(p.var, p.range, p.depth, 1, 1, range), 0.0f);
+}
+
+// The zero-variance rule: u = (Y(L_f) / L_b)^2 up to kZeroVarianceSamples samples, then falling as
+// 1 / n, so that a pixel whose samples are all 0 leaves the filter (its bias vanishes) once it
+// has enough of them; and pixel_samples reads each pixel's own count back from its threshold factor.
+TEST(ZeroVarianceRule, FallsAsOneOverNFromKSamples) {
+  EXPECT_EQ(zero_variance_u(0.5f, 2.0f, 0.0f), 0.0625f);  // n unknown: no decay
+  EXPECT_EQ(zero_variance_u(0.5f, 2.0f, 64.0f), 0.0625f);
+  EXPECT_EQ(zero_variance_u(0.5f, 2.0f, kZeroVarianceSamples), 0.0625f);
+  EXPECT_FLOAT_EQ(zero_variance_u(0.5f, 2.0f, 4 * kZeroVarianceSamples), 0.0625f / 4);
+  EXPECT_FLOAT_EQ(zero_variance_u(0.5f, 2.0f, 1e6f), 0.0625f * kZeroVarianceSamples / 1e6f);
+  EXPECT_EQ(zero_variance_u(0.0f, 2.0f, 1e6f), 0.0f);  // black L_f: nothing to blend in
+  EXPECT_EQ(zero_variance_u(0.5f, 0.0f, 1e6f), kInf);
+  // A pixel of L_f = L_b at t = 0.01 is clean (u <= t) from 1024 / 0.01 samples on, not before.
+  EXPECT_GT(zero_variance_u(1.0f, 1.0f, 1e5f), 0.01f);
+  EXPECT_LE(zero_variance_u(1.0f, 1.0f, 1.03e5f), 0.01f);
+}
+
+TEST(ZeroVarianceRule, PixelSamplesInvertTheThresholdFactor) {
+  for (uint64_t run : {16u, 1024u, 40000u})
+    for (uint64_t own : {5u, 64u, 1000u, 40000u, 1000000u}) {
+      const float factor = effective_threshold(0.01f, own) / effective_threshold(0.01f, run);
+      // The factor is a float near 1: n_p comes back to 0.2 % up to 40000 samples, 10 % at 1e6
+      // (enough for a decay that only has to fall as 1 / n).
+      EXPECT_NEAR(pixel_samples(static_cast<float>(run), factor), static_cast<float>(own), (own > 40000 ? 0.1f : 2e-3f) * own)
+          << run << " " << own;
+    }
+  EXPECT_EQ(pixel_samples(40000.0f, 1.0f), 40000.0f);  // a uniform frame's pixels: exactly n
+  EXPECT_EQ(pixel_samples(0.0f, 0.5f), 0.0f);          // n unknown
+  EXPECT_EQ(pixel_samples(1024.0f, effective_threshold(0.01f, 2) / effective_threshold(0.01f, 1024)), 4.0f);
 }
 
 TEST(PooledVariance, DarkSpeckleIsFilteredNotKept) {

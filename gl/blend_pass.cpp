@@ -52,13 +52,14 @@ void BlendPass::run(const PreviewInputs& inputs, const Texture2D* filtered, cons
   const bool guard = params.bias_guard && filtered;
   if (guard) run_bias_guard(inputs, *filtered);
   last_ = LastRun{&inputs.hv(), &inputs.lv(), filtered, guide, filtered ? centre_weight : nullptr,
-                  shared::BlendSwitches{filtered != nullptr, guide != nullptr, guard, t}, params.range};
+                  shared::BlendSwitches{filtered != nullptr, guide != nullptr, guard, t, params.samples}, params.range};
   program_.set("has_filtered", last_.switches.has_filtered ? 1 : 0);
   program_.set("has_guide", last_.switches.has_guide ? 1 : 0);
   program_.set("has_centre_weight", last_.centre_weight ? 1 : 0);
   program_.set("k_c", params.range.k_c);
   program_.set("k_d", params.range.k_d);
   program_.set("t", t);
+  program_.set("samples", last_.switches.samples);
   program_.set("bias_guard", last_.switches.bias_guard ? 1 : 0);
   const std::array<uint32_t, kBlendCaseCount> zeros{};
   counts_.upload(zeros.data(), sizeof zeros);

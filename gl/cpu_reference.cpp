@@ -221,7 +221,7 @@ BlendOutput cpu_blend(const Image& lv, const Image& hv, const Image& var_u, cons
   BlendOutput out{Image::rgb(w, h), Image::gray(w, h), Image::gray(w, h)};
   const TexelView hv_texels{&hv, &var_u};
   const TexelView filtered_texels = filtered ? TexelView{&filtered->filtered, &filtered->variance} : hv_texels;
-  const shared::BlendSwitches on{filtered != nullptr, pool, params.bias_guard, t};
+  const shared::BlendSwitches on{filtered != nullptr, pool, params.bias_guard, t, params.samples};
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
       const glm::ivec2 p(x, y);

@@ -20,7 +20,10 @@ using shared::clean;
 using shared::clean_var;
 // var / lb^2 without overflow in the intermediate: 0 when var <= 0, +inf when lb <= 0.
 using shared::relative_variance;
-// u of a pixel whose samples were all equal (Var[L_u] = 0, n >= 2): (Y(L_f) / L_b)^2.
+// u of a pixel whose samples were all equal (Var[L_u] = 0, n >= 2): (Y(L_f) / L_b)^2, falling as
+// 1 / n from kZeroVarianceSamples on; the pixel's own n from its threshold factor: pixel_samples.
+using shared::kZeroVarianceSamples;
+using shared::pixel_samples;
 using shared::zero_variance_u;
 
 struct BlendDecision {

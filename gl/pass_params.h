@@ -134,6 +134,9 @@ struct BlendParams {
   // kCaseBiasGuard). Off here, the method's blend as published; the preview's
   // default turns it on (PreviewSettings).
   bool bias_guard = false;
+  // The run's sample count n, from which the zero-variance rule's decay reads each pixel's own
+  // (shared::zero_variance_u, shared::pixel_samples); 0: unknown, no decay.
+  float samples = 0.0f;
 };
 
 // TonemapParams: image/tonemap.h (the tone map formula lives there).

@@ -733,6 +733,67 @@ TEST(BlendVsCpu, BackgroundPixelsWithoutHvTakeNoFilteredLight) {
   EXPECT_GT(other_cases, 0) << "the rest still blends";
 }
 
+// Pixels whose HV samples were all 0 (variance 0) beside lit neighbours: filtered at few samples,
+// unfiltered (case 2) once the zero-variance rule's decay brings their u below t; the pass as its
+// CPU reference, with the pixels' own counts read from the threshold factors of adaptive sampling.
+TEST(BlendVsCpu, ZeroVariancePixelsLeaveTheFilterAsSamplesGrow) {
+  test::osmesa_context();
+  Scenario s = make_scenario(29);
+  Image lv_rgba = Image::rgba(W, H);
+  std::vector<size_t> zero;
+  for (size_t i = 0; i < s.lv.pixel_count(); ++i) {
+    for (int c = 0; c < 3; ++c) lv_rgba.pixels[4 * i + c] = s.lv.pixels[3 * i + c];
+    lv_rgba.pixels[4 * i + 3] = 1.0f;
+    if (i % 7 == 3) {
+      zero.push_back(i);
+      for (int c = 0; c < 3; ++c) s.hv.pixels[3 * i + c] = 0.0f;
+      s.var.pixels[i] = 0.0f;
+    }
+  }
+  FilterParams fp;
+  FilterOutput ref_f = cpu_filter(s.hv, s.var, s.lv, s.range, s.depth, fp, 0.0f);
+  ref_f.centre_weight = Image();  // the blend gets L_f as a plain texture, without a centre weight
+  const Texture2D filtered = filtered_texture(ref_f);
+  const float t = 0.01f;
+  auto zero_pixels_in_case2 = [&](const Image& cases) {
+    size_t n = 0;
+    for (size_t i : zero) n += cases.pixels[i] == float(kCaseUnfiltered);
+    return n;
+  };
+  size_t previous = 0;
+  for (float samples : {0.0f, 64.0f, 1e5f, 1e8f}) {
+    SCOPED_TRACE(testing::Message() << "samples=" << samples);
+    PreviewInputs inputs(W, H);
+    inputs.upload(lv_rgba, s.hv, s.var);
+    BlendParams bp{range_weights(fp), false, samples};
+    BlendPass blend(W, H);
+    blend.run(inputs, &filtered, nullptr, t, bp);
+    const BlendOutput ref = cpu_blend(lv_rgba, s.hv, s.var, &ref_f, t, bp, nullptr, nullptr);
+    expect_close(blend.case_image(), ref.blend_case, 0.0f, 0.0f, "case");
+    expect_close(blend.final_image(), ref.final_rgb, 1e-4f, 1e-6f, "final");
+    const size_t clean = zero_pixels_in_case2(ref.blend_case);
+    EXPECT_GE(clean, previous);
+    if (samples <= kZeroVarianceSamples) {
+      EXPECT_LT(clean, zero.size() / 2) << "few samples all 0 are no evidence of low variance";
+    }
+    if (samples == 1e8f) {
+      EXPECT_EQ(clean, zero.size());
+    }
+    previous = clean;
+  }
+  // The same pixels at their own counts under adaptive sampling: a run of 64 frames whose
+  // zero-variance pixels hold 1e8 samples each (threshold factor t_{1e8} / t_64) are all clean.
+  for (size_t i : zero) lv_rgba.pixels[4 * i + 3] = effective_threshold(t, 100000000u) / effective_threshold(t, 64);
+  PreviewInputs inputs(W, H);
+  inputs.upload(lv_rgba, s.hv, s.var);
+  const BlendParams bp{range_weights(fp), false, 64.0f};
+  BlendPass blend(W, H);
+  blend.run(inputs, &filtered, nullptr, effective_threshold(t, 64), bp);
+  const BlendOutput ref = cpu_blend(lv_rgba, s.hv, s.var, &ref_f, effective_threshold(t, 64), bp, nullptr, nullptr);
+  expect_close(blend.case_image(), ref.blend_case, 0.0f, 0.0f, "case");
+  EXPECT_EQ(zero_pixels_in_case2(ref.blend_case), zero.size());
+}
+
 TEST(BlendVsCpu, NoFilteredValueMeansUnfiltered) {
   test::osmesa_context();
   Scenario s = make_scenario(5);

@@ -14,6 +14,7 @@ uniform int has_guide;  // 0: u from the pixel's own variance only
 uniform float k_c;      // range weights of the variance pooling (the filter's)
 uniform float k_d;
 uniform float t;         // times the pixel's factor: pixel_threshold
+uniform float samples;   // the run's n, for the zero-variance rule's decay (pixel_samples); 0: unknown
 uniform int bias_guard;  // 1: raise s where L_f is measurably biased (bias_guard_factor)
 
 layout(std430, binding = kBufferCounts) buffer CaseCounts { uint case_counts[kBlendCaseCount]; };
@@ -29,7 +30,7 @@ void main() {
   px.lv = texelFetch(lv_tex, p, 0);
   px.filtered = texelFetch(filtered_tex, p, 0);
   px.guide_distance = texelFetch(guide_tex, p, 0).a;
-  BlendSwitches on = BlendSwitches(has_filtered != 0, has_guide != 0, bias_guard != 0, t);
+  BlendSwitches on = BlendSwitches(has_filtered != 0, has_guide != 0, bias_guard != 0, t, samples);
   BlendVarianceInputs v = blend_variance_inputs_none();
   if (blend_compares_variances(px, on)) {
     if (on.has_guide) v.var_u_pooled = pooled_var_u(hv_tex, guide_tex, p, k_c, k_d);

@@ -169,11 +169,32 @@ PXF_INLINE float relative_variance(float var, float lb) {
 // 0, in practice all zero): that is no evidence of low variance, only that rare paths were missed.
 // A mean of L_f is as consistent with such samples as their own mean, so the variance of the mean
 // is taken as Y(L_f)^2: u = (Y(L_f) / L_b)^2. Zero where L_f is black (nothing to blend in).
-PXF_INLINE float zero_variance_u(float y_f, float lb) {
+// From kZeroVarianceSamples samples on, the variance taken falls as 1 / n: Y(L_f)^2 k / n is the
+// largest variance of the mean that light of mean Y(L_f) can have when it arrives in paths no
+// rarer than 1 in k (all of it in paths of probability 1/k, by Cauchy-Schwarz). Without that, a
+// pixel whose light truly is 0 beside lit neighbours (cornell: points of the mirror sphere that
+// reflect the open front) kept u = (Y(L_f) / L_b)^2 whatever its samples, stayed filtered forever
+// and so kept the filter's bias: measured, 3 of the 7 pixels cornell 128^2 at t = 0.01 still
+// filtered after 39620 spp, all HV samples 0. 1024: the rarest light the built-in scenes are known
+// to need, the mirror sphere's caustic on a wall, comes in about 1 BSDF sample in 1000
+// (docs/guiding.md). n: the pixel's own sample count (pixel_samples); 0 or unknown: no decay.
+PXF_CONST float kZeroVarianceSamples = 1024.0f;
+PXF_INLINE float zero_variance_u(float y_f, float lb, float n) {
   if (!(y_f > 0.0f)) return 0.0f;
   if (!(lb > 0.0f)) return kInf;
   float r = y_f / lb;
-  return r * r;
+  return n > kZeroVarianceSamples ? r * r * (kZeroVarianceSamples / n) : r * r;
+}
+
+// The pixel's own sample count n_p, from the run's count n and the pixel's threshold factor
+// (pixel_threshold): n where the factor is 1 (every pixel of a uniform frame), else the count whose
+// threshold correction (n_p - 3) / (n_p - 1) is the factor times the run's (n <= 4 counts as 4, as
+// effective_threshold does). 0 where n is unknown (0).
+PXF_INLINE float pixel_samples(float run_samples, float factor) {
+  if (factor == 1.0f || !(run_samples > 4.0f)) return run_samples;
+  float g = factor * ((run_samples - 3.0f) / (run_samples - 1.0f));  // (n_p - 3) / (n_p - 1)
+  if (!(g < 1.0f)) return kInf;
+  return max((3.0f - g) / (1.0f - g), 4.0f);
 }
 
 // The least range weight a neighbour's variance is pooled with: the smallest normal float. The
@@ -499,6 +520,7 @@ struct BlendSwitches {
   bool has_guide;     // the range buffer is given: the background rule and the variance pooling apply
   bool bias_guard;    // raise s where L_f is measurably biased (guarded_blend_factor)
   float t;            // the run's threshold t_n; the pixel's own is pixel_threshold(t, lv)
+  float samples;      // the run's sample count n (the zero-variance rule's decay); 0: unknown
 };
 
 // What the blend reads only where it compares variances (blend_compares_variances): the pooling
@@ -563,7 +585,7 @@ PXF_INLINE BlendPixel blend_pixel(BlendTexels px, BlendSwitches on, BlendVarianc
   b.s = b.blend_case == kCaseUnknownVar ? 0.0f : 1.0f;
   if (b.blend_case == kCaseByVariances) {
     float var_f = max(clean_var(px.filtered.a), 0.0f);  // unknown (no neighbour's variance known) reads as 0
-    b.u = b.var_u > 0.0f ? relative_variance(b.var_u, b.lb) : zero_variance_u(luminance(lf), b.lb);
+    b.u = b.var_u > 0.0f ? relative_variance(b.var_u, b.lb) : zero_variance_u(luminance(lf), b.lb, pixel_samples(on.samples, px.lv.a));
     b.f = relative_variance(var_f, b.lb);
     b.s = blend_factor_covariance(b.u, b.f, b.t, v.centre_weight, b.blend_case);
     if (on.bias_guard) b.s = guarded_blend_factor(v.guard, b.s, b.u, b.f, v.centre_weight, b.lb, b.blend_case);
