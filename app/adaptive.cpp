@@ -43,15 +43,19 @@ std::vector<float> neighbourhood_need(const std::vector<float>& need, int width,
 
 namespace {
 
-// w_p of the goal (app/adaptive.h): s_p = sqrt(r_p n_p), the per-path relative deviation over
+// w_p of goal Error (app/adaptive.h): s_p = sqrt(r_p n_p), the per-path relative deviation over
 // sqrt(t) (r falls as 1/n).
 float allocation_weight(float need, uint32_t paths, const AdaptiveParams& params) {
   const float n = static_cast<float>(std::max<uint32_t>(paths, 1));
-  const bool young = paths < params.min_samples;
-  if (young) need = std::max(need, 1.0f);  // not retired on few samples
-  const float deviation = std::sqrt(need * n);  // s_p
-  if (params.goal == AdaptiveGoal::Error) return deviation;
-  return need > 1.0f || young ? deviation : 0.0f;
+  if (paths < params.min_samples) need = std::max(need, 1.0f);  // not retired on few samples
+  return std::sqrt(need * n);
+}
+
+// The rates of clamp(lambda w, floor, max_rate) raised to at least `level`; their sum.
+double raise_to(std::vector<float>& rates, double level) {
+  double sum = 0;
+  for (float& r : rates) sum += (r = std::max(r, static_cast<float>(level)));
+  return sum;
 }
 
 }  // namespace
@@ -74,7 +78,21 @@ std::vector<float> water_fill(const std::vector<float>& weights, double total, f
     (rates_for(mid, nullptr) < total ? lo : hi) = mid;
   }
   std::vector<float> rates(weights.size());
-  rates_for(lo, &rates);
+  if (rates_for(hi, &rates) >= total) {
+    rates_for(lo, &rates);
+    return rates;
+  }
+  // The weights cannot take the paths (every weighted pixel at max_rate): the rest go to every
+  // pixel alike, the floor rising by bisection until the rates add up (or all are at max_rate).
+  double level_lo = floor_rate, level_hi = max_rate;
+  std::vector<float> raised = rates;
+  if (raise_to(raised, max_rate) <= total) level_lo = max_rate;  // a budget past every cap
+  for (int i = 0; i < 100 && level_hi - level_lo > 1e-7 * level_hi; ++i) {
+    const double mid = 0.5 * (level_lo + level_hi);
+    raised = rates;
+    (raise_to(raised, mid) < total ? level_lo : level_hi) = mid;
+  }
+  raise_to(rates, level_lo);
   return rates;
 }
 
@@ -88,9 +106,34 @@ std::vector<float> allocation_weights(const std::vector<float>& dilated_need, co
   return weights;
 }
 
+std::vector<float> clean_shortfall(const std::vector<float>& need, const std::vector<uint32_t>& paths, int width,
+                                   int height, const AdaptiveParams& params) {
+  std::vector<float> count_needed(need.size());  // x_q = r_q n_q, the count that brings q to t
+  for (size_t q = 0; q < need.size(); ++q) {
+    const float r = std::isnan(need[q]) ? std::numeric_limits<float>::infinity() : need[q];
+    count_needed[q] = r * static_cast<float>(std::max<uint32_t>(paths[q], 1));
+  }
+  const std::vector<float> predicted = neighbourhood_need(count_needed, width, height, params.dilation_radius);
+  std::vector<float> shortfall(need.size());
+  for (size_t p = 0; p < need.size(); ++p) {
+    const float target = std::max(static_cast<float>(params.min_samples), params.clean_margin * predicted[p]);
+    shortfall[p] = std::max(0.0f, target - static_cast<float>(paths[p]));
+  }
+  return shortfall;
+}
+
 std::vector<float> sampling_rates(const std::vector<float>& dilated_need, const std::vector<uint32_t>& paths,
                                   const AdaptiveParams& params) {
   const std::vector<float> weights = allocation_weights(dilated_need, paths, params);
+  const double total = static_cast<double>(params.frame_paths) * static_cast<double>(weights.size());
+  return water_fill(weights, total, params.floor_rate, std::min(params.max_rate, static_cast<float>(kMaxPathsPerFrame)));
+}
+
+std::vector<float> allocation_rates(const std::vector<float>& need, const std::vector<uint32_t>& paths, int width,
+                                    int height, const AdaptiveParams& params) {
+  if (params.goal == AdaptiveGoal::Error)
+    return sampling_rates(neighbourhood_need(need, width, height, params.dilation_radius), paths, params);
+  const std::vector<float> weights = clean_shortfall(need, paths, width, height, params);
   const double total = static_cast<double>(params.frame_paths) * static_cast<double>(weights.size());
   return water_fill(weights, total, params.floor_rate, std::min(params.max_rate, static_cast<float>(kMaxPathsPerFrame)));
 }

@@ -1,8 +1,8 @@
 // The allocation of adaptive sampling (app/adaptive.h) under fake variance images: the need is the
 // final pixel's perceived variance over its own threshold, decided for each pixel by the others in
-// its box; the paths follow its standard deviation (goal Error) or its variance where not yet clean
-// (goal Clean), water-filled to a uniform frame's paths; the floor, the cap, the minimum and the
-// dilation hold.
+// its box; the paths follow its standard deviation (goal Error) or what it lacks of the count its
+// neighbours predict (goal Clean), water-filled to a uniform frame's paths; the floor, the cap, the
+// minimum and the dilation hold.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -90,7 +90,9 @@ TEST(AdaptiveNeighbourhood, APixelsOwnNeedNeverDecidesItsWeight) {
     std::vector<std::vector<float>> weights;
     for (float own : {0.0f, 1.0f, 50.0f, kInf}) {
       need[centre] = own;
-      weights.push_back(allocation_weights(neighbourhood_need(need, w, h, params.dilation_radius), paths, params));
+      weights.push_back(goal == AdaptiveGoal::Error
+                            ? allocation_weights(neighbourhood_need(need, w, h, params.dilation_radius), paths, params)
+                            : clean_shortfall(need, paths, w, h, params));
     }
     for (const auto& wt : weights) EXPECT_EQ(wt[centre], weights[0][centre]);
     EXPECT_LT(weights[0][5 * w + 5], weights[2][5 * w + 5]);  // a neighbour's weight does follow it
@@ -133,24 +135,35 @@ TEST(AdaptiveRates, ForTheErrorSamplesFollowTheStandardDeviation) {
   for (size_t p = 0; p < need.size(); ++p) EXPECT_NEAR(traced[p], kFrames * rates[p], 1.0) << p;
 }
 
-// Goal Clean: paths in proportion to the standard deviation for the pixels not yet clean, the floor
-// for the others.
-TEST(AdaptiveRates, ForCleanSamplesFollowTheDeviationOfThePixelsNotYetClean) {
+// Goal Clean: each pixel lacks clean_margin times the largest count x_q = r_q n_q among the others
+// of its box, less its own paths; the pixels short of paths take them in proportion to what they
+// lack, the others sit at the floor.
+TEST(AdaptiveRates, ForCleanEachPixelGetsWhatItLacksOfItsNeighboursCount) {
   AdaptiveParams params;
   params.goal = AdaptiveGoal::Clean;
-  const std::vector<float> need = {2.0f, 8.0f, 18.0f, 0.9f, 1.0f, 0.2f, 4.5f, 2.0f};
-  std::vector<uint32_t> paths(need.size(), 1000);
-  paths[7] = 4000;
-  const std::vector<float> rates = sampling_rates(need, paths, params);
+  params.dilation_radius = 1;
+  const int w = 8, h = 1;
+    // x = r n:                      2000  400   1000  100   100   3000  100   100
+  const std::vector<float> need = {2.0f, 0.4f, 1.0f, 0.1f, 0.1f, 3.0f, 0.1f, 0.1f};
+  const std::vector<uint32_t> paths(need.size(), 1000);
+  const std::vector<float> shortfall = clean_shortfall(need, paths, w, h, params);
+  const float m = params.clean_margin;
+  const std::vector<float> expected = {m * 400 - 1000, m * 2000 - 1000, m * 400 - 1000, m * 1000 - 1000,
+                                       m * 3000 - 1000, m * 100 - 1000, m * 3000 - 1000, m * 100 - 1000};
+  for (size_t p = 0; p < need.size(); ++p) EXPECT_FLOAT_EQ(shortfall[p], std::max(0.0f, expected[p])) << p;
+  const std::vector<float> rates = allocation_rates(need, paths, w, h, params);
   EXPECT_NEAR(sum_of(rates), need.size() * params.frame_paths, 1e-3);
-  EXPECT_NEAR(rates[1] / rates[0], 2.0f, 1e-4f);
-  EXPECT_NEAR(rates[2] / rates[0], 3.0f, 1e-4f);
-  EXPECT_NEAR(rates[6] / rates[0], 1.5f, 1e-4f);
-  EXPECT_NEAR(rates[7] / rates[0], 2.0f, 1e-4f);
-  for (size_t p : {3, 4, 5}) EXPECT_EQ(rates[p], params.floor_rate) << p;  // clean: the floor only
-  // Every pixel clean: every pixel at the floor, and a frame traces only the floor's paths.
-  const std::vector<float> clean_rates = sampling_rates(std::vector<float>(8, 0.5f), paths, params);
-  for (float r : clean_rates) EXPECT_EQ(r, params.floor_rate);
+  EXPECT_NEAR(rates[4] / rates[1], (m * 3000 - 1000) / (m * 2000 - 1000), 1e-4);
+  EXPECT_EQ(rates[6], rates[4]);
+  EXPECT_NEAR(rates[3] / rates[1], (m * 1000 - 1000) / (m * 2000 - 1000), 1e-4);
+  for (size_t p : {0, 2, 5, 7}) EXPECT_EQ(rates[p], params.floor_rate) << p;  // enough paths: the floor
+  // The pixel's own count is what it has: twice the paths, less lacking.
+  std::vector<uint32_t> more = paths;
+  more[1] = 2000;
+  EXPECT_FLOAT_EQ(clean_shortfall(need, more, w, h, params)[1], m * 2000 - 2000);
+  // Below the minimum a pixel lacks at least the minimum, whatever its neighbours.
+  const std::vector<uint32_t> young(need.size(), params.min_samples - 10);
+  EXPECT_FLOAT_EQ(clean_shortfall(std::vector<float>(need.size(), 0.0f), young, w, h, params)[3], 10.0f);
 }
 
 TEST(AdaptiveRates, WaterFillingKeepsTheCapAndTheFloorAndSpendsTheBudget) {
@@ -164,9 +177,18 @@ TEST(AdaptiveRates, WaterFillingKeepsTheCapAndTheFloorAndSpendsTheBudget) {
   for (size_t p = 2; p < 12; ++p) EXPECT_EQ(rates[p], 0.0625f);
   EXPECT_NEAR(sum_of(rates), 200.0, 1e-3);
   EXPECT_NEAR(rates[50], (200.0 - 64.0 - 10 * 0.0625) / 88.0, 1e-4);
+  // Paths the weights cannot take go to every pixel alike: the floor rises.
+  std::vector<float> few(100, 0.0f);
+  few[7] = 1.0f;
+  few[9] = 2.0f;
+  const std::vector<float> spread = water_fill(few, 100.0, 0.0625f, 32.0f);
+  EXPECT_EQ(spread[7], 32.0f);
+  EXPECT_EQ(spread[9], 32.0f);
+  EXPECT_NEAR(spread[0], 36.0 / 98.0, 1e-5);
+  EXPECT_NEAR(sum_of(spread), 100.0, 1e-3);
+  for (float r : water_fill(std::vector<float>(10, 0.0f), 10.0, 0.0625f, 32.0f)) EXPECT_NEAR(r, 1.0f, 1e-5f);
   // A budget past every cap: every pixel at the cap; below every floor: every pixel at the floor.
-  const std::vector<float> rich = water_fill(weights, 1e6, 0.0625f, 32.0f);  // nothing to gain stays at the floor
-  for (size_t p = 0; p < rich.size(); ++p) EXPECT_EQ(rich[p], weights[p] == 0.0f ? 0.0625f : 32.0f) << p;
+  for (float r : water_fill(weights, 1e6, 0.0625f, 32.0f)) EXPECT_EQ(r, 32.0f);
   for (float r : water_fill(std::vector<float>(10, 1.0f), 1e6, 0.0625f, 32.0f)) EXPECT_EQ(r, 32.0f);
   for (float r : water_fill(std::vector<float>(10, 1.0f), 0.1, 0.0625f, 32.0f)) EXPECT_EQ(r, 0.0625f);
 }
@@ -186,10 +208,11 @@ TEST(AdaptiveRates, ARateAboveOneTracesSeveralPathsInAFrame) {
 }
 
 TEST(AdaptiveRates, TheFloorRevisitsEveryPixelRegularly) {
-  AdaptiveParams params;
-  params.goal = AdaptiveGoal::Clean;  // every pixel clean: all at the floor
-  const std::vector<float> need = {0.0f, 1e-6f, 0.05f};
-  const std::vector<float> rates = sampling_rates(need, std::vector<uint32_t>(3, 1000), params);
+  const AdaptiveParams params;
+  // Three pixels at the floor beside one that takes the rest of the budget.
+  std::vector<float> rates = water_fill({0.0f, 0.0f, 0.0f, 1.0f}, 4.0, params.floor_rate, params.max_rate);
+  EXPECT_NEAR(rates[3], 4.0 - 3 * params.floor_rate, 1e-5);
+  rates.pop_back();
   for (float r : rates) EXPECT_EQ(r, params.floor_rate);
   std::vector<float> credit;
   std::vector<int> last(3, -1);
@@ -214,10 +237,11 @@ TEST(AdaptiveRates, APixelBelowTheMinimumIsNotRetired) {
     const std::vector<float> need = {0.0f, 0.0f, 0.0f, 0.0f};
     const std::vector<uint32_t> paths = {params.min_samples - 1, params.min_samples, params.min_samples,
                                          params.min_samples};
-    const std::vector<float> weights = allocation_weights(need, paths, params);
+    const std::vector<float> weights = goal == AdaptiveGoal::Error ? allocation_weights(need, paths, params)
+                                                                    : clean_shortfall(need, paths, 4, 1, params);
     EXPECT_GT(weights[0], 0.0f);  // counts as at the threshold
     EXPECT_EQ(weights[1], 0.0f);  // at the minimum: may retire
-    const std::vector<float> rates = sampling_rates(need, paths, params);
+    const std::vector<float> rates = allocation_rates(need, paths, 4, 1, params);
     EXPECT_GT(rates[0], params.floor_rate);
     EXPECT_EQ(rates[1], params.floor_rate);
   }
@@ -235,8 +259,7 @@ TEST(AdaptiveRates, ACausticKeepsItselfAndItsQuietNeighboursSampled) {
     std::vector<float> need(w * h, 0.1f);
     for (int y = 5; y <= 6; ++y)
       for (int x = 6; x <= 7; ++x) need[y * w + x] = 40.0f;
-    const std::vector<float> rates = sampling_rates(neighbourhood_need(need, w, h, params.dilation_radius),
-                                                    std::vector<uint32_t>(w * h, 500), params);
+    const std::vector<float> rates = allocation_rates(need, std::vector<uint32_t>(w * h, 500), w, h, params);
     const std::vector<int> traced = traced_over(rates, 32);
     const int near_count = 36, far_count = w * h - near_count;
     const double far_rate = goal == AdaptiveGoal::Error ? w * h / (near_count * 20.0 + far_count) : params.floor_rate;

@@ -346,7 +346,7 @@ void Preview::blend_and_tonemap() {
   // acts in cases 1 and 3 only, would change nothing: its passes are left out (the same image).
   const bool guard = settings_.bias_guard && !schedule_.all_pixels_case2;
   blend_.run(inputs(), have_filtered_ ? &filtered_output() : nullptr, &range_.guide(), threshold_now(),
-             BlendParams{range_weights(settings_.filter), guard}, have_filtered_ ? filter_.centre_weight() : nullptr);
+             BlendParams{range_weights(settings_.filter), guard, static_cast<float>(samples())}, have_filtered_ ? filter_.centre_weight() : nullptr);
   last_.blend += blend_.last_ms();
   tonemap_.run(blend_.output(), settings_.tonemap);
   last_.tonemap += tonemap_.last_ms();
@@ -394,14 +394,14 @@ std::vector<float> Preview::allocation_rates() {
       lv.pixels[3 * p + c] = acc.lv_mean[p][c];
       hv.pixels[3 * p + c] = acc.hv_mean[p][c];
     }
-    var_lv.pixels[p] = acc.lv_variance_of_mean(p);
+    // Case 2, the clean goal's aim, reads Var[L_u] alone: there Var[L_lv] is left at 0.
+    if (settings_.adaptive_params.goal == AdaptiveGoal::Error) var_lv.pixels[p] = acc.lv_variance_of_mean(p);
   }
   Image var_u = Image::gray(w, h);
   acc.variance_of_mean_image(var_u.pixels.data(), 1);
   const std::vector<uint32_t>& paths = renderer_->pixel_frames();
   const std::vector<float> need = final_pixel_need(lv, hv, var_u, var_lv, paths, settings_.threshold);
-  const AdaptiveParams& params = settings_.adaptive_params;
-  return sampling_rates(neighbourhood_need(need, w, h, params.dilation_radius), paths, params);
+  return pxf::allocation_rates(need, paths, w, h, settings_.adaptive_params);
 }
 
 void Preview::plan_next_frame() {

@@ -126,10 +126,10 @@ TEST(Consistency, AdaptiveUnfilteredMeanHasNoBiasFromStopping) {
     for (int i = 0; i < 1024; ++i) r.add_frame();
     reference.push_back(block_means(r.unfiltered_image()));
   }
-  // Goal error; goal clean weights the same neighbourhood need (the weights' independence of the
-  // pixel's own need, both goals: AdaptiveNeighbourhood.APixelsOwnNeedNeverDecidesItsWeight).
-  {
-    const AdaptiveGoal goal = AdaptiveGoal::Error;
+  // Both goals: error (the neighbourhood's need) and clean (the count the neighbours predict); in
+  // both a pixel's weight is independent of its own samples
+  // (AdaptiveNeighbourhood.APixelsOwnNeedNeverDecidesItsWeight).
+  for (AdaptiveGoal goal : {AdaptiveGoal::Error, AdaptiveGoal::Clean}) {
     std::vector<std::vector<double>> adaptive;
     double spread = 0;  // the mean over seeds of the most paths a pixel got over the mean
     for (int seed = 1; seed <= 32; ++seed) {
