@@ -214,16 +214,16 @@ void ViewRenderer::draw_scalar(const Texture2D& source, int channel, const Scala
   scalar_.set("hi", s.hi);
   scalar_.set("sentinels", sentinels ? 1 : 0);
   scalar_.set("background", background);
-  source.bind(0);
   scalar_.use();
-  quad_.draw(target, width, height);
+  scalar_.bind(0, source);
+  quad_.draw(scalar_, target, width, height);
 }
 
 void ViewRenderer::draw_display(const Texture2D& source, bool encode_srgb, int slot) {
   display_.set("encode_srgb", encode_srgb ? 1 : 0);
-  source.bind(0);
   display_.use();
-  quad_.draw(output_fbos_[slot], width_, height_);
+  display_.bind(0, source);
+  quad_.draw(display_, output_fbos_[slot], width_, height_);
 }
 
 void ViewRenderer::tonemap_like_final(const Texture2D& hdr, Preview& preview, int slot) {
@@ -271,9 +271,9 @@ const Texture2D& ViewRenderer::render(BufferView view, Preview& preview, int slo
       draw_scalar(preview.blend().output(), 3, scale(view), false, 0.0f, target, width_, height_);
       break;
     case BufferView::Case:
-      preview.blend().case_texture().bind(0);
       case_.use();
-      quad_.draw(target, width_, height_);
+      case_.bind(0, preview.blend().case_texture());
+      quad_.draw(case_, target, width_, height_);
       break;
     case BufferView::Samples:  // CPU data: the snapshot, not the preview (set_sampling)
       upload_sampling();
@@ -299,10 +299,10 @@ const Texture2D& ViewRenderer::render(BufferView view, Preview& preview, int slo
 
 const Texture2D& ViewRenderer::split(const Texture2D& left, const Texture2D& right, float divider) {
   split_.set("divider", divider);
-  left.bind(0);
-  right.bind(1);
   split_.use();
-  quad_.draw(split_fbo_, width_, height_);
+  split_.bind(0, left);
+  split_.bind(1, right);
+  quad_.draw(split_, split_fbo_, width_, height_);
   check_gl_error("explorer split view");
   return split_output_;
 }

@@ -25,15 +25,15 @@ BlendPass::BlendPass(int width, int height)
 
 void BlendPass::run_bias_guard(const PreviewInputs& inputs, const Texture2D& filtered) {
   ++guard_runs_;
-  inputs.hv().bind(shared::kUnitHv);
-  filtered.bind(shared::kUnitFiltered);
   guard_rows_program_.use();
-  quad_.draw(guard_rows_fbo_, width_, height_);
-  guard_rows_.bind(shared::kUnitGuardSums);
-  guard_rows_low_x_.bind(shared::kUnitGuardRowsLowX);
-  guard_rows_high_x_.bind(shared::kUnitGuardRowsHighX);
+  guard_rows_program_.bind(shared::kUnitHv, inputs.hv());
+  guard_rows_program_.bind(shared::kUnitFiltered, filtered);
+  quad_.draw(guard_rows_program_, guard_rows_fbo_, width_, height_);
   guard_columns_program_.use();
-  quad_.draw(guard_fbo_, width_, height_);
+  guard_columns_program_.bind(shared::kUnitGuardSums, guard_rows_);
+  guard_columns_program_.bind(shared::kUnitGuardRowsLowX, guard_rows_low_x_);
+  guard_columns_program_.bind(shared::kUnitGuardRowsHighX, guard_rows_high_x_);
+  quad_.draw(guard_columns_program_, guard_fbo_, width_, height_);
 }
 
 void BlendPass::run(const PreviewInputs& inputs, const FilterPass* filtered, const Texture2D& guide, float t,
@@ -64,15 +64,15 @@ void BlendPass::run(const PreviewInputs& inputs, const Texture2D* filtered, cons
   const std::array<uint32_t, kBlendCaseCount> zeros{};
   counts_.upload(zeros.data(), sizeof zeros);
   counts_.bind_storage(shared::kBufferCounts);
-  inputs.hv().bind(shared::kUnitHv);
-  inputs.lv().bind(shared::kUnitLv);
-  // Unused units still get a texture, so every sampler is valid.
-  (filtered ? *filtered : inputs.hv()).bind(shared::kUnitFiltered);
-  (guide ? *guide : inputs.hv()).bind(shared::kUnitGuide);
-  (centre_weight ? *centre_weight : inputs.hv()).bind(shared::kUnitCentreWeight);
-  guard_.bind(shared::kUnitGuardSums);
   program_.use();
-  quad_.draw(fbo_, width_, height_);
+  program_.bind(shared::kUnitHv, inputs.hv());
+  program_.bind(shared::kUnitLv, inputs.lv());
+  // Unused units still get a texture, so every sampler is valid.
+  program_.bind(shared::kUnitFiltered, filtered ? *filtered : inputs.hv());
+  program_.bind(shared::kUnitGuide, guide ? *guide : inputs.hv());
+  program_.bind(shared::kUnitCentreWeight, centre_weight ? *centre_weight : inputs.hv());
+  program_.bind(shared::kUnitGuardSums, guard_);
+  quad_.draw(program_, fbo_, width_, height_);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
   timer_.end();
   check_gl_error("blend pass");

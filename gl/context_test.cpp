@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <functional>
+
 #include <cstdlib>
 
 #include "gl/context.h"
@@ -31,7 +33,7 @@ void main() {
   fbo.check("pattern");
   FullscreenPass quad;
   program.use();
-  quad.draw(fbo, w, h);
+  quad.draw(program, fbo, w, h);
   Image image = target.download({"R", "G", "B", "A"});
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
@@ -157,6 +159,52 @@ void main() { color = vec4(gain); }
     EXPECT_NE(message.find("'gian'"), std::string::npos) << message;
     EXPECT_EQ(message.find('\n'), std::string::npos) << message;
   }
+}
+
+// Texture inputs, as Falcor checks shader variables: binding a texture at a unit where the program
+// has no sampler fails, and so does drawing before every sampler was bound by the pass itself
+// (since its use()); a binding left by an earlier draw of the same program does not count.
+TEST(Shader, TextureInputsAreBoundByThePassThatReadsThem) {
+  test::osmesa_context();
+  const std::string frag = R"(#version 450 core
+layout(binding = 3) uniform sampler2D light_tex;
+layout(binding = 5) uniform sampler2D albedo_tex;
+layout(location = 0) out vec4 color;
+void main() { color = texelFetch(light_tex, ivec2(gl_FragCoord.xy), 0) * texelFetch(albedo_tex, ivec2(gl_FragCoord.xy), 0); }
+)";
+  Shader vs(ShaderStage::Vertex, "fullscreen.vert", embedded_shader("fullscreen.vert"));
+  Shader fs(ShaderStage::Fragment, "product.frag", frag);
+  Program program({&vs, &fs});
+  const int w = 4, h = 2;
+  Texture2D light(w, h, TextureFormat::RGBA32F), albedo(w, h, TextureFormat::RGBA32F), target(w, h, TextureFormat::RGBA32F);
+  light.upload(Image::rgba(w, h, 2.0f));
+  albedo.upload(Image::rgba(w, h, 0.25f));
+  Framebuffer fbo;
+  fbo.attach(0, target);
+  fbo.check("product");
+  FullscreenPass quad;
+  auto expect_one_line_error = [](const std::function<void()>& f, const std::string& needle) {
+    try {
+      f();
+      ADD_FAILURE() << "no error; expected one naming " << needle;
+    } catch (const Error& e) {
+      const std::string message = e.what();
+      EXPECT_NE(message.find("product.frag"), std::string::npos) << message;
+      EXPECT_NE(message.find(needle), std::string::npos) << message;
+      EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+    }
+  };
+  program.use();
+  expect_one_line_error([&] { program.bind(4, light); }, "texture unit 4");  // no sampler there
+  program.bind(3, light);
+  expect_one_line_error([&] { quad.draw(program, fbo, w, h); }, "'albedo_tex' (texture unit 5)");
+  albedo.bind(5);  // bound behind the program's back: not the pass's own binding
+  expect_one_line_error([&] { quad.draw(program, fbo, w, h); }, "'albedo_tex'");
+  program.bind(5, albedo);
+  EXPECT_NO_THROW(quad.draw(program, fbo, w, h));
+  EXPECT_FLOAT_EQ(target.download({"R", "G", "B", "A"}).at(1, 1, 0), 0.5f);
+  program.use();  // a new set of inputs: the last draw's bindings do not carry over
+  expect_one_line_error([&] { quad.draw(program, fbo, w, h); }, "'light_tex' (texture unit 3)");
 }
 
 TEST(Shader, EveryEmbeddedPassCompiles) {

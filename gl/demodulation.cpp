@@ -24,12 +24,12 @@ void Demodulation::demodulate(const PreviewInputs& inputs, const Texture2D& guid
   demod_program_.set("k_d", range.k_d);
   demod_program_.set("t", t);
   demod_program_.set("skip_case2", p.skip_case2 ? 1 : 0);
-  inputs.hv().bind(shared::kUnitHv);
-  inputs.lv().bind(shared::kUnitLv);
-  guide.bind(shared::kUnitGuide);
-  inputs.albedo().bind(shared::kUnitAlbedo);
   demod_program_.use();
-  quad_.draw(demod_fbo_, width_, height_);
+  demod_program_.bind(shared::kUnitHv, inputs.hv());
+  demod_program_.bind(shared::kUnitLv, inputs.lv());
+  demod_program_.bind(shared::kUnitGuide, guide);
+  demod_program_.bind(shared::kUnitAlbedo, inputs.albedo());
+  quad_.draw(demod_program_, demod_fbo_, width_, height_);
   demod_timer_.end();
   check_gl_error("demodulation");
 }
@@ -39,10 +39,10 @@ void Demodulation::remodulate(const Texture2D& filtered, const PreviewInputs& in
       inputs.height() != height_)
     throw Error("remodulation: input size differs from the pass size");
   remod_timer_.begin();
-  filtered.bind(shared::kUnitFiltered);
-  inputs.albedo().bind(shared::kUnitAlbedo);
   remod_program_.use();
-  quad_.draw(remod_fbo_, width_, height_);
+  remod_program_.bind(shared::kUnitFiltered, filtered);
+  remod_program_.bind(shared::kUnitAlbedo, inputs.albedo());
+  quad_.draw(remod_program_, remod_fbo_, width_, height_);
   remod_timer_.end();
   check_gl_error("remodulation");
 }

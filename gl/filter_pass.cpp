@@ -23,19 +23,16 @@ void FilterPass::run(const PreviewInputs& inputs, const Texture2D& guide, const 
   const uint32_t zero = 0;
   counter_.upload(&zero, sizeof zero);
   counter_.bind_storage(shared::kBufferCounts);
-  inputs.hv().bind(shared::kUnitHv);
-  inputs.lv().bind(shared::kUnitLv);
-  guide.bind(shared::kUnitGuide);
   centre_weight_valid_ =
       p.kind == FilterKind::Bilateral || p.kind == FilterKind::BilateralDepth || p.kind == FilterKind::Grid;
   if (p.kind == FilterKind::Atrous)
-    run_atrous(inputs, p, t);
+    run_atrous(inputs, guide, p, t);
   else if (p.kind == FilterKind::Subsampled)
-    run_subsampled(p, t);
+    run_subsampled(inputs, guide, p, t);
   else if (p.kind == FilterKind::Grid)
-    run_grid(p, t);
+    run_grid(inputs, guide, p, t);
   else
-    run_bilateral(inputs, p, t);
+    run_bilateral(inputs, guide, p, t);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
   timer_.end();
   ++runs_;
@@ -51,50 +48,58 @@ void set_range_and_skip(Program& program, const FilterParams& p, float t) {
   program.set("skip_case2", p.skip_case2 ? 1 : 0);
   program.set("t", t);
 }
+// Makes `program` current with the inputs every variant's shader reads: L_u, L_lv (the skip) and
+// the guide.
+void use_with_inputs(const Program& program, const PreviewInputs& inputs, const Texture2D& guide) {
+  program.use();
+  program.bind(shared::kUnitHv, inputs.hv());
+  program.bind(shared::kUnitLv, inputs.lv());
+  program.bind(shared::kUnitGuide, guide);
+}
 }  // namespace
 
-void FilterPass::run_bilateral(const PreviewInputs& inputs, const FilterParams& p, float t) {
+void FilterPass::run_bilateral(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& p, float t) {
   const int radius = std::min(kMaxFilterRadius, static_cast<int>(std::ceil(3.0f * std::max(p.sigma_s, 0.0f))));
   program_.set("radius", radius);
   program_.set("k_s", inv_two_sigma2(p.sigma_s));
   set_range_and_skip(program_, p, t);
-  program_.use();
+  use_with_inputs(program_, inputs, guide);
   if (p.kind == FilterKind::Separable) {
     program_.set("extent", glm::ivec2(1, 0));
     program_.set("final_pass", 0);
-    inputs.hv().bind(shared::kUnitSignal);
-    quad_.draw(scratch_target(0), width_, height_);
+    program_.bind(shared::kUnitSignal, inputs.hv());
+    quad_.draw(program_, scratch_target(0), width_, height_);
     program_.set("extent", glm::ivec2(0, 1));
-    scratch_[0].bind(shared::kUnitSignal);
+    program_.bind(shared::kUnitSignal, scratch_[0]);
   } else {
     program_.set("extent", glm::ivec2(1, 1));
-    inputs.hv().bind(shared::kUnitSignal);
+    program_.bind(shared::kUnitSignal, inputs.hv());
   }
   program_.set("final_pass", 1);
-  quad_.draw(fbo_, width_, height_);
+  quad_.draw(program_, fbo_, width_, height_);
 }
 
 // atrous_iterations(sigma_s) passes at hole spacing 1, 2, 4, ...: each reads the previous pass's
 // output (the first reads the HV buffer), the intermediate ones ping-pong between the scratch
 // textures, the last writes output_ (and alone skips case-2 pixels and counts).
-void FilterPass::run_atrous(const PreviewInputs& inputs, const FilterParams& p, float t) {
+void FilterPass::run_atrous(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& p, float t) {
   if (!atrous_program_.id()) atrous_program_ = Program::from_embedded("fullscreen.vert", "atrous.frag");
   set_range_and_skip(atrous_program_, p, t);
-  atrous_program_.use();
+  use_with_inputs(atrous_program_, inputs, guide);
   const int passes = atrous_iterations(p.sigma_s);
-  inputs.hv().bind(shared::kUnitSignal);
+  atrous_program_.bind(shared::kUnitSignal, inputs.hv());
   for (int i = 0; i < passes; ++i) {
     const bool last = i + 1 == passes;
     atrous_program_.set("step_px", 1 << i);
     atrous_program_.set("variance_correction", atrous_variance_correction(i));
     atrous_program_.set("final_pass", last ? 1 : 0);
-    quad_.draw(last ? fbo_ : scratch_target(i % 2), width_, height_);
-    if (!last) scratch_[i % 2].bind(shared::kUnitSignal);
+    quad_.draw(atrous_program_, last ? fbo_ : scratch_target(i % 2), width_, height_);
+    if (!last) atrous_program_.bind(shared::kUnitSignal, scratch_[i % 2]);
   }
 }
 
 // One pass over the tap table of (sigma_s, taps), uploaded again only when those change.
-void FilterPass::run_subsampled(const FilterParams& p, float t) {
+void FilterPass::run_subsampled(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& p, float t) {
   if (!subsampled_program_.id()) subsampled_program_ = Program::from_embedded("fullscreen.vert", "subsampled.frag");
   const int taps = p.subsampled_taps > 0 ? p.subsampled_taps : kSubsampledTaps;
   const SubsampledTapTable table = subsampled_tap_table(p.sigma_s, taps);
@@ -108,13 +113,13 @@ void FilterPass::run_subsampled(const FilterParams& p, float t) {
   set_range_and_skip(subsampled_program_, p, t);
   subsampled_program_.set("taps_per_rotation", table.per_rotation);
   subsampled_program_.set("rotations", kSubsampledRotations);
-  subsampled_program_.use();
-  quad_.draw(fbo_, width_, height_);
+  use_with_inputs(subsampled_program_, inputs, guide);
+  quad_.draw(subsampled_program_, fbo_, width_, height_);
 }
 
-void FilterPass::run_grid(const FilterParams& p, float t) {
+void FilterPass::run_grid(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& p, float t) {
   if (!grid_) grid_ = std::make_unique<GridFilter>(width_, height_);
-  grid_->run(p, t, fbo_);
+  grid_->run(inputs, guide, p, t, fbo_);
 }
 
 const Framebuffer& FilterPass::scratch_target(int index) {

@@ -44,10 +44,10 @@ class FilterPass {
   Image raw_variance_image() const;  // "Y" with the sentinels kept
 
  private:
-  void run_bilateral(const PreviewInputs& inputs, const FilterParams& params, float t);
-  void run_atrous(const PreviewInputs& inputs, const FilterParams& params, float t);
-  void run_subsampled(const FilterParams& params, float t);
-  void run_grid(const FilterParams& params, float t);
+  void run_bilateral(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& params, float t);
+  void run_atrous(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& params, float t);
+  void run_subsampled(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& params, float t);
+  void run_grid(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& params, float t);
   const Framebuffer& scratch_target(int index);  // allocates scratch_[index] on first use
 
   int width_, height_;

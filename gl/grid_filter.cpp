@@ -18,7 +18,8 @@ void GridFilter::resize_grid(const GridLayout& layout) {
   layout_ = layout;
 }
 
-void GridFilter::run(const FilterParams& p, float t, const Framebuffer& target) {
+void GridFilter::run(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& p, float t,
+                     const Framebuffer& target) {
   resize_grid(grid_layout(width_, height_, p));
   const glm::ivec2 grid_xy(layout_.nx, layout_.ny);
   const float inv_cell_s = 1.0f / layout_.cell_s;
@@ -28,6 +29,8 @@ void GridFilter::run(const FilterParams& p, float t, const Framebuffer& target) 
   bounds_buffer_.bind_storage(shared::kBufferGridBounds);
 
   bounds_.use();
+  bounds_.bind(shared::kUnitGuide, guide);
+  bounds_.require_inputs();
   const int strips = (width_ + 63) / 64 * height_;  // 64-pixel row strips (grid_bounds.comp)
   dispatch_compute_1d("grid filter bounds", (strips + 63) / 64);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
@@ -39,6 +42,9 @@ void GridFilter::run(const FilterParams& p, float t, const Framebuffer& target) 
   splat_.set("inv_cell_s", inv_cell_s);
   splat_.set("min_cell_z", grid_min_cell_z(p.sigma_c));
   splat_.use();
+  splat_.bind(shared::kUnitHv, inputs.hv());
+  splat_.bind(shared::kUnitGuide, guide);
+  splat_.require_inputs();
   grid_[0].bind_storage(shared::kBufferGrid);
   dispatch_compute("grid filter splat", (layout_.nx + 7) / 8, (layout_.ny + 7) / 8);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
@@ -48,6 +54,7 @@ void GridFilter::run(const FilterParams& p, float t, const Framebuffer& target) 
   blur_.set("grid_xy", grid_xy);
   blur_.set("grid_z_cells", layout_.nz);
   blur_.use();
+  blur_.require_inputs();
   const uint64_t groups = (layout_.cells() + 63) / 64;
   for (int axis = 0; axis < 2; ++axis) {  // z was blurred in the splat
     blur_.set("axis", axis);
@@ -68,8 +75,11 @@ void GridFilter::run(const FilterParams& p, float t, const Framebuffer& target) 
   slice_.set("skip_case2", p.skip_case2 ? 1 : 0);
   slice_.set("t", t);
   slice_.use();
+  slice_.bind(shared::kUnitHv, inputs.hv());
+  slice_.bind(shared::kUnitLv, inputs.lv());
+  slice_.bind(shared::kUnitGuide, guide);
   grid_[0].bind_storage(shared::kBufferGrid);
-  quad_.draw(target, width_, height_);
+  quad_.draw(slice_, target, width_, height_);
   step_ms_[3] = step_timer_.end();
 }
 

@@ -18,7 +18,9 @@ class GridFilter {
   // Expects FilterPass's bindings: HV at texture unit 0, LV at 1, the guide at 2, the filtered-pixel
   // counter at storage binding 0. Draws rgb L_f, a Var[L_f] into `target`; t: the blend threshold,
   // for the case-2 skip.
-  void run(const FilterParams& params, float t, const Framebuffer& target);
+  // inputs: L_u (splat, slice) and L_lv (the slice's skip); guide: the range buffer.
+  void run(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& params, float t,
+           const Framebuffer& target);
   // ms of the last run's steps (bounds, splat, blur, slice), measured as gl_timing() says.
   static constexpr const char* kStepNames[4] = {"bounds", "splat", "blur", "slice"};
   const std::array<double, 4>& last_step_ms() const { return step_ms_; }

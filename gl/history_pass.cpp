@@ -87,13 +87,13 @@ void HistoryPass::reproject(const Texture2D& guide, const Texture2D& specular_fl
   reproject_program_.use();
   set_camera_uniforms(reproject_program_, "now", view_camera(camera, width_, height_));
   set_camera_uniforms(reproject_program_, "before", view_camera(kept_camera_, width_, height_));
-  kept_lv_.bind(shared::kUnitHistoryLv);
-  kept_hv_.bind(shared::kUnitHistoryHv);
-  kept_guide_.bind(shared::kUnitHistoryGuide);
-  kept_normals_.bind(shared::kUnitHistoryNormals);
-  guide.bind(shared::kUnitGuide);
-  normals_.bind(shared::kUnitNormals);
-  quad_.draw(reproject_fbo_, width_, height_);
+  reproject_program_.bind(shared::kUnitHistoryLv, kept_lv_);
+  reproject_program_.bind(shared::kUnitHistoryHv, kept_hv_);
+  reproject_program_.bind(shared::kUnitHistoryGuide, kept_guide_);
+  reproject_program_.bind(shared::kUnitHistoryNormals, kept_normals_);
+  reproject_program_.bind(shared::kUnitGuide, guide);
+  reproject_program_.bind(shared::kUnitNormals, normals_);
+  quad_.draw(reproject_program_, reproject_fbo_, width_, height_);
   last_ms_ = timer_.end();
   total_ms_ += last_ms_;
   check_gl_error("history reprojection");
@@ -107,9 +107,9 @@ void HistoryPass::compute_normals(const Texture2D& guide, const Texture2D& specu
     throw Error("history pass: specular flags' size differs from the pass size");
   normals_program_.use();
   set_camera_uniforms(normals_program_, "cam", view_camera(camera, width_, height_));
-  guide.bind(shared::kUnitGuide);
-  specular_flags.bind(shared::kUnitSignal);
-  quad_.draw(target, width_, height_);
+  normals_program_.bind(shared::kUnitGuide, guide);
+  normals_program_.bind(shared::kUnitSignal, specular_flags);
+  quad_.draw(normals_program_, target, width_, height_);
 }
 
 void HistoryPass::run_combine(const PreviewInputs& fresh, float samples, bool with_history) {
@@ -119,11 +119,11 @@ void HistoryPass::run_combine(const PreviewInputs& fresh, float samples, bool wi
   combine_program_.use();
   combine_program_.set("samples", samples);
   combine_program_.set("has_history", with_history ? 1 : 0);
-  fresh.hv().bind(shared::kUnitHv);
-  fresh.lv().bind(shared::kUnitLv);
-  history_lv_.bind(shared::kUnitHistoryLv);
-  history_hv_.bind(shared::kUnitHistoryHv);
-  quad_.draw(combine_fbo_, width_, height_);
+  combine_program_.bind(shared::kUnitHv, fresh.hv());
+  combine_program_.bind(shared::kUnitLv, fresh.lv());
+  combine_program_.bind(shared::kUnitHistoryLv, history_lv_);
+  combine_program_.bind(shared::kUnitHistoryHv, history_hv_);
+  quad_.draw(combine_program_, combine_fbo_, width_, height_);
   last_ms_ = timer_.end();
   total_ms_ += last_ms_;
   check_gl_error("history combination");

@@ -148,10 +148,10 @@ void RangePass::draw_environment(const glm::mat4& view_projection) {
   background_.set("size", glm::vec2(width_, height_));
   background_.set("strength", environment_strength_);
   background_.set("background_distance", kBackgroundDepth);
-  environment_.bind(0);
   background_.use();
+  background_.bind(0, environment_);
   glDisable(GL_DEPTH_TEST);
-  quad_.draw(frame_fbo_, width_, height_);
+  quad_.draw(background_, frame_fbo_, width_, height_);
 }
 
 void RangePass::draw_scene(glm::vec2 jitter) {
@@ -179,7 +179,7 @@ void RangePass::draw_scene(glm::vec2 jitter) {
     const Material& m = g.material >= 0 ? materials_[g.material] : kDefault;
     const TextureRef& ref = m.base_color_texture;
     bool textured = ref.valid() && ref.texture < static_cast<int>(textures_.size()) && textures_[ref.texture].valid();
-    (textured ? textures_[ref.texture] : white_).bind(0);
+    raster_.bind(0, textured ? textures_[ref.texture] : white_);
     raster_.set("base_color", m.base_color);
     raster_.set("texcoord", ref.texcoord);
     raster_.set("uv_transform", ref.transform);
@@ -190,6 +190,7 @@ void RangePass::draw_scene(glm::vec2 jitter) {
     raster_.set("double_sided", m.double_sided ? 1 : 0);
     raster_.set("specular", material_is_perfect_specular(m) ? 1.0f : 0.0f);
     g.vao.bind();
+    raster_.require_inputs();
     glDrawElements(GL_TRIANGLES, g.index_count, GL_UNSIGNED_INT, nullptr);
   }
   glDisable(GL_DEPTH_TEST);
@@ -242,6 +243,7 @@ void RangePass::apply_specular_chains(const std::vector<uint32_t>& pixels, const
   frame_fbo_.bind(width_, height_);
   glDisable(GL_DEPTH_TEST);
   point_vao_.bind();
+  points_.require_inputs();
   glDrawArrays(GL_POINTS, 0, static_cast<GLsizei>(pixels.size()));
 }
 
@@ -249,11 +251,11 @@ void RangePass::end_frame() {
   if (frames_ == 0) last_change_ = 1.0f;
   const int next = 1 - current_;  // ping-pong: never sample the texture being written
   accumulate_.set("count", frames_ + 1);
-  frame_color_.bind(0);
-  frame_distance_.bind(1);
-  guide_[current_].bind(2);
   accumulate_.use();
-  quad_.draw(accum_fbo_[next], width_, height_);
+  accumulate_.bind(0, frame_color_);
+  accumulate_.bind(1, frame_distance_);
+  accumulate_.bind(2, guide_[current_]);
+  quad_.draw(accumulate_, accum_fbo_[next], width_, height_);
   current_ = next;
   ++frames_;
   // The change is only needed once min_frames are in (its GPU reduction costs about a raster).

@@ -15,10 +15,11 @@ void GpuReduction::run(const Texture2D& source, int mode, float delta) {
   program_.set("mode", mode);
   program_.set("delta", delta);
   program_.set("partial_count", gx * gy);
-  source.bind(0);
+  program_.use();
+  program_.bind(0, source);
+  program_.require_inputs();
   partials_.bind_storage(1);
   result_.bind_storage(2);
-  program_.use();
   program_.set("stage", 0);
   dispatch_compute("reduction", gx, gy);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);

@@ -1,5 +1,6 @@
 #include "gl/resources.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <glm/gtc/type_ptr.hpp>
@@ -94,7 +95,10 @@ Program::Program(const std::vector<const Shader*>& shaders) {
   for (const Shader* s : shaders) glDetachShader(name_.id, s->id());
   GLint ok = 0;
   glGetProgramiv(name_.id, GL_LINK_STATUS, &ok);
-  if (ok) return;
+  if (ok) {
+    find_samplers();
+    return;
+  }
   GLint length = 0;
   glGetProgramiv(name_.id, GL_INFO_LOG_LENGTH, &length);
   std::string log(static_cast<size_t>(length > 1 ? length : 1), '\0');
@@ -120,7 +124,42 @@ Program Program::from_embedded_compute(const std::string& compute_file) {
   return Program({&cs});
 }
 
-void Program::use() const { glUseProgram(name_.id); }
+void Program::find_samplers() {
+  GLint count = 0;
+  glGetProgramiv(name_.id, GL_ACTIVE_UNIFORMS, &count);
+  for (GLint i = 0; i < count; ++i) {
+    char name[256];
+    GLint size = 0;
+    GLenum type = 0;
+    glGetActiveUniform(name_.id, static_cast<GLuint>(i), sizeof name, nullptr, &size, &type, name);
+    const bool sampler = type == GL_SAMPLER_2D || type == GL_SAMPLER_3D || type == GL_SAMPLER_CUBE ||
+                         type == GL_SAMPLER_2D_ARRAY || type == GL_INT_SAMPLER_2D || type == GL_UNSIGNED_INT_SAMPLER_2D;
+    if (!sampler) continue;
+    GLint unit = 0;
+    glGetUniformiv(name_.id, glGetUniformLocation(name_.id, name), &unit);
+    if (unit < 0 || unit >= 64) throw Error("shader program " + files_ + ": sampler '" + name + "' at texture unit " + std::to_string(unit) + " (0 to 63 are checked)");
+    samplers_.push_back({unit, name});
+  }
+}
+
+void Program::use() const {
+  glUseProgram(name_.id);
+  bound_units_ = 0;
+}
+
+void Program::bind(int unit, const Texture2D& texture) const {
+  const bool declared = std::any_of(samplers_.begin(), samplers_.end(), [unit](const Sampler& s) { return s.unit == unit; });
+  if (!declared) throw Error("shader program " + files_ + " has no active sampler at texture unit " + std::to_string(unit));
+  texture.bind(unit);
+  bound_units_ |= uint64_t{1} << unit;
+}
+
+void Program::require_inputs() const {
+  for (const Sampler& s : samplers_)
+    if (!(bound_units_ >> s.unit & 1u))
+      throw Error("shader program " + files_ + ": sampler '" + s.name + "' (texture unit " + std::to_string(s.unit) +
+                  ") was not bound by its pass");
+}
 int Program::location(const char* uniform) const { return glGetUniformLocation(name_.id, uniform); }
 // A pass that sets a uniform the program does not have (misspelt, or one the shader no longer
 // reads and the linker dropped) fails loudly, as Falcor's shader variables do: GL would ignore
@@ -289,7 +328,8 @@ void VertexArray::element_buffer(const Buffer& buffer) { glVertexArrayElementBuf
 
 // ---- Full-screen pass ----
 
-void FullscreenPass::draw(const Framebuffer& target, int width, int height) const {
+void FullscreenPass::draw(const Program& program, const Framebuffer& target, int width, int height) const {
+  program.require_inputs();
   target.bind(width, height);
   glDisable(GL_DEPTH_TEST);
   glDisable(GL_BLEND);

@@ -63,6 +63,7 @@ class Program {
   static Program from_embedded_compute(const std::string& compute_file);
 
   GlHandle id() const { return name_.id; }
+  // Makes the program current and starts a new set of inputs (bind, require_inputs).
   void use() const;
   int location(const char* uniform) const;  // -1 when absent (optimized out)
   // set(): throws pxf::Error naming the program and the uniform when the program has no active
@@ -76,11 +77,26 @@ class Program {
   void set(const char* uniform, const glm::mat3& v) const;
   void set(const char* uniform, const glm::mat4& v) const;
 
+  // Texture inputs, checked as Falcor checks shader variables. bind() binds `texture` to a texture
+  // unit where the program has an active sampler, and throws pxf::Error naming the program and the
+  // unit where it has none. require_inputs() (FullscreenPass::draw calls it, compute passes before
+  // their dispatch) throws where one of the program's samplers was not bound through bind() since
+  // use(): a pass binds what it reads itself, never relying on a binding another pass left behind.
+  void bind(int unit, const class Texture2D& texture) const;
+  void require_inputs() const;
+
  private:
   int declared_location(const char* uniform) const;
+  void find_samplers();
 
+  struct Sampler {
+    int unit = 0;
+    std::string name;
+  };
   GlName name_;
   std::string files_;
+  std::vector<Sampler> samplers_;  // the active sampler uniforms and their units
+  mutable uint64_t bound_units_ = 0;  // bit u: unit u bound through bind() since use()
 };
 
 enum class TextureFormat { R32F, RG32F, RGBA32F, RGBA8, SRGB8_ALPHA8, Depth32F };
@@ -180,7 +196,9 @@ class VertexArray {
 // attribute-less VAO that a core profile needs (VAOs are per context, so one per pass object).
 class FullscreenPass {
  public:
-  void draw(const Framebuffer& target, int width, int height) const;
+  // Draws with `program`, which must be current (Program::use) and have all its inputs bound
+  // (Program::require_inputs).
+  void draw(const Program& program, const Framebuffer& target, int width, int height) const;
 
  private:
   VertexArray vao_;

@@ -21,9 +21,9 @@ void TonemapPass::run(const Texture2D& hdr, const TonemapParams& p) {
   program_.set("white", p.white);
   program_.set("log_average", p.log_average > 0 ? p.log_average : 0.0f);
   reduction_.result_buffer().bind_storage(2);
-  hdr.bind(0);
   program_.use();
-  quad_.draw(fbo_, width_, height_);
+  program_.bind(0, hdr);
+  quad_.draw(program_, fbo_, width_, height_);
   timer_.end();
   check_gl_error("tone map pass");
 }
