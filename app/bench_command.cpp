@@ -497,7 +497,7 @@ int run_bench(const Args& args) {
            "with --pathtracer: estimated / empirical Var[L_u] of the pixel mean over --seeds seeds at --spp");
   cli.flag("--threshold-fidelity", &threshold_fidelity,
            "empirical perceived variance of the final image over --seeds seeds at --spp (default 16,64,256) "
-           "against t = 0.001 and 0.01, by blend case (the --filter's; bilateral and bilateral-depth give the "
+           "against --threshold (default both t = 0.001 and 0.01), by blend case (the --filter's; bilateral and bilateral-depth give the "
            "blend the covariance of L_u and L_f); with --adaptive also adaptive sampling at the uniform job's wall time");
   cli.option("--spp", &spp_text, "LIST",
              "spp of --sampler-error (default 8,32,128), --variance-ratio (4,16,64,256) or --threshold-fidelity (16,64,256)");
@@ -555,7 +555,9 @@ int run_bench(const Args& args) {
     FidelityBenchSetup fb{b.scene, std::filesystem::path(scene_options.scene).stem().string(), b.filtered,
                           b.width, b.height, out};
     fb.with_adaptive = adaptive;
-    run_threshold_fidelity_bench(fb, parse_counts("--spp", spp_text.empty() ? "16,64,256" : spp_text), {0.001f, 0.01f},
+    const std::vector<float> thresholds =
+        cli.given("--threshold") ? std::vector<float>{preview_settings.threshold} : std::vector<float>{0.001f, 0.01f};
+    run_threshold_fidelity_bench(fb, parse_counts("--spp", spp_text.empty() ? "16,64,256" : spp_text), thresholds,
                                  seeds);
     return 0;
   }

@@ -316,6 +316,38 @@ TEST(Cli, BenchSamplerErrorSaysWhereTheErrorSits) {
   EXPECT_EQ(rows, 4);  // two samplers at two sample counts
 }
 
+// The threshold-fidelity bench measures the --threshold it is given (by default both 0.001 and
+// 0.01): every row of its CSV is at that threshold.
+TEST(Cli, BenchThresholdFidelityTakesTheThreshold) {
+  for (const std::string threshold : {"", "0.05"}) {
+    SCOPED_TRACE(threshold);
+    const std::string out = temp_dir("fidelity" + threshold);
+    const Result r = run("bench --threshold-fidelity --size 16x16 --seeds 2 --spp 16 " +
+                         (threshold.empty() ? "" : "--threshold " + threshold + " ") + "--out " + out);
+    ASSERT_EQ(r.code, 0) << r.err;
+    std::istringstream csv(slurp(out + "/threshold_fidelity_cornell.csv"));
+    std::string line;
+    std::getline(csv, line);
+    const size_t t_column = [&] {
+      size_t column = 0;
+      std::istringstream header(line);
+      for (std::string f; std::getline(header, f, ','); ++column)
+        if (f == "t") return column;
+      return size_t{99};
+    }();
+    ASSERT_NE(t_column, 99u) << line;
+    std::set<std::string> seen;
+    while (std::getline(csv, line)) {
+      std::istringstream fields(line);
+      std::string f;
+      for (size_t c = 0; c <= t_column; ++c) std::getline(fields, f, ',');
+      seen.insert(f);
+    }
+    const std::set<std::string> expected = threshold.empty() ? std::set<std::string>{"0.001", "0.01"} : std::set<std::string>{"0.05"};
+    EXPECT_EQ(seen, expected);
+  }
+}
+
 TEST(Cli, RenderWithTimeStopsByItselfAndFinishes) {
   // No --spp: only the budget stops it. The finish filters the last frame and writes everything.
   const std::string out = temp_dir("render_time");
