@@ -51,10 +51,10 @@ float allocation_weight(float need, uint32_t paths, const AdaptiveParams& params
   return std::sqrt(need * n);
 }
 
-// The rates of clamp(lambda w, floor, max_rate) raised to at least `level`; their sum.
-double raise_to(std::vector<float>& rates, double level) {
+// The sum of the rates once each is raised to at least `level`.
+double sum_raised_to(const std::vector<float>& rates, double level) {
   double sum = 0;
-  for (float& r : rates) sum += (r = std::max(r, static_cast<float>(level)));
+  for (float r : rates) sum += std::max(r, static_cast<float>(level));
   return sum;
 }
 
@@ -85,14 +85,12 @@ std::vector<float> water_fill(const std::vector<float>& weights, double total, f
   // The weights cannot take the paths (every weighted pixel at max_rate): the rest go to every
   // pixel alike, the floor rising by bisection until the rates add up (or all are at max_rate).
   double level_lo = floor_rate, level_hi = max_rate;
-  std::vector<float> raised = rates;
-  if (raise_to(raised, max_rate) <= total) level_lo = max_rate;  // a budget past every cap
+  if (sum_raised_to(rates, max_rate) <= total) level_lo = max_rate;  // a budget past every cap
   for (int i = 0; i < 100 && level_hi - level_lo > 1e-7 * level_hi; ++i) {
     const double mid = 0.5 * (level_lo + level_hi);
-    raised = rates;
-    (raise_to(raised, mid) < total ? level_lo : level_hi) = mid;
+    (sum_raised_to(rates, mid) < total ? level_lo : level_hi) = mid;
   }
-  raise_to(rates, level_lo);
+  for (float& r : rates) r = std::max(r, static_cast<float>(level_lo));
   return rates;
 }
 

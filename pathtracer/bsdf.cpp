@@ -27,6 +27,20 @@ inline glm::vec3 schlick(glm::vec3 f0, float f90, float cos_theta) {
 // A smooth or textured parameter is "delta-capable" only when it is a constant factor.
 bool constant(const TextureRef& ref) { return !ref.valid(); }
 
+// A lobe's normal n turned to wo's side of the face (ng faces wo); the face itself where wo is below
+// n's horizon (interpolated or mapped normals can put it there).
+glm::vec3 normal_facing(glm::vec3 n, glm::vec3 ng, glm::vec3 wo) {
+  const glm::vec3 facing = glm::dot(n, ng) >= 0.0f ? n : -n;
+  return glm::dot(wo, facing) > 1e-4f ? facing : ng;
+}
+
+// wo in a lobe's frame, kept just above its horizon.
+glm::vec3 local_view(const Frame& frame, glm::vec3 wo) {
+  glm::vec3 local = frame.to_local(wo);
+  local.z = std::max(local.z, 1e-6f);
+  return local;
+}
+
 }  // namespace
 
 BsdfParams eval_material(const Scene& scene, const Material& m, glm::vec2 uv0, glm::vec2 uv1,
@@ -170,12 +184,9 @@ Bsdf::Bsdf(const BsdfMaterial& k, glm::vec3 shading_normal, glm::vec3 geometric_
       fresnel_at_0_(k.fresnel_at_0),
       fresnel_slope_(k.fresnel_slope) {
   ng_ = glm::dot(wo, geometric_normal) >= 0.0f ? geometric_normal : -geometric_normal;
-  glm::vec3 ns = glm::dot(shading_normal, ng_) >= 0.0f ? shading_normal : -shading_normal;
-  // Interpolated or mapped normals can put wo below the shading horizon: fall back to the face.
-  if (!(glm::dot(wo, ns) > 1e-4f)) ns = ng_;
+  const glm::vec3 ns = normal_facing(shading_normal, ng_, wo);
   frame_ = Frame::from_normal(ns);
-  wo_local_ = frame_.to_local(wo);
-  wo_local_.z = std::max(wo_local_.z, 1e-6f);
+  wo_local_ = local_view(frame_, wo);
   lambda_o_ = ggx_lambda(wo_local_, alpha_);
   g1_o_ = 1.0f / (1.0f + lambda_o_);
   // The coat reflects clearcoat * E_coat of the light, the sheen below it sheen_color * E_sheen of
@@ -246,11 +257,8 @@ float Bsdf::set_up_coat(const BsdfMaterial& k, glm::vec3 coat_normal, glm::vec3 
   if (!(clearcoat_ > 0.0f)) return 0.0f;
   coat_alpha_ = k.coat_alpha;
   coat_delta_ = k.coat_delta;
-  glm::vec3 nc = glm::dot(coat_normal, ng_) >= 0.0f ? coat_normal : -coat_normal;
-  if (!(glm::dot(wo, nc) > 1e-4f)) nc = ng_;
-  coat_frame_ = Frame::from_normal(nc);
-  coat_wo_local_ = coat_frame_.to_local(wo);
-  coat_wo_local_.z = std::max(coat_wo_local_.z, 1e-6f);
+  coat_frame_ = Frame::from_normal(normal_facing(coat_normal, ng_, wo));
+  coat_wo_local_ = local_view(coat_frame_, wo);
   coat_lambda_o_ = ggx_lambda(coat_wo_local_, coat_alpha_);
   const float cos_o = coat_wo_local_.z;
   const GgxAlbedo e = coat_delta_ ? GgxAlbedo{1.0f, schlick_weight(cos_o)} : ggx_albedo(cos_o, coat_alpha_);
