@@ -139,16 +139,26 @@ TEST(Guiding, TrainedFieldFindsTheMirrorCaustic) {
     std::vector<HvSampleClass> classes(out.size());
     int found = 0;
     double moment = 0.0;
+    // Where the HV light's second moment comes from, by the class of each sample's largest HV term
+    // (docs/guiding.md, "Where the variance left is").
+    double class_moment[static_cast<int>(HvClass::Count)] = {};
     for (int frame = 0; frame < measure; ++frame) {
       tracer.trace_pixels_classified(scene.camera, size, size, rect, 1000 + frame, p, out.data(), classes.data());
-      for (size_t i = 0; i < out.size(); ++i)
+      for (size_t i = 0; i < out.size(); ++i) {
+        const double hv = luminance(out[i].hv);
+        class_moment[static_cast<int>(classes[i].dominant)] += hv * hv;
         if (classes[i].dominant == HvClass::CausticMirror) {
           ++found;
           moment += double(classes[i].dominant_luminance) * classes[i].dominant_luminance;
         }
+      }
     }
+    const double samples = double(out.size()) * measure;
     std::printf("%s: %d samples found the mirror caustic, their second moment %.5f per sample\n",
-                guided ? "guided" : "unguided", found, moment / (double(out.size()) * measure));
+                guided ? "guided" : "unguided", found, moment / samples);
+    for (int c = 0; c < static_cast<int>(HvClass::Count); ++c)
+      if (class_moment[c] > 0.0)
+        std::printf("  HV second moment per sample, %s: %.5f\n", hv_class_name(static_cast<HvClass>(c)), class_moment[c] / samples);
     return found;
   };
   const int unguided = caustic_samples(false), guided = caustic_samples(true);
