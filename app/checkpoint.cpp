@@ -62,6 +62,23 @@ SampleSettings render_sample_settings(const SceneOptions& scene, const PreviewSe
   return s;
 }
 
+void apply_sample_settings(const SampleSettings& s, SceneOptions& scene, PreviewSettings& preview) {
+  scene.width = static_cast<int>(s.width);
+  scene.height = static_cast<int>(s.height);
+  preview.trace.seed = s.seed;
+  preview.trace.max_vertices = s.max_vertices;
+  preview.trace.rr_start_vertex = s.rr_start_vertex;
+  preview.trace.all_hv = s.all_hv != 0;
+  preview.trace.sampler = static_cast<SamplerType>(s.sampler);
+  preview.trace.replicates = static_cast<int>(s.replicates);
+  preview.adaptive = s.adaptive != 0;
+  if (s.adaptive != 0) preview.adaptive_params.goal = s.adaptive == 2 ? AdaptiveGoal::Clean : AdaptiveGoal::Error;
+  preview.trace.guiding = s.guiding != 0;
+  const auto mode = static_cast<SpecularSamplingMode>(s.specular_sampling);
+  preview.trace.specular_sampling = mode == SpecularSamplingMode::All;
+  preview.trace.near_specular_sampling = mode == SpecularSamplingMode::Near;
+}
+
 Checkpointer::Checkpointer(const CheckpointOptions& options, const std::string& out_dir,
                            const SampleSettings& settings, FrameRange range)
     : options_(options),

@@ -29,6 +29,9 @@ FrameRange render_frame_range(const CheckpointOptions& options, int spp);
 
 // The sample settings of a render: the scene's content hash, size and path-tracing parameters.
 SampleSettings render_sample_settings(const SceneOptions& scene, const PreviewSettings& settings);
+// The inverse for what a state records: size and the settings that change the samples (pxf merge
+// takes them from the states, so that the merged image is the render its shards were made of).
+void apply_sample_settings(const SampleSettings& s, SceneOptions& scene, PreviewSettings& settings);
 
 class Checkpointer {
  public:

@@ -34,6 +34,11 @@ class CommandLine {
   void choice(const std::string& name, E* target, const std::vector<std::string>& names, const std::string& help) {
     choice_index(name, [target](size_t i) { *target = static_cast<E>(i); }, names, help);
   }
+  // A value from a name table, given to `set` as its index (a field reached through an accessor).
+  void choice_setter(const std::string& name, std::function<void(size_t)> set, const std::vector<std::string>& names,
+                     const std::string& help) {
+    choice_index(name, std::move(set), names, help);
+  }
   // "WxH" sizes.
   void size_option(const std::string& name, int* width, int* height, const std::string& help);
   void positional(const std::string& name, std::string* target, const std::string& help);

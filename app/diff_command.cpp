@@ -10,6 +10,7 @@
 
 #include "app/cli.h"
 #include "app/commands.h"
+#include "app/setting_table.h"
 #include "core/json_depth.h"
 #include "gl/cpu_reference.h"
 #include "image/image.h"
@@ -93,18 +94,14 @@ void write_display_images(const std::string& dir, const Image& test, const Image
 // The blend's settings of the render that wrote TEST (its stats.json beside it: threshold t and the
 // range sigmas of the variance pooling), else the defaults.
 struct BlendSettings {
-  float threshold = 0.001f;
-  FilterParams filter;
+  PreviewSettings settings;  // what stats.json records (read_settings_json), the defaults for the rest
   std::string source = "the defaults";
 };
 BlendSettings blend_settings_of(const std::string& buffers_path) {
   BlendSettings b;
   const std::optional<nlohmann::json> json = stats_beside(buffers_path);
   if (!json || !json->contains("settings")) return b;
-  const nlohmann::json& s = (*json)["settings"];
-  b.threshold = s.value("threshold", b.threshold);
-  b.filter.sigma_c = s.value("sigma_c", b.filter.sigma_c);
-  b.filter.sigma_d = s.value("sigma_d", b.filter.sigma_d);
+  read_settings_json((*json)["settings"], b.settings);
   b.source = stats_path_beside(buffers_path);
   return b;
 }
@@ -139,7 +136,8 @@ void print_perfect_filter(const std::string& test_path, const std::string& refer
   if (ref_hv.width != hv.width || ref_hv.height != hv.height)
     throw Error(reference_path + ": " + std::to_string(ref_hv.width) + "x" + std::to_string(ref_hv.height) +
                 ", " + test_path + ": " + std::to_string(hv.width) + "x" + std::to_string(hv.height));
-  const BlendSettings settings = blend_settings_of(test_path);
+  const BlendSettings read = blend_settings_of(test_path);
+  const PreviewSettings& settings = read.settings;
   const float spp = samples.pixels.empty() ? 0.0f : *std::max_element(samples.pixels.begin(), samples.pixels.end());
   const float t = effective_threshold(settings.threshold, static_cast<uint64_t>(spp));
   FilterOutput perfect;
@@ -149,7 +147,7 @@ void print_perfect_filter(const std::string& test_path, const std::string& refer
       cpu_blend(lv, hv, layer_of(test, "var_u", test_path), &perfect, t, BlendParams{range_weights(settings.filter), false, spp},
                 &layer_of(test, "range_color", test_path), &layer_of(test, "depth", test_path));
   std::printf("perfect filter: t %g (%g at %.0f spp), sigma_c %g, sigma_d %g from %s\n", settings.threshold, t, spp,
-              settings.filter.sigma_c, settings.filter.sigma_d, settings.source.c_str());
+              settings.filter.sigma_c, settings.filter.sigma_d, read.source.c_str());
   print_error_line("blend with a perfect filter", blended.final_rgb, ref_final, display);
   print_error_line("unfiltered (lv + hv)", sum_of(lv, hv), ref_final, display);
   print_error_line("lv + reference hv", sum_of(lv, ref_hv), ref_final, display);
@@ -174,10 +172,14 @@ void check_second_reference(const std::string& reference_path, const std::string
                 "  scene with the same sample count and different seeds, which cannot be checked here\n");
     return;
   }
-  for (const char* key : {"scene", "width", "height", "spp", "sampler", "max_vertices"})
+  // The scene, size and sample count, and every setting that changes the samples but the seed.
+  std::vector<std::string> keys{"scene", "width", "height", "spp"};
+  for (const SettingDescriptor& d : setting_table())
+    if (d.effect == SettingEffect::Retrace && std::string(d.key) != "seed") keys.push_back(d.key);
+  for (const std::string& key : keys)
     if (first->contains(key) && second->contains(key) && (*first)[key] != (*second)[key])
-      throw Error(second_path + ": its " + key + " (" + second->value(key, nlohmann::json()).dump() +
-                  ") differs from the reference's (" + first->value(key, nlohmann::json()).dump() +
+      throw Error(second_path + ": its " + key + " (" + (*second)[key].dump() +
+                  ") differs from the reference's (" + (*first)[key].dump() +
                   "); --second-reference needs a render like the reference's with another seed");
   if (first->value("seed", -1) == second->value("seed", -1))
     throw Error(second_path + ": the same seed as the reference, so the same noise; --second-reference needs "

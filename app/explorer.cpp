@@ -17,6 +17,7 @@
 #include "app/pixel_probe.h"
 #include "app/preview.h"
 #include "app/render_output.h"
+#include "app/setting_table.h"
 #include "pathtracer/auto_camera.h"
 #include "gl/context.h"
 #include "gl/gl.h"
@@ -462,26 +463,37 @@ class Explorer {
     if (!ImGui::CollapsingHeader("Parameters", ImGuiTreeNodeFlags_DefaultOpen)) return;
     PreviewSettings& s = settings_;
     bool changed = false;
-    changed |= ImGui::SliderFloat("threshold t", &s.threshold, 1e-5f, 1.0f, "%.2e", ImGuiSliderFlags_Logarithmic);
-    changed |= ImGui::SliderFloat("sigma s (px)", &s.filter.sigma_s, 0.5f, kMaxFilterRadius / 3.0f, "%.2f");
-    changed |= ImGui::Checkbox("shrink sigma s with spp", &s.shrink_sigma);
-    changed |= ImGui::SliderFloat("sigma c", &s.filter.sigma_c, 1e-4f, 10.0f, "%.3g", ImGuiSliderFlags_Logarithmic);
-    changed |= ImGui::SliderFloat("sigma d", &s.filter.sigma_d, 1e-3f, 1e3f, "%.3g", ImGuiSliderFlags_Logarithmic);
-    changed |= enum_combo("filter", filter_option_names(), &s.filter.kind);
-    changed |= ImGui::Checkbox("albedo demodulation", &s.demodulate);
-    changed |= ImGui::Checkbox("bias guard", &s.bias_guard);
-    changed |= enum_combo("schedule", filter_schedule_names(), &s.schedule);
-    changed |= ImGui::SliderInt("path length", &s.trace.max_vertices, 2, 32);
-    changed |= ImGui::Checkbox("all HV", &s.trace.all_hv);
-    changed |= ImGui::Checkbox("specular sampling", &s.trace.specular_sampling);
-    changed |= ImGui::Checkbox("near specular sampling", &s.trace.near_specular_sampling);
-    changed |= ImGui::SliderFloat("exposure key", &s.tonemap.key, 0.01f, 2.0f, "%.3f", ImGuiSliderFlags_Logarithmic);
+    for (const SettingDescriptor& d : setting_table()) changed |= setting_widget(d, s);
     ImGui::Checkbox("pause", &paused_);
     ImGui::SameLine();
     ImGui::SetNextItemWidth(120);
     ImGui::InputInt("stop at spp", &options_.spp, 0);
     options_.spp = std::max(options_.spp, 0);
     settings_changed_ |= changed;
+  }
+
+  // The widget of one setting (app/setting_table.h): its label, range and kind come from its descriptor.
+  static bool setting_widget(const SettingDescriptor& d, PreviewSettings& s) {
+    const SettingWidget& w = d.widget;
+    if (*w.label == '\0') return false;
+    const ImGuiSliderFlags flags = w.logarithmic ? ImGuiSliderFlags_Logarithmic : 0;
+    switch (d.type) {
+      case SettingType::Float:
+        return ImGui::SliderFloat(w.label, &d.float_field(s), static_cast<float>(w.min), static_cast<float>(w.max), w.format, flags);
+      case SettingType::Int:
+        return ImGui::SliderInt(w.label, &d.int_field(s), static_cast<int>(w.min), static_cast<int>(w.max), w.format, flags);
+      case SettingType::Switch:
+        return ImGui::Checkbox(w.label, &d.switch_field(s));
+      case SettingType::Choice: {
+        size_t index = d.choice_index(s);
+        if (!enum_combo(w.label, *d.names, &index)) return false;
+        d.set_choice_index(s, index);
+        return true;
+      }
+      case SettingType::Seed:
+        return false;  // no widget: a new seed is a new render, set on the command line
+    }
+    return false;
   }
 
   // A combo box over an enum's name table (names[i] names static_cast<E>(i), as on the command line).
@@ -505,8 +517,6 @@ class Explorer {
     ImGui::TextWrapped("left drag: orbit   right/middle drag: pan   wheel: zoom   WASD: fly, Q/E: down/up "
                        "(Shift: faster)   R: reset");
     if (ImGui::Button("reset camera (R)")) reset_camera();
-    ImGui::SameLine();
-    if (ImGui::Checkbox("reproject history", &settings_.motion_history)) settings_changed_ = true;
     ImGui::SameLine();
     ImGui::Checkbox("skip filter while moving", &fast_while_moving_);
   }

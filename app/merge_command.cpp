@@ -12,28 +12,6 @@
 
 namespace pxf {
 
-namespace {
-
-// The sample settings of the states decide size and path-tracing parameters: the command line's
-// must not contradict them (the merged image is the render the shards were made of).
-void take_settings_from_state(const SampleSettings& s, SceneOptions& scene, PreviewSettings& preview) {
-  scene.width = static_cast<int>(s.width);
-  scene.height = static_cast<int>(s.height);
-  preview.trace.seed = s.seed;
-  preview.trace.max_vertices = s.max_vertices;
-  preview.trace.rr_start_vertex = s.rr_start_vertex;
-  preview.trace.all_hv = s.all_hv != 0;
-  preview.trace.sampler = static_cast<SamplerType>(s.sampler);
-  preview.trace.replicates = static_cast<int>(s.replicates);
-  preview.adaptive = s.adaptive != 0;
-  preview.trace.guiding = s.guiding != 0;
-  const auto mode = static_cast<SpecularSamplingMode>(s.specular_sampling);
-  preview.trace.specular_sampling = mode == SpecularSamplingMode::All;
-  preview.trace.near_specular_sampling = mode == SpecularSamplingMode::Near;
-}
-
-}  // namespace
-
 int run_merge(const Args& args) {
   SceneOptions scene_options;
   PreviewSettings preview_settings;
@@ -57,7 +35,7 @@ int run_merge(const Args& args) {
   const double merge_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 
   Scene scene = load_scene_for(scene_options, preview_settings, cli);
-  take_settings_from_state(merged.settings, scene_options, preview_settings);
+  apply_sample_settings(merged.settings, scene_options, preview_settings);
   const SampleSettings here = render_sample_settings(scene_options, preview_settings);
   const std::string diff = merged.settings.difference(here);
   if (!diff.empty()) throw Error("the states were not rendered from this scene: " + diff);

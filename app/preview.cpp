@@ -3,26 +3,16 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "app/setting_table.h"
 #include "core/timing.h"
 
 namespace pxf {
 
 namespace {
 
-// Every TraceParams field that changes the samples: a change of any of them makes the accumulated
-// samples another render's. Near specular sampling under full specular sampling changes nothing.
-bool same_trace_params(const TraceParams& a, const TraceParams& b) {
-  return a.max_vertices == b.max_vertices && a.rr_start_vertex == b.rr_start_vertex && a.all_hv == b.all_hv &&
-         specular_sampling_mode(a) == specular_sampling_mode(b) &&
-         a.seed == b.seed && a.threads == b.threads &&
-         a.sampler == b.sampler && a.replicates == b.replicates && a.guiding == b.guiding;
-}
-
-bool same_filter_params(const PreviewSettings& a, const PreviewSettings& b) {
-  return a.filter.kind == b.filter.kind && a.filter.sigma_s == b.filter.sigma_s &&
-         a.filter.sigma_c == b.filter.sigma_c && a.filter.sigma_d == b.filter.sigma_d &&
-         a.filter.skip_case2 == b.filter.skip_case2 && a.filter.subsampled_taps == b.filter.subsampled_taps &&
-         a.threshold == b.threshold && a.demodulate == b.demodulate && a.shrink_sigma == b.shrink_sigma;
+// The filter's parameters that are not settings (FilterParams fields the benches set).
+bool same_internal_filter_params(const FilterParams& a, const FilterParams& b) {
+  return a.skip_case2 == b.skip_case2 && a.subsampled_taps == b.subsampled_taps;
 }
 }  // namespace
 
@@ -197,8 +187,10 @@ void Preview::reproject_history(const Camera& camera) {
 }
 
 void Preview::set_settings(const PreviewSettings& settings) {
-  const bool retrace = !same_trace_params(settings.trace, settings_.trace);
-  const bool refilter = !same_filter_params(settings, settings_);
+  // What the change invalidates: each setting's descriptor says (app/setting_table.h).
+  const bool retrace = changes(settings_, settings, SettingEffect::Retrace) || changes(settings_, settings, SettingEffect::Restart);
+  const bool refilter = changes(settings_, settings, SettingEffect::Refilter) ||
+                        !same_internal_filter_params(settings.filter, settings_.filter);
   settings_ = settings;
   range_.set_settings(settings_.range);
   renderer_->set_sample_stride(sample_stride(settings_));

@@ -1,4 +1,6 @@
 #include "app/render_output.h"
+
+#include "app/setting_table.h"
 #include "core/timing.h"
 
 #include <filesystem>
@@ -34,34 +36,15 @@ nlohmann::json stats_json(Preview& preview, const RenderReport& r) {
   const TraceStats& trace = preview.renderer().stats();
   const StageTimes& total = preview.total_times();
   nlohmann::json j;
-  j["settings"] = {{"scene", r.scene->scene},
-                   {"env", r.scene->env},
-                   {"width", preview.width()},
-                   {"height", preview.height()},
-                   {"spp", preview.samples()},
-                   {"threshold", s.threshold},
-                   {"filter", filter_kind_name(s.filter.kind)},
-                   {"demodulate", s.demodulate},
-                   {"bias_guard", s.bias_guard},
-                   {"schedule", filter_schedule_names()[static_cast<int>(s.schedule)]},
-                   {"sigma_s", s.filter.sigma_s},
-                   {"sigma_shrink", s.shrink_sigma},
-                   {"adaptive", s.adaptive},
-                   {"sigma_c", s.filter.sigma_c},
-                   {"sigma_d", s.filter.sigma_d},
-                   {"seed", s.trace.seed},
-                   {"sampler", sampler_type_names()[static_cast<int>(s.trace.sampler)]},
-                   {"threads", s.trace.threads},
-                   {"max_vertices", s.trace.max_vertices},
-                   {"rr_start_vertex", s.trace.rr_start_vertex},
-                   {"all_hv", s.trace.all_hv},
-                   {"specular_sampling", s.trace.specular_sampling},
-                   {"near_specular_sampling", s.trace.near_specular_sampling},
-                   {"guiding", s.trace.guiding},
-                   {"key", s.tonemap.key},
-                   {"gl", r.gl_backend},
-                   {"stage_timing", gl_timing_names()[static_cast<int>(gl_timing())]},
-                   {"gl_renderer", r.gl_renderer}};
+  j["settings"] = settings_json(s);  // every preview setting (app/setting_table.h)
+  j["settings"].update({{"scene", r.scene->scene},
+                        {"env", r.scene->env},
+                        {"width", preview.width()},
+                        {"height", preview.height()},
+                        {"spp", preview.samples()},
+                        {"gl", r.gl_backend},
+                        {"stage_timing", gl_timing_names()[static_cast<int>(gl_timing())]},
+                        {"gl_renderer", r.gl_renderer}});
   j["stage_ms_total"] = times_json(total);
   j["stage_ms_per_frame"] = {{"path_tracing", preview.samples() ? total.path_tracing / preview.samples() : 0.0}};
   j["wall_ms"] = r.wall_ms;
