@@ -206,6 +206,24 @@ TEST(Checkpoint, AdaptiveShardsMergeIntoTheirExactSum) {
   EXPECT_NE(other.err.find("adaptive sampling"), std::string::npos) << other.err;
 }
 
+// Shards of an adaptive --until-clean render (the allocation's goal clean, SampleSettings::adaptive
+// 2) merge: pxf merge takes the goal back from the states with the other sampling settings
+// (apply_sample_settings). It once compared them with goal error and refused.
+TEST(Checkpoint, UntilCleanAdaptiveShardsMerge) {
+  std::string states;
+  for (const char* shard : {"0/2", "1/2"}) {
+    const std::string dir = temp_dir(std::string("clean_shard_") + shard[0]);
+    const Result r = pxf_run("render " + kScene + " --adaptive on --until-clean --threshold 0.5 --spp 40 --shard " +
+                             shard + " --out " + dir);
+    ASSERT_EQ(r.code, 0) << r.err;
+    states += " " + dir + "/state.pxfs";
+  }
+  const std::string merged_dir = temp_dir("clean_merged");
+  const Result r = pxf_run("merge" + states + " --scene cornell --out " + merged_dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(slurp(merged_dir + "/stats.json"))["settings"]["adaptive"], true);
+}
+
 // Path guiding (docs/guiding.md): the state holds the field learned so far, so a resumed guided
 // render continues exactly, whatever moment of the field's iterations it was killed at.
 TEST(Checkpoint, GuidedResumeAfterSigkillIsBitIdentical) {
