@@ -1,3 +1,4 @@
+#include "app/bench_harness.h"
 #include "app/adaptive_bench.h"
 
 #include <algorithm>
@@ -21,12 +22,6 @@ PreviewSettings with_adaptive(PreviewSettings s, bool adaptive, AdaptiveGoal goa
   s.adaptive = adaptive;
   s.adaptive_params.goal = goal;
   return s;
-}
-
-void write_text_file(const std::string& path, const std::string& text) {
-  std::ofstream out(path);
-  out << text;
-  if (!out) throw Error(path + ": cannot write");
 }
 
 float luminance_at(const Image& rgb, size_t p) {
@@ -81,7 +76,7 @@ void throughput_table(const AdaptiveBenchSetup& b, int rounds) {
     std::printf("   %-20s %12.0f paths/s  %6.3fx\n", mode.name, m, m / uniform);
     csv << mode.name << "," << m << "," << m / uniform << "\n";
   }
-  write_text_file(b.out + "/adaptive_throughput_" + b.scene_name + ".csv", csv.str());
+  write_bench_text(b.out + "/adaptive_throughput_" + b.scene_name + ".csv", csv.str());
 }
 
 // ---------------------------------------------------------------------------------- 2. equal time
@@ -157,7 +152,7 @@ void equal_time_table(const AdaptiveBenchSetup& b, const AdaptiveBenchPlan& plan
                 median_of(f.hdr_ratio), median_of(f.uniform_dark), median_of(f.adaptive_dark));
     std::fflush(stdout);
   }
-  write_text_file(b.out + "/adaptive_equal_time_" + b.scene_name + ".csv", csv.str());
+  write_bench_text(b.out + "/adaptive_equal_time_" + b.scene_name + ".csv", csv.str());
   write_svg_plot(b.out + "/adaptive_error_vs_time_" + b.scene_name + ".svg",
                  {"display NRMSE at equal wall time: " + b.scene_name, "wall time (s)", "display NRMSE (%)", true, true},
                  {uniform_points, adaptive_points});
@@ -249,7 +244,7 @@ void clean_table(const AdaptiveBenchSetup& b, double cap_s) {
     std::printf("   at equal time %.1f s: uniform %.2f %% clean, adaptive %.2f %% clean\n", t / 1000,
                 100 * share_at(runs[0], t), 100 * share_at(runs[1], t));
   }
-  write_text_file(b.out + "/adaptive_clean_" + b.scene_name + ".csv", csv.str());
+  write_bench_text(b.out + "/adaptive_clean_" + b.scene_name + ".csv", csv.str());
   write_svg_plot(b.out + "/adaptive_clean_vs_time_" + b.scene_name + ".svg",
                  {"clean (case 2) pixels: " + b.scene_name, "wall time (s)", "clean pixels (%)", true, false}, series);
 }

@@ -1,11 +1,9 @@
 // pxf bench: run time against error (README "Current figures", docs/measurements.md). Not a
-// test: it prints figures and writes CSV and SVG plots into --out.
-//   pxf bench                 per-stage times, filtering overhead, equal-time NRMSE, spp to match
-//   pxf bench --pathtracer    paths/s, rays/s, ms/frame and the raw Embree ray rate
-//   pxf bench --pathtracer --sampler-error | --variance-ratio   the samplers (app/sampler_bench.h)
-//   pxf bench --threshold-fidelity   the blend's threshold against the empirical variance (app/fidelity_bench.h)
-//   pxf bench --adaptive      adaptive against uniform sampling (app/adaptive_bench.h)
-//   pxf bench --guiding-ab    path guiding against none, unfiltered (app/guiding_bench.h)
+// test: it prints figures and writes CSV and SVG plots into --out. One mode per run, chosen by its
+// flag (bench_modes() below: the default tables, --pathtracer, --sampler-error, --variance-ratio,
+// --variants, --stage-table, --threshold-fidelity, --guiding-ab, --adaptive, --demodulation-ab,
+// --motion); each mode is a small entry point over the shared harness (app/bench_harness.h) that
+// declares its own options and defaults.
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -16,6 +14,7 @@
 #include <sstream>
 
 #include "app/adaptive_bench.h"
+#include "app/bench_harness.h"
 #include "app/guiding_bench.h"
 #include "app/bench_runs.h"
 #include "app/motion_bench.h"
@@ -37,14 +36,6 @@ namespace {
 
 using Clock = BenchClock;
 
-void write_text(const std::string& path, const std::string& text) {
-  write_file_atomically(path, [&](const std::string& tmp) {
-    std::ofstream out(tmp);
-    out << text;
-    if (!out) throw Error(path + ": cannot write");
-  });
-}
-
 // CSV columns beside the HDR NRMSE ones: "<prefix>display_nrmse_percent,<prefix>flip".
 std::string display_csv_header(const std::string& prefix) {
   return prefix + "display_nrmse_percent," + prefix + "flip";
@@ -53,44 +44,6 @@ std::string display_csv(const RowError& e) {
   std::ostringstream s;
   s << e.display_nrmse << "," << e.flip;
   return s.str();
-}
-
-struct BenchSetup {
-  Scene scene;
-  PreviewSettings filtered, plain;
-  int width = 0, height = 0;
-  std::string out;
-};
-
-// The reference: a high-spp plain path tracing (independent seed), cached in the output folder.
-// `layer` "hv": its HV buffer alone (for the variant table; read from layer hv of a given file,
-// e.g. the buffers.exr of `pxf render --filter none`), else what plain path tracing shows.
-Image obtain_reference(const BenchSetup& b, const std::string& given, int spp, const std::string& scene_name,
-                       const std::string& layer = "") {
-  if (!given.empty()) return read_exr(given, layer);
-  const std::string base = std::filesystem::path(scene_name).stem().string();
-  const auto cache_name = [&](const std::string& prefix) {
-    return b.out + "/" + prefix + base + "_" + std::to_string(b.width) + "x" + std::to_string(b.height) + "_" +
-           std::to_string(spp) + "spp.exr";
-  };
-  const std::string cache = cache_name(layer == "hv" ? "reference_hv_" : "reference_");
-  if (std::filesystem::exists(cache)) {
-    std::printf("reference: %s (cached)\n", cache.c_str());
-    return read_exr(cache);
-  }
-  TraceParams params = b.plain.trace;
-  params.seed = b.plain.trace.seed + 7919;  // independent of the runs being judged
-  ProgressiveRenderer renderer(b.scene, params, b.width, b.height);
-  const auto start = Clock::now();
-  for (int i = 0; i < spp; ++i) {
-    renderer.add_frame();
-    if ((i + 1) % 256 == 0 || i + 1 == spp)
-      std::fprintf(stderr, "reference: %d/%d spp, %.0f s\n", i + 1, spp, elapsed_ms(start) / 1000);
-  }
-  write_exr(cache_name("reference_"), renderer.unfiltered_image());  // both cached: one render serves both
-  write_exr(cache_name("reference_hv_"), renderer.hv_image());
-  std::printf("reference: wrote %s (%d spp, %.1f s)\n", cache.c_str(), spp, elapsed_ms(start) / 1000);
-  return read_exr(cache);
 }
 
 struct FilteredRun {
@@ -196,19 +149,6 @@ double spp_to_match(const PlainRun& run, double target) {
 }
 
 // A comma-separated list of counts in [1, 65536] (empty: none).
-std::vector<int> parse_counts(const std::string& option, const std::string& text) {
-  std::vector<int> counts;
-  std::stringstream in(text);
-  std::string item;
-  while (std::getline(in, item, ',')) {
-    char* end = nullptr;
-    const long v = std::strtol(item.c_str(), &end, 10);
-    if (item.empty() || *end || v < 1 || v > 1 << 16) throw UsageError(option + ": '" + item + "' is not a count");
-    counts.push_back(static_cast<int>(v));
-  }
-  return counts;
-}
-
 // One scene's row of the per-stage table: medians over `frames` frames of the
 // scheduled run, and the overhead of the filtered run over the unfiltered one. The two runs advance
 // frame by frame in turn, so that background load on a shared machine hits both alike.
@@ -276,7 +216,7 @@ int run_stage_table(SceneOptions scene_options, PreviewSettings preview_settings
     overhead.x.push_back(static_cast<double>(overhead.x.size() + 1));
     overhead.y.push_back(100.0 * r.overhead());
   }
-  write_text(out + "/stage_table.csv", csv.str());
+  write_bench_text(out + "/stage_table.csv", csv.str());
   write_svg_plot(out + "/stage_overhead.svg",
                  {"filtering overhead per built-in scene (x: scene number, order of --scene list)", "scene",
                   "overhead (%)", false, false},
@@ -297,7 +237,7 @@ int run_pathtracer_bench(const BenchSetup& b, int timed) {
       << r.embree_rays_per_s << "," << r.fraction_of_embree << "," << r.embree_stream_rays_per_s << ","
       << r.fraction_of_embree_stream << "," << r.primary_ray_ms << "," << r.primary_fraction
       << "\n";
-  write_text(b.out + "/pathtracer.csv", csv.str());
+  write_bench_text(b.out + "/pathtracer.csv", csv.str());
   std::printf("wrote %s/pathtracer.csv\n", b.out.c_str());
   return 0;
 }
@@ -381,7 +321,7 @@ int run_variant_bench(const BenchSetup& b, const Image& reference_hv, int spp, i
       std::printf(" %s %.1f", GridFilter::kStepNames[i], median_of(grid_step_ms[i]));
     std::printf("\n");
   }
-  write_text(b.out + "/variants.csv", csv.str());
+  write_bench_text(b.out + "/variants.csv", csv.str());
   write_svg_plot(b.out + "/variants.svg",
                  {"Filter variants at " + std::to_string(spp) + " spp: HV-only NRMSE vs cost", "PT frames per application",
                   "HV NRMSE (%)", true, false},
@@ -432,184 +372,16 @@ int run_demodulation_ab(const BenchSetup& b, const Image& reference, double pt_m
                 median_of(plain_spp), median_of(plain_e), median_of(off_spp), median_of(off_e), median_of(off_ratio),
                 median_of(on_spp), median_of(on_e), median_of(on_ratio));
   }
-  write_text(b.out + "/demodulation.csv", csv.str());
+  write_bench_text(b.out + "/demodulation.csv", csv.str());
   std::printf("\nwrote %s/demodulation.csv, demod_<unfiltered|off|on>_<budget>.png\n", b.out.c_str());
   return 0;
 }
 
-}  // namespace
 
-int run_bench(const Args& args) {
-  SceneOptions scene_options;
-  PreviewSettings preview_settings;
-  bool pathtracer = false, variants = false, stage_table = false, sampler_error = false, variance_ratio = false;
-  bool demodulation_ab = false, guiding_ab = false;
-  bool threshold_fidelity = false, adaptive = false, motion = false;
-  int motion_frames = 60;
-  double orbit_degrees = 90;
-  double clean_cap_s = 300;
-  int variant_spp = 4, variant_rounds = 5;
-  std::string extra_taps_text;
-  std::string reference_path, out = "bench-out", budgets_text = "8,32,128,256";
-  int reference_spp = 2048, frames = 32, max_spp = 1024, timed = 20;
-  int seeds = 32, rounds = 7;
-  std::string spp_text;
-  CommandLine cli("bench", "[options]",
-                  "Run time against error on one scene (default cornell, 512x512, default settings):\n"
-                  "  1. per-stage times of one scheduled filter application, in ms and in path-tracing frames;\n"
-                  "  2. the relative overhead of filtering over --frames frames;\n"
-                  "  3. NRMSE to the reference of unfiltered vs filtered images at equal wall time of the whole job\n"
-                  "     (the --time machinery), at budgets of --budgets median path-tracing frames, in HDR and on\n"
-                  "     display values (both tone-mapped with the reference's key and log-average), with the mean\n"
-                  "     LDR-FLIP of the display images;\n"
-                  "  4. the spp at which unfiltered path tracing reaches the NRMSE of the filtered image at --frames.\n"
-                  "The reference (--reference-spp plain path tracing) is cached in --out. Writes CSV and SVG plots.\n"
-                  "--pathtracer instead measures paths/s, rays/s and the raw Embree incoherent-ray rate.\n"
-                  "--variants instead tabulates every filter variant on one --variant-spp HV buffer: ms per\n"
-                  "application, path-tracing frames, HV-only NRMSE against the reference's HV (layer hv of\n"
-                  "--reference, e.g. buffers.exr of `pxf render --filter none`; default: rendered and cached).");
-  scene_options.stage_timing = GlTiming::Finish;  // exact per-stage figures
-  add_scene_options(cli, scene_options, /*headless=*/true);
-  add_preview_options(cli, preview_settings, /*adaptive_option=*/false);
-  cli.flag("--pathtracer", &pathtracer, "path tracer throughput only");
-  cli.flag("--adaptive", &adaptive,
-           "instead of 1-4: adaptive against uniform sampling, both filtered (app/adaptive_bench.h): paths/s at\n"
-           "100/50/10 % active pixels, display and HDR NRMSE at equal wall time (--budgets, default 8,32,128,512;\n"
-           "--rounds, default 3), starved dark pixels, and the clean share over time up to --clean-cap");
-  cli.option("--clean-cap", &clean_cap_s, "seconds of each until-clean run of --adaptive (default 300; 0: none)", 0.0,
-             1e6);
-  cli.flag("--motion", &motion,
-           "a camera orbit of --motion-frames frames over --orbit-degrees, one path per pixel per frame, with the\n"
-           "reprojected history and the filter every frame against restart + unfiltered at equal frame time:\n"
-           "error, flicker, disocclusions, frame times (references: --reference-spp, default 1024, per frame)");
-  cli.option("--motion-frames", &motion_frames, "frames of the --motion orbit (default 60)", 2, 100000);
-  cli.option("--orbit-degrees", &orbit_degrees, "the whole --motion orbit in degrees (default 90)", 0.0, 3600.0);
-  cli.flag("--variants", &variants, "the filter variant table (time vs HV-only NRMSE)");
-  cli.option("--variant-spp", &variant_spp, "spp of the --variants HV buffer (default 4)", 1, 1 << 16);
-  cli.option("--variant-rounds", &variant_rounds, "timed rounds of --variants (default 5, after a warm-up)", 1, 1000);
-  cli.option("--subsampled-taps", &extra_taps_text, "LIST", "--variants: also the subsampled variant with these tap counts");
-  cli.flag("--stage-table", &stage_table,
-           "per-stage ms and overhead over --frames frames for every built-in scene (no reference)");
-  cli.flag("--sampler-error", &sampler_error,
-           "with --pathtracer: unfiltered NRMSE (and LV alone) of sobol vs independent at --spp against a "
-           "--reference-spp Sobol reference of another seed, and paths/s of both back to back");
-  cli.flag("--variance-ratio", &variance_ratio,
-           "with --pathtracer: estimated / empirical Var[L_u] of the pixel mean over --seeds seeds at --spp");
-  cli.flag("--threshold-fidelity", &threshold_fidelity,
-           "empirical perceived variance of the final image over --seeds seeds at --spp (default 16,64,256) "
-           "against --threshold (default both t = 0.001 and 0.01), by blend case (the --filter's; bilateral and bilateral-depth give the "
-           "blend the covariance of L_u and L_f); with --adaptive also adaptive sampling at the uniform job's wall time");
-  cli.option("--spp", &spp_text, "LIST",
-             "spp of --sampler-error (default 8,32,128), --variance-ratio (4,16,64,256) or --threshold-fidelity (16,64,256)");
-  cli.option("--seeds", &seeds, "seeds of --variance-ratio and --threshold-fidelity (default 32), --sampler-error (8)", 2, 4096);
-  cli.flag("--guiding-ab", &guiding_ab,
-           "instead of 1-4: path guiding against none, unfiltered (app/guiding_bench.h): ms per frame at equal spp\n"
-           "(--frames), and HDR and display NRMSE at equal wall time of --budgets SECONDS (default 2,8), median of\n"
-           "--rounds (default 5) alternating rounds");
-  cli.flag("--demodulation-ab", &demodulation_ab,
-           "instead of 1-4: albedo demodulation off vs on at equal wall time (--budgets, --rounds rounds, back\n"
-           "to back with the unfiltered run); writes demodulation.csv and demod_*.png");
-  cli.option("--rounds", &rounds, "rounds of --sampler-error (default 7), --demodulation-ab and --adaptive (default 3)", 1, 1000);
-  cli.option("--timed-frames", &timed, "timed frames of --pathtracer (after 3 warm-up frames)", 1, 100000);
-  cli.option("--reference", &reference_path, "REF.exr", "reference image (default: render and cache one)");
-  cli.option("--reference-spp", &reference_spp, "samples of the rendered reference (default 2048)", 1, 1 << 20);
-  cli.option("--frames", &frames, "frames of the filtered run (default 32)", 1, 1 << 16);
-  cli.option("--budgets", &budgets_text, "LIST", "equal-time budgets in median path-tracing frames (default 8,32,128,256)");
-  cli.option("--max-spp", &max_spp, "most unfiltered spp tried to match the filtered NRMSE (default 1024)", 1, 1 << 20);
-  cli.option("--out", &out, "DIR", "folder for CSV, plots and the cached reference (default bench-out)");
-  if (!cli.parse(args)) return 0;
-  if (print_scene_list_if_asked(scene_options)) return 0;
-  set_gl_timing(scene_options.stage_timing);
-  const std::vector<int> budgets = parse_counts("--budgets", budgets_text);
-  const std::vector<int> extra_taps = parse_counts("--subsampled-taps", extra_taps_text);
-  if (stage_table) {
-    std::filesystem::create_directories(out);
-    if (!preview_settings.filtering()) throw UsageError("--filter none: nothing to compare against");
-    auto context = create_gl_context(parse_gl_backend(scene_options.gl));
-    return run_stage_table(scene_options, preview_settings, cli, frames, out);
-  }
 
-  BenchSetup b;
-  b.filtered = preview_settings;
-  b.scene = load_scene_for(scene_options, b.filtered, cli);
-  b.width = scene_options.width;
-  b.height = scene_options.height;
-  b.out = out;
-  if (!b.filtered.filtering()) throw UsageError("--filter none: nothing to compare against");
-  b.plain = b.filtered;
-  b.plain.filter.kind = FilterKind::None;
-  std::filesystem::create_directories(out);
-  if (pathtracer && (sampler_error || variance_ratio)) {
-    SamplerBenchSetup sb{b.scene, std::filesystem::path(scene_options.scene).stem().string(), b.plain.trace, b.width,
-                         b.height, out};
-    if (sampler_error)
-      run_sampler_error_bench(sb, cli.given("--reference-spp") ? reference_spp : 2048,
-                              parse_counts("--spp", spp_text.empty() ? "8,32,128" : spp_text), rounds,
-                              cli.given("--seeds") ? seeds : 8);
-    if (variance_ratio) run_variance_ratio_bench(sb, parse_counts("--spp", spp_text.empty() ? "4,16,64,256" : spp_text), seeds);
-    return 0;
-  }
-  if (pathtracer) return run_pathtracer_bench(b, timed);
-  if (threshold_fidelity) {
-    auto context = create_gl_context(parse_gl_backend(scene_options.gl));
-    FidelityBenchSetup fb{b.scene, std::filesystem::path(scene_options.scene).stem().string(), b.filtered,
-                          b.width, b.height, out};
-    fb.with_adaptive = adaptive;
-    const std::vector<float> thresholds =
-        cli.given("--threshold") ? std::vector<float>{preview_settings.threshold} : std::vector<float>{0.001f, 0.01f};
-    run_threshold_fidelity_bench(fb, parse_counts("--spp", spp_text.empty() ? "16,64,256" : spp_text), thresholds,
-                                 seeds);
-    return 0;
-  }
-
-  auto context = create_gl_context(parse_gl_backend(scene_options.gl));
-  if (motion) {
-    MotionBenchSetup mb{b.scene, scene_options.scene, b.filtered, b.width, b.height, out};
-    mb.frames = motion_frames;
-    mb.orbit_degrees = static_cast<float>(orbit_degrees);
-    mb.reference_spp = cli.given("--reference-spp") ? reference_spp : 1024;
-    run_motion_bench(mb);
-    return 0;
-  }
-  std::printf("bench: %s %dx%d, t=%g, filter %s, sigma_s=%g sigma_c=%g sigma_d=%g, GL %s (%s)\n",
-              scene_options.scene.c_str(), b.width, b.height, b.filtered.threshold,
-              filter_kind_name(b.filtered.filter.kind), b.filtered.filter.sigma_s, b.filtered.filter.sigma_c,
-              b.filtered.filter.sigma_d, context->backend_name(), context->gl_renderer().c_str());
-  if (variants)
-    return run_variant_bench(b, obtain_reference(b, reference_path, reference_spp, scene_options.scene, "hv"),
-                             variant_spp, variant_rounds, extra_taps);
-  const Image reference = obtain_reference(b, reference_path, reference_spp, scene_options.scene);
-  if (reference.width != b.width || reference.height != b.height) throw Error("reference size differs from --size");
-
-  if (guiding_ab) {
-    GuidingBenchPlan plan;
-    plan.budgets_s = parse_counts("--budgets", cli.given("--budgets") ? budgets_text : "2,8");
-    plan.rounds = cli.given("--rounds") ? rounds : 5;
-    plan.cost_frames = frames;
-    run_guiding_bench({b.scene, b.plain.trace, b.width, b.height, out, reference}, plan);
-    return 0;
-  }
-  if (adaptive) {
-    AdaptiveBenchPlan plan;
-    plan.budgets = parse_counts("--budgets", cli.given("--budgets") ? budgets_text : "8,32,128,512");
-    plan.rounds = cli.given("--rounds") ? rounds : 3;
-    plan.clean_cap_s = clean_cap_s;
-    run_adaptive_bench({b.scene, std::filesystem::path(scene_options.scene).stem().string(), b.filtered, b.width,
-                        b.height, out, reference},
-                       plan);
-    return 0;
-  }
-  if (demodulation_ab) {
-    // The budgets' unit: the median path-tracing frame of a short unfiltered warm-up.
-    Preview warm(b.scene, b.plain, b.width, b.height);
-    std::vector<double> frame_ms;
-    for (int i = 0; i < 8; ++i) {
-      warm.add_frame(i == 7, i == 7);
-      frame_ms.push_back(warm.last_times().path_tracing);
-    }
-    return run_demodulation_ab(b, reference, median_of(frame_ms), budgets, cli.given("--rounds") ? rounds : 3);
-  }
-
+// The default mode's tables 1-4 (see its --help).
+int run_time_tables(const BenchSetup& b, const Image& reference, int frames, const std::vector<int>& budgets,
+                    int max_spp) {
   // 1. Stage times. llvmpipe compiles each shader at its first draw: a warm-up run filters twice
   // first, so that the figures are what a later filter run or a camera change costs.
   {
@@ -631,7 +403,7 @@ int run_bench(const Args& args) {
     if (t.filter > 0) filter_app.push_back(t.filter + t.upload), range.push_back(t.range);
     if (t.blend > 0) display.push_back(t.blend + t.tonemap);
   }
-  write_text(out + "/stages.csv", stages_csv.str());
+  write_bench_text(b.out + "/stages.csv", stages_csv.str());
   const double pt_ms = median_of(pt), filter_ms = median_of(filter_app), display_ms = median_of(display);
   const double range_ms = range.empty() ? 0 : range.front();
   std::printf("\n1. one scheduled filter application (median of %zu runs, after a warm-up that compiled the shaders):\n", filter_app.size());
@@ -672,7 +444,7 @@ int run_bench(const Args& args) {
     plain_points.x.push_back(row.plain.used_ms / 1000);
     plain_points.y.push_back(row.plain.error.hdr_nrmse);
   }
-  write_text(out + "/equal_time.csv", eq_csv.str());
+  write_bench_text(b.out + "/equal_time.csv", eq_csv.str());
 
   const double match = spp_to_match(plain, filtered.nrmse);
   std::printf("\n4. filtered at %d spp: NRMSE %.3f %%; unfiltered reaches it at ", frames, filtered.nrmse);
@@ -690,13 +462,288 @@ int run_bench(const Args& args) {
     plain_curve.x.push_back(plain.nrmse_wall_ms[i] / 1000);
     plain_curve.y.push_back(plain.nrmse[i]);
   }
-  write_text(out + "/convergence.csv", conv_csv.str());
+  write_bench_text(b.out + "/convergence.csv", conv_csv.str());
   PlotSeries filtered_end{"filtered " + std::to_string(frames) + " spp", {filtered.wall_ms / 1000}, {filtered.nrmse}, true};
-  write_svg_plot(out + "/nrmse_vs_time.svg",
-                 {"NRMSE vs wall time: " + scene_options.scene, "wall time (s)", "NRMSE (%)", true, true},
+  write_svg_plot(b.out + "/nrmse_vs_time.svg",
+                 {"NRMSE vs wall time: " + b.scene_name, "wall time (s)", "NRMSE (%)", true, true},
                  {plain_curve, plain_points, filtered_points, filtered_end});
-  std::printf("\nwrote %s/stages.csv, equal_time.csv, convergence.csv, nrmse_vs_time.svg\n", out.c_str());
+  std::printf("\nwrote %s/stages.csv, equal_time.csv, convergence.csv, nrmse_vs_time.svg\n", b.out.c_str());
   return 0;
+}
+
+// --- The modes: each a small entry point over the shared harness (app/bench_harness.h), with its
+// own options and defaults.
+
+int time_mode(const Args& args, const std::string& summary) {
+  BenchHarness h("", summary);
+  int frames = 32, max_spp = 1024;
+  std::string budgets_text = "8,32,128,256";
+  h.add_reference_options(2048);
+  h.cli().option("--frames", &frames, "frames of the filtered run (default 32)", 1, 1 << 16);
+  h.cli().option("--budgets", &budgets_text, "LIST", "equal-time budgets in median path-tracing frames (default 8,32,128,256)");
+  h.cli().option("--max-spp", &max_spp, "most unfiltered spp tried to match the filtered NRMSE (default 1024)", 1, 1 << 20);
+  if (!h.parse(args)) return 0;
+  const std::vector<int> budgets = parse_counts("--budgets", budgets_text);
+  const BenchSetup b = h.setup(/*needs_filter=*/true);
+  auto context = h.gl_context();
+  std::printf("bench: %s %dx%d, t=%g, filter %s, sigma_s=%g sigma_c=%g sigma_d=%g, GL %s (%s)\n",
+              h.scene_options().scene.c_str(), b.width, b.height, b.filtered.threshold,
+              filter_kind_name(b.filtered.filter.kind), b.filtered.filter.sigma_s, b.filtered.filter.sigma_c,
+              b.filtered.filter.sigma_d, context->backend_name(), context->gl_renderer().c_str());
+  return run_time_tables(b, h.reference(b), frames, budgets, max_spp);
+}
+
+int pathtracer_mode(const Args& args, const std::string& summary) {
+  BenchHarness h("--pathtracer", summary);
+  int timed = 20;
+  h.cli().option("--timed-frames", &timed, "timed frames (after 3 warm-up frames; default 20)", 1, 100000);
+  if (!h.parse(args)) return 0;
+  return run_pathtracer_bench(h.setup(/*needs_filter=*/false), timed);
+}
+
+SamplerBenchSetup sampler_setup(const BenchSetup& b) {
+  return SamplerBenchSetup{b.scene, b.scene_name, b.plain.trace, b.width, b.height, b.out};
+}
+
+int sampler_error_mode(const Args& args, const std::string& summary) {
+  BenchHarness h("--sampler-error", summary);
+  std::string spp_text = "8,32,128";
+  int seeds = 8, rounds = 7, reference_spp = 2048;
+  h.cli().option("--spp", &spp_text, "LIST", "sample counts (default 8,32,128)");
+  h.cli().option("--seeds", &seeds, "seeds (default 8)", 2, 4096);
+  h.cli().option("--rounds", &rounds, "rounds of the paths/s comparison (default 7)", 1, 1000);
+  h.cli().option("--reference-spp", &reference_spp, "samples of the Sobol reference of another seed (default 2048)", 1, 1 << 20);
+  if (!h.parse(args)) return 0;
+  run_sampler_error_bench(sampler_setup(h.setup(/*needs_filter=*/false)), reference_spp, parse_counts("--spp", spp_text),
+                          rounds, seeds);
+  return 0;
+}
+
+int variance_ratio_mode(const Args& args, const std::string& summary) {
+  BenchHarness h("--variance-ratio", summary);
+  std::string spp_text = "4,16,64,256";
+  int seeds = 32;
+  h.cli().option("--spp", &spp_text, "LIST", "sample counts (default 4,16,64,256)");
+  h.cli().option("--seeds", &seeds, "seeds (default 32)", 2, 4096);
+  if (!h.parse(args)) return 0;
+  run_variance_ratio_bench(sampler_setup(h.setup(/*needs_filter=*/false)), parse_counts("--spp", spp_text), seeds);
+  return 0;
+}
+
+int variants_mode(const Args& args, const std::string& summary) {
+  BenchHarness h("--variants", summary);
+  int variant_spp = 4, variant_rounds = 5;
+  std::string extra_taps_text;
+  h.add_reference_options(2048);
+  h.cli().option("--variant-spp", &variant_spp, "spp of the HV buffer (default 4)", 1, 1 << 16);
+  h.cli().option("--variant-rounds", &variant_rounds, "timed rounds (default 5, after a warm-up)", 1, 1000);
+  h.cli().option("--subsampled-taps", &extra_taps_text, "LIST", "also the subsampled variant with these tap counts");
+  if (!h.parse(args)) return 0;
+  const std::vector<int> extra_taps = parse_counts("--subsampled-taps", extra_taps_text);
+  const BenchSetup b = h.setup(/*needs_filter=*/true);
+  auto context = h.gl_context();
+  return run_variant_bench(b, h.reference(b, "hv"), variant_spp, variant_rounds, extra_taps);
+}
+
+int stage_table_mode(const Args& args, const std::string& summary) {
+  BenchHarness h("--stage-table", summary);
+  int frames = 32;
+  h.cli().option("--frames", &frames, "frames per scene (default 32)", 1, 1 << 16);
+  if (!h.parse(args)) return 0;
+  if (!h.settings().filtering()) throw UsageError("--filter none: nothing to compare against");
+  const std::string out = h.setup(/*needs_filter=*/true).out;  // validates the options and creates --out
+  auto context = h.gl_context();
+  return run_stage_table(h.scene_options(), h.settings(), h.cli(), frames, out);
+}
+
+int threshold_fidelity_mode(const Args& args, const std::string& summary) {
+  BenchHarness h("--threshold-fidelity", summary);
+  std::string spp_text = "16,64,256";
+  int seeds = 32;
+  bool adaptive = false;
+  h.cli().option("--spp", &spp_text, "LIST", "sample counts (default 16,64,256)");
+  h.cli().option("--seeds", &seeds, "seeds (default 32)", 2, 4096);
+  h.cli().flag("--adaptive", &adaptive, "also adaptive sampling, at the uniform job's wall time");
+  if (!h.parse(args)) return 0;
+  const BenchSetup b = h.setup(/*needs_filter=*/true);
+  auto context = h.gl_context();
+  FidelityBenchSetup fb{b.scene, b.scene_name, b.filtered, b.width, b.height, b.out};
+  fb.with_adaptive = adaptive;
+  const std::vector<float> thresholds =
+      h.cli().given("--threshold") ? std::vector<float>{b.filtered.threshold} : std::vector<float>{0.001f, 0.01f};
+  run_threshold_fidelity_bench(fb, parse_counts("--spp", spp_text), thresholds, seeds);
+  return 0;
+}
+
+int guiding_mode(const Args& args, const std::string& summary) {
+  BenchHarness h("--guiding-ab", summary);
+  GuidingBenchPlan plan;
+  plan.rounds = 5;
+  plan.cost_frames = 32;
+  std::string budgets_text = "2,8";
+  h.add_reference_options(2048);
+  h.cli().option("--budgets", &budgets_text, "LIST", "equal-time budgets in seconds (default 2,8)");
+  h.cli().option("--rounds", &plan.rounds, "alternating rounds (default 5)", 1, 1000);
+  h.cli().option("--frames", &plan.cost_frames, "frames of the equal-spp cost comparison (default 32)", 1, 1 << 16);
+  if (!h.parse(args)) return 0;
+  plan.budgets_s = parse_counts("--budgets", budgets_text);
+  const BenchSetup b = h.setup(/*needs_filter=*/false);
+  run_guiding_bench({b.scene, b.plain.trace, b.width, b.height, b.out, h.reference(b)}, plan);
+  return 0;
+}
+
+int adaptive_mode(const Args& args, const std::string& summary) {
+  BenchHarness h("--adaptive", summary);
+  AdaptiveBenchPlan plan;
+  plan.rounds = 3;
+  plan.clean_cap_s = 300;
+  std::string budgets_text = "8,32,128,512";
+  h.add_reference_options(2048);
+  h.cli().option("--budgets", &budgets_text, "LIST", "equal-time budgets in median path-tracing frames (default 8,32,128,512)");
+  h.cli().option("--rounds", &plan.rounds, "alternating rounds (default 3)", 1, 1000);
+  h.cli().option("--clean-cap", &plan.clean_cap_s, "seconds of each until-clean run (default 300; 0: none)", 0.0, 1e6);
+  if (!h.parse(args)) return 0;
+  plan.budgets = parse_counts("--budgets", budgets_text);
+  const BenchSetup b = h.setup(/*needs_filter=*/true);
+  auto context = h.gl_context();
+  run_adaptive_bench({b.scene, b.scene_name, b.filtered, b.width, b.height, b.out, h.reference(b)}, plan);
+  return 0;
+}
+
+int demodulation_mode(const Args& args, const std::string& summary) {
+  BenchHarness h("--demodulation-ab", summary);
+  int rounds = 3;
+  std::string budgets_text = "8,32,128,256";
+  h.add_reference_options(2048);
+  h.cli().option("--budgets", &budgets_text, "LIST", "equal-time budgets in median path-tracing frames (default 8,32,128,256)");
+  h.cli().option("--rounds", &rounds, "rounds, back to back with the unfiltered run (default 3)", 1, 1000);
+  if (!h.parse(args)) return 0;
+  const std::vector<int> budgets = parse_counts("--budgets", budgets_text);
+  const BenchSetup b = h.setup(/*needs_filter=*/true);
+  auto context = h.gl_context();
+  const Image reference = h.reference(b);
+  // The budgets' unit: the median path-tracing frame of a short unfiltered warm-up.
+  Preview warm(b.scene, b.plain, b.width, b.height);
+  std::vector<double> frame_ms;
+  for (int i = 0; i < 8; ++i) {
+    warm.add_frame(i == 7, i == 7);
+    frame_ms.push_back(warm.last_times().path_tracing);
+  }
+  return run_demodulation_ab(b, reference, median_of(frame_ms), budgets, rounds);
+}
+
+int motion_mode(const Args& args, const std::string& summary) {
+  BenchHarness h("--motion", summary);
+  int frames = 60, reference_spp = 1024;
+  double orbit_degrees = 90;
+  h.cli().option("--motion-frames", &frames, "frames of the orbit (default 60)", 2, 100000);
+  h.cli().option("--orbit-degrees", &orbit_degrees, "the whole orbit in degrees (default 90)", 0.0, 3600.0);
+  h.cli().option("--reference-spp", &reference_spp, "samples of each frame's reference (default 1024)", 1, 1 << 20);
+  if (!h.parse(args)) return 0;
+  const BenchSetup b = h.setup(/*needs_filter=*/true);
+  auto context = h.gl_context();
+  MotionBenchSetup mb{b.scene, h.scene_options().scene, b.filtered, b.width, b.height, b.out};
+  mb.frames = frames;
+  mb.orbit_degrees = static_cast<float>(orbit_degrees);
+  mb.reference_spp = reference_spp;
+  run_motion_bench(mb);
+  return 0;
+}
+
+struct BenchMode {
+  const char* flag;  // "" the default mode
+  const char* brief;  // one line for the list of modes
+  const char* summary;
+  int (*run)(const Args& args, const std::string& summary);
+};
+
+const std::vector<BenchMode>& bench_modes() {
+  static const std::vector<BenchMode> modes{
+      {"", "per-stage times, filtering overhead, equal-time NRMSE, spp to match", "run time against error on one scene (default cornell at its size, default settings):\n"
+           "  1. per-stage times of one scheduled filter application, in ms and in path-tracing frames;\n"
+           "  2. the relative overhead of filtering over --frames frames;\n"
+           "  3. NRMSE to the reference of unfiltered vs filtered images at equal wall time of the whole job\n"
+           "     (the --time machinery), at budgets of --budgets median path-tracing frames, in HDR and on\n"
+           "     display values (both tone-mapped with the reference's key and log-average), with the mean\n"
+           "     LDR-FLIP of the display images;\n"
+           "  4. the spp at which unfiltered path tracing reaches the NRMSE of the filtered image at --frames.\n"
+           "The reference (--reference-spp plain path tracing) is cached in --out. Writes CSV and SVG plots.",
+       time_mode},
+      {"--pathtracer", "path tracer throughput", "path tracer throughput: paths/s, rays/s, ms/frame and the raw Embree incoherent-ray rate",
+       pathtracer_mode},
+      {"--sampler-error", "Sobol against independent numbers: error and speed",
+       "unfiltered NRMSE (and LV alone) of sobol vs independent at --spp against a Sobol reference of another\n"
+       "seed, and paths/s of both back to back (app/sampler_bench.h)",
+       sampler_error_mode},
+      {"--variance-ratio", "the estimated against the empirical variance of the mean", "estimated / empirical Var[L_u] of the pixel mean over --seeds seeds at --spp (app/sampler_bench.h)",
+       variance_ratio_mode},
+      {"--variants", "every filter variant: time against HV error",
+       "every filter variant on one --variant-spp HV buffer: ms per application, path-tracing frames, HV-only\n"
+       "NRMSE against the reference's HV (layer hv of --reference, e.g. buffers.exr of `pxf render --filter\n"
+       "none`; default: rendered and cached)",
+       variants_mode},
+      {"--stage-table", "per-stage times of every built-in scene", "per-stage ms and overhead over --frames frames for every built-in scene (no reference)",
+       stage_table_mode},
+      {"--threshold-fidelity", "the blend's threshold against the empirical perceived variance",
+       "empirical perceived variance of the final image over --seeds seeds at --spp against --threshold\n"
+       "(default both t = 0.001 and 0.01), by blend case (the --filter's; bilateral and bilateral-depth give\n"
+       "the blend the covariance of L_u and L_f); with --adaptive also adaptive sampling at the uniform\n"
+       "job's wall time (app/fidelity_bench.h)",
+       threshold_fidelity_mode},
+      {"--guiding-ab", "path guiding against none at equal time",
+       "path guiding against none, unfiltered (app/guiding_bench.h): ms per frame at equal spp (--frames), and\n"
+       "HDR and display NRMSE at equal wall time of --budgets seconds, median of --rounds alternating rounds",
+       guiding_mode},
+      {"--adaptive", "adaptive against uniform sampling: equal time, time to clean, throughput",
+       "adaptive against uniform sampling, both filtered (app/adaptive_bench.h): paths/s at 100/50/10 %\n"
+       "active pixels, display and HDR NRMSE at equal wall time (--budgets, --rounds), starved dark pixels,\n"
+       "and the clean share over time up to --clean-cap",
+       adaptive_mode},
+      {"--demodulation-ab", "albedo demodulation off against on at equal time",
+       "albedo demodulation off vs on at equal wall time (--budgets, --rounds rounds, back to back with the\n"
+       "unfiltered run); writes demodulation.csv and demod_*.png",
+       demodulation_mode},
+      {"--motion", "a camera orbit: reprojected history against restarts",
+       "a camera orbit of --motion-frames frames over --orbit-degrees, one path per pixel per frame, with the\n"
+       "reprojected history and the filter every frame against restart + unfiltered at equal frame time:\n"
+       "error, flicker, disocclusions, frame times (app/motion_bench.h)",
+       motion_mode},
+  };
+  return modes;
+}
+
+// The default mode's --help: its own text, then the other modes.
+std::string default_summary() {
+  std::string text = bench_modes()[0].summary;
+  text += "\n\nOther modes (`pxf bench MODE --help` for each one's options):";
+  for (size_t i = 1; i < bench_modes().size(); ++i) {
+    char line[160];
+    std::snprintf(line, sizeof line, "\n  %-22s %s", bench_modes()[i].flag, bench_modes()[i].brief);
+    text += line;
+  }
+  return text;
+}
+
+}  // namespace
+
+// Picks the mode from its flag and hands it the other arguments. Two combinations of earlier
+// versions still read the same: --pathtracer with --sampler-error or --variance-ratio (the flag is
+// dropped), and --threshold-fidelity with --adaptive (that mode's own --adaptive).
+int run_bench(const Args& args) {
+  Args rest = args;
+  const auto has = [&](const std::string& flag) { return std::find(rest.begin(), rest.end(), flag) != rest.end(); };
+  if (has("--sampler-error") || has("--variance-ratio")) rest.erase(std::remove(rest.begin(), rest.end(), "--pathtracer"), rest.end());
+  const BenchMode* chosen = &bench_modes()[0];
+  for (size_t i = 1; i < bench_modes().size(); ++i) {
+    const BenchMode& mode = bench_modes()[i];
+    if (!has(mode.flag)) continue;
+    if (std::string(mode.flag) == "--adaptive" && has("--threshold-fidelity")) continue;
+    if (chosen != &bench_modes()[0])
+      throw UsageError(std::string(chosen->flag) + " and " + mode.flag + " are separate modes; give one");
+    chosen = &mode;
+  }
+  if (chosen != &bench_modes()[0]) rest.erase(std::find(rest.begin(), rest.end(), chosen->flag));
+  return chosen->run(rest, chosen == &bench_modes()[0] ? default_summary() : chosen->summary);
 }
 
 }  // namespace pxf

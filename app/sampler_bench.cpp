@@ -1,3 +1,4 @@
+#include "app/bench_harness.h"
 #include "app/sampler_bench.h"
 
 #include <algorithm>
@@ -14,13 +15,6 @@ namespace {
 
 const char* sampler_name(SamplerType type) { return sampler_type_names()[static_cast<int>(type)].c_str(); }
 constexpr SamplerType kSamplers[2] = {SamplerType::Independent, SamplerType::Sobol};
-
-void write_csv(const std::string& path, const std::string& text) {
-  std::ofstream out(path);
-  out << text;
-  if (!out) throw Error(path + ": cannot write");
-  std::printf("wrote %s\n", path.c_str());
-}
 
 TraceParams with_sampler(TraceParams params, SamplerType type, uint64_t seed) {
   params.sampler = type;
@@ -110,7 +104,9 @@ void run_sampler_error_bench(const SamplerBenchSetup& b, int reference_spp, cons
   for (size_t k = 0; k < spps.size() && k < kMaxSpps; ++k)
     std::printf("%d spp: sobol / independent NRMSE %.3f, LV %.3f, HV %.3f\n", spps[k], nrmse[1][0][k] / nrmse[0][0][k],
                 nrmse[1][1][k] / nrmse[0][1][k], nrmse[1][2][k] / nrmse[0][2][k]);
-  write_csv(b.out + "/sampler_error_" + b.scene_name + ".csv", csv.str());
+  const std::string csv_path = b.out + "/sampler_error_" + b.scene_name + ".csv";
+  write_bench_text(csv_path, csv.str());
+  std::printf("wrote %s\n", csv_path.c_str());
   std::printf("where the squared error sits, summed over the seeds (%% of the unfiltered image's): LV's and HV's\n"
               "own; of LV's, the pixels that see an emitter (its edges); of HV's, each image's worst 1 %% of pixels\n");
   std::printf("%-12s %6s %10s %16s %10s %16s\n", "sampler", "spp", "LV", "emitter pixels", "HV", "worst 1 %");
@@ -190,7 +186,9 @@ void run_variance_ratio_bench(const SamplerBenchSetup& b, const std::vector<int>
           << single_fraction << "," << ratios.size() << "\n";
     }
   }
-  write_csv(b.out + "/variance_ratio_" + b.scene_name + ".csv", csv.str());
+  const std::string csv_path = b.out + "/variance_ratio_" + b.scene_name + ".csv";
+  write_bench_text(csv_path, csv.str());
+  std::printf("wrote %s\n", csv_path.c_str());
 }
 
 }  // namespace pxf
