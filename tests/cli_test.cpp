@@ -54,7 +54,8 @@ void write_half_rgba(const std::string& path, const std::vector<float>& rgb, int
 TEST(Cli, UsageErrorsExitWithCode2AndOneLine) {
   for (const char* args : {"", "bogus", "render --nope", "render --spp 0", "render --spp", "render --size 3",
                            "render --threshold -1", "render --filter gauss", "render --gl window", "bench --budgets 4,x",
-                           "bench --variants --subsampled-taps 0",
+                           "bench --variants --subsampled-taps 0", "bench --adaptive --motion",
+                           "bench --pathtracer --clean-cap 3",
                            "diff only-one.exr", "explore --sigma-s abc", "render --time 0", "render --time -3",
                            "render --time nan", "render --time 1e99", "render --time soon", "render --schedule x"}) {
     const Result r = run(args);
@@ -72,6 +73,24 @@ TEST(Cli, EveryCommandHasHelp) {
     EXPECT_NE(r.out.find("usage: pxf " + std::string(command)), std::string::npos) << command;
   }
   EXPECT_EQ(run("--help").code, 0);
+}
+
+// Each bench mode is its own entry point (app/bench_command.cpp): pxf bench --help lists them, a
+// mode's --help shows its own options and not another's, and an option of another mode is an error.
+TEST(Cli, BenchModesHaveTheirOwnOptions) {
+  const Result list = run("bench --help");
+  ASSERT_EQ(list.code, 0);
+  for (const char* mode : {"--pathtracer", "--sampler-error", "--variance-ratio", "--variants", "--stage-table",
+                           "--threshold-fidelity", "--guiding-ab", "--adaptive", "--demodulation-ab", "--motion"})
+    EXPECT_NE(list.out.find(std::string("\n  ") + mode + " "), std::string::npos) << mode;
+  const Result adaptive = run("bench --adaptive --help");
+  ASSERT_EQ(adaptive.code, 0);
+  EXPECT_NE(adaptive.out.find("usage: pxf bench --adaptive"), std::string::npos);
+  for (const char* own : {"--clean-cap", "--budgets", "--rounds", "--threshold", "--reference"})
+    EXPECT_NE(adaptive.out.find(own), std::string::npos) << own;
+  for (const char* other : {"--variant-spp", "--motion-frames", "--timed-frames"})
+    EXPECT_EQ(adaptive.out.find(other), std::string::npos) << other;
+  EXPECT_NE(run("bench --adaptive --variant-spp 3").err.find("--variant-spp"), std::string::npos);
 }
 
 TEST(Cli, SceneListPrintsTheBuiltins) {
