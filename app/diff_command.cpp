@@ -95,6 +95,7 @@ void write_display_images(const std::string& dir, const Image& test, const Image
 // range sigmas of the variance pooling), else the defaults.
 struct BlendSettings {
   PreviewSettings settings;  // what stats.json records (read_settings_json), the defaults for the rest
+  float frames = 0.0f;       // the run's sample count n (stats.json "spp"); 0: unknown
   std::string source = "the defaults";
 };
 BlendSettings blend_settings_of(const std::string& buffers_path) {
@@ -102,6 +103,7 @@ BlendSettings blend_settings_of(const std::string& buffers_path) {
   const std::optional<nlohmann::json> json = stats_beside(buffers_path);
   if (!json || !json->contains("settings")) return b;
   read_settings_json((*json)["settings"], b.settings);
+  b.frames = (*json)["settings"].value("spp", 0.0f);
   b.source = stats_path_beside(buffers_path);
   return b;
 }
@@ -117,6 +119,20 @@ const Image& layer_of(const std::vector<Layer>& layers, const std::string& name,
 void print_error_line(const char* label, const Image& test, const Image& reference, const DisplayMetricOptions& o) {
   const DisplayMetrics m = compare_display(test, reference, nullptr, o);
   std::printf("%s: HDR NRMSE %.4f %%  display NRMSE %.4f %%\n", label, m.hdr.nrmse_percent, m.display_nrmse_percent);
+}
+
+// L_lv with each pixel's threshold factor as its alpha, as the preview uploads it for an adaptive
+// render (Preview::upload): the pixel's threshold t_{n_p} (its own count, the samples layer)
+// against the run's t_n.
+Image with_threshold_factors(const Image& lv, const Image& samples, float threshold, float t_run) {
+  Image out = Image::rgba(lv.width, lv.height);
+  for (int y = 0; y < lv.height; ++y)
+    for (int x = 0; x < lv.width; ++x) {
+      for (int c = 0; c < 3; ++c) out.at(x, y, c) = lv.at(x, y, c);
+      const float t_pixel = effective_threshold(threshold, static_cast<uint64_t>(samples.at(x, y, 0)));
+      out.at(x, y, 3) = t_run > 0.0f ? t_pixel / t_run : 1.0f;
+    }
+  return out;
 }
 
 // --perfect-filter: where TEST's error comes from. The blend is run again on TEST's own buffers
@@ -138,14 +154,17 @@ void print_perfect_filter(const std::string& test_path, const std::string& refer
                 ", " + test_path + ": " + std::to_string(hv.width) + "x" + std::to_string(hv.height));
   const BlendSettings read = blend_settings_of(test_path);
   const PreviewSettings& settings = read.settings;
-  const float spp = samples.pixels.empty() ? 0.0f : *std::max_element(samples.pixels.begin(), samples.pixels.end());
+  const float spp = read.frames > 0.0f ? read.frames
+                    : samples.pixels.empty() ? 0.0f
+                                             : *std::max_element(samples.pixels.begin(), samples.pixels.end());
   const float t = effective_threshold(settings.threshold, static_cast<uint64_t>(spp));
   FilterOutput perfect;
   perfect.filtered = ref_hv;
   perfect.variance = Image::gray(hv.width, hv.height);
-  const BlendOutput blended =
-      cpu_blend(lv, hv, layer_of(test, "var_u", test_path), &perfect, t, BlendParams{range_weights(settings.filter), false, spp},
-                &layer_of(test, "range_color", test_path), &layer_of(test, "depth", test_path));
+  const Image lv_with_factors = settings.adaptive ? with_threshold_factors(lv, samples, settings.threshold, t) : lv;
+  const BlendOutput blended = cpu_blend(lv_with_factors, hv, layer_of(test, "var_u", test_path), &perfect, t,
+                                        BlendParams{range_weights(settings.filter), false, spp},
+                                        &layer_of(test, "range_color", test_path), &layer_of(test, "depth", test_path));
   std::printf("perfect filter: t %g (%g at %.0f spp), sigma_c %g, sigma_d %g from %s\n", settings.threshold, t, spp,
               settings.filter.sigma_c, settings.filter.sigma_d, read.source.c_str());
   print_error_line("blend with a perfect filter", blended.final_rgb, ref_final, display);
