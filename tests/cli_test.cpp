@@ -541,6 +541,15 @@ TEST(Cli, DiffPerfectFilterBlendsTheTestBuffersWithTheReferenceHv) {
                 number_after(r.out, dir == keep ? "unfiltered (lv + hv):" : "lv + reference hv:", "HDR NRMSE "), 1e-4)
         << r.out;
   }
+  // An adaptive render: the run's n is its frame count (stats.json), each pixel's threshold its own
+  // count's, though the samples layer holds counts above n.
+  const std::string adaptive = temp_dir("perfect_adaptive");
+  ASSERT_EQ(run("render --size 40x40 --spp 48 --adaptive on --quiet --out " + adaptive).code, 0);
+  const Image counts = read_exr(adaptive + "/buffers.exr", "samples");
+  EXPECT_GT(*std::max_element(counts.pixels.begin(), counts.pixels.end()), 48.0f);
+  const Result adaptive_run = run("diff " + adaptive + "/buffers.exr " + ref + "/buffers.exr --perfect-filter");
+  ASSERT_EQ(adaptive_run.code, 0) << adaptive_run.err;
+  EXPECT_NE(adaptive_run.out.find(" at 48 spp)"), std::string::npos) << adaptive_run.out;
   // A final.exr has no buffers: a clear error naming the file and the layer.
   const Result bad = run("diff " + keep + "/final.exr " + ref + "/buffers.exr --perfect-filter");
   EXPECT_EQ(bad.code, 1);
