@@ -119,10 +119,11 @@ class Explorer {
       const bool run_done =
           (options_.spp <= 0 && options_.time_s <= 0) || (finished_ && !tracing_ && !preview_->passes_pending());
       const bool last = options_.frames > 0 && frame + 1 >= options_.frames && run_done;
-      if (last) finish_run();
       // The longest display frame before the swap (which may wait for vsync), from the third
-      // traced frame on: the first runs of each pass include compiling its shaders.
+      // traced frame on: the first runs of each pass include compiling its shaders. Before the
+      // last frame's capture and screenshot, which are not a display frame's work.
       if (frames_traced_ > 2) longest_frame_ms_ = std::max(longest_frame_ms_, ms_between(frame_start, Clock::now()));
+      if (last) finish_run();
       context_.present();
       if (last) break;
     }
@@ -749,8 +750,8 @@ class Explorer {
       write_png(options_.screenshot, read_window(window_width_, window_height_));
       std::string cases;
       for (uint32_t n : shown_case_counts_) cases += " " + std::to_string(n);
-      std::fprintf(stderr, "pxf explore: wrote %s (its status line counts the blend cases%s)\n",
-                   options_.screenshot.c_str(), cases.c_str());
+      std::fprintf(stderr, "pxf explore: wrote %s (its status line counts the blend cases%s; longest display frame %.0f ms)\n",
+                   options_.screenshot.c_str(), cases.c_str(), longest_frame_ms_);
     }
   }
 

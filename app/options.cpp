@@ -1,8 +1,7 @@
 #include "app/options.h"
 
-#include <string>
-
 #include <cstdio>
+#include <string>
 
 #include "app/setting_table.h"
 #include "gl/context.h"
