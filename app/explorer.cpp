@@ -275,7 +275,31 @@ class Explorer {
     if (p.blended) blend_decision_lines(p.blend);
     else ImGui::TextDisabled("(not blended yet)");
     ImGui::Text("range     %.3f %.3f %.3f   depth %.4g", p.guide.r, p.guide.g, p.guide.b, p.guide.a);
+    material_lines(p.surface);
     ImGui::EndTooltip();
+  }
+
+  // The material under the pixel and the lobes its BSDF samples there (ProgressiveRenderer::surface_material).
+  static void material_lines(const SurfaceMaterial& m) {
+    if (!m.hit) {
+      ImGui::TextDisabled("material  (none: the environment)");
+      return;
+    }
+    ImGui::Text("material  %s", m.material.c_str());
+    ImGui::Text("  base %.3f %.3f %.3f  metallic %.2f  roughness %.2f", m.base_color.r, m.base_color.g, m.base_color.b,
+                m.metallic, m.roughness);
+    if (m.transmission > 0.0f) ImGui::Text("  transmission %.2f  ior %.3f", m.transmission, m.ior);
+    if (m.clearcoat > 0.0f) ImGui::Text("  clearcoat %.2f  roughness %.2f", m.clearcoat, m.clearcoat_roughness);
+    if (m.sheen_color != glm::vec3(0.0f))
+      ImGui::Text("  sheen %.3f %.3f %.3f  roughness %.2f", m.sheen_color.r, m.sheen_color.g, m.sheen_color.b, m.sheen_roughness);
+    if (m.emission != glm::vec3(0.0f)) ImGui::Text("  emission %.4g %.4g %.4g", m.emission.r, m.emission.g, m.emission.b);
+    std::string lobes = "  lobes";
+    for (const SurfaceLobe& lobe : m.lobes) {
+      char part[64];
+      std::snprintf(part, sizeof part, "  %s %.2f%s", lobe.name.c_str(), lobe.probability, lobe.delta ? " (delta)" : "");
+      lobes += part;
+    }
+    ImGui::TextUnformatted(m.lobes.empty() ? "  lobes  none (black)" : lobes.c_str());
   }
 
   // The blend's inputs and decision at the pixel, as the last blend run made them (pooled u, the

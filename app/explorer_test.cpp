@@ -250,7 +250,7 @@ TEST(ExplorerInspector, ShowsTheBlendPassDecisionAtEveryPixel) {
   Preview preview(scene, PreviewSettings{}, kW, kH);
   for (int i = 0; i < kFrames; ++i) preview.add_frame(i + 1 == kFrames);
   const Image s = preview.blend().s_image(), cases = preview.blend().case_image();
-  int compared = 0, decided_by_pooling = 0;
+  int compared = 0, decided_by_pooling = 0, surfaces = 0, delta_surfaces = 0;
   for (int y = 0; y < kH; ++y)
     for (int x = 0; x < kW; ++x) {
       SCOPED_TRACE(testing::Message() << "pixel " << x << "," << y);
@@ -261,6 +261,9 @@ TEST(ExplorerInspector, ShowsTheBlendPassDecisionAtEveryPixel) {
       EXPECT_EQ(shown.blend_case, static_cast<int>(cases.at(x, y, 0)));
       EXPECT_NEAR(shown.s, s.at(x, y, 0), 1e-4f);
       EXPECT_EQ(probe.final_s.a, s.at(x, y, 0));
+      // The material under the pixel (the box, or beside it at this aspect the background) and its lobes.
+      surfaces += probe.surface.hit;
+      for (const SurfaceLobe& lobe : probe.surface.lobes) delta_surfaces += lobe.delta && lobe.probability == 1.0f;
       if (!shared::blend_compares_variances(probe.blend.texels, probe.blend.switches)) continue;
       ++compared;
       shared::BlendVarianceInputs own = probe.blend.variance_inputs;
@@ -269,6 +272,8 @@ TEST(ExplorerInspector, ShowsTheBlendPassDecisionAtEveryPixel) {
       decided_by_pooling += std::abs(s_own - s.at(x, y, 0)) > 0.01f;
     }
   EXPECT_GT(compared, kW * kH / 4) << "too few pixels whose variances the blend compared";
+  EXPECT_GT(surfaces, kW * kH / 2);
+  EXPECT_GT(delta_surfaces, 10) << "the mirror and glass spheres' pixels show a delta lobe";
   EXPECT_GT(decided_by_pooling, 0) << "no pixel whose s the pooled variance changed: the test cannot tell an "
                                       "inspector that uses the pixel's own variance";
 }

@@ -12,6 +12,7 @@ PixelProbe probe_pixel(const Preview& preview, const std::vector<uint32_t>& samp
   p.guide = preview.range().guide().texel(x, y);
   p.blended = preview.blend().has_run();
   if (p.blended) p.blend = preview.blend().inspect(x, y);
+  p.surface = preview.renderer().surface_material(x, y);
   return p;
 }
 

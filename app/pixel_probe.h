@@ -1,7 +1,7 @@
 // What the explorer's pixel inspector shows of one pixel: the buffers there and the blend's
 // decision as the last blend run made it (BlendPass::inspect: the shared blend_pixel on the texels
-// the pass read, so pooled u, t_n, s, f and the case are the ones the image was made with). GL
-// only, no ImGui, so it can be tested headless.
+// the pass read, so pooled u, t_n, s, f and the case are the ones the image was made with), and the
+// material under it with its BSDF's lobes. GL only, no ImGui, so it can be tested headless.
 #pragma once
 #include <cstdint>
 #include <vector>
@@ -18,6 +18,7 @@ struct PixelProbe {
   glm::vec4 guide{0.0f};    // the range buffer: rgb range color, a distance
   bool blended = false;     // the blend has run (else `blend` is empty)
   BlendInspection blend;    // L_u, L_lv, L_f and their variances, the run's switches and the decision
+  SurfaceMaterial surface;  // the material the pixel's centre ray meets first, and its lobes
 };
 
 // `samples`: the paths per pixel (a snapshot of Preview::pixel_samples(), row-major); 0 outside it.

@@ -458,4 +458,14 @@ bool Bsdf::sample_smooth_glass(glm::vec2 u, BsdfSample* out) const {
   return true;
 }
 
+std::vector<SurfaceLobe> Bsdf::lobes() const {
+  const SurfaceLobe all[] = {{"diffuse", p_diffuse_, false}, {"glossy", p_glossy_, glossy_delta_},
+                             {"sheen", p_sheen_, false},      {"clearcoat", p_coat_, coat_delta_},
+                             {"glass", p_glass_, glass_delta_}};
+  std::vector<SurfaceLobe> picked;
+  for (const SurfaceLobe& lobe : all)
+    if (lobe.probability > 0.0f) picked.push_back(lobe);
+  return picked;
+}
+
 }  // namespace pxf

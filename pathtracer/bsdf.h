@@ -12,7 +12,10 @@
 // delta lobes (a mirror, smooth glass). Lobes are picked stochastically by their albedo at wo;
 // pdf() is the combined pdf of the non-delta lobes.
 #pragma once
+#include <vector>
+
 #include <glm/glm.hpp>
+#include "pathtracer/pathtracer.h"  // SurfaceLobe
 #include "pathtracer/sampling.h"
 #include "pathtracer/scene.h"
 
@@ -117,6 +120,9 @@ class Bsdf {
   }
   bool is_black() const { return black_; }
   glm::vec3 shading_normal() const { return frame_.n; }
+  // The lobes sample() picks from, each with its probability and whether it is a delta lobe (the
+  // explorer's inspector shows them: ProgressiveRenderer::surface_material).
+  std::vector<SurfaceLobe> lobes() const;
 
  private:
   glm::vec3 eval_local(glm::vec3 wi, float* pdf) const;

@@ -662,6 +662,34 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
   return true;
 }
 
+SurfaceMaterial PathTracer::surface_material(const Ray& camera_ray) const {
+  SurfaceMaterial out;
+  const Hit hit = geometry_.intersect(camera_ray);
+  if (!hit.valid()) return out;
+  const Scene& scene = geometry_.scene();
+  const SurfacePoint sp = geometry_.surface_point(hit, camera_ray);
+  const Material& material = *sp.material;
+  const size_t index = static_cast<size_t>(sp.material - scene.materials.data());
+  const BsdfParams p = eval_material(scene, material, sp.uv0, sp.uv1, sp.color);
+  out.hit = true;
+  out.material = material.name.empty() ? "material " + std::to_string(index) : material.name;
+  out.base_color = p.base_color;
+  out.metallic = p.metallic;
+  out.roughness = p.roughness;
+  out.transmission = p.transmission;
+  out.ior = p.ior;
+  out.clearcoat = p.clearcoat;
+  out.clearcoat_roughness = p.clearcoat_roughness;
+  out.sheen_color = p.sheen_color;
+  out.sheen_roughness = p.sheen_roughness;
+  if (emission_visible(material, sp)) out.emission = eval_emission(scene, material, sp.uv0, sp.uv1);
+  BsdfMaterial scratch;
+  const Bsdf bsdf(bsdf_material_at(sp, &scratch), sp.shading_normal, sp.geometric_normal, -camera_ray.direction,
+                  sp.front_face, sp.clearcoat_normal);
+  if (!bsdf.is_black()) out.lobes = bsdf.lobes();
+  return out;
+}
+
 bool PathTracer::first_hit_is_emissive(const Ray& camera_ray) const {
   const Hit hit = geometry_.intersect(camera_ray);
   if (!hit.valid()) return false;

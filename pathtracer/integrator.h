@@ -91,6 +91,8 @@ class PathTracer {
                                const TraceParams& params, PathSample* out, HvSampleClass* classes) const;
 
   SpecularChainHit trace_specular_chain(const Ray& camera_ray) const;
+  // The material the ray meets first (ProgressiveRenderer::surface_material).
+  SurfaceMaterial surface_material(const Ray& camera_ray) const;
   // The ray's first surface emits toward it (the emission the path tracer adds at vertex 1).
   bool first_hit_is_emissive(const Ray& camera_ray) const;
 

@@ -68,6 +68,52 @@ Scene sphere_in_furnace(const Material& material) {
 // along its normal. Every camera ray crosses exactly the slab's thickness d inside the medium and
 // neither refracts nor reflects, so each pixel is exactly the Beer-Lambert transmittance
 // exp(-sigma d) times the uniform sky, per channel.
+// The explorer's inspector shows the material under a pixel with the lobes its BSDF samples there
+// (ProgressiveRenderer::surface_material): cornell's mirror, glass, walls and light, a clear-coated
+// sphere's two lobes, and nothing where the ray leaves the scene.
+TEST(Integrator, SurfaceMaterialNamesTheLobesUnderAPixel) {
+  const Scene cornell = make_cornell_box(true);
+  ProgressiveRenderer renderer(cornell, TraceParams{}, 64, 64);
+  const auto lobes = [&](int x, int y) {
+    std::string text;
+    for (const SurfaceLobe& l : renderer.surface_material(x, y).lobes)
+      text += l.name + (l.delta ? " delta " : " ") + std::to_string(l.probability).substr(0, 4) + ";";
+    return text;
+  };
+  EXPECT_EQ(renderer.surface_material(22, 45).material, "mirror");
+  EXPECT_EQ(lobes(22, 45), "glossy delta 1.00;");
+  EXPECT_EQ(renderer.surface_material(43, 47).material, "glass");
+  EXPECT_FLOAT_EQ(renderer.surface_material(43, 47).transmission, 1.0f);
+  EXPECT_EQ(lobes(43, 47), "glass delta 1.00;");
+  const SurfaceMaterial red = renderer.surface_material(5, 32);
+  EXPECT_EQ(lobes(5, 32), "diffuse 1.00;");
+  EXPECT_GT(red.base_color.r, 5.0f * red.base_color.g);
+  const SurfaceMaterial light = renderer.surface_material(32, 4);
+  EXPECT_TRUE(light.hit);
+  EXPECT_GT(light.emission.r, 1.0f);
+  EXPECT_TRUE(light.lobes.empty());  // a black BSDF: the emitter only emits
+  EXPECT_FALSE(renderer.surface_material(64, 0).hit);  // outside the image
+
+  Scene coated;
+  Material m = make_diffuse(glm::vec3(0.5f));
+  m.clearcoat = 1.0f;
+  m.clearcoat_roughness = 0.3f;
+  m.name = "varnish";
+  coated.materials = {m};
+  coated.meshes.push_back(make_sphere(glm::vec3(0.0f), 0.5f, 0));
+  coated.camera = look_at_camera(glm::vec3(0, 0, 3.0f), glm::vec3(0), glm::vec3(0, 1, 0), 0.75f);
+  ProgressiveRenderer sphere(coated, TraceParams{}, 32, 32);
+  const SurfaceMaterial centre = sphere.surface_material(16, 16);
+  EXPECT_EQ(centre.material, "varnish");
+  EXPECT_FLOAT_EQ(centre.clearcoat, 1.0f);
+  ASSERT_EQ(centre.lobes.size(), 2u);
+  EXPECT_EQ(centre.lobes[0].name, "diffuse");
+  EXPECT_EQ(centre.lobes[1].name, "clearcoat");
+  EXPECT_FALSE(centre.lobes[1].delta);
+  EXPECT_NEAR(centre.lobes[0].probability + centre.lobes[1].probability, 1.0f, 1e-5f);
+  EXPECT_FALSE(sphere.surface_material(0, 0).hit);  // the environment
+}
+
 TEST(Integrator, AbsorbingSlabTransmitsBeerLambert) {
   const glm::vec3 sigma(0.5f, 1.0f, 2.0f);
   for (float d : {0.1f, 0.7f, 2.0f}) {

@@ -136,6 +136,26 @@ struct SpecularChainHit {
   bool hit = false;       // false: the chain escaped (the range pass uses the background distance)
 };
 
+// The material under a pixel as the path tracer shades the camera ray's first surface (the
+// explorer's inspector, issue 35): its evaluated parameters there (textures and vertex colour
+// applied) and the lobes its BSDF samples from, each with the probability sample() picks it.
+struct SurfaceLobe {
+  std::string name;  // diffuse, glossy, sheen, clearcoat, glass
+  float probability = 0.0f;
+  bool delta = false;  // perfectly specular: a mirror direction, which the range buffer follows
+};
+struct SurfaceMaterial {
+  bool hit = false;  // false: the ray left the scene (the environment)
+  std::string material;  // the glTF material's name, else "material N"
+  glm::vec3 base_color{0.0f};
+  float metallic = 0.0f, roughness = 0.0f, transmission = 0.0f, ior = 1.5f;
+  float clearcoat = 0.0f, clearcoat_roughness = 0.0f;
+  glm::vec3 sheen_color{0.0f};
+  float sheen_roughness = 0.0f;
+  glm::vec3 emission{0.0f};  // toward the camera (0 from the back of a one-sided emitter)
+  std::vector<SurfaceLobe> lobes;
+};
+
 // Per-pixel accumulations, row-major, top row first.
 struct Accumulation {
   int width = 0, height = 0;
@@ -264,6 +284,8 @@ class ProgressiveRenderer {
   // True when a perfectly specular surface is directly visible somewhere (cheap check by the
   // caller's raster flag is preferred; this is what the renderer knows from its materials).
   bool scene_has_perfect_specular() const;
+  // The material the camera ray through the centre of pixel (x, y) meets first.
+  SurfaceMaterial surface_material(int x, int y) const;
   // Follows the specular chain for the camera rays through (x + jitter) of the given pixels.
   std::vector<SpecularChainHit> trace_specular_chains(const std::vector<uint32_t>& pixels, glm::vec2 jitter) const;
 

@@ -360,6 +360,13 @@ std::vector<float> ProgressiveRenderer::variance_of_mean() const {
 bool ProgressiveRenderer::scene_has_perfect_specular() const { return impl_->tracer->has_perfect_specular(); }
 bool ProgressiveRenderer::scene_is_dark() const { return impl_->tracer->dark(); }
 
+SurfaceMaterial ProgressiveRenderer::surface_material(int x, int y) const {
+  const int w = impl_->width, h = impl_->height;
+  if (x < 0 || y < 0 || x >= w || y >= h) return SurfaceMaterial{};
+  return impl_->tracer->surface_material(
+      camera_ray(impl_->camera, w, h, static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f));
+}
+
 std::vector<SpecularChainHit> ProgressiveRenderer::trace_specular_chains(const std::vector<uint32_t>& pixels,
                                                                          glm::vec2 jitter) const {
   std::vector<SpecularChainHit> hits(pixels.size());
