@@ -290,7 +290,7 @@ glm::vec3 Bsdf::eval_local(glm::vec3 wi, float* pdf) const {
       *pdf += glossy_pdf_scale_ * d;  // VNDF: G1(wo) D / (4 cos_o)
     }
     if (glass) {  // reflected with probability F(wo.h) of the sampled microfacet
-      float fresnel = fresnel_dielectric(cos_oh, eta());
+      float fresnel = glass_fresnel(cos_oh);
       f += glm::vec3(c_glass_ * fresnel * spec);
       *pdf += p_glass_ * fresnel * g1_o_ * d * inv_4cos_o_;
     }
@@ -309,7 +309,7 @@ glm::vec3 Bsdf::eval_glass_transmission(glm::vec3 wi, float* pdf) const {
   if (h.z < 0.0f) h = -h;
   const float cos_oh = glm::dot(wo_local_, h), cos_ih = glm::dot(wi, h);
   if (cos_oh <= 0.0f || cos_ih >= 0.0f) return glm::vec3(0.0f);  // a microfacet seen from its back
-  const float transmitted = 1.0f - fresnel_dielectric(cos_oh, eta);
+  const float transmitted = 1.0f - glass_fresnel(cos_oh);
   const float denom = cos_ih + cos_oh / eta;
   const float jacobian = -cos_ih / (denom * denom);  // d omega_h / d omega_i
   if (!(transmitted > 0.0f) || !std::isfinite(jacobian)) return glm::vec3(0.0f);
@@ -413,6 +413,18 @@ bool Bsdf::sample_coat(glm::vec2 u, BsdfSample* out) const {
   return wi.z > 0.0f && finish_nondelta_sample(coat_frame_.to_world(wi), false, out);
 }
 
+// Built with PXF_CYCLES_GLASS_FRESNEL (CMake option, scripts/cycles_compare.sh only), the split
+// between reflection and refraction is Cycles 3.x's Glass BSDF's instead: the Fresnel of the macro
+// normal, F(wo.n), for every microfacet. docs/materials.md compares the two against Cycles.
+float Bsdf::glass_fresnel(float cos_oh) const {
+#ifdef PXF_CYCLES_GLASS_FRESNEL
+  static_cast<void>(cos_oh);
+  return fresnel_dielectric(wo_local_.z, eta());
+#else
+  return fresnel_dielectric(cos_oh, eta());
+#endif
+}
+
 // A visible microfacet normal, then reflection with probability F(wo.h), else refraction through it.
 bool Bsdf::sample_rough_glass(float u_choice, glm::vec2 u, BsdfSample* out) const {
   const glm::vec3& wo = wo_local_;
@@ -420,7 +432,7 @@ bool Bsdf::sample_rough_glass(float u_choice, glm::vec2 u, BsdfSample* out) cons
   const float cos_oh = glm::dot(wo, h);
   if (!(cos_oh > 0.0f)) return false;
   const float eta = this->eta();
-  if (u_choice < fresnel_dielectric(cos_oh, eta)) {
+  if (u_choice < glass_fresnel(cos_oh)) {
     const glm::vec3 wi = glm::reflect(-wo, h);
     return wi.z > 0.0f && finish_nondelta_sample(frame_.to_world(wi), false, out);
   }

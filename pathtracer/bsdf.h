@@ -140,6 +140,8 @@ class Bsdf {
   bool sample_rough_glass(float u_choice, glm::vec2 u, BsdfSample* out) const;
   bool finish_nondelta_sample(glm::vec3 wi, bool transmitted, BsdfSample* out) const;
   float eta() const { return front_face_ ? ior_ : 1.0f / ior_; }  // eta_t / eta_i across the surface
+  // The rough glass's Fresnel reflectance at a microfacet seen at cos_oh (Walter et al. 2007).
+  float glass_fresnel(float cos_oh) const;
 
   Frame frame_{};
   glm::vec3 ng_{0.0f};      // geometric normal on wo's side

@@ -12,7 +12,9 @@ Two modes, driven by scripts/cycles_compare.sh:
 
 The materials (glTF roughness r, GGX alpha = r^2 in both renderers):
   glass-0.1, glass-0.3: KHR_materials_transmission 1, ior 1.5, alpha 0.1 / 0.3; in Cycles a Glass
-      BSDF with GGX (single scattering, as pxf's Walter et al. BSDF, docs/materials.md).
+      BSDF with GGX (single scattering, as pxf's Walter et al. BSDF, docs/materials.md; Cycles 3.x
+      splits reflection and refraction by the Fresnel of the macro normal, pxf by each microfacet's,
+      so DIR/pxf-cycles-fresnel/final.exr, from a build with Cycles' split, is compared too).
   metal-0.49: metallic 1, base colour (0.95, 0.64, 0.54), alpha 0.49; in Cycles the Principled BSDF
       with Multiscatter GGX (pxf compensates the lost energy, Turquin 2019).
 The floor: base colour 0.5 with KHR_materials_specular 0 (pure Lambert in pxf); in Cycles a Diffuse
@@ -191,7 +193,17 @@ def render_and_compare(case, out, spp):
         pixels = np.array(image.pixels[:], dtype=np.float64).reshape(image.size[1], image.size[0], 4)[:, :, :3]
         return pixels
 
-    cycles, pxf = load(os.path.join(out, "cycles.exr")), load(os.path.join(out, "pxf", "final.exr"))
+    cycles = load(os.path.join(out, "cycles.exr"))
+    compare(case, out, cycles, load(os.path.join(out, "pxf", "final.exr")), "pxf", "compare.png")
+    # The glass cases again, from the build with Cycles 3.x's Fresnel split (scripts/cycles_compare.sh).
+    variant = os.path.join(out, "pxf-cycles-fresnel", "final.exr")
+    if os.path.exists(variant):
+        compare(case, out, cycles, load(variant), "pxf with Cycles' glass Fresnel", "compare-cycles-fresnel.png")
+
+
+def compare(case, out, cycles, pxf, label, picture_name):
+    import bpy
+    import numpy as np
     if cycles.shape != pxf.shape:
         sys.exit("sizes differ: cycles %s, pxf %s" % (cycles.shape, pxf.shape))
     mean_c, mean_p = cycles.mean(), pxf.mean()
@@ -204,11 +216,11 @@ def render_and_compare(case, out, spp):
     strip = np.concatenate([shown(pxf), shown(cycles), signed], axis=1)
     picture = bpy.data.images.new("compare", strip.shape[1], strip.shape[0], alpha=False)
     picture.pixels[:] = np.concatenate([strip, np.ones(strip.shape[:2] + (1,))], axis=2).ravel()
-    picture.filepath_raw = os.path.join(out, "compare.png")
+    picture.filepath_raw = os.path.join(out, picture_name)
     picture.file_format = "PNG"
     picture.save()
-    print("CYCLES-COMPARE %s: mean pxf %.5f, cycles %.5f (pxf / cycles %.4f); 16x16-block NRMSE %.2f %%"
-          % (case, mean_p, mean_c, mean_p / mean_c, 100.0 * block_nrmse))
+    print("CYCLES-COMPARE %s, %s: mean %.5f, cycles %.5f (ratio %.4f); 16x16-block NRMSE %.2f %%"
+          % (case, label, mean_p, mean_c, mean_p / mean_c, 100.0 * block_nrmse))
 
 
 if __name__ == "__main__":
