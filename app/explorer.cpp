@@ -100,6 +100,8 @@ class Explorer {
     started_ = Clock::now();
     for (int frame = 0; !context_.should_close(); ++frame) {
       const auto frame_start = Clock::now();
+      frame_start_ = frame_start;
+      frame_gl_work_ = false;
       glfwPollEvents();
       load_dropped_scenes();
       // Tracing and its passes before the panel is built: the status line and the case legend
@@ -112,9 +114,11 @@ class Explorer {
       panel();
       handle_keys();
       apply_changes();
+      const auto draw_start = Clock::now();
       render_views();
       ImGui::Render();
       draw_to_window();
+      ui_draw_ms_ = ms_between(draw_start, Clock::now());
       // --frames (tests): not before the --spp / --time capture is finished.
       const bool run_done =
           (options_.spp <= 0 && options_.time_s <= 0) || (finished_ && !tracing_ && !preview_->passes_pending());
@@ -597,8 +601,20 @@ class Explorer {
     if (camera_changed_ && tracing_ && !settings_.motion_history) stop_tracing(/*cancel=*/true);
     if (tracing_ || preview_->passes_pending()) return;
     const bool camera = camera_changed_;
-    if (camera_changed_)
+    if (camera_changed_) {
+      // With the history a camera change is GL work of its own (the view kept, a range-buffer
+      // frame, the reprojection): like a queued pass it waits for a later display frame when its
+      // last cost does not fit what is left of this one's budget. A display frame that waited for
+      // no traced frame and ran no pass always takes it; the next one is such a frame, since no
+      // frame is traced while a camera change waits.
+      if (settings_.motion_history &&
+          !step_fits_display_frame(ms_between(frame_start_, Clock::now()) + ui_draw_ms_, !frame_gl_work_,
+                                   camera_change_ms_))
+        return;
+      const auto start = Clock::now();
       preview_->set_camera(playing_path_ ? camera_on_path(path_, path_frame_, scene_->camera) : controller_->camera());
+      camera_change_ms_ = ms_between(start, Clock::now());
+    }
     camera_changed_ = false;
     const bool moving = fast_while_moving_ && (dragging_camera_ || flying_ || playing_path_);
     const bool settings = settings_changed_ || moving != applied_moving_;
@@ -657,10 +673,12 @@ class Explorer {
   void run_passes(double used_ms, bool fresh) {
     double gl_ms = 0;  // of the steps run
     for (int steps = 0; preview_->passes_pending(); ++steps) {
-      if (!step_fits_display_frame(used_ms + gl_ms, fresh && steps == 0, preview_->predict_pass_ms(preview_->next_pass())))
+      if (!step_fits_display_frame(used_ms + gl_ms + ui_draw_ms_, fresh && steps == 0,
+                                   preview_->predict_pass_ms(preview_->next_pass())))
         break;
       const auto start = Clock::now();
       preview_->run_next_pass();
+      frame_gl_work_ = true;
       gl_ms += ms_between(start, Clock::now());
     }
   }
@@ -676,6 +694,7 @@ class Explorer {
         if (trace_result_.wait_for(wait) != std::future_status::ready) break;
         stop_tracing(/*cancel=*/false);
         fresh = false;
+        frame_gl_work_ = true;
       }
       run_passes(used_ms(), fresh);
       fresh = false;
@@ -808,6 +827,10 @@ class Explorer {
   bool playing_path_ = false;
   long frames_traced_ = 0;             // in all, camera moves included
   double longest_frame_ms_ = 0;        // longest display frame (the UI budget, kUiBudgetMs)
+  Clock::time_point frame_start_{};    // of the display frame being built
+  double camera_change_ms_ = 0;        // the last camera change's GL work (apply_changes)
+  bool frame_gl_work_ = false;         // this display frame waited for a traced frame or ran a pass
+  double ui_draw_ms_ = 0;              // the last display frame's views and window drawing, after the GL steps
   std::string out_dir_, scene_path_, scene_error_, status_message_;
   Clock::time_point started_;
   Clock::time_point accumulation_start_ = Clock::now();

@@ -1,9 +1,12 @@
 // The explorer's frame budget: no display frame blocks the UI for longer than kUiBudgetMs. The
 // path tracer runs on a worker thread (Preview::trace_frame), so what blocks the UI thread is the GL
 // work after each traced frame: one range-buffer frame, a filter run, the blend and tone map
-// (Preview::queue_passes). These steps are spread over display frames: each display frame runs the
-// queued steps whose predicted costs, added to the UI's own work, still fit the budget. A pure
-// function of the predicted costs, so it is tested with a fake clock (app/frame_budget_test.cpp).
+// (Preview::queue_passes), and, with the reprojected history, each camera change (the view kept, a
+// range-buffer frame, the reprojection: Preview::set_camera). These steps are spread over display
+// frames: each display frame runs the queued steps whose predicted costs (a camera change's: the
+// last one's), added to the UI's own work (the last frame's drawing of the views and the window),
+// still fit the budget. A pure function of the predicted costs, so it is tested with a fake clock
+// (app/frame_budget_test.cpp).
 #pragma once
 #include <vector>
 
