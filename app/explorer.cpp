@@ -36,6 +36,9 @@ using Clock = std::chrono::steady_clock;
 
 constexpr float kPanelWidth = 430.0f;
 constexpr double kTraceBudgetMs = 30.0;  // path tracing per displayed frame when it is fast
+// A GL step's predicted cost is its last one; the same step varies by about a third from frame to
+// frame (a filter run or a camera change at 512^2: 28-41 ms), so the budget counts it this much larger.
+constexpr double kPredictionMargin = 1.3;
 constexpr size_t kPlotLength = 600;
 constexpr float kDividerGrabPixels = 6.0f;
 
@@ -609,7 +612,7 @@ class Explorer {
       // frame is traced while a camera change waits.
       if (settings_.motion_history &&
           !step_fits_display_frame(ms_between(frame_start_, Clock::now()) + ui_draw_ms_, !frame_gl_work_,
-                                   camera_change_ms_))
+                                   kPredictionMargin * camera_change_ms_))
         return;
       const auto start = Clock::now();
       preview_->set_camera(playing_path_ ? camera_on_path(path_, path_frame_, scene_->camera) : controller_->camera());
@@ -674,7 +677,7 @@ class Explorer {
     double gl_ms = 0;  // of the steps run
     for (int steps = 0; preview_->passes_pending(); ++steps) {
       if (!step_fits_display_frame(used_ms + gl_ms + ui_draw_ms_, fresh && steps == 0,
-                                   preview_->predict_pass_ms(preview_->next_pass())))
+                                   kPredictionMargin * preview_->predict_pass_ms(preview_->next_pass())))
         break;
       const auto start = Clock::now();
       preview_->run_next_pass();
