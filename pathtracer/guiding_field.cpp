@@ -32,7 +32,7 @@ constexpr int kMaxSpatialDepth = 60;  // 20 halvings per axis: cells of a millio
 constexpr double kBelowOne = 0x1.fffffffffffffp-1;
 constexpr float kBelowOneF = 0x1.fffffep-1f;
 constexpr char kMagic[8] = {'P', 'X', 'F', 'G', 'U', 'I', 'D', 'E'};
-constexpr uint32_t kFormatVersion = 1;
+constexpr uint32_t kFormatVersion = 2;
 constexpr int kMaxIterations = 1 << 20;
 
 static_assert(sizeof(GuidingSamplingNode) == 24 && sizeof(GuidingBuildingNode) == 40, "the paper's compact nodes");
@@ -208,9 +208,17 @@ std::vector<GuidingBuildingNode> refined_tree(const std::vector<GuidingBuildingN
   return tree;
 }
 
-size_t leaf_bytes(const GuidingLeaf& leaf) {
+// What a leaf's lobes and reservoir may take, counted whether they hold it yet or not (the lobes
+// are refitted and the reservoir fills every iteration).
+size_t lobe_reserve_bytes(const GuidingSettings& settings) {
+  return settings.parallax_lobes > 0 ? settings.parallax_lobes * sizeof(GuidingLobe) +
+                                           settings.lobe_records * sizeof(GuidingLobeRecord)
+                                     : 0;
+}
+
+size_t leaf_bytes(const GuidingLeaf& leaf, const GuidingSettings& settings) {
   return sizeof(GuidingLeaf) + leaf.sampling.size() * sizeof(GuidingSamplingNode) +
-         leaf.building.size() * sizeof(GuidingBuildingNode);
+         leaf.building.size() * sizeof(GuidingBuildingNode) + lobe_reserve_bytes(settings);
 }
 
 uint32_t float_bits(float f) {
@@ -221,8 +229,12 @@ uint32_t float_bits(float f) {
 
 // A total order: equal records are identical, so any order of arrival sorts to the same sequence.
 bool record_before(const GuidingRecord& a, const GuidingRecord& b) {
-  return std::make_tuple(a.leaf, a.key, float_bits(a.u), float_bits(a.v), float_bits(a.energy)) <
-         std::make_tuple(b.leaf, b.key, float_bits(b.u), float_bits(b.v), float_bits(b.energy));
+  const auto bits = [](const GuidingRecord& r) {
+    return std::make_tuple(r.leaf, r.key, float_bits(r.u), float_bits(r.v), float_bits(r.energy), float_bits(r.position.x),
+                           float_bits(r.position.y), float_bits(r.position.z), float_bits(r.source.x),
+                           float_bits(r.source.y), float_bits(r.source.z), r.kind);
+  };
+  return bits(a) < bits(b);
 }
 
 bool non_negative_finite(double x) { return x >= 0.0 && std::isfinite(x); }
@@ -282,6 +294,70 @@ std::vector<Node> get_tree(ByteReader& r, int max_level, const char* what) {
   return tree;
 }
 
+void put_vec3(ByteWriter& w, const glm::vec3& v) {
+  for (int a = 0; a < 3; ++a) w.put(v[a]);
+}
+
+glm::vec3 get_vec3(ByteReader& r, const char* what) {
+  glm::vec3 v;
+  for (int a = 0; a < 3; ++a) {
+    v[a] = r.get<float>(what);
+    if (!std::isfinite(v[a])) throw Error(std::string("guiding field has a non-finite point in its ") + what);
+  }
+  return v;
+}
+
+void put_lobes(ByteWriter& w, const GuidingLeaf& leaf) {
+  w.put(static_cast<uint64_t>(leaf.lobes.size()));
+  for (const GuidingLobe& lobe : leaf.lobes) {
+    put_vec3(w, lobe.direction);
+    put_vec3(w, lobe.source);
+    w.put(lobe.distance);
+    w.put(lobe.kappa);
+    w.put(lobe.share);
+  }
+  put_vec3(w, leaf.lobe_origin);
+  std::vector<GuidingLobeRecord> reservoir = leaf.reservoir;  // in key order: the bytes do not depend on arrival
+  std::sort(reservoir.begin(), reservoir.end(), [](const auto& a, const auto& b) { return a.key < b.key; });
+  w.put(static_cast<uint64_t>(reservoir.size()));
+  for (const GuidingLobeRecord& rec : reservoir) {
+    w.put(rec.key);
+    w.put(rec.priority);
+    put_vec3(w, rec.position);
+    put_vec3(w, rec.source);
+    w.put(rec.kind);
+  }
+}
+
+void get_lobes(ByteReader& r, const GuidingSettings& settings, GuidingLeaf* leaf) {
+  const size_t count = r.get_count(sizeof(GuidingLobe), "lobes");
+  if (count > size_t(settings.parallax_lobes)) throw Error("guiding field has more lobes than its settings allow");
+  leaf->lobes.resize(count);
+  for (GuidingLobe& lobe : leaf->lobes) {
+    lobe.direction = get_vec3(r, "lobes");
+    lobe.source = get_vec3(r, "lobes");
+    lobe.distance = r.get<float>("lobes");
+    lobe.kappa = r.get<float>("lobes");
+    lobe.share = r.get<float>("lobes");
+    if (std::abs(glm::length(lobe.direction) - 1.0f) > 1e-3f || !std::isfinite(lobe.distance) ||
+        !(lobe.kappa > 0.0f && lobe.kappa <= kMaxLobeKappa) || !(lobe.share >= 0.0f && lobe.share <= 1.0f))
+      throw Error("guiding field has an invalid lobe");
+  }
+  leaf->lobe_origin = get_vec3(r, "lobes");
+  const size_t records = r.get_count(sizeof(GuidingLobeRecord) / 2, "lobe records");
+  if (records > (settings.parallax_lobes > 0 ? settings.lobe_records : 0))
+    throw Error("guiding field has more lobe records than its settings allow");
+  leaf->reservoir.resize(records);
+  for (GuidingLobeRecord& rec : leaf->reservoir) {
+    rec.key = r.get<uint64_t>("lobe records");
+    rec.priority = r.get<float>("lobe records");
+    rec.position = get_vec3(r, "lobe records");
+    rec.source = get_vec3(r, "lobe records");
+    rec.kind = r.get<uint32_t>("lobe records");
+    if (!(rec.priority <= 0.0f) || rec.kind > kSourceAhead) throw Error("guiding field has an invalid lobe record");
+  }
+}
+
 }  // namespace
 
 GuidingField::GuidingField() : buffers_(std::make_unique<RecordBuffers>()) {}
@@ -320,11 +396,16 @@ void GuidingField::validate_settings() const {
     throw Error("guiding field energy threshold must be in (0, 1]");
   if (s.max_directional_depth < 1 || s.max_directional_depth > kMaxDirectionalDepth)
     throw Error("guiding field directional depth must be in 1.." + std::to_string(kMaxDirectionalDepth));
-  if (s.max_bytes < kMinBytes)
+  if (s.max_bytes < kMinBytes + lobe_reserve_bytes(s))
     throw Error("guiding field memory bound " + std::to_string(s.max_bytes) + " is below the minimum " +
-                std::to_string(kMinBytes));
+                std::to_string(kMinBytes + lobe_reserve_bytes(s)));
   if (!(s.uniform_fraction > 0.0f && s.uniform_fraction < 1.0f))
     throw Error("guiding field uniform fraction must be in (0, 1)");
+  if (s.parallax_lobes < 0 || s.parallax_lobes > kMaxGuidingLobes)
+    throw Error("guiding field lobe count must be in 0.." + std::to_string(kMaxGuidingLobes));
+  if (s.parallax_lobes > 0 && (s.lobe_records < kMinLobeRecords || s.lobe_records > (1u << 20)))
+    throw Error("guiding field lobe records must be in " + std::to_string(kMinLobeRecords) + ".." +
+                std::to_string(1u << 20));
 }
 
 uint32_t GuidingField::find_leaf(const glm::vec3& position, Box* leaf_box) const {
@@ -353,7 +434,7 @@ GuidingField::Box GuidingField::leaf_box(const glm::vec3& position) const {
 }
 
 void GuidingField::record(uint64_t key, const glm::vec3& position, const glm::vec3& direction, float radiance,
-                          float weight) {
+                          float weight, float distance) {
   if (!(radiance >= 0.0f) || !(weight >= 0.0f) || !std::isfinite(radiance) || !std::isfinite(weight)) return;
   if (!std::isfinite(position.x) || !std::isfinite(position.y) || !std::isfinite(position.z)) return;
   glm::dvec2 uv;
@@ -361,7 +442,13 @@ void GuidingField::record(uint64_t key, const glm::vec3& position, const glm::ve
   const float energy = static_cast<float>(std::min(double(radiance) * double(weight), double(FLT_MAX)));
   // float(uv) may round up to 1: kept below, the square's half-open range.
   const float u = std::min(static_cast<float>(uv.x), kBelowOneF), v = std::min(static_cast<float>(uv.y), kBelowOneF);
-  buffers_->per_thread.local().push_back({key, find_leaf(position), u, v, energy});
+  const glm::vec3 unit = glm::vec3(direction_of(uv));
+  const uint32_t leaf = find_leaf(position);
+  const bool at_infinity = distance == 0.0f || !std::isfinite(distance);
+  const glm::vec3 source = at_infinity ? unit : position + distance * glm::normalize(direction);
+  if (!std::isfinite(source.x) || !std::isfinite(source.y) || !std::isfinite(source.z)) return;
+  const uint32_t kind = at_infinity ? kSourceAtInfinity : distance > 0.0f ? kSourceBehind : kSourceAhead;
+  buffers_->per_thread.local().push_back({key, leaf, u, v, energy, position, source, kind});
 }
 
 size_t GuidingField::pending_records() const {
@@ -394,6 +481,15 @@ void GuidingField::apply_records() {
     GuidingLeaf& leaf = leaves_[pending_[starts[group]].leaf];
     leaf.records += starts[group + 1] - starts[group];
     for (size_t i = starts[group]; i < starts[group + 1]; ++i) add_energy(leaf.building, pending_[i]);
+    if (settings_.parallax_lobes > 0) {
+      std::vector<GuidingLobeRecord> incoming;
+      for (size_t i = starts[group]; i < starts[group + 1]; ++i) {
+        const GuidingRecord& r = pending_[i];
+        if (r.energy > 0.0f)
+          incoming.push_back({r.key, lobe_record_priority(r.key, r.energy), r.position, r.source, r.kind});
+      }
+      merge_into_reservoir(leaf.reservoir, incoming, settings_.lobe_records);
+    }
   });
   std::vector<GuidingRecord>().swap(pending_);
 }
@@ -404,6 +500,18 @@ void GuidingField::end_iteration() {
     const double total = sum4(leaf.building[0].energy);
     // A leaf that received no energy this time (dark, or rarely reached) keeps what it knew.
     if (total > 0.0) leaf.sampling = sampling_tree(leaf.building, total);
+  }
+  if (settings_.parallax_lobes > 0) {
+    tbb::parallel_for(size_t(0), leaves_.size(), [&](size_t i) {
+      GuidingLeaf& leaf = leaves_[i];
+      glm::vec3 origin;
+      std::vector<GuidingLobe> lobes = fit_guiding_lobes(leaf.reservoir, settings_.parallax_lobes, &origin);
+      if (!lobes.empty()) {  // too few records: the leaf keeps what it knew
+        leaf.lobes = std::move(lobes);
+        leaf.lobe_origin = origin;
+      }
+      leaf.reservoir.clear();
+    });
   }
   refine_directions();
   split_leaves(double(settings_.spatial_threshold) * std::pow(2.0, 0.5 * iteration_));
@@ -416,7 +524,8 @@ void GuidingField::end_iteration() {
 // a leaf's sampling tree is its last collecting tree (24 bytes a node where that took 40) or the one
 // it kept, so with one-node collecting trees no leaf takes more than it did before.
 void GuidingField::refine_directions() {
-  size_t fixed = nodes_.size() * sizeof(GuidingSpatialNode) + leaves_.size() * sizeof(GuidingLeaf);
+  size_t fixed = nodes_.size() * sizeof(GuidingSpatialNode) +
+                 leaves_.size() * (sizeof(GuidingLeaf) + lobe_reserve_bytes(settings_));
   for (const GuidingLeaf& leaf : leaves_) fixed += leaf.sampling.size() * sizeof(GuidingSamplingNode);
   std::vector<std::vector<GuidingBuildingNode>> refined(leaves_.size());
   for (double rho = settings_.energy_threshold;; rho *= 2.0) {
@@ -433,7 +542,7 @@ void GuidingField::refine_directions() {
 
 size_t GuidingField::planned_bytes() const {
   size_t bytes = nodes_.size() * sizeof(GuidingSpatialNode);
-  for (const GuidingLeaf& leaf : leaves_) bytes += leaf_bytes(leaf);
+  for (const GuidingLeaf& leaf : leaves_) bytes += leaf_bytes(leaf, settings_);
   return bytes;
 }
 
@@ -453,7 +562,7 @@ void GuidingField::split_leaves(double threshold) {
   for (size_t head = 0; head < queue.size(); ++head) {
     const auto [node, node_depth] = queue[head];
     const uint32_t lower_leaf = nodes_[node].leaf;
-    const size_t cost = 2 * sizeof(GuidingSpatialNode) + leaf_bytes(leaves_[lower_leaf]);
+    const size_t cost = 2 * sizeof(GuidingSpatialNode) + leaf_bytes(leaves_[lower_leaf], settings_);
     if (node_depth >= kMaxSpatialDepth || bytes + cost > settings_.max_bytes || nodes_.size() + 2 > UINT32_MAX) continue;
     bytes += cost;
     const uint32_t first = static_cast<uint32_t>(nodes_.size()), upper_leaf = static_cast<uint32_t>(leaves_.size());
@@ -473,10 +582,14 @@ void GuidingField::split_leaves(double threshold) {
 }
 
 GuidingField::Distribution GuidingField::distribution(const glm::vec3& position) const {
-  return Distribution(leaves_[find_leaf(position)].sampling, settings_.uniform_fraction);
+  const GuidingLeaf& leaf = leaves_[find_leaf(position)];
+  if (settings_.parallax_lobes > 0)
+    return Distribution(LobeMixture(leaf.lobes, leaf.lobe_origin, position, settings_.uniform_fraction));
+  return Distribution(leaf.sampling, settings_.uniform_fraction);
 }
 
 glm::vec3 GuidingField::Distribution::sample(glm::vec2 u, float* pdf_out) const {
+  if (use_lobes_) return lobes_.sample(u, pdf_out);
   glm::dvec2 w(unit_interval(u.x), unit_interval(u.y));
   const double uniform = uniform_fraction_;
   glm::vec3 direction;
@@ -494,16 +607,20 @@ glm::vec3 GuidingField::Distribution::sample(glm::vec2 u, float* pdf_out) const 
   return direction;
 }
 
-bool GuidingField::Distribution::learned() const { return tree_ && sum4((*tree_)[0].share) > 0.0; }
+bool GuidingField::Distribution::learned() const {
+  return use_lobes_ ? !lobes_.empty() : tree_ && sum4((*tree_)[0].share) > 0.0;
+}
 
 float GuidingField::Distribution::pdf(const glm::vec3& direction) const {
-  return direction_pdf(*tree_, uniform_fraction_, direction);
+  return use_lobes_ ? lobes_.pdf(direction) : direction_pdf(*tree_, uniform_fraction_, direction);
 }
 
 size_t GuidingField::memory_bytes() const {
   size_t bytes = nodes_.capacity() * sizeof(GuidingSpatialNode) + leaves_.capacity() * sizeof(GuidingLeaf);
   for (const GuidingLeaf& leaf : leaves_)
-    bytes += leaf.sampling.capacity() * sizeof(GuidingSamplingNode) + leaf.building.capacity() * sizeof(GuidingBuildingNode);
+    bytes += leaf.sampling.capacity() * sizeof(GuidingSamplingNode) + leaf.building.capacity() * sizeof(GuidingBuildingNode) +
+             std::max(leaf.lobes.capacity() * sizeof(GuidingLobe) + leaf.reservoir.capacity() * sizeof(GuidingLobeRecord),
+                      lobe_reserve_bytes(settings_));
   return bytes;
 }
 
@@ -532,6 +649,8 @@ std::vector<uint8_t> GuidingField::serialize() const {
   w.put(static_cast<int32_t>(settings_.max_directional_depth));
   w.put(settings_.max_bytes);
   w.put(settings_.uniform_fraction);
+  w.put(static_cast<int32_t>(settings_.parallax_lobes));
+  w.put(settings_.lobe_records);
   for (int a = 0; a < 3; ++a) w.put(box_lo_[a]);
   for (int a = 0; a < 3; ++a) w.put(box_hi_[a]);
   w.put(static_cast<int32_t>(iteration_));
@@ -545,6 +664,7 @@ std::vector<uint8_t> GuidingField::serialize() const {
     w.put(leaf.records);
     put_tree(w, leaf.sampling);
     put_tree(w, leaf.building);
+    put_lobes(w, leaf);
   }
   const std::vector<GuidingRecord> records = sorted_pending();  // sorted: the bytes do not depend on threads
   w.put(static_cast<uint64_t>(records.size()));
@@ -554,6 +674,9 @@ std::vector<uint8_t> GuidingField::serialize() const {
     w.put(r.u);
     w.put(r.v);
     w.put(r.energy);
+    put_vec3(w, r.position);
+    put_vec3(w, r.source);
+    w.put(r.kind);
   }
   w.put(fnv1a64(w.bytes.data(), w.bytes.size()));
   return std::move(w.bytes);
@@ -579,6 +702,8 @@ GuidingField GuidingField::deserialize(const uint8_t* data, size_t size) {
   f.settings_.max_directional_depth = r.get<int32_t>("settings");
   f.settings_.max_bytes = r.get<uint64_t>("settings");
   f.settings_.uniform_fraction = r.get<float>("settings");
+  f.settings_.parallax_lobes = r.get<int32_t>("settings");
+  f.settings_.lobe_records = r.get<uint32_t>("settings");
   f.validate_settings();
   for (int a = 0; a < 3; ++a) f.box_lo_[a] = r.get<float>("box");
   for (int a = 0; a < 3; ++a) f.box_hi_[a] = r.get<float>("box");
@@ -624,16 +749,20 @@ GuidingField GuidingField::deserialize(const uint8_t* data, size_t size) {
     leaf.records = r.get<uint64_t>("leaves");
     leaf.sampling = get_tree<GuidingSamplingNode>(r, f.settings_.max_directional_depth, "sampling");
     leaf.building = get_tree<GuidingBuildingNode>(r, f.settings_.max_directional_depth, "building");
+    get_lobes(r, f.settings_, &leaf);
   }
-  f.pending_.resize(r.get_count(sizeof(GuidingRecord), "records"));
+  f.pending_.resize(r.get_count(52, "records"));  // the bytes serialize() writes per record
   for (GuidingRecord& rec : f.pending_) {
     rec.key = r.get<uint64_t>("records");
     rec.leaf = r.get<uint32_t>("records");
     rec.u = r.get<float>("records");
     rec.v = r.get<float>("records");
     rec.energy = r.get<float>("records");
+    rec.position = get_vec3(r, "records");
+    rec.source = get_vec3(r, "records");
+    rec.kind = r.get<uint32_t>("records");
     if (rec.leaf >= leaf_count || !(rec.u >= 0.0f && rec.u < 1.0f) || !(rec.v >= 0.0f && rec.v < 1.0f) ||
-        !non_negative_finite(rec.energy))
+        !non_negative_finite(rec.energy) || rec.kind > kSourceAhead)
       throw Error("guiding field has an invalid record");
   }
   if (r.remaining() != 0) throw Error("guiding field has " + std::to_string(r.remaining()) + " trailing bytes");

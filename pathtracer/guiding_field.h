@@ -40,6 +40,8 @@
 
 #include <glm/glm.hpp>
 
+#include "pathtracer/guiding_lobes.h"
+
 namespace pxf {
 
 struct GuidingSettings {
@@ -55,6 +57,12 @@ struct GuidingSettings {
   // direction the records missed (a light no path found yet) keeps a density and no sample ever
   // gets pdf 0. In (0, 1).
   float uniform_fraction = 0.01f;
+  // The directional distribution a leaf samples: 0, its quadtree (the paper's); 1 to
+  // kMaxGuidingLobes, at most that many parallax-aware vMF lobes (guiding_lobes.h) fitted to
+  // lobe_records photon records per leaf and iteration (the quadtrees are still built: leaves split
+  // by their record counts either way).
+  int parallax_lobes = 0;
+  uint32_t lobe_records = 128;
 };
 
 // The parts of a GuidingField (its internals, shown for the serialized format and for tests).
@@ -75,6 +83,11 @@ struct GuidingLeaf {
   std::vector<GuidingSamplingNode> sampling;  // never empty
   std::vector<GuidingBuildingNode> building;  // never empty
   uint64_t records = 0;                       // this iteration's, applied
+  // Parallax lobes (settings.parallax_lobes > 0): the sampling lobes, the mean position of the
+  // records they were fitted to, and this iteration's reservoir.
+  std::vector<GuidingLobe> lobes;
+  glm::vec3 lobe_origin{0.0f};
+  std::vector<GuidingLobeRecord> reservoir;
 };
 struct GuidingSpatialNode {
   uint32_t children = 0;  // index of the first of two (lower, upper half), 0: a leaf
@@ -85,6 +98,9 @@ struct GuidingRecord {
   uint32_t leaf;
   float u, v;    // the direction on the square
   float energy;  // radiance * weight
+  glm::vec3 position;
+  glm::vec3 source;  // where the light seems to come from (see kind)
+  uint32_t kind;     // GuidingSourceKind
 };
 
 class GuidingField {
@@ -114,7 +130,11 @@ class GuidingField {
   // incident radiance over a directional bin. `key` orders the records (determinism): unique per
   // record, e.g. (frame * pixels + pixel) * max_vertices + vertex. Records with a non-finite or
   // negative radiance or weight, a non-finite position or a zero or non-finite direction are dropped.
-  void record(uint64_t key, const glm::vec3& position, const glm::vec3& direction, float radiance, float weight);
+  // `distance`: how far along `direction` the light seems to come from (the previous vertex, or its
+  // image through delta bounces), for the parallax lobes; negative: from a focus that far the
+  // other way; 0 or not finite: unknown or at infinity.
+  void record(uint64_t key, const glm::vec3& position, const glm::vec3& direction, float radiance, float weight,
+              float distance = 0.0f);
   // Adds the buffered records to the building trees (see the determinism note above).
   void apply_records();
   // Ends the iteration (iteration() counts the ended ones): see the notes above.
@@ -150,19 +170,24 @@ class GuidingField {
     friend class GuidingField;
     Distribution(const std::vector<GuidingSamplingNode>& tree, float uniform_fraction)
         : tree_(&tree), uniform_fraction_(uniform_fraction) {}
+    explicit Distribution(const LobeMixture& lobes) : lobes_(lobes), use_lobes_(true) {}
     const std::vector<GuidingSamplingNode>* tree_ = nullptr;
     float uniform_fraction_ = 0.0f;
+    LobeMixture lobes_;
+    bool use_lobes_ = false;
   };
   Distribution distribution(const glm::vec3& position) const;
   glm::vec3 sample(const glm::vec3& position, glm::vec2 u, float* pdf) const { return distribution(position).sample(u, pdf); }
   float pdf(const glm::vec3& position, const glm::vec3& direction) const { return distribution(position).pdf(direction); }
 
   // --- Inspection.
-  static constexpr uint64_t kMinBytes = 128;  // one leaf with one node per tree
+  static constexpr uint64_t kMinBytes = 192;  // one leaf with one node per tree
   size_t memory_bytes() const;
   Stats stats() const;
   Box bounds() const { return {box_lo_, box_hi_}; }
   Box leaf_box(const glm::vec3& position) const;  // the spatial leaf that holds the point
+  // The parallax lobes of that leaf (empty with the quadtree model or before they are fitted).
+  const std::vector<GuidingLobe>& lobes(const glm::vec3& position) const { return leaves_[find_leaf(position)].lobes; }
   const GuidingSettings& settings() const { return settings_; }
 
   // --- Save and restore (a checkpointed render resumes exactly): everything, buffered records

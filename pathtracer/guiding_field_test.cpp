@@ -320,11 +320,16 @@ TEST(GuidingField, SameRecordsGiveTheSameFieldWhateverTheOrderAndThreads) {
 }
 
 TEST(GuidingField, MemoryBoundHoldsUnderAFloodOfRecords) {
-  for (uint64_t bound : {GuidingField::kMinBytes, uint64_t(16) << 10, uint64_t(256) << 10}) {
+  // The quadtrees alone, then with parallax lobes (whose reservoirs and lobes count at their most).
+  const uint64_t with_lobes = GuidingField::kMinBytes + 8 * sizeof(GuidingLobe) + 128 * sizeof(GuidingLobeRecord);
+  for (uint64_t bound : {GuidingField::kMinBytes, uint64_t(16) << 10, uint64_t(256) << 10, with_lobes, uint64_t(64) << 10,
+                         uint64_t(512) << 10}) {
     SCOPED_TRACE(bound);
+    const bool lobes = bound == with_lobes || bound == (uint64_t(64) << 10) || bound == (uint64_t(512) << 10);
     GuidingSettings settings;
     settings.spatial_threshold = 10.0f;
     settings.max_bytes = bound;
+    settings.parallax_lobes = lobes ? 8 : 0;
     GuidingField field(glm::vec3(-1.0f), glm::vec3(1.0f), settings);
     EXPECT_LE(field.memory_bytes(), bound);
     std::mt19937 spiky(7);
@@ -337,7 +342,7 @@ TEST(GuidingField, MemoryBoundHoldsUnderAFloodOfRecords) {
       EXPECT_LE(field.memory_bytes(), bound) << "iteration " << iteration;
     }
     const GuidingField::Stats stats = field.stats();
-    if (bound == GuidingField::kMinBytes) {
+    if (bound == GuidingField::kMinBytes || bound == with_lobes) {
       EXPECT_EQ(stats.spatial_leaves, 1u);
       EXPECT_EQ(stats.building_nodes, 1u);
     } else {

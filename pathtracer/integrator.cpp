@@ -439,10 +439,42 @@ void PathTracer::trace_guiding_photons(uint32_t frame, int count, const TracePar
   });
 }
 
+namespace {
+
+// The companion of a photon (below) leaves the chain's source this many radians off the photon's
+// direction, or, from a light at infinity, this far beside it per unit of the first segment's length.
+constexpr float kCompanionSpread = 2e-3f;
+
+// A unit vector at kCompanionSpread radians from the unit vector d.
+glm::vec3 turned(const glm::vec3& d) {
+  const glm::vec3 side = std::abs(d.x) < 0.9f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0);
+  return glm::normalize(d + kCompanionSpread * glm::normalize(glm::cross(d, side)));
+}
+
+// Where along the line (p, unit u) it passes closest to the line (q, unit v); 0 when they are parallel.
+float closest_approach(const glm::vec3& p, const glm::vec3& u, const glm::vec3& q, const glm::vec3& v) {
+  const glm::dvec3 w(p - q);
+  const double b = glm::dot(glm::dvec3(u), glm::dvec3(v));
+  const double denom = 1.0 - b * b;
+  if (!(denom > 1e-12)) return 0.0f;
+  const double d = glm::dot(glm::dvec3(u), w), e = glm::dot(glm::dvec3(v), w);
+  return static_cast<float>((b * e - d) / denom);
+}
+
+}  // namespace
+
 // One photon: the flux it carries is recorded (key: frame, photon, bounce) at its non-delta
 // surfaces from the second on, then it scatters by BSDF sampling (the BSDF is treated as
 // symmetric: the shading-normal correction of adjoint transport only changes the guide's
 // weights, never an image's expectation) with Russian roulette on its share of the emitted flux.
+//
+// Each record says where its light seems to come from, for the field's parallax lobes: the previous
+// vertex, unless delta bounces came between. Then a companion ray leaves the chain's source (the last
+// non-delta vertex or the emission point) turned by kCompanionSpread (parallel and beside the photon
+// from a light at infinity) and takes the same delta bounces; where the two rays' lines pass closest
+// is the light's apparent source at the record (its image in a curved mirror, ahead of it where the
+// rays converge to a focus). Without that, a caustic's source would be its point on the mirror, which
+// moves with the receiving point.
 void PathTracer::trace_guiding_photon(uint32_t frame, uint32_t index, const TraceParams& params) const {
   constexpr uint64_t kPhotonStream = 0x70686f746f6e73ULL;  // apart from every camera path's stream
   Rng rng(params.seed ^ kPhotonStream, index, frame);
@@ -454,25 +486,71 @@ void PathTracer::trace_guiding_photon(uint32_t frame, uint32_t index, const Trac
   glm::vec3 flux = photon.flux;
   const uint64_t key = (static_cast<uint64_t>(frame) << 36) | (static_cast<uint64_t>(index) << 4);  // + surface < 16
   const int max_surfaces = std::min(params.max_vertices - 1, kMaxPhotonSurfaces);
+  const auto bsdf_at = [&](const SurfacePoint& sp, const glm::vec3& wo, BsdfMaterial* scratch) {
+    return Bsdf(bsdf_material_at(sp, scratch), sp.shading_normal, sp.geometric_normal, wo, sp.front_face, sp.clearcoat_normal);
+  };
+  Ray chain_start = ray;  // the segment that left the chain's source
+  bool chain_from_infinity = photon.from_infinity, chain_has_delta = false;
+  enum class CompanionState { kNone, kActive, kLost } companion = CompanionState::kNone;
+  Ray companion_ray;
+  SurfacePoint companion_sp;
+  // The companion's next surface, which must be the photon's (the same material), else it is lost.
+  const auto advance_companion = [&](const SurfacePoint& sp) {
+    const Hit hit = geometry_.intersect(companion_ray);
+    if (!hit.valid()) return false;
+    companion_sp = geometry_.surface_point(hit, companion_ray);
+    return companion_sp.material == sp.material && companion_sp.front_face == sp.front_face;
+  };
   for (int surface = 0; surface < max_surfaces; ++surface) {
     const Hit hit = geometry_.intersect(ray);
     if (!hit.valid()) return;
     const SurfacePoint sp = geometry_.surface_point(hit, ray);
     if (!sp.front_face && sp.material->has_volume()) flux *= volume_transmittance(*sp.material, hit.t);
+    if (companion == CompanionState::kActive && !advance_companion(sp)) companion = CompanionState::kLost;
     BsdfMaterial scratch;
-    const Bsdf bsdf(bsdf_material_at(sp, &scratch), sp.shading_normal, sp.geometric_normal, -ray.direction, sp.front_face,
-                    sp.clearcoat_normal);
+    const Bsdf bsdf = bsdf_at(sp, -ray.direction, &scratch);
     if (bsdf.is_black()) return;
-    if (surface > 0 && bsdf.has_nondelta())
-      guiding_->record(key + static_cast<uint64_t>(surface), sp.position, -ray.direction, luminance(flux), 1.0f);
+    if (surface > 0 && bsdf.has_nondelta()) {
+      float distance = hit.t * glm::length(ray.direction);
+      if (chain_has_delta && companion == CompanionState::kActive) {
+        distance = closest_approach(sp.position, -ray.direction, companion_sp.position, -companion_ray.direction);
+      }
+      guiding_->record(key + static_cast<uint64_t>(surface), sp.position, -ray.direction, luminance(flux), 1.0f, distance);
+    }
     BsdfSample bs;
     const float u_lobe = rng.next_float();
-    if (!bsdf.sample(u_lobe, rng.next_2d(), &bs)) return;
+    const glm::vec2 u_bsdf = rng.next_2d();
+    if (!bsdf.sample(u_lobe, u_bsdf, &bs)) return;
+    if (bs.delta && companion != CompanionState::kLost) {
+      if (companion == CompanionState::kNone) {  // the first delta bounce of the chain: catch up
+        const float beside = kCompanionSpread * (1.0f + hit.t);
+        companion_ray = chain_from_infinity
+                            ? Ray{chain_start.origin + beside * glm::normalize(glm::cross(chain_start.direction, turned(chain_start.direction))), chain_start.direction}
+                            : Ray{chain_start.origin, turned(chain_start.direction)};
+        companion = advance_companion(sp) ? CompanionState::kActive : CompanionState::kLost;
+      }
+      BsdfMaterial companion_scratch;
+      BsdfSample cs;
+      if (companion == CompanionState::kActive &&
+          bsdf_at(companion_sp, -companion_ray.direction, &companion_scratch).sample(u_lobe, u_bsdf, &cs) && cs.delta &&
+          cs.transmitted == bs.transmitted) {
+        companion_ray = Ray{offset_ray_origin(companion_sp.position, companion_sp.geometric_normal, cs.wi), cs.wi};
+      } else {
+        companion = CompanionState::kLost;
+      }
+    }
     flux *= bs.weight;
     const float survive = std::min(1.0f, max_component(flux) / emitted);
     if (!(rng.next_float() < survive)) return;
     flux /= survive;
     ray = Ray{offset_ray_origin(sp.position, sp.geometric_normal, bs.wi), bs.wi};
+    if (bs.delta) {
+      chain_has_delta = true;
+    } else {  // a new chain starts here, from this point
+      chain_start = ray;
+      chain_from_infinity = chain_has_delta = false;
+      companion = CompanionState::kNone;
+    }
   }
 }
 

@@ -671,6 +671,7 @@ EmittedPhoton LightSampler::emit_from_infinity(glm::vec3 toward_light, glm::vec3
   photon.origin = scene_center_ + scene_radius_ * toward_light + frame.t * disc.x + frame.b * disc.y;
   photon.direction = -toward_light;
   photon.flux = radiance * (kPi * scene_radius_ * scene_radius_ / pdf);
+  photon.from_infinity = true;
   return photon;
 }
 

@@ -31,6 +31,7 @@ glm::vec3 equirect_direction(glm::vec2 uv);
 // `direction` carrying `flux` (the power it stands for: the lights' total over the number drawn).
 struct EmittedPhoton {
   glm::vec3 origin{0.0f}, direction{0.0f}, flux{0.0f};
+  bool from_infinity = false;  // an environment's or a sun's: its wavefront is plane, not from `origin`
 };
 
 class LightSampler {

@@ -28,8 +28,10 @@ constexpr int kChunk = kTileSize * kTileSize;  // jobs per batch that one thread
 // which left a Cornell box wall in one leaf at these photon counts.
 constexpr double kGuidingPhotonsPerPixel = 0.25;
 constexpr double kGuidingMinPhotonsPerFrame = 16384;
-constexpr double kGuidingPhotonsPerIteration = double(1 << 22);
-constexpr float kGuidingSpatialThreshold = 300.0f;
+constexpr double kGuidingPhotonsPerIteration = double(1 << 18);
+constexpr float kGuidingSpatialThreshold = 100.0f;
+// The directional model: at most 8 parallax-aware lobes per leaf (docs/guiding.md), not the quadtree.
+constexpr int kGuidingLobes = 8;
 
 int guiding_photons_per_frame(int width, int height, int iteration) {
   const double wanted = std::max(kGuidingMinPhotonsPerFrame, kGuidingPhotonsPerPixel * width * height);
@@ -94,6 +96,7 @@ struct ProgressiveRenderer::Impl {
       guiding_box(scene, &lo, &hi);
       GuidingSettings settings;
       settings.spatial_threshold = kGuidingSpatialThreshold;
+      settings.parallax_lobes = kGuidingLobes;
       guiding = std::make_unique<GuidingField>(lo, hi, settings);
     }
     tracer->set_guiding(guiding.get());

@@ -1,0 +1,279 @@
+#include "pathtracer/guiding_lobes.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace pxf {
+
+namespace {
+
+constexpr double kTwoPi = 6.283185307179586476925;
+constexpr double kInvFourPi = 0.0795774715459476678844;
+constexpr double kMinKappa = 0.05;  // below this a lobe is as good as uniform
+constexpr int kKMeansRounds = 4;
+constexpr int kEmRounds = 10;
+constexpr double kMinLobeShare = 1e-3;
+
+uint64_t mix64(uint64_t x) {  // splitmix64's finaliser
+  x += 0x9e3779b97f4a7c15ULL;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
+  return x ^ (x >> 31);
+}
+
+bool kept_before(const GuidingLobeRecord& a, const GuidingLobeRecord& b) {
+  return a.priority != b.priority ? a.priority > b.priority : a.key < b.key;
+}
+
+// An orthonormal frame around a unit vector (Duff et al. 2017).
+void tangents(const glm::dvec3& n, glm::dvec3* t, glm::dvec3* b) {
+  const double sign = std::copysign(1.0, n.z);
+  const double a = -1.0 / (sign + n.z);
+  const double c = n.x * n.y * a;
+  *t = glm::dvec3(1.0 + sign * n.x * n.x * a, sign * c, -sign * n.x);
+  *b = glm::dvec3(c, sign + n.y * n.y * a, -n.y);
+}
+
+glm::dvec3 unit_or(const glm::dvec3& v, const glm::dvec3& fallback) {
+  const double length = glm::length(v);
+  return length > 1e-12 && std::isfinite(length) ? v / length : fallback;
+}
+
+// Banerjee et al. 2005's estimate of kappa from the mean resultant length r in [0, 1).
+double kappa_of(double r) {
+  r = std::min(std::max(r, 0.0), 0.999999);
+  const double kappa = r * (3.0 - r * r) / (1.0 - r * r);
+  return std::min(std::max(kappa, kMinKappa), double(kMaxLobeKappa));
+}
+
+// log of the vMF density without its constant's log(2 pi): log kappa - log(1 - e^-2kappa) - kappa |mu - w|^2 / 2.
+double vmf_log(const glm::dvec3& mean, double kappa, const glm::dvec3& w) {
+  const glm::dvec3 d = mean - w;
+  return std::log(kappa) - std::log(-std::expm1(-2.0 * kappa)) - 0.5 * kappa * glm::dot(d, d);
+}
+
+// Farthest-point seeds then a few rounds of spherical k-means: a deterministic start for EM.
+std::vector<glm::dvec3> seed_means(const std::vector<glm::dvec3>& v, int count) {
+  std::vector<glm::dvec3> means{v[0]};
+  std::vector<double> nearest(v.size(), -2.0);  // the largest cosine to any mean so far
+  while (static_cast<int>(means.size()) < count) {
+    size_t far = 0;
+    for (size_t i = 0; i < v.size(); ++i) {
+      nearest[i] = std::max(nearest[i], glm::dot(v[i], means.back()));
+      if (nearest[i] < nearest[far]) far = i;
+    }
+    if (nearest[far] > 0.9999) break;  // every direction is already next to a mean
+    means.push_back(v[far]);
+  }
+  for (int round = 0; round < kKMeansRounds; ++round) {
+    std::vector<glm::dvec3> sums(means.size(), glm::dvec3(0.0));
+    for (const glm::dvec3& d : v) {
+      size_t best = 0;
+      for (size_t j = 1; j < means.size(); ++j)
+        if (glm::dot(d, means[j]) > glm::dot(d, means[best])) best = j;
+      sums[best] += d;
+    }
+    for (size_t j = 0; j < means.size(); ++j) means[j] = unit_or(sums[j], means[j]);
+  }
+  return means;
+}
+
+}  // namespace
+
+float lobe_record_priority(uint64_t key, float energy) {
+  // u in (0, 1] from the key; A-ES keeps the largest u^(1/energy), i.e. log(u) / energy.
+  const double u = (double(mix64(key) >> 11) + 1.0) * 0x1.0p-53;
+  return static_cast<float>(std::log(u) / std::max(double(energy), 1e-30));
+}
+
+void merge_into_reservoir(std::vector<GuidingLobeRecord>& reservoir, const std::vector<GuidingLobeRecord>& incoming,
+                          size_t capacity) {
+  std::vector<GuidingLobeRecord> all = reservoir;
+  all.insert(all.end(), incoming.begin(), incoming.end());
+  if (all.size() > capacity) std::nth_element(all.begin(), all.begin() + capacity, all.end(), kept_before);
+  reservoir.reserve(capacity);  // the reservoir never holds more than its capacity, nor allocates more
+  reservoir.assign(all.begin(), all.begin() + std::min(capacity, all.size()));
+}
+
+std::vector<GuidingLobe> fit_guiding_lobes(const std::vector<GuidingLobeRecord>& unordered, int max_lobes,
+                                           glm::vec3* mean_position) {
+  if (unordered.size() < kMinLobeRecords || max_lobes < 1) return {};
+  std::vector<GuidingLobeRecord> records = unordered;  // in key order: the fit does not depend on arrival
+  std::sort(records.begin(), records.end(), [](const auto& a, const auto& b) { return a.key < b.key; });
+  const size_t n = records.size();
+  glm::dvec3 o(0.0);
+  for (const GuidingLobeRecord& r : records) o += glm::dvec3(r.position);
+  o /= double(n);
+  *mean_position = glm::vec3(o);
+
+  // Each record's light seen from the mean position: toward its source, away from a focus ahead
+  // (its own direction where the source is at the mean position).
+  std::vector<glm::dvec3> v(n);
+  for (size_t i = 0; i < n; ++i) {
+    const GuidingLobeRecord& r = records[i];
+    if (r.kind == kSourceAtInfinity) {
+      v[i] = glm::dvec3(r.source);
+      continue;
+    }
+    const double sign = r.kind == kSourceAhead ? -1.0 : 1.0;
+    const glm::dvec3 own = unit_or(sign * (glm::dvec3(r.source) - glm::dvec3(r.position)), {0, 0, 1});
+    v[i] = unit_or(sign * (glm::dvec3(r.source) - o), own);
+  }
+
+  // Weighted EM of a vMF mixture (every kept record weighs the same: the reservoir sampled by energy).
+  std::vector<glm::dvec3> mean = seed_means(v, std::min<int>(max_lobes, std::max<int>(1, int(n / kMinLobeRecords))));
+  const size_t k = mean.size();
+  std::vector<double> kappa(k, 10.0), share(k, 1.0 / double(k));
+  std::vector<double> resp(n * k);
+  for (int round = 0; round < kEmRounds; ++round) {
+    for (size_t i = 0; i < n; ++i) {  // E: responsibilities, in logs (tight lobes overflow exp)
+      double top = -1e300;
+      for (size_t j = 0; j < k; ++j) {
+        resp[i * k + j] = share[j] > 0.0 ? std::log(share[j]) + vmf_log(mean[j], kappa[j], v[i]) : -1e300;
+        top = std::max(top, resp[i * k + j]);
+      }
+      double sum = 0.0;
+      for (size_t j = 0; j < k; ++j) sum += resp[i * k + j] = std::exp(resp[i * k + j] - top);
+      for (size_t j = 0; j < k; ++j) resp[i * k + j] /= sum;
+    }
+    for (size_t j = 0; j < k; ++j) {  // M
+      double weight = 0.0;
+      glm::dvec3 resultant(0.0);
+      for (size_t i = 0; i < n; ++i) {
+        weight += resp[i * k + j];
+        resultant += resp[i * k + j] * v[i];
+      }
+      share[j] = weight / double(n);
+      if (!(weight > 0.0)) continue;
+      mean[j] = unit_or(resultant, mean[j]);
+      kappa[j] = kappa_of(glm::length(resultant) / weight);
+    }
+  }
+
+  std::vector<GuidingLobe> lobes;
+  lobes.reserve(k);  // exactly: the field counts a leaf's lobes at their capacity
+  double kept = 0.0;
+  for (size_t j = 0; j < k; ++j) {
+    if (!(share[j] >= kMinLobeShare)) continue;
+    // The lobe's source: the mean of its records' sources of the kind most of them have.
+    double weight[3] = {0.0, 0.0, 0.0};
+    glm::dvec3 sources[3] = {glm::dvec3(0.0), glm::dvec3(0.0), glm::dvec3(0.0)};
+    for (size_t i = 0; i < n; ++i) {
+      const double r = resp[i * k + j];
+      weight[records[i].kind] += r;
+      sources[records[i].kind] += r * glm::dvec3(records[i].source);
+    }
+    GuidingLobe lobe;
+    lobe.direction = glm::vec3(mean[j]);
+    lobe.kappa = static_cast<float>(kappa[j]);
+    lobe.share = static_cast<float>(share[j]);
+    const int kind = weight[kSourceAhead] > weight[kSourceBehind] ? kSourceAhead : kSourceBehind;
+    if (weight[kind] > weight[kSourceAtInfinity] && weight[kind] > 0.0) {  // parallax: most of its light has a source
+      const glm::dvec3 centre = sources[kind] / weight[kind];
+      const double distance = glm::length(centre - o);
+      const double sign = kind == kSourceAhead ? -1.0 : 1.0;
+      if (distance > 0.0 && std::isfinite(distance)) {
+        lobe.source = glm::vec3(centre);
+        lobe.distance = static_cast<float>(sign * distance);
+        lobe.direction = glm::vec3(sign * (centre - o) / distance);
+      }
+    }
+    kept += share[j];
+    lobes.push_back(lobe);
+  }
+  for (GuidingLobe& lobe : lobes) lobe.share = static_cast<float>(lobe.share / kept);
+  return lobes;
+}
+
+double vmf_pdf(const glm::dvec3& mean, double kappa, const glm::dvec3& w) {
+  return std::exp(vmf_log(mean, kappa, w)) / kTwoPi;
+}
+
+glm::dvec3 vmf_sample(const glm::dvec3& mean, double kappa, glm::dvec2 u) {
+  // cos theta = 1 + log(u + (1 - u) e^-2kappa) / kappa, inverted from the CDF of cos theta.
+  const double x = std::max(u.x + (1.0 - u.x) * std::exp(-2.0 * kappa), 1e-300);
+  const double one_minus_cos = std::min(std::max(-std::log(x) / kappa, 0.0), 2.0);
+  const double cos_theta = 1.0 - one_minus_cos;
+  const double sin_theta = std::sqrt(std::max(0.0, one_minus_cos * (2.0 - one_minus_cos)));
+  const double phi = kTwoPi * u.y;
+  glm::dvec3 t, b;
+  tangents(mean, &t, &b);
+  return glm::normalize(cos_theta * mean + sin_theta * (std::cos(phi) * t + std::sin(phi) * b));
+}
+
+LobeMixture::LobeMixture(const std::vector<GuidingLobe>& lobes, const glm::vec3& region_mean, const glm::vec3& point,
+                         float uniform_fraction)
+    : uniform_fraction_(uniform_fraction) {
+  float total = 0.0f;
+  for (const GuidingLobe& lobe : lobes) {
+    if (count_ == kMaxGuidingLobes) break;
+    glm::vec3 mean = lobe.direction;
+    float kappa = lobe.kappa;
+    if (lobe.distance != 0.0f) {
+      const glm::vec3 to_source = lobe.source - point;
+      const float distance = glm::length(to_source), reference = std::abs(lobe.distance);
+      if (distance > 1e-6f * reference && std::isfinite(distance)) {
+        mean = (lobe.distance > 0.0f ? 1.0f : -1.0f) * to_source / distance;
+        const float ratio = distance / reference;
+        kappa = std::min(kMaxLobeKappa, kappa * std::min(4.0f, std::max(0.25f, ratio * ratio)));
+      }
+    }
+    mean_[count_] = mean;
+    kappa_[count_] = kappa;
+    weight_[count_] = lobe.share;
+    total += lobe.share;
+    cumulative_[count_] = total;
+    ++count_;
+  }
+  if (!(total > 0.0f)) {
+    count_ = 0;
+    return;
+  }
+  for (int j = 0; j < count_; ++j) {
+    const float kappa = kappa_[j];
+    // 1 - e^-2kappa, which rounds to 1 in float from kappa = 9 on: most lobes skip the exponential.
+    const float normalisation = kappa < 9.0f ? -std::expm1(-2.0f * kappa) : 1.0f;
+    weight_[j] = weight_[j] / total * kappa / (float(kTwoPi) * normalisation);
+    cumulative_[j] /= total;
+  }
+  cumulative_[count_ - 1] = 1.0f;
+}
+
+glm::vec3 LobeMixture::sample(glm::vec2 u, float* pdf_out) const {
+  double x = std::min(std::max(double(u.x), 0.0), 0x1.fffffffffffffp-1);
+  const double y = std::min(std::max(double(u.y), 0.0), 0x1.fffffffffffffp-1);
+  glm::dvec3 direction;
+  if (count_ == 0 || x < uniform_fraction_) {
+    const double z = count_ == 0 ? 1.0 - 2.0 * x : 1.0 - 2.0 * (x / uniform_fraction_);
+    const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+    direction = glm::dvec3(r * std::cos(kTwoPi * y), r * std::sin(kTwoPi * y), z);
+  } else {
+    x = (x - uniform_fraction_) / (1.0 - uniform_fraction_);
+    int j = 0;
+    while (j < count_ - 1 && x >= cumulative_[j]) ++j;
+    const double lo = j == 0 ? 0.0 : cumulative_[j - 1];
+    const double width = cumulative_[j] - lo;
+    const double within = width > 0.0 ? std::min(std::max((x - lo) / width, 0.0), 0x1.fffffffffffffp-1) : 0.5;
+    direction = vmf_sample(glm::dvec3(mean_[j]), kappa_[j], glm::dvec2(within, y));
+  }
+  const glm::vec3 d(direction);
+  if (pdf_out) *pdf_out = pdf(d);  // the same function as every MIS weight of this direction uses
+  return d;
+}
+
+float LobeMixture::pdf(const glm::vec3& direction) const {
+  const double length = glm::length(glm::dvec3(direction));
+  if (!(length > 0.0) || !std::isfinite(length)) return 0.0f;
+  if (count_ == 0) return static_cast<float>(kInvFourPi);
+  const glm::vec3 w = glm::vec3(glm::dvec3(direction) / length);
+  float lobes = 0.0f;
+  for (int j = 0; j < count_; ++j) {
+    const glm::vec3 d = mean_[j] - w;  // kappa (cos - 1) = -kappa |mean - w|^2 / 2, exact near the mean
+    const float exponent = 0.5f * kappa_[j] * glm::dot(d, d);
+    // Beyond e^-60 a lobe adds less than 1e-21 of its peak (at most 1e5 / 2 pi): nothing next to the uniform part.
+    if (exponent < 60.0f) lobes += weight_[j] * std::exp(-exponent);
+  }
+  return static_cast<float>(uniform_fraction_ * kInvFourPi + (1.0 - uniform_fraction_) * double(lobes));
+}
+
+}  // namespace pxf
