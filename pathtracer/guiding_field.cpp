@@ -401,6 +401,8 @@ void GuidingField::validate_settings() const {
                 std::to_string(kMinBytes + lobe_reserve_bytes(s)));
   if (!(s.uniform_fraction > 0.0f && s.uniform_fraction < 1.0f))
     throw Error("guiding field uniform fraction must be in (0, 1)");
+  if (!(s.min_lobe_kappa >= 0.0f && s.min_lobe_kappa <= kMaxLobeKappa))
+    throw Error("guiding field minimum lobe kappa must be in [0, " + std::to_string(int(kMaxLobeKappa)) + "]");
   if (s.parallax_lobes < 0 || s.parallax_lobes > kMaxGuidingLobes)
     throw Error("guiding field lobe count must be in 0.." + std::to_string(kMaxGuidingLobes));
   if (s.parallax_lobes > 0 && (s.lobe_records < kMinLobeRecords || s.lobe_records > (1u << 20)))
@@ -581,10 +583,10 @@ void GuidingField::split_leaves(double threshold) {
   leaves_.shrink_to_fit();
 }
 
-GuidingField::Distribution GuidingField::distribution(const glm::vec3& position) const {
+GuidingField::Distribution GuidingField::distribution(const glm::vec3& position, const glm::vec3& normal) const {
   const GuidingLeaf& leaf = leaves_[find_leaf(position)];
   if (settings_.parallax_lobes > 0)
-    return Distribution(LobeMixture(leaf.lobes, leaf.lobe_origin, position, settings_.uniform_fraction));
+    return Distribution(LobeMixture(leaf.lobes, position, settings_.uniform_fraction, normal, settings_.min_lobe_kappa));
   return Distribution(leaf.sampling, settings_.uniform_fraction);
 }
 
@@ -651,6 +653,7 @@ std::vector<uint8_t> GuidingField::serialize() const {
   w.put(settings_.uniform_fraction);
   w.put(static_cast<int32_t>(settings_.parallax_lobes));
   w.put(settings_.lobe_records);
+  w.put(settings_.min_lobe_kappa);
   for (int a = 0; a < 3; ++a) w.put(box_lo_[a]);
   for (int a = 0; a < 3; ++a) w.put(box_hi_[a]);
   w.put(static_cast<int32_t>(iteration_));
@@ -704,6 +707,7 @@ GuidingField GuidingField::deserialize(const uint8_t* data, size_t size) {
   f.settings_.uniform_fraction = r.get<float>("settings");
   f.settings_.parallax_lobes = r.get<int32_t>("settings");
   f.settings_.lobe_records = r.get<uint32_t>("settings");
+  f.settings_.min_lobe_kappa = r.get<float>("settings");
   f.validate_settings();
   for (int a = 0; a < 3; ++a) f.box_lo_[a] = r.get<float>("box");
   for (int a = 0; a < 3; ++a) f.box_hi_[a] = r.get<float>("box");

@@ -63,6 +63,10 @@ struct GuidingSettings {
   // by their record counts either way).
   int parallax_lobes = 0;
   uint32_t lobe_records = 128;
+  // Lobes wider than this concentration (kappa 10: about 18 degrees) are not sampled: BSDF sampling
+  // serves such light about as well, so the guided samples go to concentrated light only, and the
+  // renderer scales its guided share by the lobes' share that is left (Distribution::share()).
+  float min_lobe_kappa = 10.0f;
 };
 
 // The parts of a GuidingField (its internals, shown for the serialized format and for tests).
@@ -165,6 +169,8 @@ class GuidingField {
     // False where the leaf has learned no light: its distribution is uniform over the sphere,
     // which guides nowhere (the renderer then samples the BSDF alone there).
     bool learned() const;
+    // The share of the learned light this point's distribution holds (1 for the quadtree).
+    float share() const { return use_lobes_ ? lobes_.share() : 1.0f; }
 
    private:
     friend class GuidingField;
@@ -176,7 +182,10 @@ class GuidingField {
     LobeMixture lobes_;
     bool use_lobes_ = false;
   };
-  Distribution distribution(const glm::vec3& position) const;
+  // `normal` (unit, optional): the side of the surface the directions serve. Lobes whose mean points
+  // more than about one standard deviation below it are left out of that point's distribution (a
+  // leaf may hold both sides of a wall, or a corner's two walls); the quadtree ignores it.
+  Distribution distribution(const glm::vec3& position, const glm::vec3& normal = glm::vec3(0.0f)) const;
   glm::vec3 sample(const glm::vec3& position, glm::vec2 u, float* pdf) const { return distribution(position).sample(u, pdf); }
   float pdf(const glm::vec3& position, const glm::vec3& direction) const { return distribution(position).pdf(direction); }
 

@@ -201,8 +201,8 @@ glm::dvec3 vmf_sample(const glm::dvec3& mean, double kappa, glm::dvec2 u) {
   return glm::normalize(cos_theta * mean + sin_theta * (std::cos(phi) * t + std::sin(phi) * b));
 }
 
-LobeMixture::LobeMixture(const std::vector<GuidingLobe>& lobes, const glm::vec3& region_mean, const glm::vec3& point,
-                         float uniform_fraction)
+LobeMixture::LobeMixture(const std::vector<GuidingLobe>& lobes, const glm::vec3& point, float uniform_fraction,
+                         const glm::vec3& normal, float min_kappa)
     : uniform_fraction_(uniform_fraction) {
   float total = 0.0f;
   for (const GuidingLobe& lobe : lobes) {
@@ -218,6 +218,8 @@ LobeMixture::LobeMixture(const std::vector<GuidingLobe>& lobes, const glm::vec3&
         kappa = std::min(kMaxLobeKappa, kappa * std::min(4.0f, std::max(0.25f, ratio * ratio)));
       }
     }
+    if (glm::dot(mean, normal) < -1.0f / std::sqrt(kappa)) continue;
+    if (kappa < min_kappa) continue;
     mean_[count_] = mean;
     kappa_[count_] = kappa;
     weight_[count_] = lobe.share;
@@ -225,8 +227,10 @@ LobeMixture::LobeMixture(const std::vector<GuidingLobe>& lobes, const glm::vec3&
     cumulative_[count_] = total;
     ++count_;
   }
+  share_ = std::min(total, 1.0f);
   if (!(total > 0.0f)) {
     count_ = 0;
+    share_ = 0.0f;
     return;
   }
   for (int j = 0; j < count_; ++j) {

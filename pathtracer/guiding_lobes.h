@@ -75,15 +75,21 @@ class LobeMixture {
  public:
   LobeMixture() = default;
   // uniform_fraction of the density is uniform over the sphere (no direction gets pdf 0).
-  LobeMixture(const std::vector<GuidingLobe>& lobes, const glm::vec3& region_mean, const glm::vec3& point,
-              float uniform_fraction);
+  // A non-zero `normal` leaves out the lobes whose (re-aimed) mean lies more than 1 / sqrt(kappa),
+  // about one standard deviation, below its horizon: light from behind the surface serves no sample.
+  // Lobes less concentrated than min_kappa (there) are left out too. share() says what is left.
+  LobeMixture(const std::vector<GuidingLobe>& lobes, const glm::vec3& point, float uniform_fraction,
+              const glm::vec3& normal = glm::vec3(0.0f), float min_kappa = 0.0f);
   bool empty() const { return count_ == 0; }
+  // The share of the region's lobes this point samples (those left out: behind it, or too wide).
+  float share() const { return share_; }
   glm::vec3 sample(glm::vec2 u, float* pdf) const;  // pdf: exactly pdf(direction)
   float pdf(const glm::vec3& direction) const;
 
  private:
   int count_ = 0;
   float uniform_fraction_ = 0.0f;
+  float share_ = 0.0f;
   glm::vec3 mean_[kMaxGuidingLobes];
   float kappa_[kMaxGuidingLobes];
   float weight_[kMaxGuidingLobes];  // share x the vMF normalisation

@@ -105,7 +105,7 @@ std::vector<GuidingLobe> three_lobes() {
 TEST(GuidingLobes, MixtureSamplesFollowItsPdfAndRoundTrip) {
   const std::vector<GuidingLobe> lobes = three_lobes();
   const glm::vec3 point(0.3f, -0.2f, 0.1f);  // off the region's mean: the first lobe re-aims
-  const LobeMixture mixture(lobes, glm::vec3(0.0f), point, 0.01f);
+  const LobeMixture mixture(lobes, point, 0.01f);
   const glm::dvec3 aimed = glm::normalize(glm::dvec3(lobes[0].source - point));
   for (glm::dvec3 pole : {aimed, glm::dvec3(0, 0, -1)}) {  // bins that resolve the narrow lobe, then the wide one
     double sum = 0.0;
@@ -136,9 +136,8 @@ TEST(GuidingLobes, ALobeReaimsAtItsSourceAndNarrowsWithDistance) {
   lobes[0].direction = glm::vec3(0, 0, 1);
   lobes[0].kappa = 400.0f;
   lobes[0].share = 1.0f;
-  const glm::vec3 region_mean(0.0f);
   for (glm::vec3 point : {glm::vec3(0.0f), glm::vec3(0.5f, 0.0f, 0.0f), glm::vec3(-0.3f, 0.4f, -2.0f)}) {
-    const LobeMixture mixture(lobes, region_mean, point, 0.01f);
+    const LobeMixture mixture(lobes, point, 0.01f);
     const glm::vec3 toward = glm::normalize(lobes[0].source - point);
     // The density peaks toward the source, and at twice the distance the lobe is about 4x as concentrated.
     EXPECT_GT(mixture.pdf(toward), mixture.pdf(glm::normalize(toward + glm::vec3(0.02f, 0.0f, 0.0f))));
@@ -148,8 +147,31 @@ TEST(GuidingLobes, ALobeReaimsAtItsSourceAndNarrowsWithDistance) {
   }
   // Without a source (at infinity) the lobe keeps its direction everywhere.
   lobes[0].distance = 0.0f;
-  const LobeMixture far(lobes, region_mean, glm::vec3(5.0f, 0.0f, 0.0f), 0.01f);
+  const LobeMixture far(lobes, glm::vec3(5.0f, 0.0f, 0.0f), 0.01f);
   EXPECT_NEAR(far.pdf(glm::vec3(0, 0, 1)) * 2.0 * kPiD / 0.99, 400.0, 4.0);
+}
+
+TEST(GuidingLobes, LobesBehindTheSurfaceAreLeftOut) {
+  std::vector<GuidingLobe> lobes(2);
+  lobes[0].direction = glm::vec3(0, 0, 1);
+  lobes[0].kappa = 100.0f;
+  lobes[0].share = 0.5f;
+  lobes[1].direction = glm::normalize(glm::vec3(1, 0, -0.3f));  // 17 degrees below a +z surface's horizon
+  lobes[1].kappa = 100.0f;                                      // one standard deviation: about 6 degrees
+  lobes[1].share = 0.5f;
+  const LobeMixture both(lobes, glm::vec3(0.0f), 0.01f), above(lobes, glm::vec3(0.0f), 0.01f, glm::vec3(0, 0, 1));
+  EXPECT_NEAR(both.pdf(lobes[1].direction), 0.99 * 0.5 * 100.0 / (2.0 * kPiD), 0.1);
+  EXPECT_NEAR(above.pdf(lobes[1].direction), 0.01 / (4.0 * kPiD) + 0.99 * 100.0 / (2.0 * kPiD) * std::exp(-100.0 * (1.0 - glm::dot(lobes[0].direction, lobes[1].direction))), 1e-6);
+  EXPECT_NEAR(above.pdf(glm::vec3(0, 0, 1)), 0.99 * 100.0 / (2.0 * kPiD), 0.1);  // the lobe above takes all the share
+  lobes[1].kappa = 4.0f;  // wide: half a radian, so 17 degrees below is within reach and it stays
+  EXPECT_GT(LobeMixture(lobes, glm::vec3(0.0f), 0.01f, glm::vec3(0, 0, 1)).pdf(lobes[1].direction), 0.1);
+  EXPECT_TRUE(LobeMixture({lobes[0]}, glm::vec3(0.0f), 0.01f, glm::vec3(0, 0, -1)).empty());
+  EXPECT_FLOAT_EQ(LobeMixture(lobes, glm::vec3(0.0f), 0.01f).share(), 1.0f);
+  // Lobes wider than min_kappa are left out too, and share() says what is left.
+  const LobeMixture narrow(lobes, glm::vec3(0.0f), 0.01f, glm::vec3(0.0f), 10.0f);
+  EXPECT_FLOAT_EQ(narrow.share(), 0.5f);
+  EXPECT_NEAR(narrow.pdf(glm::vec3(0, 0, 1)), 0.99 * 100.0 / (2.0 * kPiD), 0.1);
+  EXPECT_FLOAT_EQ(LobeMixture(lobes, glm::vec3(0.0f), 0.01f, glm::vec3(0.0f), 200.0f).share(), 0.0f);
 }
 
 // Photons from a small sphere of light (radius 0.05 around `light`) arriving at points spread over
@@ -196,7 +218,7 @@ TEST(GuidingLobes, FitFindsTheSourcesOfTwoLights) {
   // about 0.4 % of the directions together): the lobes aim at the lights, not in the directions
   // the lights had from the region's centre.
   for (glm::vec3 corner : {lo, hi, glm::vec3(0.2f, -0.2f, 0.2f)}) {
-    const LobeMixture mixture(lobes, origin, corner, 0.01f);
+    const LobeMixture mixture(lobes, corner, 0.01f);
     Rng rng(9, 9, 9);
     int hits = 0;
     constexpr int kSamples = 20000;

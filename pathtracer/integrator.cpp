@@ -616,13 +616,15 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
   // BSDF's diffuse share: the field knows the incident light, not the BSDF, so it serves a diffuse
   // lobe; glossy and delta lobes keep their samples). Deeper vertices sample the BSDF alone: most
   // of the heavy-tailed light arrives at the first, and a guided vertex pays field lookups for its
-  // sample and every MIS weight. A leaf that learned no light (a uniform distribution) is not
-  // guided. Measured in docs/guiding.md.
+  // sample and every MIS weight. A leaf that learned no light (a uniform distribution), or only
+  // light behind the surface or too wide to guide, is not guided, and alpha is scaled by the
+  // learned light's share the point's distribution holds. Measured in docs/guiding.md.
   GuidingMixture mixture;
   if (guiding_ && params.guiding && s.nonspecular == 0 && bsdf.has_nondelta() && guiding_->trained()) {
-    mixture.guide = guiding_->distribution(sp.position);
+    const glm::vec3 n = sp.geometric_normal, wo = -path.ray.direction;
+    mixture.guide = guiding_->distribution(sp.position, glm::dot(n, wo) >= 0.0f ? n : -n);
     mixture.guided = mixture.guide.learned();
-    mixture.alpha = kGuidingAlpha * bsdf.diffuse_probability();
+    mixture.alpha = kGuidingAlpha * bsdf.diffuse_probability() * mixture.guide.share();
   }
 
   // Next event estimation (the light vertex is vertex + 1 <= max_vertices).
