@@ -275,13 +275,20 @@ std::vector<TestRecord> make_records(int count, uint64_t seed) {
   return records;
 }
 
+// Sources behind, at infinity and ahead (a focus) alike: the lobes' fits see every kind.
+void record_one(GuidingField& field, const TestRecord& r) {
+  field.record(r.key, r.position, r.direction, r.radiance, r.weight, 0.4f * float(int(r.key % 5) - 2));
+}
 void record_all(GuidingField& field, const std::vector<TestRecord>& records) {
-  for (const TestRecord& r : records) field.record(r.key, r.position, r.direction, r.radiance, r.weight);
+  for (const TestRecord& r : records) record_one(field, r);
 }
 
 TEST(GuidingField, SameRecordsGiveTheSameFieldWhateverTheOrderAndThreads) {
+ for (int lobes : {0, 8}) {  // the quadtrees, then the lobes' reservoirs and fits too
+  SCOPED_TRACE(lobes);
   GuidingSettings settings;
   settings.spatial_threshold = 300.0f;
+  settings.parallax_lobes = lobes;
   GuidingField in_order(glm::vec3(-1.0f), glm::vec3(1.0f), settings);
   GuidingField shuffled(glm::vec3(-1.0f), glm::vec3(1.0f), settings);
   GuidingField threaded(glm::vec3(-1.0f), glm::vec3(1.0f), settings);
@@ -297,7 +304,7 @@ TEST(GuidingField, SameRecordsGiveTheSameFieldWhateverTheOrderAndThreads) {
       for (int t = 0; t < 4; ++t)
         threads.emplace_back([&, t] {
           for (size_t i = size_t(t); i < mixed.size(); i += 4)
-            threaded.record(mixed[i].key, mixed[i].position, mixed[i].direction, mixed[i].radiance, mixed[i].weight);
+            record_one(threaded, mixed[i]);
         });
       for (std::thread& thread : threads) thread.join();
       ASSERT_EQ(in_order.pending_records(), records.size());
@@ -317,6 +324,7 @@ TEST(GuidingField, SameRecordsGiveTheSameFieldWhateverTheOrderAndThreads) {
     EXPECT_EQ(bytes, threaded.serialize()) << "iteration " << iteration;
   }
   EXPECT_GT(in_order.stats().spatial_leaves, 8u);
+ }
 }
 
 TEST(GuidingField, MemoryBoundHoldsUnderAFloodOfRecords) {
@@ -421,10 +429,11 @@ TEST(GuidingField, IterationsDoubleInLength) {
   EXPECT_EQ(ends, (std::vector<uint64_t>{1, 3, 7, 15, 31, 63}));  // iteration k: 2^k frames
 }
 
-// A trained field with several leaves and buffered records.
-GuidingField trained_field() {
+// A trained field with several leaves and buffered records (and lobes, with `lobes` > 0).
+GuidingField trained_field(int lobes = 0) {
   GuidingSettings settings;
   settings.spatial_threshold = 1000.0f;
+  settings.parallax_lobes = lobes;
   GuidingField field(glm::vec3(-2.0f, -1.0f, 0.0f), glm::vec3(2.0f, 1.0f, 1.0f), settings);
   for (int k = 0; k < 3; ++k) {
     record_all(field, make_records(3000, uint64_t(k + 1)));
@@ -475,7 +484,9 @@ void fix_checksum(std::vector<uint8_t>& bytes) {
 }
 
 TEST(GuidingField, CorruptBytesAreRejectedWithOneLine) {
-  const GuidingField field = trained_field();
+ for (int lobes : {0, 8}) {
+  SCOPED_TRACE(lobes);
+  const GuidingField field = trained_field(lobes);
   const std::vector<uint8_t> good = field.serialize();
   const uint64_t bound = field.settings().max_bytes;
   int rejected = 0, accepted = 0;
@@ -535,6 +546,7 @@ TEST(GuidingField, CorruptBytesAreRejectedWithOneLine) {
   EXPECT_GT(rejected, 3000);
   EXPECT_GT(accepted, 0) << "mutated values with a fixed checksum: the checks of an accepted field ran";
   EXPECT_EQ(GuidingField::deserialize(good.data(), good.size()).serialize(), good);
+ }
 }
 
 }  // namespace
