@@ -46,10 +46,13 @@ double kappa_of(double r) {
   return std::min(std::max(kappa, kMinKappa), double(kMaxLobeKappa));
 }
 
-// log of the vMF density without its constant's log(2 pi): log kappa - log(1 - e^-2kappa) - kappa |mu - w|^2 / 2.
-double vmf_log(const glm::dvec3& mean, double kappa, const glm::dvec3& w) {
+// log of the vMF density's constant without log(1 / 2 pi): log kappa - log(1 - e^-2kappa).
+double vmf_log_normalisation(double kappa) { return std::log(kappa) - std::log(-std::expm1(-2.0 * kappa)); }
+
+// log of the vMF density without log(1 / 2 pi); the exponent kappa (cos - 1) as -kappa |mu - w|^2 / 2.
+double vmf_log(const glm::dvec3& mean, double kappa, double log_normalisation, const glm::dvec3& w) {
   const glm::dvec3 d = mean - w;
-  return std::log(kappa) - std::log(-std::expm1(-2.0 * kappa)) - 0.5 * kappa * glm::dot(d, d);
+  return log_normalisation - 0.5 * kappa * glm::dot(d, d);
 }
 
 // Farthest-point seeds then a few rounds of spherical k-means: a deterministic start for EM.
@@ -126,10 +129,12 @@ std::vector<GuidingLobe> fit_guiding_lobes(const std::vector<GuidingLobeRecord>&
   std::vector<double> kappa(k, 10.0), share(k, 1.0 / double(k));
   std::vector<double> resp(n * k);
   for (int round = 0; round < kEmRounds; ++round) {
+    std::vector<double> log_weight(k);  // log(share x the vMF's normalisation)
+    for (size_t j = 0; j < k; ++j) log_weight[j] = share[j] > 0.0 ? std::log(share[j]) + vmf_log_normalisation(kappa[j]) : -1e300;
     for (size_t i = 0; i < n; ++i) {  // E: responsibilities, in logs (tight lobes overflow exp)
       double top = -1e300;
       for (size_t j = 0; j < k; ++j) {
-        resp[i * k + j] = share[j] > 0.0 ? std::log(share[j]) + vmf_log(mean[j], kappa[j], v[i]) : -1e300;
+        resp[i * k + j] = share[j] > 0.0 ? vmf_log(mean[j], kappa[j], log_weight[j], v[i]) : -1e300;
         top = std::max(top, resp[i * k + j]);
       }
       double sum = 0.0;
@@ -186,7 +191,7 @@ std::vector<GuidingLobe> fit_guiding_lobes(const std::vector<GuidingLobeRecord>&
 }
 
 double vmf_pdf(const glm::dvec3& mean, double kappa, const glm::dvec3& w) {
-  return std::exp(vmf_log(mean, kappa, w)) / kTwoPi;
+  return std::exp(vmf_log(mean, kappa, vmf_log_normalisation(kappa), w)) / kTwoPi;
 }
 
 glm::dvec3 vmf_sample(const glm::dvec3& mean, double kappa, glm::dvec2 u) {
@@ -207,6 +212,7 @@ LobeMixture::LobeMixture(const std::vector<GuidingLobe>& lobes, const glm::vec3&
   float total = 0.0f;
   for (const GuidingLobe& lobe : lobes) {
     if (count_ == kMaxGuidingLobes) break;
+    if (lobe.kappa * 4.0f < min_kappa) continue;  // too wide even at the largest distance factor
     glm::vec3 mean = lobe.direction;
     float kappa = lobe.kappa;
     if (lobe.distance != 0.0f) {
@@ -218,8 +224,9 @@ LobeMixture::LobeMixture(const std::vector<GuidingLobe>& lobes, const glm::vec3&
         kappa = std::min(kMaxLobeKappa, kappa * std::min(4.0f, std::max(0.25f, ratio * ratio)));
       }
     }
-    if (glm::dot(mean, normal) < -1.0f / std::sqrt(kappa)) continue;
     if (kappa < min_kappa) continue;
+    const float below = -glm::dot(mean, normal);  // below the horizon by more than 1 / sqrt(kappa)?
+    if (below > 0.0f && below * below * kappa > 1.0f) continue;
     mean_[count_] = mean;
     kappa_[count_] = kappa;
     weight_[count_] = lobe.share;

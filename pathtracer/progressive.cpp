@@ -20,14 +20,15 @@ namespace {
 constexpr int kTileSize = 16;
 constexpr int kChunk = kTileSize * kTileSize;  // jobs per batch that one thread traces
 
-// Path guiding's training (docs/guiding.md, measured there): after each frame, a quarter of a
+// Path guiding's training (docs/guiding.md, measured there): after each frame, an eighth of a
 // photon per pixel, but at least kGuidingMinPhotonsPerFrame (the field's resolution depends on the
 // scene, not on the image), and no iteration (2^k frames) traces more than
 // kGuidingPhotonsPerIteration, so the training's cost per frame falls once the field has that
-// many. The field's spatial leaves split at c = 300 records (x sqrt(2^k)), not the paper's 12000,
-// which left a Cornell box wall in one leaf at these photon counts.
-constexpr double kGuidingPhotonsPerPixel = 0.25;
-constexpr double kGuidingMinPhotonsPerFrame = 16384;
+// many: a leaf's lobes are fitted to a reservoir of 128 records. The field's spatial leaves split at
+// c = 100 records (x sqrt(2^k)), not the paper's 12000, which left a Cornell box wall in one leaf
+// at these photon counts.
+constexpr double kGuidingPhotonsPerPixel = 0.125;
+constexpr double kGuidingMinPhotonsPerFrame = 8192;
 constexpr double kGuidingPhotonsPerIteration = double(1 << 18);
 constexpr float kGuidingSpatialThreshold = 100.0f;
 // The directional model: at most 8 parallax-aware lobes per leaf (docs/guiding.md), not the quadtree.
