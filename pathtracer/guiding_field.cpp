@@ -232,7 +232,8 @@ bool record_before(const GuidingRecord& a, const GuidingRecord& b) {
   const auto bits = [](const GuidingRecord& r) {
     return std::make_tuple(r.leaf, r.key, float_bits(r.u), float_bits(r.v), float_bits(r.energy), float_bits(r.position.x),
                            float_bits(r.position.y), float_bits(r.position.z), float_bits(r.source.x),
-                           float_bits(r.source.y), float_bits(r.source.z), r.kind);
+                           float_bits(r.source.y), float_bits(r.source.z), r.kind, float_bits(r.normal.x), float_bits(r.normal.y),
+                           float_bits(r.normal.z));
   };
   return bits(a) < bits(b);
 }
@@ -317,6 +318,7 @@ void put_lobes(ByteWriter& w, const GuidingLeaf& leaf) {
     w.put(lobe.share);
   }
   put_vec3(w, leaf.lobe_origin);
+  w.put(leaf.alpha);
   std::vector<GuidingLobeRecord> reservoir = leaf.reservoir;  // in key order: the bytes do not depend on arrival
   std::sort(reservoir.begin(), reservoir.end(), [](const auto& a, const auto& b) { return a.key < b.key; });
   w.put(static_cast<uint64_t>(reservoir.size()));
@@ -326,6 +328,7 @@ void put_lobes(ByteWriter& w, const GuidingLeaf& leaf) {
     put_vec3(w, rec.position);
     put_vec3(w, rec.source);
     w.put(rec.kind);
+    put_vec3(w, rec.normal);
   }
 }
 
@@ -344,7 +347,9 @@ void get_lobes(ByteReader& r, const GuidingSettings& settings, GuidingLeaf* leaf
       throw Error("guiding field has an invalid lobe");
   }
   leaf->lobe_origin = get_vec3(r, "lobes");
-  const size_t records = r.get_count(sizeof(GuidingLobeRecord) / 2, "lobe records");
+  leaf->alpha = r.get<float>("lobes");
+  if (!(leaf->alpha >= 0.0f && leaf->alpha <= 1.0f)) throw Error("guiding field has an invalid guided share");
+  const size_t records = r.get_count(52, "lobe records");  // the bytes put_lobes writes per record
   if (records > (settings.parallax_lobes > 0 ? settings.lobe_records : 0))
     throw Error("guiding field has more lobe records than its settings allow");
   leaf->reservoir.resize(records);
@@ -354,6 +359,7 @@ void get_lobes(ByteReader& r, const GuidingSettings& settings, GuidingLeaf* leaf
     rec.position = get_vec3(r, "lobe records");
     rec.source = get_vec3(r, "lobe records");
     rec.kind = r.get<uint32_t>("lobe records");
+    rec.normal = get_vec3(r, "lobe records");
     if (!(rec.priority <= 0.0f) || rec.kind > kSourceAhead) throw Error("guiding field has an invalid lobe record");
   }
 }
@@ -436,7 +442,7 @@ GuidingField::Box GuidingField::leaf_box(const glm::vec3& position) const {
 }
 
 void GuidingField::record(uint64_t key, const glm::vec3& position, const glm::vec3& direction, float radiance,
-                          float weight, float distance) {
+                          float weight, float distance, const glm::vec3& normal) {
   if (!(radiance >= 0.0f) || !(weight >= 0.0f) || !std::isfinite(radiance) || !std::isfinite(weight)) return;
   if (!std::isfinite(position.x) || !std::isfinite(position.y) || !std::isfinite(position.z)) return;
   glm::dvec2 uv;
@@ -450,7 +456,9 @@ void GuidingField::record(uint64_t key, const glm::vec3& position, const glm::ve
   const glm::vec3 source = at_infinity ? unit : position + distance * glm::normalize(direction);
   if (!std::isfinite(source.x) || !std::isfinite(source.y) || !std::isfinite(source.z)) return;
   const uint32_t kind = at_infinity ? kSourceAtInfinity : distance > 0.0f ? kSourceBehind : kSourceAhead;
-  buffers_->per_thread.local().push_back({key, leaf, u, v, energy, position, source, kind});
+  const float normal_length = glm::length(normal);
+  const glm::vec3 unit_normal = normal_length > 0.0f && std::isfinite(normal_length) ? normal / normal_length : glm::vec3(0.0f);
+  buffers_->per_thread.local().push_back({key, leaf, u, v, energy, position, source, kind, unit_normal});
 }
 
 size_t GuidingField::pending_records() const {
@@ -488,7 +496,7 @@ void GuidingField::apply_records() {
       for (size_t i = starts[group]; i < starts[group + 1]; ++i) {
         const GuidingRecord& r = pending_[i];
         if (r.energy > 0.0f)
-          incoming.push_back({r.key, lobe_record_priority(r.key, r.energy), r.position, r.source, r.kind});
+          incoming.push_back({r.key, lobe_record_priority(r.key, r.energy), r.position, r.source, r.kind, r.normal});
       }
       merge_into_reservoir(leaf.reservoir, incoming, settings_.lobe_records);
     }
@@ -506,6 +514,8 @@ void GuidingField::end_iteration() {
   if (settings_.parallax_lobes > 0) {
     tbb::parallel_for(size_t(0), leaves_.size(), [&](size_t i) {
       GuidingLeaf& leaf = leaves_[i];
+      if (!leaf.lobes.empty())  // judged on records the lobes were not fitted to
+        leaf.alpha = best_guided_share(leaf.lobes, leaf.reservoir, settings_.uniform_fraction, settings_.min_lobe_kappa, leaf.alpha);
       glm::vec3 origin;
       std::vector<GuidingLobe> lobes = fit_guiding_lobes(leaf.reservoir, settings_.parallax_lobes, &origin);
       if (!lobes.empty()) {  // too few records: the leaf keeps what it knew
@@ -586,8 +596,9 @@ void GuidingField::split_leaves(double threshold) {
 GuidingField::Distribution GuidingField::distribution(const glm::vec3& position, const glm::vec3& normal) const {
   const GuidingLeaf& leaf = leaves_[find_leaf(position)];
   if (settings_.parallax_lobes > 0)
-    return Distribution(LobeMixture(leaf.lobes, position, settings_.uniform_fraction, normal, settings_.min_lobe_kappa));
-  return Distribution(leaf.sampling, settings_.uniform_fraction);
+    return Distribution(LobeMixture(leaf.lobes, position, settings_.uniform_fraction, normal, settings_.min_lobe_kappa),
+                        leaf.alpha);
+  return Distribution(leaf.sampling, settings_.uniform_fraction, leaf.alpha);
 }
 
 glm::vec3 GuidingField::Distribution::sample(glm::vec2 u, float* pdf_out) const {
@@ -680,6 +691,7 @@ std::vector<uint8_t> GuidingField::serialize() const {
     put_vec3(w, r.position);
     put_vec3(w, r.source);
     w.put(r.kind);
+    put_vec3(w, r.normal);
   }
   w.put(fnv1a64(w.bytes.data(), w.bytes.size()));
   return std::move(w.bytes);
@@ -755,7 +767,7 @@ GuidingField GuidingField::deserialize(const uint8_t* data, size_t size) {
     leaf.building = get_tree<GuidingBuildingNode>(r, f.settings_.max_directional_depth, "building");
     get_lobes(r, f.settings_, &leaf);
   }
-  f.pending_.resize(r.get_count(52, "records"));  // the bytes serialize() writes per record
+  f.pending_.resize(r.get_count(64, "records"));  // the bytes serialize() writes per record
   for (GuidingRecord& rec : f.pending_) {
     rec.key = r.get<uint64_t>("records");
     rec.leaf = r.get<uint32_t>("records");
@@ -765,6 +777,7 @@ GuidingField GuidingField::deserialize(const uint8_t* data, size_t size) {
     rec.position = get_vec3(r, "records");
     rec.source = get_vec3(r, "records");
     rec.kind = r.get<uint32_t>("records");
+    rec.normal = get_vec3(r, "records");
     if (rec.leaf >= leaf_count || !(rec.u >= 0.0f && rec.u < 1.0f) || !(rec.v >= 0.0f && rec.v < 1.0f) ||
         !non_negative_finite(rec.energy) || rec.kind > kSourceAhead)
       throw Error("guiding field has an invalid record");

@@ -92,6 +92,10 @@ struct GuidingLeaf {
   std::vector<GuidingLobe> lobes;
   glm::vec3 lobe_origin{0.0f};
   std::vector<GuidingLobeRecord> reservoir;
+  // The guided share of the leaf's vertices: Müller et al.'s fixed 0.5 until the lobes have been
+  // judged, then what best_guided_share() finds for the lobes of the last iteration on the records
+  // of this one (records they were not fitted to).
+  float alpha = 0.5f;
 };
 struct GuidingSpatialNode {
   uint32_t children = 0;  // index of the first of two (lower, upper half), 0: a leaf
@@ -105,6 +109,7 @@ struct GuidingRecord {
   glm::vec3 position;
   glm::vec3 source;  // where the light seems to come from (see kind)
   uint32_t kind;     // GuidingSourceKind
+  glm::vec3 normal;  // of the receiving surface, toward the light's side (0: unknown)
 };
 
 class GuidingField {
@@ -136,9 +141,10 @@ class GuidingField {
   // negative radiance or weight, a non-finite position or a zero or non-finite direction are dropped.
   // `distance`: how far along `direction` the light seems to come from (the previous vertex, or its
   // image through delta bounces), for the parallax lobes; negative: from a focus that far the
-  // other way; 0 or not finite: unknown or at infinity.
+  // other way; 0 or not finite: unknown or at infinity. `normal`: of the receiving surface (either
+  // side; 0: unknown), for the lobes' guided share.
   void record(uint64_t key, const glm::vec3& position, const glm::vec3& direction, float radiance, float weight,
-              float distance = 0.0f);
+              float distance = 0.0f, const glm::vec3& normal = glm::vec3(0.0f));
   // Adds the buffered records to the building trees (see the determinism note above).
   void apply_records();
   // Ends the iteration (iteration() counts the ended ones): see the notes above.
@@ -171,14 +177,17 @@ class GuidingField {
     bool learned() const;
     // The share of the learned light this point's distribution holds (1 for the quadtree).
     float share() const { return use_lobes_ ? lobes_.share() : 1.0f; }
+    // The guided share its leaf learned (GuidingLeaf::alpha).
+    float alpha() const { return alpha_; }
 
    private:
     friend class GuidingField;
-    Distribution(const std::vector<GuidingSamplingNode>& tree, float uniform_fraction)
-        : tree_(&tree), uniform_fraction_(uniform_fraction) {}
-    explicit Distribution(const LobeMixture& lobes) : lobes_(lobes), use_lobes_(true) {}
+    Distribution(const std::vector<GuidingSamplingNode>& tree, float uniform_fraction, float alpha)
+        : tree_(&tree), uniform_fraction_(uniform_fraction), alpha_(alpha) {}
+    Distribution(const LobeMixture& lobes, float alpha) : alpha_(alpha), lobes_(lobes), use_lobes_(true) {}
     const std::vector<GuidingSamplingNode>* tree_ = nullptr;
     float uniform_fraction_ = 0.0f;
+    float alpha_ = 0.5f;
     LobeMixture lobes_;
     bool use_lobes_ = false;
   };
@@ -190,7 +199,7 @@ class GuidingField {
   float pdf(const glm::vec3& position, const glm::vec3& direction) const { return distribution(position).pdf(direction); }
 
   // --- Inspection.
-  static constexpr uint64_t kMinBytes = 192;  // one leaf with one node per tree
+  static constexpr uint64_t kMinBytes = 200;  // one leaf with one node per tree
   size_t memory_bytes() const;
   Stats stats() const;
   Box bounds() const { return {box_lo_, box_hi_}; }

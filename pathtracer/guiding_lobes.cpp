@@ -83,6 +83,42 @@ std::vector<glm::dvec3> seed_means(const std::vector<glm::dvec3>& v, int count) 
 
 }  // namespace
 
+glm::vec3 record_direction(const GuidingLobeRecord& r) {
+  if (r.kind == kSourceAtInfinity) return r.source;
+  const glm::vec3 d = r.kind == kSourceAhead ? r.position - r.source : r.source - r.position;
+  const float length = glm::length(d);
+  return length > 0.0f && std::isfinite(length) ? d / length : glm::vec3(0.0f);
+}
+
+float best_guided_share(const std::vector<GuidingLobe>& lobes, const std::vector<GuidingLobeRecord>& records,
+                        float uniform_fraction, float min_kappa, float fallback) {
+  constexpr int kSteps = 10;  // alpha = 0, 0.1, ..., 0.9: the BSDF keeps at least a tenth
+  struct Densities {
+    double guide, cosine, share;
+  };
+  std::vector<Densities> at;
+  for (const GuidingLobeRecord& r : records) {
+    const glm::vec3 d = record_direction(r);
+    const float cosine = glm::dot(d, r.normal);
+    if (!(cosine > 0.0f)) continue;  // no normal, or light from behind: not a sample of L_i cos
+    const LobeMixture mixture(lobes, r.position, uniform_fraction, r.normal, min_kappa);
+    at.push_back({mixture.empty() ? 0.0 : double(mixture.pdf(d)), cosine / 3.14159265358979323846, mixture.share()});
+  }
+  if (at.size() < kMinLobeRecords) return fallback;
+  int best = 0;
+  double best_divergence = 0.0;
+  for (int step = 0; step < kSteps; ++step) {
+    const double alpha = step / double(kSteps);
+    double divergence = 0.0;  // minus the sum of log p_mixture
+    for (const Densities& x : at) divergence -= std::log(alpha * x.share * x.guide + (1.0 - alpha * x.share) * x.cosine);
+    if (step == 0 || divergence < best_divergence) {
+      best = step;
+      best_divergence = divergence;
+    }
+  }
+  return best / float(kSteps);
+}
+
 float lobe_record_priority(uint64_t key, float energy) {
   // u in (0, 1] from the key; A-ES keeps the largest u^(1/energy), i.e. log(u) / energy.
   const double u = (double(mix64(key) >> 11) + 1.0) * 0x1.0p-53;

@@ -47,7 +47,11 @@ struct GuidingLobeRecord {
   glm::vec3 position{0.0f};
   glm::vec3 source{0.0f};
   uint32_t kind = kSourceBehind;
+  glm::vec3 normal{0.0f};  // of the receiving surface, on the side the light arrives; 0: unknown
 };
+
+// The direction toward the light of a record (from its source and kind).
+glm::vec3 record_direction(const GuidingLobeRecord& record);
 
 constexpr int kMaxGuidingLobes = 8;
 constexpr float kMaxLobeKappa = 1.0e5f;  // about 0.2 degrees wide: far narrower than any light seen here
@@ -63,6 +67,15 @@ void merge_into_reservoir(std::vector<GuidingLobeRecord>& reservoir, const std::
 constexpr size_t kMinLobeRecords = 16;
 std::vector<GuidingLobe> fit_guiding_lobes(const std::vector<GuidingLobeRecord>& records, int max_lobes,
                                            glm::vec3* mean_position);
+
+// The guided share alpha (of 0, 0.1, ..., 0.9) whose mixture alpha s p_lobes + (1 - alpha s) p_cos
+// is closest to the light the records show, with p_lobes the LobeMixture at each record's point and
+// normal, s its share() and p_cos = cos / pi: the records are distributed like that light (L_i cos),
+// so the mean of log p_mixture over them is, up to a constant, minus the KL divergence from it
+// (Müller et al. 2019 learn their selection probability by the same divergence). `fallback` where
+// fewer than kMinLobeRecords records have a normal.
+float best_guided_share(const std::vector<GuidingLobe>& lobes, const std::vector<GuidingLobeRecord>& records,
+                        float uniform_fraction, float min_kappa, float fallback);
 
 // The vMF density on the unit sphere, stable for large kappa.
 double vmf_pdf(const glm::dvec3& mean, double kappa, const glm::dvec3& direction);

@@ -237,6 +237,38 @@ TEST(GuidingLobes, FitFindsTheSourcesOfTwoLights) {
   }
 }
 
+TEST(GuidingLobes, GuidedShareFollowsHowWellTheLobesFitTheRecords) {
+  // Records of a small light above a floor region (normal +z), and lobes fitted to other records of it.
+  const glm::vec3 light(0.0f, 0.0f, 1.0f), lo(-0.2f, -0.2f, 0.0f), hi(0.2f, 0.2f, 0.0f);
+  std::vector<GuidingLobeRecord> fit = photons_from(light, lo, hi, 200, 21), judge = photons_from(light, lo, hi, 200, 22);
+  for (GuidingLobeRecord& r : judge) r.normal = glm::vec3(0, 0, 1);
+  glm::vec3 origin;
+  const std::vector<GuidingLobe> good = fit_guiding_lobes(fit, 8, &origin);
+  EXPECT_GE(best_guided_share(good, judge, 0.01f, 10.0f, 0.5f), 0.8f);
+  // Lobes aimed 60 degrees off the light (above the horizon, so not left out): no guiding pays.
+  std::vector<GuidingLobe> wrong = good;
+  for (GuidingLobe& lobe : wrong) {
+    lobe.distance = 0.0f;
+    lobe.direction = glm::normalize(glm::vec3(std::sqrt(3.0f), 0.0f, 1.0f));
+  }
+  EXPECT_EQ(best_guided_share(wrong, judge, 0.01f, 10.0f, 0.5f), 0.0f);
+  // Half the light from the small light, half from the whole sky: somewhere between.
+  std::vector<GuidingLobeRecord> mixed = judge;
+  Rng rng(8, 8, 8);
+  for (GuidingLobeRecord& r : mixed)
+    if (r.key % 2) {
+      const glm::vec2 u = rng.next_2d();
+      const float z = std::sqrt(u.x), s = std::sqrt(1.0f - u.x);  // cosine-distributed: L_i cos of a uniform sky
+      r.source = glm::vec3(s * std::cos(6.2831853f * u.y), s * std::sin(6.2831853f * u.y), z);
+      r.kind = kSourceAtInfinity;
+    }
+  const float between = best_guided_share(good, mixed, 0.01f, 10.0f, 0.5f);
+  EXPECT_GT(between, 0.0f);
+  EXPECT_LT(between, best_guided_share(good, judge, 0.01f, 10.0f, 0.5f));
+  // Records without a normal cannot judge: the fallback stays.
+  EXPECT_EQ(best_guided_share(good, fit, 0.01f, 10.0f, 0.3f), 0.3f);
+}
+
 TEST(GuidingLobes, ReservoirKeepsTheSameRecordsWhateverTheOrder) {
   std::vector<GuidingLobeRecord> records = photons_from(glm::vec3(0, 0, 1), glm::vec3(-1.0f), glm::vec3(1.0f), 2000, 4);
   for (size_t i = 0; i < records.size(); ++i) records[i].priority = lobe_record_priority(records[i].key, 1.0f + float(i % 5));

@@ -515,7 +515,8 @@ void PathTracer::trace_guiding_photon(uint32_t frame, uint32_t index, const Trac
       if (chain_has_delta && companion == CompanionState::kActive) {
         distance = closest_approach(sp.position, -ray.direction, companion_sp.position, -companion_ray.direction);
       }
-      guiding_->record(key + static_cast<uint64_t>(surface), sp.position, -ray.direction, luminance(flux), 1.0f, distance);
+      const glm::vec3 n = glm::dot(sp.geometric_normal, ray.direction) < 0.0f ? sp.geometric_normal : -sp.geometric_normal;
+      guiding_->record(key + static_cast<uint64_t>(surface), sp.position, -ray.direction, luminance(flux), 1.0f, distance, n);
     }
     BsdfSample bs;
     const float u_lobe = rng.next_float();
@@ -624,7 +625,7 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
     const glm::vec3 n = sp.geometric_normal, wo = -path.ray.direction;
     mixture.guide = guiding_->distribution(sp.position, glm::dot(n, wo) >= 0.0f ? n : -n);
     mixture.guided = mixture.guide.learned();
-    mixture.alpha = kGuidingAlpha * bsdf.diffuse_probability() * mixture.guide.share();
+    mixture.alpha = mixture.guide.alpha() * bsdf.diffuse_probability() * mixture.guide.share();
   }
 
   // Next event estimation (the light vertex is vertex + 1 <= max_vertices).

@@ -43,15 +43,12 @@ struct TraceParams {
   bool near_specular_sampling = true;
   // Path guiding (docs/guiding.md): the renderer learns an SD-tree of the indirect light from
   // photons it traces from the lights after each frame, and once trained each path's first
-  // non-delta vertex samples its direction from it with probability kGuidingAlpha (times the
-  // BSDF's non-delta share), from the BSDF otherwise, weighted by the mixture pdf (one-sample MIS;
+  // non-delta vertex samples its direction from it with the probability its region learned (times
+  // the BSDF's diffuse share), from the BSDF otherwise, weighted by the mixture pdf (one-sample MIS;
   // NEE and specular sampling MIS against that mixture). Off by default; off traces the samples
   // of before, bit for bit.
   bool guiding = false;
 };
-
-// The guided share of a guided vertex's directions (Müller et al. 2017's fixed 0.5).
-constexpr float kGuidingAlpha = 0.5f;
 
 // A sphere subtends solid angle 2 pi (1 - cos a) from a point at distance d from its center, with
 // sin a = r / d. Near: at least pi sr (a >= 60 degrees), i.e. d^2 <= r^2 / sin^2 a = r^2 / (1 - cos^2 a).
