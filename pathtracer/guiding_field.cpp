@@ -595,9 +595,11 @@ void GuidingField::split_leaves(double threshold) {
 
 GuidingField::Distribution GuidingField::distribution(const glm::vec3& position, const glm::vec3& normal) const {
   const GuidingLeaf& leaf = leaves_[find_leaf(position)];
-  if (settings_.parallax_lobes > 0)
+  if (settings_.parallax_lobes > 0) {
+    if (leaf.alpha == 0.0f) return Distribution(LobeMixture(), 0.0f);  // learned not to guide: not learned()
     return Distribution(LobeMixture(leaf.lobes, position, settings_.uniform_fraction, normal, settings_.min_lobe_kappa),
                         leaf.alpha);
+  }
   return Distribution(leaf.sampling, settings_.uniform_fraction, leaf.alpha);
 }
 
