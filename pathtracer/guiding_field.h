@@ -6,7 +6,9 @@
 // does, so that cyclic x, y, z splits at the midpoint give near-cubic cells). Directional part:
 // in each spatial leaf a quadtree over the cylindrical map of the sphere, (cos theta, phi) ->
 // ((cos theta + 1) / 2, phi / 2 pi) in [0,1)^2, which preserves area: a density over the square
-// divided by 4 pi is the solid-angle density.
+// divided by 4 pi is the solid-angle density. With settings.parallax_lobes > 0 a leaf samples
+// parallax-aware vMF lobes instead (guiding_lobes.h), fitted at the end of each iteration to a
+// reservoir of its records, with a guided share learned per leaf; the quadtrees are still built.
 //
 // Learning runs in iterations of doubling length: iteration k lasts 2^k frames (frames
 // [2^k - 1, 2^(k+1) - 1) of the render; iteration_ends_after() says when to call end_iteration()).
