@@ -308,6 +308,25 @@ glm::vec3 get_vec3(ByteReader& r, const char* what) {
   return v;
 }
 
+// Where a record (GuidingRecord or GuidingLobeRecord) arrived and where its light came from: the
+// fields both kinds of record share, in the order both write them.
+template <class Record>
+void put_arrival(ByteWriter& w, const Record& rec) {
+  put_vec3(w, rec.position);
+  put_vec3(w, rec.source);
+  w.put(rec.kind);
+  put_vec3(w, rec.normal);
+}
+
+template <class Record>
+void get_arrival(ByteReader& r, const char* what, Record* rec) {
+  rec->position = get_vec3(r, what);
+  rec->source = get_vec3(r, what);
+  rec->kind = r.get<uint32_t>(what);
+  rec->normal = get_vec3(r, what);
+  if (rec->kind > kSourceAhead) throw Error(std::string("guiding field has an invalid source kind in its ") + what);
+}
+
 void put_lobes(ByteWriter& w, const GuidingLeaf& leaf) {
   w.put(static_cast<uint64_t>(leaf.lobes.size()));
   for (const GuidingLobe& lobe : leaf.lobes) {
@@ -317,7 +336,6 @@ void put_lobes(ByteWriter& w, const GuidingLeaf& leaf) {
     w.put(lobe.kappa);
     w.put(lobe.share);
   }
-  put_vec3(w, leaf.lobe_origin);
   w.put(leaf.alpha);
   std::vector<GuidingLobeRecord> reservoir = leaf.reservoir;  // in key order: the bytes do not depend on arrival
   std::sort(reservoir.begin(), reservoir.end(), [](const auto& a, const auto& b) { return a.key < b.key; });
@@ -325,10 +343,7 @@ void put_lobes(ByteWriter& w, const GuidingLeaf& leaf) {
   for (const GuidingLobeRecord& rec : reservoir) {
     w.put(rec.key);
     w.put(rec.priority);
-    put_vec3(w, rec.position);
-    put_vec3(w, rec.source);
-    w.put(rec.kind);
-    put_vec3(w, rec.normal);
+    put_arrival(w, rec);
   }
 }
 
@@ -346,7 +361,6 @@ void get_lobes(ByteReader& r, const GuidingSettings& settings, GuidingLeaf* leaf
         !(lobe.kappa > 0.0f && lobe.kappa <= kMaxLobeKappa) || !(lobe.share >= 0.0f && lobe.share <= 1.0f))
       throw Error("guiding field has an invalid lobe");
   }
-  leaf->lobe_origin = get_vec3(r, "lobes");
   leaf->alpha = r.get<float>("lobes");
   if (!(leaf->alpha >= 0.0f && leaf->alpha <= 1.0f)) throw Error("guiding field has an invalid guided share");
   const size_t records = r.get_count(52, "lobe records");  // the bytes put_lobes writes per record
@@ -356,11 +370,8 @@ void get_lobes(ByteReader& r, const GuidingSettings& settings, GuidingLeaf* leaf
   for (GuidingLobeRecord& rec : leaf->reservoir) {
     rec.key = r.get<uint64_t>("lobe records");
     rec.priority = r.get<float>("lobe records");
-    rec.position = get_vec3(r, "lobe records");
-    rec.source = get_vec3(r, "lobe records");
-    rec.kind = r.get<uint32_t>("lobe records");
-    rec.normal = get_vec3(r, "lobe records");
-    if (!(rec.priority <= 0.0f) || rec.kind > kSourceAhead) throw Error("guiding field has an invalid lobe record");
+    get_arrival(r, "lobe records", &rec);
+    if (!(rec.priority <= 0.0f)) throw Error("guiding field has an invalid lobe record");
   }
 }
 
@@ -516,12 +527,8 @@ void GuidingField::end_iteration() {
       GuidingLeaf& leaf = leaves_[i];
       if (!leaf.lobes.empty())  // judged on records the lobes were not fitted to
         leaf.alpha = best_guided_share(leaf.lobes, leaf.reservoir, settings_.uniform_fraction, settings_.min_lobe_kappa, leaf.alpha);
-      glm::vec3 origin;
-      std::vector<GuidingLobe> lobes = fit_guiding_lobes(leaf.reservoir, settings_.parallax_lobes, &origin);
-      if (!lobes.empty()) {  // too few records: the leaf keeps what it knew
-        leaf.lobes = std::move(lobes);
-        leaf.lobe_origin = origin;
-      }
+      std::vector<GuidingLobe> lobes = fit_guiding_lobes(leaf.reservoir, settings_.parallax_lobes);
+      if (!lobes.empty()) leaf.lobes = std::move(lobes);  // too few records: the leaf keeps what it knew
       leaf.reservoir.clear();
     });
   }
@@ -690,10 +697,7 @@ std::vector<uint8_t> GuidingField::serialize() const {
     w.put(r.u);
     w.put(r.v);
     w.put(r.energy);
-    put_vec3(w, r.position);
-    put_vec3(w, r.source);
-    w.put(r.kind);
-    put_vec3(w, r.normal);
+    put_arrival(w, r);
   }
   w.put(fnv1a64(w.bytes.data(), w.bytes.size()));
   return std::move(w.bytes);
@@ -776,12 +780,9 @@ GuidingField GuidingField::deserialize(const uint8_t* data, size_t size) {
     rec.u = r.get<float>("records");
     rec.v = r.get<float>("records");
     rec.energy = r.get<float>("records");
-    rec.position = get_vec3(r, "records");
-    rec.source = get_vec3(r, "records");
-    rec.kind = r.get<uint32_t>("records");
-    rec.normal = get_vec3(r, "records");
+    get_arrival(r, "records", &rec);
     if (rec.leaf >= leaf_count || !(rec.u >= 0.0f && rec.u < 1.0f) || !(rec.v >= 0.0f && rec.v < 1.0f) ||
-        !non_negative_finite(rec.energy) || rec.kind > kSourceAhead)
+        !non_negative_finite(rec.energy))
       throw Error("guiding field has an invalid record");
   }
   if (r.remaining() != 0) throw Error("guiding field has " + std::to_string(r.remaining()) + " trailing bytes");

@@ -89,10 +89,8 @@ struct GuidingLeaf {
   std::vector<GuidingSamplingNode> sampling;  // never empty
   std::vector<GuidingBuildingNode> building;  // never empty
   uint64_t records = 0;                       // this iteration's, applied
-  // Parallax lobes (settings.parallax_lobes > 0): the sampling lobes, the mean position of the
-  // records they were fitted to, and this iteration's reservoir.
+  // Parallax lobes (settings.parallax_lobes > 0): the sampling lobes and this iteration's reservoir.
   std::vector<GuidingLobe> lobes;
-  glm::vec3 lobe_origin{0.0f};
   std::vector<GuidingLobeRecord> reservoir;
   // The guided share of the leaf's vertices: Müller et al.'s fixed 0.5 until the lobes have been
   // judged, then what best_guided_share() finds for the lobes of the last iteration on the records
@@ -201,7 +199,7 @@ class GuidingField {
   float pdf(const glm::vec3& position, const glm::vec3& direction) const { return distribution(position).pdf(direction); }
 
   // --- Inspection.
-  static constexpr uint64_t kMinBytes = 200;  // one leaf with one node per tree
+  static constexpr uint64_t kMinBytes = 184;  // one leaf with one node per tree
   size_t memory_bytes() const;
   Stats stats() const;
   Box bounds() const { return {box_lo_, box_hi_}; }

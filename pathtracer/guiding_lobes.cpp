@@ -134,8 +134,7 @@ void merge_into_reservoir(std::vector<GuidingLobeRecord>& reservoir, const std::
   reservoir.assign(all.begin(), all.begin() + std::min(capacity, all.size()));
 }
 
-std::vector<GuidingLobe> fit_guiding_lobes(const std::vector<GuidingLobeRecord>& unordered, int max_lobes,
-                                           glm::vec3* mean_position) {
+std::vector<GuidingLobe> fit_guiding_lobes(const std::vector<GuidingLobeRecord>& unordered, int max_lobes) {
   if (unordered.size() < kMinLobeRecords || max_lobes < 1) return {};
   std::vector<GuidingLobeRecord> records = unordered;  // in key order: the fit does not depend on arrival
   std::sort(records.begin(), records.end(), [](const auto& a, const auto& b) { return a.key < b.key; });
@@ -143,7 +142,6 @@ std::vector<GuidingLobe> fit_guiding_lobes(const std::vector<GuidingLobeRecord>&
   glm::dvec3 o(0.0);
   for (const GuidingLobeRecord& r : records) o += glm::dvec3(r.position);
   o /= double(n);
-  *mean_position = glm::vec3(o);
 
   // Each record's light seen from the mean position: toward its source, away from a focus ahead
   // (its own direction where the source is at the mean position).

@@ -63,10 +63,10 @@ float lobe_record_priority(uint64_t key, float energy);
 void merge_into_reservoir(std::vector<GuidingLobeRecord>& reservoir, const std::vector<GuidingLobeRecord>& incoming,
                           size_t capacity);
 
-// The lobes that fit a reservoir (at most max_lobes; none when it holds fewer than kMinLobeRecords).
+// The lobes that fit a reservoir (at most max_lobes; none when it holds fewer than kMinLobeRecords),
+// their directions and distances seen from the records' mean position.
 constexpr size_t kMinLobeRecords = 16;
-std::vector<GuidingLobe> fit_guiding_lobes(const std::vector<GuidingLobeRecord>& records, int max_lobes,
-                                           glm::vec3* mean_position);
+std::vector<GuidingLobe> fit_guiding_lobes(const std::vector<GuidingLobeRecord>& records, int max_lobes);
 
 // The guided share alpha (of 0, 0.1, ..., 0.9) whose mixture alpha s p_lobes + (1 - alpha s) p_cos
 // is closest to the light the records show, with p_lobes the LobeMixture at each record's point and
