@@ -170,9 +170,9 @@ std::vector<SettingDescriptor> make_table() {
   };
   t.push_back(near);
   t.push_back(on_off("guiding", "--guiding",
-                     "path guiding: learn where indirect light comes from (an SD-tree, Mueller et al. 2017) and send\n"
-                     "half of the diffuse and glossy directions there, MIS-combined with BSDF sampling: unbiased\n"
-                     "(docs/guiding.md)",
+                     "path guiding: learn from photons where indirect light comes from (parallax-aware lobes in\n"
+                     "an SD-tree's regions) and send a learned share of the first diffuse bounce there,\n"
+                     "MIS-combined with BSDF sampling: unbiased (docs/guiding.md)",
                      [](PreviewSettings& s) -> bool& { return s.trace.guiding; }, E::Retrace, "path guiding"));
   t.push_back(on_off("all_hv", "--all-hv",
                      "put every contribution into the HV buffer but what the camera sees directly or through\n"
