@@ -110,8 +110,9 @@ int run_render(const Args& args) {
   cli.flag("--quiet", &quiet, "no progress bar");
   bool until_clean = false;
   cli.flag("--until-clean", &until_clean,
-           "stop once every pixel is case 2 (the unbiased image at threshold t), counted by a blend after each filter run; "
-           "or earlier at --spp (unbounded without it), --time or Ctrl-C");
+           "stop once every pixel is case 2 (the unbiased image at threshold t), checked by a filter run and a blend "
+           "at 16 frames and each time the frames grew by a quarter; or earlier at --spp (unbounded without it), "
+           "--time or Ctrl-C");
   CheckpointOptions checkpoint_options;
   add_checkpoint_options(cli, checkpoint_options);
   std::string camera_path;

@@ -128,8 +128,10 @@ std::vector<SettingDescriptor> make_table() {
                      [](PreviewSettings& s) -> bool& { return s.motion_history; }, E::Redisplay, "reproject history"));
   // Sampling: these change the samples (the state file records them).
   t.push_back(on_off("adaptive", "--adaptive",
-                     "adaptive sampling: after 16 uniform frames each frame traces the pixels whose final pixel is\n"
-                     "furthest from the threshold, every pixel at least every 16 frames (app/adaptive.h)",
+                     "adaptive sampling: after 16 uniform frames each frame's paths (as many as a uniform frame's)\n"
+                     "go where the neighbourhood's noise is furthest above the threshold, up to 32 a pixel, every\n"
+                     "pixel at least every 16 frames; with --until-clean, to the pixels short of the count their\n"
+                     "neighbours predict (docs/sampling.md)",
                      [](PreviewSettings& s) -> bool& { return s.adaptive; }, E::Retrace, "adaptive sampling"));
   SettingDescriptor seed;
   seed.type = SettingType::Seed;
