@@ -223,6 +223,64 @@ Image card_guide(const Camera& camera) {
   return g;
 }
 
+// Whether a guide's pixel is background with the surface among its eight neighbours.
+bool background_beside_card(const Image& guide, int x, int y) {
+  if (guide.at(x, y, 3) < shared::kBackgroundDistanceMin) return false;
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx) {
+      const int u = x + dx, v = y + dy;
+      if (u >= 0 && v >= 0 && u < W && v < H && guide.at(u, v, 3) < shared::kBackgroundDistanceMin) return true;
+    }
+  return false;
+}
+
+// A background pixel beside a surface mixes the two in its samples: it neither gives history (a
+// marked value in such pixels of the previous view reaches no pixel of the new one) nor takes any.
+// Reprojected as background it carried an orbited sphere's light away with the background.
+TEST(HistoryPass, ABackgroundPixelBesideASurfaceNeitherGivesNorTakesHistory) {
+  test::osmesa_context();
+  const Camera before = test_camera({0.0f, 0.0f, 0.0f}, 0.0f);
+  const Camera now = test_camera({0.0f, 0.0f, 0.0f}, 4.0f);
+  const Image guide_before = card_guide(before), guide_now = card_guide(now);
+  FreshSamples previous = random_samples(6);
+  constexpr float kMarker = 1000.0f;
+  int marked = 0;
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x)
+      if (background_beside_card(guide_before, x, y)) {
+        for (int c = 0; c < 3; ++c) previous.lv.at(x, y, c) = kMarker;
+        ++marked;
+      }
+  const HistoryCombination kept = cpu_combine_history(previous.lv, previous.hv, 3.0f, nullptr);
+  const HistoryReprojection cpu = cpu_reproject_history(kept.state, kept.hv, guide_before, before, guide_now, now);
+
+  HistoryPass pass(W, H);
+  PreviewInputs inputs(W, H);
+  upload(inputs, previous);
+  const Texture2D guide_before_tex = texture_of(guide_before), guide_now_tex = texture_of(guide_now);
+  const Texture2D no_flags = texture_of(Image::rgba(W, H));
+  pass.keep(inputs, 3.0f, guide_before_tex, no_flags, before);
+  pass.reproject(guide_now_tex, no_flags, now);
+  const Image outcome = pass.outcome_image(), lv = pass.history_lv_image();
+  EXPECT_EQ(outcome.pixels, cpu.outcome.pixels);
+
+  int beside = 0, background_kept = 0;
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      for (const Image* image : {&cpu.lv, &lv}) EXPECT_LT(image->at(x, y, 0), 0.5f * kMarker) << x << "," << y;
+      if (background_beside_card(guide_now, x, y)) {
+        ++beside;
+        EXPECT_EQ(cpu.lv.at(x, y, 3), 0.0f) << x << "," << y;
+        EXPECT_EQ(lv.at(x, y, 3), 0.0f) << x << "," << y;
+      } else if (guide_now.at(x, y, 3) >= shared::kBackgroundDistanceMin && cpu.lv.at(x, y, 3) > 0.0f) {
+        ++background_kept;
+      }
+    }
+  EXPECT_GT(marked, 20);
+  EXPECT_GT(beside, 20);
+  EXPECT_GT(background_kept, W * H / 3);  // the rest of the background keeps its history
+}
+
 // A thin card seen from its other side: the same distance and range color, but it faces away.
 TEST(HistoryPass, TheOtherSideOfAThinCardIsRejected) {
   const Camera before = test_camera({0.0f, 0.0f, 0.0f}, 0.0f);

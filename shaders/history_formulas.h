@@ -104,12 +104,26 @@ PXF_SAMPLER_FN vec3 guide_step(sampler2D guide, ivec2 p, ivec2 axis, ViewCamera 
   return point - view_point(c, vec2(behind) + vec2(0.5f), d_behind);
 }
 
+// Whether a background pixel of a guide has a surface among its eight neighbours. Its samples then
+// mix the surface and the background (the path tracer's pixel footprint), so it is a silhouette
+// from the other side: reprojected as background, it carried a lit object's light away with the
+// background, a trail of specks beside a sphere that the camera orbits.
+PXF_SAMPLER_FN bool background_beside_surface(sampler2D guide, ivec2 p) {
+  ivec2 size = textureSize(guide, 0);
+  for (int i = 0; i < 9; ++i) {
+    ivec2 q = p + ivec2(i % 3 - 1, i / 3 - 1);
+    if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) continue;
+    if (clean(texelFetch(guide, q, 0).a) < kBackgroundDistanceMin) return true;
+  }
+  return false;
+}
+
 // The unit normal of the surface a guide shows at pixel p, from the distances of p and its
 // neighbours, turned towards the camera, in xyz; w = 1 where known, 0 on the background (no
-// evidence either way), -1 where it cannot be told (a silhouette, a degenerate step).
+// evidence either way), -1 where it cannot be told (a silhouette on either side, a degenerate step).
 PXF_SAMPLER_FN vec4 guide_normal(sampler2D guide, ivec2 p, ViewCamera c) {
   float d = clean(texelFetch(guide, p, 0).a);
-  if (!(d < kBackgroundDistanceMin)) return vec4(0.0f);
+  if (!(d < kBackgroundDistanceMin)) return background_beside_surface(guide, p) ? vec4(0.0f, 0.0f, 0.0f, -1.0f) : vec4(0.0f);
   vec3 point = view_point(c, vec2(p) + vec2(0.5f), d);
   vec3 n = cross(guide_step(guide, p, ivec2(1, 0), c, point, d), guide_step(guide, p, ivec2(0, 1), c, point, d));
   float len = length(n);
