@@ -184,6 +184,22 @@ void Preview::reproject_history(const Camera& camera) {
   step_range_buffer();  // the new view's distances
   history_->reproject(range_.guide(), range_.frame_color(), camera);
   last_.range += history_->last_ms();
+  plan_first_frame_after_move();
+}
+
+// The pixels whose history holds fewer than shared::kHistoryFirstFrameSamples samples trace the
+// difference in the first frame (shared::first_frame_paths); the others one path, as always.
+void Preview::plan_first_frame_after_move() {
+  const auto start = BenchClock::now();
+  const Image history = history_->history_lv_image();  // alpha: the samples it holds
+  std::vector<uint8_t> paths(static_cast<size_t>(width_) * height_, 1);
+  bool more = false;
+  for (size_t p = 0; p < paths.size(); ++p) {
+    paths[p] = static_cast<uint8_t>(shared::first_frame_paths(history.pixels[4 * p + 3]));
+    more = more || paths[p] > 1;
+  }
+  if (more) next_active_ = std::move(paths);
+  last_.range += elapsed_ms(start);
 }
 
 void Preview::set_settings(const PreviewSettings& settings) {

@@ -215,6 +215,7 @@ class Preview {
   // Keeps the current view for the history before the camera changes to `camera`, then reprojects.
   void keep_history();
   void reproject_history(const Camera& camera);
+  void plan_first_frame_after_move();  // next_active_: more paths where the history holds few samples
   void run_filter();
   bool filter_worthwhile();  // HV's energy share reaches kMinHvShare (else counts a skip)
   bool step_range_buffer();     // one antialiasing frame of the range pass; false once converged

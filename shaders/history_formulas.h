@@ -243,6 +243,22 @@ PXF_SAMPLER_FN HistorySample reproject_history(sampler2D previous_lv, sampler2D 
   return h;
 }
 
+// ---- The first frame after a move ----
+
+// A pixel of the new view should hold about this many samples in its first frame, history and fresh
+// paths together: one whose history holds less (disoccluded, outside the previous view, a partial
+// footprint) traces the difference, so that the pixels without history are not the noisiest of the
+// frame and know their own variance (n >= 2) at once.
+PXF_CONST float kHistoryFirstFrameSamples = 4.0f;
+
+// The paths pixel p traces in the first frame after a move, given the samples its reprojected
+// history holds (HistorySample::count, 0 without history): at least 1, at most
+// kHistoryFirstFrameSamples.
+PXF_INLINE int first_frame_paths(float history_count) {
+  float missing = kHistoryFirstFrameSamples - max(clean(history_count), 0.0f);
+  return int(clamp(ceil(missing), 1.0f, kHistoryFirstFrameSamples));
+}
+
 // ---- The history beside the fresh samples ----
 
 // The samples the history counts as after n fresh ones: at most kHistoryMaxCount, falling linearly

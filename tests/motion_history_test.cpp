@@ -6,6 +6,7 @@
 #include "app/explorer_camera.h"
 #include "app/preview.h"
 #include "app/render_output.h"
+#include "pathtracer/accumulation_state.h"
 #include "image/metrics.h"
 #include "tests/test_support.h"
 
@@ -26,9 +27,11 @@ std::vector<Layer> render_at(Preview& preview, int spp) {
   return preview.buffers();
 }
 
-// 64 spp after a move against 64 spp of a camera that never moved: the same fresh samples, and a
-// final image within the tolerance of the consistency test's last checkpoint (the filtered image
-// 4 % NRMSE from the unfiltered one there; here both filter the same samples).
+// 64 frames after a move against 64 spp of a camera that never moved: the same fresh samples (the
+// first frame after the move traced more paths where the history held few, so the path tracer
+// alone, given the same counts, is the reference for those), and a final image within the
+// tolerance of the consistency test's last checkpoint (the filtered image 4 % NRMSE from the
+// unfiltered one there; here both filter nearly the same samples).
 TEST(MotionHistory, AfterTheCameraRestsTheRenderConvergesToTheStaticOne) {
   test_support::headless_context();
   Scene scene = load_scene("cornell");
@@ -44,15 +47,75 @@ TEST(MotionHistory, AfterTheCameraRestsTheRenderConvergesToTheStaticOne) {
   ASSERT_TRUE(moved.history() && moved.history()->reprojected());
   moved.add_frame(false, false);
   EXPECT_TRUE(moved.history_active());
+  const std::vector<uint32_t> first_frame = moved.pixel_samples();
   moved.converge_range_buffer();
   const std::vector<Layer> after = render_at(moved, 63);
   EXPECT_FALSE(moved.history_active());
-  for (const char* name : {"lv", "hv"})
-    EXPECT_EQ(layer_image(after, name).pixels, layer_image(reference, name).pixels) << name;
+
+  ProgressiveRenderer same_paths(scene, settings.trace, kSize, kSize);
+  same_paths.add_frame(std::vector<uint8_t>(first_frame.begin(), first_frame.end()));
+  for (int i = 0; i < 63; ++i) same_paths.add_frame();
+  EXPECT_EQ(layer_image(after, "lv").pixels, same_paths.lv_image().pixels);
+  EXPECT_EQ(layer_image(after, "hv").pixels, same_paths.hv_image().pixels);
   // The passes read the fresh samples again, exactly.
-  EXPECT_EQ(moved.inputs().hv_image().pixels, layer_image(reference, "hv").pixels);
-  const double nrmse = compare_images(layer_image(after, "final"), layer_image(reference, "final")).nrmse_percent;
+  EXPECT_EQ(moved.inputs().hv_image().pixels, same_paths.hv_image().pixels);
+  // And filter and blend them as a render of those samples that never moved does.
+  AccumulationState state;
+  state.frames = {{0, 64}};
+  state.acc = same_paths.accumulation();
+  state.traced = same_paths.pixel_frames();
+  Preview unmoved(scene, settings, kSize, kSize);
+  unmoved.converge_range_buffer();
+  unmoved.load_state(state);
+  unmoved.finish();
+  const double nrmse = compare_images(layer_image(after, "final"), unmoved.final_image()).nrmse_percent;
   EXPECT_LT(nrmse, 1.0);
+  // The extra paths of the first frame changed few pixels: still close to the static render.
+  EXPECT_LT(compare_images(layer_image(after, "final"), layer_image(reference, "final")).nrmse_percent, 4.0);
+}
+
+TEST(MotionHistory, FirstFramePathsFillTheHistoryUpToFourSamples) {
+  using shared::first_frame_paths;
+  EXPECT_EQ(first_frame_paths(0.0f), 4);
+  EXPECT_EQ(first_frame_paths(0.5f), 4);
+  EXPECT_EQ(first_frame_paths(2.5f), 2);
+  EXPECT_EQ(first_frame_paths(3.0f), 1);
+  EXPECT_EQ(first_frame_paths(8.0f), 1);
+  EXPECT_EQ(first_frame_paths(-1.0f), 4);
+  EXPECT_EQ(first_frame_paths(std::numeric_limits<float>::quiet_NaN()), 4);
+  EXPECT_EQ(first_frame_paths(std::numeric_limits<float>::infinity()), 4);  // clean(): not a count
+}
+
+// The first frame after a move traces shared::first_frame_paths(history count) paths per pixel:
+// more where the history holds fewer than kHistoryFirstFrameSamples samples (the pixels the move
+// uncovered, those outside the previous view), one where it holds enough.
+TEST(MotionHistory, PixelsWithoutHistoryTraceMorePathsInTheFirstFrame) {
+  test_support::headless_context();
+  Scene scene = load_scene("cornell");
+  PreviewSettings settings;
+  Preview preview(scene, settings, kSize, kSize);
+  render_at(preview, 16);
+  preview.set_camera(orbited(scene, 30.0f));
+  const Image history = preview.history()->history_lv_image();
+  const Image outcome = preview.history()->outcome_image();
+  preview.add_frame(false, true);
+  const std::vector<uint32_t>& paths = preview.pixel_samples();
+  int more = 0, one = 0;
+  for (size_t p = 0; p < paths.size(); ++p) {
+    const float held = history.pixels[4 * p + 3];
+    ASSERT_EQ(paths[p], static_cast<uint32_t>(shared::first_frame_paths(held))) << p;
+    if (outcome.pixels[p] != shared::kHistoryKept) {
+      EXPECT_EQ(paths[p], shared::kHistoryFirstFrameSamples) << p;
+    }
+    more += paths[p] > 1;
+    one += held >= shared::kHistoryFirstFrameSamples && paths[p] == 1;
+  }
+  EXPECT_GT(more, 0);
+  EXPECT_GT(one, kSize * kSize / 2);
+  // The next frame is uniform again.
+  preview.add_frame(false, true);
+  for (size_t p = 0; p < paths.size(); ++p)
+    EXPECT_EQ(preview.pixel_samples()[p], static_cast<uint32_t>(shared::first_frame_paths(history.pixels[4 * p + 3])) + 1);
 }
 
 // One frame after a small orbit, the history counts: most pixels reprojected, their weight high,
