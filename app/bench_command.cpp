@@ -564,11 +564,16 @@ int threshold_fidelity_mode(const Args& args, const std::string& summary) {
   h.cli().option("--spp", &spp_text, "LIST", "sample counts (default 16,64,256)");
   h.cli().option("--seeds", &seeds, "seeds (default 32)", 2, 4096);
   h.cli().flag("--adaptive", &adaptive, "also adaptive sampling, at the uniform job's wall time");
+  AdaptiveGoal goal = AdaptiveGoal::Error;
+  h.cli().choice("--goal", &goal, {"error", "clean"},
+                 "the adaptive allocation's goal: least error (a render to a count or time, the default) or "
+                 "clean (--until-clean's)");
   if (!h.parse(args)) return 0;
   const BenchSetup b = h.setup(/*needs_filter=*/true);
   auto context = h.gl_context();
   FidelityBenchSetup fb{b.scene, b.scene_name, b.filtered, b.width, b.height, b.out};
   fb.with_adaptive = adaptive;
+  fb.settings.adaptive_params.goal = goal;
   const std::vector<float> thresholds =
       h.cli().given("--threshold") ? std::vector<float>{b.filtered.threshold} : std::vector<float>{0.001f, 0.01f};
   run_threshold_fidelity_bench(fb, parse_counts("--spp", spp_text), thresholds, seeds);
@@ -639,6 +644,10 @@ int motion_mode(const Args& args, const std::string& summary) {
   h.cli().option("--motion-frames", &frames, "frames of the orbit (default 60)", 2, 100000);
   h.cli().option("--orbit-degrees", &orbit_degrees, "the whole orbit in degrees (default 90)", 0.0, 3600.0);
   h.cli().option("--reference-spp", &reference_spp, "samples of each frame's reference (default 1024)", 1, 1 << 20);
+  bool one_reference = false;
+  h.cli().flag("--one-reference", &one_reference,
+               "no second reference per frame (halves the references' time; the error is then not corrected "
+               "for the references' own noise)");
   if (!h.parse(args)) return 0;
   const BenchSetup b = h.setup(/*needs_filter=*/true);
   auto context = h.gl_context();
@@ -646,6 +655,7 @@ int motion_mode(const Args& args, const std::string& summary) {
   mb.frames = frames;
   mb.orbit_degrees = static_cast<float>(orbit_degrees);
   mb.reference_spp = reference_spp;
+  mb.second_reference = !one_reference;
   run_motion_bench(mb);
   return 0;
 }

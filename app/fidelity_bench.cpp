@@ -178,7 +178,10 @@ void run_threshold_fidelity_bench(const FidelityBenchSetup& b, const std::vector
   std::printf("%s %dx%d, filter %s, %d seeds: empirical perceived variance Var[Y(L - L_lv)] / L_b^2 of the final "
               "image against t, by the pixel's most frequent blend case%s\n",
               b.scene_name.c_str(), b.width, b.height, filter_kind_name(b.settings.filter.kind), seeds,
-              b.with_adaptive ? "; adaptive: at the uniform job's wall time at each spp, the allocation for that t" : "");
+              !b.with_adaptive ? ""
+              : b.settings.adaptive_params.goal == AdaptiveGoal::Clean
+                  ? "; adaptive (goal clean): at the uniform job's wall time at each spp, the allocation for that t"
+                  : "; adaptive (goal error): at the uniform job's wall time at each spp, the allocation for that t");
   std::printf("%9s %6s %7s %6s %8s %12s %22s\n", "mode", "spp", "t", "case", "pixels", "<= t", "median empirical / t");
   for (int mode = 0; mode < modes; ++mode)
     for (size_t k = 0; k < spps.size(); ++k)

@@ -171,10 +171,13 @@ RunFigures figures(const MotionRun& run, const std::vector<Image>& refs, const s
 void run_motion_bench(const MotionBenchSetup& b) {
   std::filesystem::create_directories(b.out);
   const std::vector<Camera> cameras = orbit_cameras(b);
-  const std::vector<Image> refs = references(b, cameras, 1), second = references(b, cameras, 2);
+  const std::vector<Image> refs = references(b, cameras, 1);
   std::vector<double> reference_pair;  // display NRMSE of the second reference against the first
-  for (size_t f = 0; f < refs.size(); ++f)
-    reference_pair.push_back(compare_display(second[f], refs[f]).display_nrmse_percent);
+  if (b.second_reference) {
+    const std::vector<Image> second = references(b, cameras, 2);
+    for (size_t f = 0; f < refs.size(); ++f)
+      reference_pair.push_back(compare_display(second[f], refs[f]).display_nrmse_percent);
+  }
   std::vector<Image> ref_display;
   std::vector<double> ref_change;
   for (size_t f = 0; f < refs.size(); ++f) {
@@ -199,7 +202,8 @@ void run_motion_bench(const MotionBenchSetup& b) {
          "change_today,change_reference\n";
   for (size_t f = 0; f < cameras.size(); ++f) {
     csv << f << "," << history.ms[f] << "," << today.ms[f] << "," << today.spp[f] << "," << h.error[f] << ","
-        << t.error[f] << "," << reference_pair[f];
+        << t.error[f] << ",";
+    if (b.second_reference) csv << reference_pair[f];
     if (f > 0) csv << "," << h.change[f - 1] << "," << t.change[f - 1] << "," << ref_change[f - 1];
     csv << "\n";
     write_png(frame_file(b.out, "motion_history", static_cast<int>(f), "png"), h.display[f]);
@@ -220,12 +224,13 @@ void run_motion_bench(const MotionBenchSetup& b) {
   std::printf("  error (display NRMSE, median over frames): history %.2f %%, today %.2f %%, ratio %.2f\n", eh, et,
               et > 0 ? eh / et : 0.0);
   std::vector<double> hc, tc;
-  for (size_t f = 0; f < refs.size(); ++f) {
+  for (size_t f = 0; b.second_reference && f < refs.size(); ++f) {
     hc.push_back(correct_for_reference_noise(h.error[f], reference_pair[f]).corrected_percent);
     tc.push_back(correct_for_reference_noise(t.error[f], reference_pair[f]).corrected_percent);
   }
   const double ehc = median(hc), etc_ = median(tc);
-  std::printf("  error less the references' own noise (%.2f %% between the two references, median): history %.2f %%, "
+  if (b.second_reference)
+    std::printf("  error less the references' own noise (%.2f %% between the two references, median): history %.2f %%, "
               "today %.2f %%, ratio %.2f\n",
               median(reference_pair), ehc, etc_, etc_ > 0 ? ehc / etc_ : 0.0);
   const double ch = median(h.change), ct = median(t.change), cr = median(ref_change);

@@ -24,6 +24,8 @@ struct MotionBenchSetup {
   int frames = 60;              // of the orbit
   float orbit_degrees = 90.0f;  // the whole orbit, around the explorer's orbit target
   int reference_spp = 1024;
+  // A second reference per frame (another seed) for the error less the references' own noise.
+  bool second_reference = true;
 };
 
 void run_motion_bench(const MotionBenchSetup& b);
