@@ -605,18 +605,21 @@ class Explorer {
     if (tracing_ || preview_->passes_pending()) return;
     const bool camera = camera_changed_;
     if (camera_changed_) {
-      // With the history a camera change is GL work of its own (the view kept, a range-buffer
-      // frame, the reprojection): like a queued pass it waits for a later display frame when its
-      // last cost does not fit what is left of this one's budget. A display frame that waited for
-      // no traced frame and ran no pass always takes it; the next one is such a frame, since no
-      // frame is traced while a camera change waits.
+      // With the history a camera change is GL work of its own (the view kept), and it queues two
+      // steps that run_passes spreads over display frames like any pass (the new view's range
+      // frame, the reprojection) before the view's first traced frame. Like a queued pass it waits
+      // for a later display frame when its last cost does not fit what is left of this one's
+      // budget. A display frame that waited for no traced frame and ran no pass always takes it;
+      // the next one is such a frame, since no frame is traced while a camera change waits.
       if (settings_.motion_history &&
           !step_fits_display_frame(ms_between(frame_start_, Clock::now()) + ui_draw_ms_, !frame_gl_work_,
                                    kPredictionMargin * camera_change_ms_))
         return;
       const auto start = Clock::now();
-      preview_->set_camera(playing_path_ ? camera_on_path(path_, path_frame_, scene_->camera) : controller_->camera());
+      preview_->begin_camera_change(playing_path_ ? camera_on_path(path_, path_frame_, scene_->camera)
+                                                  : controller_->camera());
       camera_change_ms_ = ms_between(start, Clock::now());
+      frame_gl_work_ = true;
     }
     camera_changed_ = false;
     const bool moving = fast_while_moving_ && (dragging_camera_ || flying_ || playing_path_);

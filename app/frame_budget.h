@@ -1,8 +1,9 @@
 // The explorer's frame budget: no display frame blocks the UI for longer than kUiBudgetMs. The
 // path tracer runs on a worker thread (Preview::trace_frame), so what blocks the UI thread is the GL
 // work after each traced frame: one range-buffer frame, a filter run, the blend and tone map
-// (Preview::queue_passes), and, with the reprojected history, each camera change (the view kept, a
-// range-buffer frame, the reprojection: Preview::set_camera). These steps are spread over display
+// (Preview::queue_passes), and, with the reprojected history, each camera change (the view kept,
+// then a range-buffer frame and the reprojection as two more steps: Preview::begin_camera_change).
+// These steps are spread over display
 // frames: each display frame runs the queued steps whose predicted costs (a camera change's: the
 // last one's), added to the UI's own work (the last frame's drawing of the views and the window),
 // still fit the budget. A pure function of the predicted costs, so it is tested with a fake clock
@@ -15,11 +16,15 @@ namespace pxf {
 // Longest time one display frame may keep the UI thread busy.
 constexpr double kUiBudgetMs = 100.0;
 
-// The GL steps that follow a traced frame, in the order they run.
+// The GL steps that follow a traced frame, in the order they run, and those that follow a camera
+// change with the reprojected history (Preview::begin_camera_change) before the new view's first
+// traced frame.
 enum class PassStep {
   RangeFrame,  // one antialiasing frame of the range buffer, if the pass budget allows
   Filter,      // a filter run, if the schedule makes one due
   Display,     // upload, blend and tone map
+  ViewRange,   // the new view's first range-buffer frame (its distances, for the reprojection)
+  Reproject,   // the kept view reprojected into the new one, and the first frame's path counts
 };
 
 // Whether the next queued step (predicted to take next_ms) runs in this display frame, which has

@@ -158,12 +158,21 @@ void Preview::load_state(const AccumulationState& state) {
 }
 
 void Preview::set_camera(const Camera& camera) {
+  begin_camera_change(camera);
+  while (passes_pending()) run_next_pass();
+}
+
+void Preview::begin_camera_change(const Camera& camera) {
   if (settings_.motion_history) keep_history();
   renderer_->set_camera(camera);
   range_.set_camera(camera);
   restart_samples();
-  if (settings_.motion_history) reproject_history(camera);
-  else if (history_) history_->drop();
+  pending_.clear();
+  if (!settings_.motion_history) {
+    if (history_) history_->drop();
+    return;
+  }
+  if (history_ && history_->has_kept()) pending_ = {PassStep::ViewRange, PassStep::Reproject};
 }
 
 bool Preview::history_active() const { return history_ && history_->active(static_cast<float>(samples())); }
@@ -179,18 +188,18 @@ void Preview::keep_history() {
   history_->keep(inputs_, static_cast<float>(samples()), range_.guide(), range_.frame_color(), renderer_->camera());
 }
 
-void Preview::reproject_history(const Camera& camera) {
-  if (!history_ || !history_->has_kept()) return;
-  step_range_buffer();  // the new view's distances
-  history_->reproject(range_.guide(), range_.frame_color(), camera);
-  last_.range += history_->last_ms();
+// After the new view's first range frame (PassStep::ViewRange, its distances).
+void Preview::reproject_history() {
+  const auto start = BenchClock::now();
+  history_->reproject(range_.guide(), range_.frame_color(), renderer_->camera());
   plan_first_frame_after_move();
+  reproject_ms_ = elapsed_ms(start);
+  last_.range += reproject_ms_;
 }
 
 // The pixels whose history holds fewer than shared::kHistoryFirstFrameSamples samples trace the
 // difference in the first frame (shared::first_frame_paths); the others one path, as always.
 void Preview::plan_first_frame_after_move() {
-  const auto start = BenchClock::now();
   const Image history = history_->history_lv_image();  // alpha: the samples it holds
   std::vector<uint8_t> paths(static_cast<size_t>(width_) * height_, 1);
   bool more = false;
@@ -199,7 +208,6 @@ void Preview::plan_first_frame_after_move() {
     more = more || paths[p] > 1;
   }
   if (more) next_active_ = std::move(paths);
-  last_.range += elapsed_ms(start);
 }
 
 void Preview::set_settings(const PreviewSettings& settings) {
@@ -444,6 +452,10 @@ double Preview::predict_pass_ms(PassStep step) const {
       return filter_due_now() ? schedule_.last_run_ms : 0.0;
     case PassStep::Display:
       return display_ms_;
+    case PassStep::ViewRange:
+      return range_.last_ms();
+    case PassStep::Reproject:
+      return reproject_ms_;
   }
   return 0.0;
 }
@@ -463,6 +475,12 @@ void Preview::run_next_pass() {
       break;
     case PassStep::Display:
       blend_and_tonemap();
+      break;
+    case PassStep::ViewRange:
+      step_range_buffer();
+      break;
+    case PassStep::Reproject:
+      reproject_history();
       break;
   }
   total_ += last_ - before;  // what this step added (its path tracing is 0)

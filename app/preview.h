@@ -130,7 +130,12 @@ class Preview {
   // Changes settings. Path-tracing changes reset the accumulation; filter, threshold and display
   // changes apply at once to the current samples (re-filtering if a filtered image exists).
   void set_settings(const PreviewSettings& settings);
-  void set_camera(const Camera& camera);  // resets
+  void set_camera(const Camera& camera);  // resets; begin_camera_change and its steps, all at once
+  // A camera change whose GL work is spread over display frames (the explorer): keeps the view for
+  // the history and resets at once, then queues the new view's range frame and the reprojection
+  // (PassStep::ViewRange, PassStep::Reproject) when there is a history to reproject. They must run
+  // (run_next_pass) before the next trace_frame, which plans with their result.
+  void begin_camera_change(const Camera& camera);
   void reset();
   // Starts the frame sequence at `first` (a shard of frames first:B); resets.
   void set_first_frame(uint32_t first);
@@ -214,7 +219,7 @@ class Preview {
   void restart_samples();
   // Keeps the current view for the history before the camera changes to `camera`, then reprojects.
   void keep_history();
-  void reproject_history(const Camera& camera);
+  void reproject_history();
   void plan_first_frame_after_move();  // next_active_: more paths where the history holds few samples
   void run_filter();
   bool filter_worthwhile();  // HV's energy share reaches kMinHvShare (else counts a skip)
@@ -262,6 +267,7 @@ class Preview {
   std::array<uint32_t, kBlendCaseCount> case_counts_{};
   std::vector<double> recent_frame_ms_;  // path tracing of the last frames, for predictions
   double display_ms_ = 0;                // upload + blend + tone map of the newest display
+  double reproject_ms_ = 0;              // the newest reprojection with its path-count plan
   std::deque<PassStep> pending_;         // queue_passes() not yet run
   bool pending_last_frame_ = false;
 };
