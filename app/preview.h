@@ -91,6 +91,10 @@ double pass_share_of_tracing(const StageTimes& t);
 double hv_energy_share(const Accumulation& acc);
 constexpr double kMinHvShare = 0.01;
 
+// The extra paths of the first frame after a camera move (Preview::plan_first_frame_after_move)
+// are at most this share of a uniform frame's paths.
+constexpr double kFirstFrameExtraShare = 0.5;
+
 // Memory a Preview of width x height needs, checked before it allocates anything: the peak memory
 // of `pxf render` grows by about this much per pixel (cornell at 256x256 and 1024x1024, 2 spp: 130
 // and 615 MiB, before the bias guard's two sums textures added 32 B: 647 MiB at 1024x1024, and its

@@ -3,6 +3,8 @@
 // never moved; while it moves, the history stands beside the fresh samples.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "app/explorer_camera.h"
 #include "app/preview.h"
 #include "app/render_output.h"
@@ -74,6 +76,33 @@ TEST(MotionHistory, AfterTheCameraRestsTheRenderConvergesToTheStaticOne) {
   EXPECT_LT(compare_images(layer_image(after, "final"), layer_image(reference, "final")).nrmse_percent, 4.0);
 }
 
+// A move that uncovers most of the image asks for more extra paths than kFirstFrameExtraShare of a
+// uniform frame: each pixel's extra paths are scaled down alike, and the frame stays within the bound.
+TEST(MotionHistory, TheFirstFramesExtraPathsAreBoundedOnALargeMove) {
+  test_support::headless_context();
+  Scene scene = load_scene("cornell");
+  PreviewSettings settings;
+  Preview preview(scene, settings, kSize, kSize);
+  render_at(preview, 16);
+  preview.set_camera(orbited(scene, 300.0f));
+  const Image history = preview.history()->history_lv_image();
+  uint64_t wanted = 0;
+  for (size_t p = 0; p < history.pixels.size() / 4; ++p) wanted += shared::first_frame_paths(history.pixels[4 * p + 3]) - 1;
+  const double bound = kFirstFrameExtraShare * kSize * kSize;
+  ASSERT_GT(static_cast<double>(wanted), bound);  // the case under test
+  preview.add_frame(false, true);
+  uint64_t extra = 0;
+  for (size_t p = 0; p < preview.pixel_samples().size(); ++p) {
+    const uint32_t n = preview.pixel_samples()[p];
+    ASSERT_GE(n, 1u);
+    const int asked = shared::first_frame_paths(history.pixels[4 * p + 3]) - 1;
+    const int scaled = static_cast<int>(std::floor(asked * bound / static_cast<double>(wanted)));
+    EXPECT_EQ(n, 1u + scaled) << p;
+    extra += n - 1;
+  }
+  EXPECT_LE(static_cast<double>(extra), bound);
+}
+
 TEST(MotionHistory, FirstFramePathsFillTheHistoryUpToFourSamples) {
   using shared::first_frame_paths;
   EXPECT_EQ(first_frame_paths(0.0f), 4);
@@ -95,9 +124,12 @@ TEST(MotionHistory, PixelsWithoutHistoryTraceMorePathsInTheFirstFrame) {
   PreviewSettings settings;
   Preview preview(scene, settings, kSize, kSize);
   render_at(preview, 16);
-  preview.set_camera(orbited(scene, 30.0f));
+  preview.set_camera(orbited(scene, 6.0f));
   const Image history = preview.history()->history_lv_image();
   const Image outcome = preview.history()->outcome_image();
+  uint64_t wanted = 0;
+  for (size_t p = 0; p < history.pixels.size() / 4; ++p) wanted += shared::first_frame_paths(history.pixels[4 * p + 3]) - 1;
+  ASSERT_LE(static_cast<double>(wanted), kFirstFrameExtraShare * kSize * kSize);  // not scaled down
   preview.add_frame(false, true);
   const std::vector<uint32_t>& paths = preview.pixel_samples();
   int more = 0, one = 0;
