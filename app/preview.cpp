@@ -191,6 +191,7 @@ void Preview::keep_history() {
 
 // After the new view's first range frame (PassStep::ViewRange, its distances).
 void Preview::reproject_history() {
+  if (!history_ || !history_->has_kept()) return;  // dropped since the step was queued
   const auto start = BenchClock::now();
   history_->reproject(range_.guide(), range_.frame_color(), renderer_->camera());
   plan_first_frame_after_move();
