@@ -123,6 +123,7 @@ void Preview::restart_samples() {
   filtered_samples_ = -1;
   case_counts_ = {};
   next_active_.clear();
+  first_frame_extra_paths_ = false;
   active_credit_.clear();
   rates_.clear();
   replans_ = replan_schedule(0);
@@ -199,6 +200,18 @@ void Preview::reproject_history() {
   last_.range += reproject_ms_;
 }
 
+// A pixel that traced extra paths in the view's first frame passes its mean with its variance
+// unknown, as a one-path pixel does. Its own variance from 4 paths, pooled over a neighbourhood that
+// the range weights cut (a crease: its taps straddle two normals, so it took no history), was often
+// too low: the blend showed it partly unfiltered, coloured specks along cornell's creases while the
+// camera moved (docs/measurements.md, "A moving camera"). Unknown, it shows the filtered value, and
+// the filter gets its 4-path mean.
+void Preview::hide_first_frame_variances() {
+  const std::vector<uint32_t>& paths = renderer_->pixel_frames();
+  for (size_t p = 0; p < paths.size(); ++p)
+    if (paths[p] > 1) hv_packed_[4 * p + 3] = kVarUnknown;
+}
+
 // The pixels whose history holds fewer than shared::kHistoryFirstFrameSamples samples trace the
 // difference in the first frame (shared::first_frame_paths); the others one path, as always. The
 // extra paths are at most kFirstFrameExtraShare of a uniform frame's: where a move uncovers much of
@@ -221,6 +234,7 @@ void Preview::plan_first_frame_after_move() {
   }
   next_active_ = std::move(paths);
   if (std::all_of(next_active_.begin(), next_active_.end(), [](uint8_t n) { return n == 1; })) next_active_.clear();
+  first_frame_extra_paths_ = !next_active_.empty();
 }
 
 void Preview::set_settings(const PreviewSettings& settings) {
@@ -252,6 +266,7 @@ void Preview::upload() {
   const Accumulation& acc = renderer_->accumulation();
   static_assert(kVarUnknown == -1.0f, "Accumulation marks an unknown variance (n < 2) with -1");
   acc.hv_and_variance_of_mean(hv_packed_.data());
+  if (samples() == 1 && first_frame_extra_paths_) hide_first_frame_variances();
   const std::vector<uint32_t>& paths = renderer_->pixel_frames();
   const uint32_t frames = static_cast<uint32_t>(samples());
   if (std::all_of(paths.begin(), paths.end(), [frames](uint32_t n) { return n == frames; })) {

@@ -225,6 +225,7 @@ class Preview {
   void keep_history();
   void reproject_history();
   void plan_first_frame_after_move();  // next_active_: more paths where the history holds few samples
+  void hide_first_frame_variances();   // upload(): those pixels' Var[L_u] unknown in that frame
   void run_filter();
   bool filter_worthwhile();  // HV's energy share reaches kMinHvShare (else counts a skip)
   bool step_range_buffer();     // one antialiasing frame of the range pass; false once converged
@@ -260,6 +261,7 @@ class Preview {
   std::vector<float> rates_;          // the last allocation's rates; empty before the first
   GrowingSchedule replans_{16, 16};   // when the rates are recomputed (replan_schedule)
   double last_active_share_ = 1.0;
+  bool first_frame_extra_paths_ = false;  // plan_first_frame_after_move gave some pixels more paths
   ScheduleState schedule_;
   bool have_filtered_ = false;
   bool uploaded_ = false;  // inputs hold the current samples

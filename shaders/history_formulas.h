@@ -248,11 +248,12 @@ PXF_SAMPLER_FN HistorySample reproject_history(sampler2D previous_lv, sampler2D 
 // A pixel of the new view should hold about this many samples in its first frame, history and fresh
 // paths together: one whose history holds less (disoccluded, outside the previous view, a partial
 // footprint) traces the difference, so that the pixels without history are not the noisiest of the
-// frame and know their own variance (n >= 2) at once. pxf bench --motion on the helmet-like GLB
-// (as above), 1 / 2 / 4 / 8: median display NRMSE 8.11 / 6.29 / 4.57 / 3.58 %, flicker 1.52 / 1.43 /
-// 1.26 / 1.07x the references', rejected pixels' display RMSE 0.226 / 0.165 / 0.108 / 0.070; the
-// cost is 3 paths in each uncovered pixel (the frame time of 1 and 4 alike within the machine's
-// noise there; cornell 128x128, whose specular spheres never take history, 1.3x the frame time).
+// frame (in that frame their variance stays unknown: Preview::hide_first_frame_variances).
+// pxf bench --motion on the helmet-like GLB (as above), 1 / 2 / 4 / 8: median display NRMSE 8.11 /
+// 6.29 / 4.57 / 3.58 %, flicker 1.52 / 1.43 / 1.26 / 1.07x the references', rejected pixels'
+// display RMSE 0.226 / 0.165 / 0.108 / 0.070; the cost is 3 paths in each uncovered pixel (the
+// frame time of 1 and 4 alike within the machine's noise there; cornell 128x128, whose specular
+// spheres never take history, 1.3x the frame time).
 PXF_CONST float kHistoryFirstFrameSamples = 4.0f;
 
 // The paths pixel p traces in the first frame after a move, given the samples its reprojected

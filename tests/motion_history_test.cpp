@@ -144,10 +144,22 @@ TEST(MotionHistory, PixelsWithoutHistoryTraceMorePathsInTheFirstFrame) {
   }
   EXPECT_GT(more, 0);
   EXPECT_GT(one, kSize * kSize / 2);
-  // The next frame is uniform again.
+  // In that frame the pixels without history pass their variance unknown (var_image: 0), as a
+  // one-path pixel does (Preview::hide_first_frame_variances).
+  const Image first_variance = preview.inputs().var_image();
+  for (size_t p = 0; p < paths.size(); ++p) {
+    if (outcome.pixels[p] != shared::kHistoryKept) {
+      ASSERT_EQ(first_variance.pixels[p], 0.0f) << p;
+    }
+  }
+  // The next frame is uniform again, and their variance is known.
   preview.add_frame(false, true);
   for (size_t p = 0; p < paths.size(); ++p)
     EXPECT_EQ(preview.pixel_samples()[p], static_cast<uint32_t>(shared::first_frame_paths(history.pixels[4 * p + 3])) + 1);
+  const Image second_variance = preview.inputs().var_image();
+  int known = 0;
+  for (size_t p = 0; p < paths.size(); ++p) known += outcome.pixels[p] != shared::kHistoryKept && second_variance.pixels[p] > 0.0f;
+  EXPECT_GT(known, 0);
 }
 
 // One frame after a small orbit, the history counts: most pixels reprojected, their weight high,
