@@ -619,7 +619,6 @@ class Explorer {
       preview_->begin_camera_change(playing_path_ ? camera_on_path(path_, path_frame_, scene_->camera)
                                                   : controller_->camera());
       camera_change_ms_ = ms_between(start, Clock::now());
-      frame_gl_work_ = true;
     }
     camera_changed_ = false;
     const bool moving = fast_while_moving_ && (dragging_camera_ || flying_ || playing_path_);

@@ -179,9 +179,9 @@ void run_threshold_fidelity_bench(const FidelityBenchSetup& b, const std::vector
               "image against t, by the pixel's most frequent blend case%s\n",
               b.scene_name.c_str(), b.width, b.height, filter_kind_name(b.settings.filter.kind), seeds,
               !b.with_adaptive ? ""
-              : b.settings.adaptive_params.goal == AdaptiveGoal::Clean
-                  ? "; adaptive (goal clean): at the uniform job's wall time at each spp, the allocation for that t"
-                  : "; adaptive (goal error): at the uniform job's wall time at each spp, the allocation for that t");
+              : b.settings.adaptive_params.goal == AdaptiveGoal::Clean ? "; adaptive (goal clean)"
+                                                                        : "; adaptive (goal error)");
+  if (b.with_adaptive) std::printf("  adaptive: at the uniform job's wall time at each spp, the allocation for that t\n");
   std::printf("%9s %6s %7s %6s %8s %12s %22s\n", "mode", "spp", "t", "case", "pixels", "<= t", "median empirical / t");
   for (int mode = 0; mode < modes; ++mode)
     for (size_t k = 0; k < spps.size(); ++k)

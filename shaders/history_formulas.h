@@ -12,9 +12,10 @@ PXF_SHARED_BEGIN
 // The history counts as at most this many samples (an exponential moving average of about this
 // length while the camera keeps moving), so that the lag and the blur of repeated resampling stay
 // short. pxf bench --motion, median display NRMSE and flicker against the references' own, for
-// 4 / 8 / 16 (before kHistoryFirstFrameSamples, one path everywhere): the helmet-like GLB under the envmap (384x216, 60 frames over 90 degrees, 1024-spp
-// references) 8.43 / 8.11 / 8.10 % and 1.58 / 1.52 / 1.50x; cornell 128x128 (30 frames over 45
-// degrees) 14.74 / 14.77 / 14.73 % and 1.01x for all three. Longer keeps a wrongly kept history longer.
+// 4 / 8 / 16 (with one path everywhere, before kHistoryFirstFrameSamples): the helmet-like GLB
+// under the envmap (384x216, 60 frames over 90 degrees, 1024-spp references) 8.43 / 8.11 / 8.10 %
+// and 1.58 / 1.52 / 1.50x; cornell 128x128 (30 frames over 45 degrees) 14.74 / 14.77 / 14.73 % and
+// 1.01x for all three. Longer keeps a wrongly kept history longer.
 PXF_CONST float kHistoryMaxCount = 8.0f;
 // The history's weight falls linearly to 0 over this many fresh samples: from then on the pixel is
 // the unbiased mean of its fresh samples, exactly as if the camera had never moved.

@@ -76,27 +76,37 @@ TEST(MotionHistory, AfterTheCameraRestsTheRenderConvergesToTheStaticOne) {
   EXPECT_LT(compare_images(layer_image(after, "final"), layer_image(reference, "final")).nrmse_percent, 4.0);
 }
 
+// A preview of cornell after 16 frames, moved by an orbit of `dx` pixels (its first frame not yet
+// traced), and the extra paths its reprojected history asks for in all.
+struct MovedPreview {
+  Scene scene = load_scene("cornell");
+  Preview preview{scene, PreviewSettings{}, kSize, kSize};
+  Image history;  // the reprojected history: alpha the samples it holds
+  uint64_t wanted_extra = 0;
+  explicit MovedPreview(float dx) {
+    render_at(preview, 16);
+    preview.set_camera(orbited(scene, dx));
+    history = preview.history()->history_lv_image();
+    for (size_t p = 0; p < history.pixels.size() / 4; ++p) wanted_extra += shared::first_frame_paths(held(p)) - 1;
+  }
+  float held(size_t p) const { return history.pixels[4 * p + 3]; }
+};
+
 // A move that uncovers most of the image asks for more extra paths than kFirstFrameExtraShare of a
 // uniform frame: each pixel's extra paths are scaled down alike, and the frame stays within the bound.
 TEST(MotionHistory, TheFirstFramesExtraPathsAreBoundedOnALargeMove) {
   test_support::headless_context();
-  Scene scene = load_scene("cornell");
-  PreviewSettings settings;
-  Preview preview(scene, settings, kSize, kSize);
-  render_at(preview, 16);
-  preview.set_camera(orbited(scene, 300.0f));
-  const Image history = preview.history()->history_lv_image();
-  uint64_t wanted = 0;
-  for (size_t p = 0; p < history.pixels.size() / 4; ++p) wanted += shared::first_frame_paths(history.pixels[4 * p + 3]) - 1;
+  MovedPreview moved(300.0f);
+  Preview& preview = moved.preview;
   const double bound = kFirstFrameExtraShare * kSize * kSize;
-  ASSERT_GT(static_cast<double>(wanted), bound);  // the case under test
+  ASSERT_GT(static_cast<double>(moved.wanted_extra), bound);  // the case under test
   preview.add_frame(false, true);
   uint64_t extra = 0;
   for (size_t p = 0; p < preview.pixel_samples().size(); ++p) {
     const uint32_t n = preview.pixel_samples()[p];
     ASSERT_GE(n, 1u);
-    const int asked = shared::first_frame_paths(history.pixels[4 * p + 3]) - 1;
-    const int scaled = static_cast<int>(std::floor(asked * bound / static_cast<double>(wanted)));
+    const int asked = shared::first_frame_paths(moved.held(p)) - 1;
+    const int scaled = static_cast<int>(std::floor(asked * bound / static_cast<double>(moved.wanted_extra)));
     EXPECT_EQ(n, 1u + scaled) << p;
     extra += n - 1;
   }
@@ -120,21 +130,15 @@ TEST(MotionHistory, FirstFramePathsFillTheHistoryUpToFourSamples) {
 // uncovered, those outside the previous view), one where it holds enough.
 TEST(MotionHistory, PixelsWithoutHistoryTraceMorePathsInTheFirstFrame) {
   test_support::headless_context();
-  Scene scene = load_scene("cornell");
-  PreviewSettings settings;
-  Preview preview(scene, settings, kSize, kSize);
-  render_at(preview, 16);
-  preview.set_camera(orbited(scene, 6.0f));
-  const Image history = preview.history()->history_lv_image();
+  MovedPreview moved(6.0f);
+  Preview& preview = moved.preview;
   const Image outcome = preview.history()->outcome_image();
-  uint64_t wanted = 0;
-  for (size_t p = 0; p < history.pixels.size() / 4; ++p) wanted += shared::first_frame_paths(history.pixels[4 * p + 3]) - 1;
-  ASSERT_LE(static_cast<double>(wanted), kFirstFrameExtraShare * kSize * kSize);  // not scaled down
+  ASSERT_LE(static_cast<double>(moved.wanted_extra), kFirstFrameExtraShare * kSize * kSize);  // not scaled down
   preview.add_frame(false, true);
   const std::vector<uint32_t>& paths = preview.pixel_samples();
   int more = 0, one = 0;
   for (size_t p = 0; p < paths.size(); ++p) {
-    const float held = history.pixels[4 * p + 3];
+    const float held = moved.held(p);
     ASSERT_EQ(paths[p], static_cast<uint32_t>(shared::first_frame_paths(held))) << p;
     if (outcome.pixels[p] != shared::kHistoryKept) {
       EXPECT_EQ(paths[p], shared::kHistoryFirstFrameSamples) << p;
@@ -155,7 +159,7 @@ TEST(MotionHistory, PixelsWithoutHistoryTraceMorePathsInTheFirstFrame) {
   // The next frame is uniform again, and their variance is known.
   preview.add_frame(false, true);
   for (size_t p = 0; p < paths.size(); ++p)
-    EXPECT_EQ(preview.pixel_samples()[p], static_cast<uint32_t>(shared::first_frame_paths(history.pixels[4 * p + 3])) + 1);
+    EXPECT_EQ(preview.pixel_samples()[p], static_cast<uint32_t>(shared::first_frame_paths(moved.held(p))) + 1);
   const Image second_variance = preview.inputs().var_image();
   int known = 0;
   for (size_t p = 0; p < paths.size(); ++p) known += outcome.pixels[p] != shared::kHistoryKept && second_variance.pixels[p] > 0.0f;
