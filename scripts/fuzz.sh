@@ -6,6 +6,8 @@
 #   scripts/fuzz.sh --replay [HARNESS...]                 every committed input once, under the sanitizers
 #   scripts/fuzz.sh --merge [HARNESS...]                  minimize: merge what the campaigns found
 #                                                         (build-fuzz/corpus/) into fuzz/corpus/
+#   scripts/fuzz.sh --unit-tests                          the image and path tracer unit tests, built in
+#                                                         the same folder, so under the same sanitizers
 #   scripts/fuzz.sh --available                           exit 0 when clang++ and libFuzzer work here
 # Harnesses: gltf_scene exr_reader png_reader hdr_reader state_reader. Each campaign reads the committed
 # corpus (fuzz/corpus/H) and crashers (fuzz/crashers/H), writes new inputs to build-fuzz/corpus/H and
@@ -43,6 +45,7 @@ case "${1:-}" in
   --available) available; exit $? ;;
   --replay) mode=replay; shift ;;
   --merge) mode=merge; shift ;;
+  --unit-tests) mode=unit; shift ;;
 esac
 seconds=600
 if [ "$mode" = fuzz ] && [[ "${1:-}" =~ ^[0-9]+$ ]]; then seconds="$1"; shift; fi
@@ -58,8 +61,22 @@ CC_FUZZ="${CXX_FUZZ/clang++/clang}"
 if [ ! -f "$BUILD/CMakeCache.txt" ]; then
   launcher=()
   command -v ccache >/dev/null 2>&1 && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache)
+  # The test programs' own code at -O0: under the sanitizers it compiles in half the time of -O1,
+  # and their work is in the libraries (CMakeLists.txt, PXF_TEST_CODE_OPTIMIZATION).
   cmake -S . -B "$BUILD" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER="$CXX_FUZZ" -DCMAKE_C_COMPILER="$CC_FUZZ" \
-    -DPXF_FUZZ=ON -DPXF_BUILD_TESTS=OFF "${launcher[@]}" >/dev/null
+    -DPXF_FUZZ=ON -DPXF_BUILD_TESTS=ON -DPXF_TEST_CODE_OPTIMIZATION=-O0 "${launcher[@]}" >/dev/null
+fi
+if [ "$mode" = unit ]; then
+  # A folder configured before the unit tests were built here (PXF_BUILD_TESTS=OFF) gets them now.
+  grep -q '^PXF_BUILD_TESTS:BOOL=ON' "$BUILD/CMakeCache.txt" ||
+    cmake -S . -B "$BUILD" -DPXF_BUILD_TESTS=ON -DPXF_TEST_CODE_OPTIMIZATION=-O0 >/dev/null
+  # The libraries' coverage instrumentation (-fsanitize=fuzzer-no-link) costs these tests about a
+  # third more time, less than a second sanitizer build of the libraries would. Leaks are not
+  # findings here: the tests' process-lifetime objects (the GL context, TBB's arenas) are not freed.
+  cmake --build "$BUILD" -j "${PXF_JOBS:-$(nproc)}" --target image_tests pathtracer_tests
+  ASAN_OPTIONS=detect_leaks=0 ctest --test-dir "$BUILD" --output-on-failure -j "$(nproc)" --timeout 900 \
+    -L 'image_tests|pathtracer_tests'
+  exit
 fi
 targets=()
 for h in "${harnesses[@]}"; do targets+=("${h}_fuzz"); done
