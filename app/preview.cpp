@@ -112,6 +112,8 @@ void Preview::reset() {
 
 void Preview::restart_samples() {
   renderer_->reset();
+  pending_.clear();
+  open_run_ = OpenFilterRun{};
   combined_now_ = false;
   // The newest run's cost stays a valid prediction (same size): the share bound then also holds
   // right after a camera change.
@@ -169,7 +171,6 @@ void Preview::begin_camera_change(const Camera& camera) {
   renderer_->set_camera(camera);
   range_.set_camera(camera);
   restart_samples();
-  pending_.clear();
   if (!settings_.motion_history) {
     if (history_) history_->drop();
     return;
@@ -318,35 +319,79 @@ FilterParams Preview::filter_params_now() const {
   return p;
 }
 
+// A run in parts keeps its arguments (the inputs, the guide) in place until its last step: the
+// passes that may run between two steps (the explorer's views) only read them, and whatever changes
+// them (a traced frame, a camera change, a reset) first abandons the run (open_run_ cleared).
 void Preview::run_filter() {
+  begin_filter_run();
+  while (!step_filter_run()) {
+  }
+}
+
+void Preview::begin_filter_run() {
+  const auto start = BenchClock::now();
   const double range_before = last_.range;
   const FilterParams params = filter_params_now();
   if (range_.frames() == 0) step_range_buffer();
   upload();
-  double filter_ms = 0;
-  filtered_demodulated_ = settings_.demodulate;
+  open_run_ = OpenFilterRun{true, settings_.demodulate};
   if (settings_.demodulate) {
-    const auto start = BenchClock::now();
+    const auto demod_start = BenchClock::now();
     if (!demod_) demod_ = std::make_unique<Demodulation>(width_, height_);
     PreviewInputs& in = pass_inputs();
     in.upload_albedo(&renderer_->accumulation().albedo_mean[0].x);
     demod_->demodulate(in, range_.guide(), params, threshold_now());
-    filter_.run(demod_->filter_inputs(), range_.guide(), params, threshold_now());
-    demod_->remodulate(filter_.output(), in);
-    filter_ms = elapsed_ms(start);
+    filter_.begin(demod_->filter_inputs(), range_.guide(), params, threshold_now());
+    open_run_.filter_ms = elapsed_ms(demod_start);
   } else {
-    filter_.run(inputs(), range_.guide(), params, threshold_now());
-    filter_ms = filter_.last_ms();
+    filter_.begin(inputs(), range_.guide(), params, threshold_now());
   }
-  last_.filter += filter_ms;
-  schedule_.last_run_ms = filter_ms + (last_.range - range_before);
-  schedule_.pass_ms += schedule_.last_run_ms;
-  ++filter_runs_;
+  open_run_.range_ms = last_.range - range_before;
   last_sigma_s_ = params.sigma_s;
+  record_filter_part_ms(elapsed_ms(start));
+}
+
+void Preview::record_filter_part_ms(double ms) {
+  const size_t part = open_run_.parts_done++;
+  if (filter_part_ms_.size() <= part) filter_part_ms_.resize(part + 1, 0.0);
+  filter_part_ms_[part] = ms;
+}
+
+bool Preview::step_filter_run() {
+  const auto start = BenchClock::now();
+  const bool done = filter_.step();
+  if (done && open_run_.demodulated) demod_->remodulate(filter_.output(), pass_inputs());
+  if (open_run_.demodulated) open_run_.filter_ms += elapsed_ms(start);
+  // The read-back ends the run's GL work: a step that only submits it (the slice, a draw, with
+  // GlTiming::Submit) is paid for here, within the last part's time.
+  const uint32_t filtered_pixels = done ? filter_.filtered_pixels() : 0;
+  record_filter_part_ms(elapsed_ms(start));
+  if (!done) return false;
+  // The run's cost as the schedule and the stage times count it: the filter's own stage timer
+  // (gl_timing()), or, demodulated, the wall time of the demodulation, the filter and the
+  // remodulation.
+  if (!open_run_.demodulated) open_run_.filter_ms = filter_.last_ms();
+  last_.filter += open_run_.filter_ms;
+  filtered_demodulated_ = open_run_.demodulated;
+  schedule_.last_run_ms = open_run_.filter_ms + open_run_.range_ms;
+  schedule_.pass_ms += schedule_.last_run_ms;
+  open_run_ = OpenFilterRun{};
+  ++filter_runs_;
   filtered_samples_ = samples();
   have_filtered_ = true;
   // Every pixel skipped = every pixel already in case 2: the filter is not needed any more.
-  if (settings_.filter.skip_case2 && filter_.filtered_pixels() == 0) schedule_.all_pixels_case2 = true;
+  if (settings_.filter.skip_case2 && filtered_pixels == 0) schedule_.all_pixels_case2 = true;
+  return true;
+}
+
+void Preview::run_filter_step() {
+  if (!open_run_.open) {
+    if (!filter_due_now() || !filter_worthwhile()) return;
+    begin_filter_run();
+  } else if (step_filter_run()) {
+    return;
+  }
+  pending_.push_front(PassStep::Filter);  // more of the run to come
 }
 
 double Preview::case2_share() const {
@@ -408,6 +453,7 @@ void Preview::add_frame(bool last_frame, bool display) {
 
 bool Preview::trace_frame() {
   pending_.clear();
+  open_run_ = OpenFilterRun{};
   last_ = StageTimes{};
   const auto start = BenchClock::now();
   const bool complete = next_active_.empty() ? renderer_->add_frame() : renderer_->add_frame(next_active_);
@@ -477,7 +523,8 @@ double Preview::predict_pass_ms(PassStep step) const {
     case PassStep::RangeFrame:
       return range_due() ? range_.last_ms() : 0.0;
     case PassStep::Filter:
-      return filter_due_now() ? schedule_.last_run_ms : 0.0;
+      if (!open_run_.open && !filter_due_now()) return 0.0;
+      return open_run_.parts_done < filter_part_ms_.size() ? filter_part_ms_[open_run_.parts_done] : 0.0;
     case PassStep::Display:
       return display_ms_;
     case PassStep::ViewRange:
@@ -499,7 +546,7 @@ void Preview::run_next_pass() {
       schedule_.have_filtered = have_filtered_;
       break;
     case PassStep::Filter:
-      if (filter_due_now() && filter_worthwhile()) run_filter();
+      run_filter_step();
       break;
     case PassStep::Display:
       blend_and_tonemap();

@@ -226,7 +226,13 @@ class Preview {
   void reproject_history();
   void plan_first_frame_after_move();  // next_active_: more paths where the history holds few samples
   void hide_first_frame_variances();   // upload(): those pixels' Var[L_u] unknown in that frame
+  // A filter run, whole (run_filter) or in parts that the queued Filter step runs one per call
+  // (begin_filter_run, then step_filter_run until it returns true).
   void run_filter();
+  void begin_filter_run();  // the range frame if none yet, the upload, the demodulation
+  bool step_filter_run();   // the filter's next GL step; true after the last (then the bookkeeping)
+  void run_filter_step();   // PassStep::Filter: begins a due run or steps the open one
+  void record_filter_part_ms(double ms);  // the open run's next part took `ms`
   bool filter_worthwhile();  // HV's energy share reaches kMinHvShare (else counts a skip)
   bool step_range_buffer();     // one antialiasing frame of the range pass; false once converged
   void advance_range_buffer();  // one more range frame if the pass budget allows
@@ -275,6 +281,17 @@ class Preview {
   double display_ms_ = 0;                // upload + blend + tone map of the newest display
   double reproject_ms_ = 0;              // the newest reprojection with its path-count plan
   std::deque<PassStep> pending_;         // queue_passes() not yet run
+  // The filter run begun and not finished (begin_filter_run): what it filters and what it cost.
+  struct OpenFilterRun {
+    bool open = false;
+    bool demodulated = false;
+    double filter_ms = 0, range_ms = 0;
+    size_t parts_done = 0;  // begin_filter_run, then each step_filter_run
+  } open_run_;
+  // ms of each part of the newest run that reached it, as the Filter step's prediction: measured
+  // here, around the part, since a GL step that only submits its work (the grid's slice, a draw)
+  // is paid for at the next read-back.
+  std::vector<double> filter_part_ms_;
   bool pending_last_frame_ = false;
 };
 

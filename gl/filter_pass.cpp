@@ -16,27 +16,52 @@ FilterPass::FilterPass(int width, int height)
 }
 
 void FilterPass::run(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& p, float t) {
+  begin(inputs, guide, p, t);
+  while (!step()) {
+  }
+}
+
+void FilterPass::begin(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& p, float t) {
   if (p.kind == FilterKind::None) throw Error("filter pass: filter kind none (the caller skips the filter)");
   if (inputs.width() != width_ || inputs.height() != height_ || guide.width() != width_ || guide.height() != height_)
     throw Error("filter pass: input size differs from the pass size");
+  staged_ = Staged{&inputs, &guide, p, t};
+  if (p.kind == FilterKind::Grid) {
+    if (!grid_) grid_ = std::make_unique<GridFilter>(width_, height_);
+    grid_->begin(inputs, guide, p, t, fbo_);
+  }
+}
+
+bool FilterPass::step() {
+  if (!in_progress()) throw Error("filter pass: step() without a run in progress (begin() first)");
   timer_.begin();
-  const uint32_t zero = 0;
-  counter_.upload(&zero, sizeof zero);
-  counter_.bind_storage(shared::kBufferCounts);
-  centre_weight_valid_ =
-      p.kind == FilterKind::Bilateral || p.kind == FilterKind::BilateralDepth || p.kind == FilterKind::Grid;
+  if (!staged_.started) {
+    const uint32_t zero = 0;
+    counter_.upload(&zero, sizeof zero);
+    staged_.started = true;
+  }
+  counter_.bind_storage(shared::kBufferCounts);  // another pass may have bound its own between steps
+  const bool grid = staged_.params.kind == FilterKind::Grid;
+  const bool done = grid ? grid_->step() : (run_whole_variant(*staged_.inputs, *staged_.guide, staged_.params, staged_.t), true);
+  if (done) glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+  staged_.ms += timer_.end();
+  if (!done) return false;
+  centre_weight_valid_ = staged_.params.kind == FilterKind::Bilateral ||
+                         staged_.params.kind == FilterKind::BilateralDepth || grid;
+  last_ms_ = staged_.ms;
+  staged_ = Staged{};
+  ++runs_;
+  check_gl_error("filter pass");
+  return true;
+}
+
+void FilterPass::run_whole_variant(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& p, float t) {
   if (p.kind == FilterKind::Atrous)
     run_atrous(inputs, guide, p, t);
   else if (p.kind == FilterKind::Subsampled)
     run_subsampled(inputs, guide, p, t);
-  else if (p.kind == FilterKind::Grid)
-    run_grid(inputs, guide, p, t);
   else
     run_bilateral(inputs, guide, p, t);
-  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
-  timer_.end();
-  ++runs_;
-  check_gl_error("filter pass");
 }
 
 namespace {
@@ -115,11 +140,6 @@ void FilterPass::run_subsampled(const PreviewInputs& inputs, const Texture2D& gu
   subsampled_program_.set("rotations", kSubsampledRotations);
   use_with_inputs(subsampled_program_, inputs, guide);
   quad_.draw(subsampled_program_, fbo_, width_, height_);
-}
-
-void FilterPass::run_grid(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& p, float t) {
-  if (!grid_) grid_ = std::make_unique<GridFilter>(width_, height_);
-  grid_->run(inputs, guide, p, t, fbo_);
 }
 
 const Framebuffer& FilterPass::scratch_target(int index) {

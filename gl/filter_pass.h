@@ -24,6 +24,13 @@ class FilterPass {
   // guide: rgb range color, a distance (RangePass::guide()); t: the blend threshold, for the case-2
   // skip. params.kind must not be FilterKind::None (throws pxf::Error).
   void run(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& params, float t);
+  // The same run in steps, for a frame budget: the grid variant's four GL steps, the others' whole
+  // run as one. begin() checks the arguments (which must outlive the run) and runs nothing; each
+  // step() runs the next step, true after the last, when output() holds the new L_f. A begin()
+  // abandons a run in progress; until the last step output() keeps the previous run's result.
+  void begin(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& params, float t);
+  bool step();
+  bool in_progress() const { return staged_.inputs != nullptr; }
 
   bool has_output() const { return runs_ > 0; }
   int runs() const { return runs_; }
@@ -35,7 +42,7 @@ class FilterPass {
   Image centre_weight_image() const;  // "Y"
   // Pixels actually filtered (not skipped) by the last run; 0 = every pixel was in case 2.
   uint32_t filtered_pixels() const;
-  double last_ms() const { return timer_.last_ms(); }
+  double last_ms() const { return last_ms_; }  // the last whole run's, its steps added
   // The grid variant's step times of its last run (GridFilter::last_step_ms); nullptr before one.
   const GridFilter* grid() const { return grid_.get(); }
 
@@ -47,7 +54,7 @@ class FilterPass {
   void run_bilateral(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& params, float t);
   void run_atrous(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& params, float t);
   void run_subsampled(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& params, float t);
-  void run_grid(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& params, float t);
+  void run_whole_variant(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& params, float t);
   const Framebuffer& scratch_target(int index);  // allocates scratch_[index] on first use
 
   int width_, height_;
@@ -69,6 +76,16 @@ class FilterPass {
   std::unique_ptr<GridFilter> grid_;  // created on first use
   StageTimer timer_;
   int runs_ = 0;
+  double last_ms_ = 0;
+  // The run begin() started.
+  struct Staged {
+    const PreviewInputs* inputs = nullptr;
+    const Texture2D* guide = nullptr;
+    FilterParams params;
+    float t = 0;
+    double ms = 0;  // its steps so far
+    bool started = false;
+  } staged_;
 };
 
 }  // namespace pxf

@@ -20,38 +20,61 @@ void GridFilter::resize_grid(const GridLayout& layout) {
 
 void GridFilter::run(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& p, float t,
                      const Framebuffer& target) {
+  begin(inputs, guide, p, t, target);
+  while (!step()) {
+  }
+}
+
+void GridFilter::begin(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& p, float t,
+                       const Framebuffer& target) {
   resize_grid(grid_layout(width_, height_, p));
-  const glm::ivec2 grid_xy(layout_.nx, layout_.ny);
-  const float inv_cell_s = 1.0f / layout_.cell_s;
-  const uint32_t initial_bounds[2] = {0x7f7fffffu, 0u};  // FLT_MAX, +0
+  inputs_ = &inputs, guide_ = &guide, target_ = &target;
+  params_ = p, t_ = t;
+  next_step_ = 0;
+}
+
+bool GridFilter::step() {
+  if (next_step_ >= kSteps) throw Error("grid filter: step() without a run in progress (begin() first)");
   step_timer_.begin();
+  switch (next_step_) {
+    case 0: run_bounds(); break;
+    case 1: run_splat(); break;
+    case 2: run_blur(); break;
+    default: run_slice(); break;
+  }
+  step_ms_[next_step_] = step_timer_.end();
+  return ++next_step_ == kSteps;
+}
+
+void GridFilter::run_bounds() {
+  const uint32_t initial_bounds[2] = {0x7f7fffffu, 0u};  // FLT_MAX, +0
   bounds_buffer_.upload(initial_bounds, sizeof initial_bounds);
   bounds_buffer_.bind_storage(shared::kBufferGridBounds);
-
   bounds_.use();
-  bounds_.bind(shared::kUnitGuide, guide);
+  bounds_.bind(shared::kUnitGuide, *guide_);
   bounds_.require_inputs();
   const int strips = (width_ + 63) / 64 * height_;  // 64-pixel row strips (grid_bounds.comp)
   dispatch_compute_1d("grid filter bounds", (strips + 63) / 64);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+}
 
-  step_ms_[0] = step_timer_.end();
-  step_timer_.begin();
-  splat_.set("grid_xy", grid_xy);
+void GridFilter::run_splat() {
+  splat_.set("grid_xy", glm::ivec2(layout_.nx, layout_.ny));
   splat_.set("cell_s", layout_.cell_s);
-  splat_.set("inv_cell_s", inv_cell_s);
-  splat_.set("min_cell_z", grid_min_cell_z(p.sigma_c));
+  splat_.set("inv_cell_s", 1.0f / layout_.cell_s);
+  splat_.set("min_cell_z", grid_min_cell_z(params_.sigma_c));
   splat_.use();
-  splat_.bind(shared::kUnitHv, inputs.hv());
-  splat_.bind(shared::kUnitGuide, guide);
+  splat_.bind(shared::kUnitHv, inputs_->hv());
+  splat_.bind(shared::kUnitGuide, *guide_);
   splat_.require_inputs();
+  bounds_buffer_.bind_storage(shared::kBufferGridBounds);
   grid_[0].bind_storage(shared::kBufferGrid);
   dispatch_compute("grid filter splat", (layout_.nx + 7) / 8, (layout_.ny + 7) / 8);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+}
 
-  step_ms_[1] = step_timer_.end();
-  step_timer_.begin();
-  blur_.set("grid_xy", grid_xy);
+void GridFilter::run_blur() {
+  blur_.set("grid_xy", glm::ivec2(layout_.nx, layout_.ny));
   blur_.set("grid_z_cells", layout_.nz);
   blur_.use();
   blur_.require_inputs();
@@ -63,24 +86,24 @@ void GridFilter::run(const PreviewInputs& inputs, const Texture2D& guide, const 
     dispatch_compute_1d("grid filter blur", groups);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
   }
+}
 
-  step_ms_[2] = step_timer_.end();
-  step_timer_.begin();
-  const RangeWeights range = range_weights(p);
-  slice_.set("grid_xy", grid_xy);
-  slice_.set("inv_cell_s", inv_cell_s);
-  slice_.set("min_cell_z", grid_min_cell_z(p.sigma_c));
+void GridFilter::run_slice() {
+  const RangeWeights range = range_weights(params_);
+  slice_.set("grid_xy", glm::ivec2(layout_.nx, layout_.ny));
+  slice_.set("inv_cell_s", 1.0f / layout_.cell_s);
+  slice_.set("min_cell_z", grid_min_cell_z(params_.sigma_c));
   slice_.set("k_c", range.k_c);
   slice_.set("k_d", range.k_d);
-  slice_.set("skip_case2", p.skip_case2 ? 1 : 0);
-  slice_.set("t", t);
+  slice_.set("skip_case2", params_.skip_case2 ? 1 : 0);
+  slice_.set("t", t_);
   slice_.use();
-  slice_.bind(shared::kUnitHv, inputs.hv());
-  slice_.bind(shared::kUnitLv, inputs.lv());
-  slice_.bind(shared::kUnitGuide, guide);
+  slice_.bind(shared::kUnitHv, inputs_->hv());
+  slice_.bind(shared::kUnitLv, inputs_->lv());
+  slice_.bind(shared::kUnitGuide, *guide_);
+  bounds_buffer_.bind_storage(shared::kBufferGridBounds);
   grid_[0].bind_storage(shared::kBufferGrid);
-  quad_.draw(slice_, target, width_, height_);
-  step_ms_[3] = step_timer_.end();
+  quad_.draw(slice_, *target_, width_, height_);
 }
 
 }  // namespace pxf

@@ -21,12 +21,25 @@ class GridFilter {
   // inputs: L_u (splat, slice) and L_lv (the slice's skip); guide: the range buffer.
   void run(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& params, float t,
            const Framebuffer& target);
+  // The same run one GL step at a time (the explorer's frame budget spreads them over display
+  // frames): begin() keeps the arguments, which must outlive the run; each step() runs the next step
+  // and binds all it reads (other passes may run between two steps), true after the slice. A begin()
+  // abandons a run in progress.
+  void begin(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& params, float t,
+             const Framebuffer& target);
+  bool step();
+  static constexpr int kSteps = 4;
+  int next_step() const { return next_step_; }  // kSteps when no run is in progress
   // ms of the last run's steps (bounds, splat, blur, slice), measured as gl_timing() says.
-  static constexpr const char* kStepNames[4] = {"bounds", "splat", "blur", "slice"};
-  const std::array<double, 4>& last_step_ms() const { return step_ms_; }
+  static constexpr const char* kStepNames[kSteps] = {"bounds", "splat", "blur", "slice"};
+  const std::array<double, kSteps>& last_step_ms() const { return step_ms_; }
 
  private:
   void resize_grid(const GridLayout& layout);
+  void run_bounds();
+  void run_splat();
+  void run_blur();
+  void run_slice();
 
   int width_, height_;
   Program bounds_, splat_, blur_, slice_;
@@ -35,7 +48,14 @@ class GridFilter {
   GridLayout layout_;
   FullscreenPass quad_;
   StageTimer step_timer_;
-  std::array<double, 4> step_ms_{};
+  std::array<double, kSteps> step_ms_{};
+  // The run in progress (begin()).
+  const PreviewInputs* inputs_ = nullptr;
+  const Texture2D* guide_ = nullptr;
+  const Framebuffer* target_ = nullptr;
+  FilterParams params_;
+  float t_ = 0;
+  int next_step_ = kSteps;
 };
 
 }  // namespace pxf

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <limits>
 #include <random>
+#include "core/error.h"
 #include "gl/cpu_reference.h"
 #include "gl/filter_pass.h"
 #include "gl/grid_layout.h"
@@ -204,6 +205,70 @@ TEST(Grid, NonFiniteInputsGiveFiniteOutput) {
       EXPECT_NEAR(v.pixels[i], ref.variance.pixels[i], 1e-4f * std::abs(ref.variance.pixels[i]) + 1e-12f) << i;
     }
   }
+}
+
+// Random inputs of one size for the stepped-run test: L_lv, L_u, Var[L_u], and a guide.
+struct RandomFilterInputs {
+  PreviewInputs inputs;
+  Texture2D guide;
+  RandomFilterInputs(int w, int h, unsigned seed) : inputs(w, h), guide(w, h, TextureFormat::RGBA32F) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> u01(0.0f, 1.0f);
+    Image lv = Image::rgb(w, h), hv = Image::rgb(w, h), var = Image::gray(w, h), g = Image::rgba(w, h);
+    for (float& v : lv.pixels) v = 0.05f * u01(rng);
+    for (float& v : hv.pixels) v = u01(rng);
+    for (float& v : var.pixels) v = 0.02f * u01(rng);
+    for (float& v : g.pixels) v = 0.2f + u01(rng);
+    inputs.upload(lv, hv, var);
+    guide.upload(g);
+  }
+};
+
+// A run in steps (FilterPass::begin/step, for the explorer's frame budget) gives the very run of
+// FilterPass::run, even when other filter runs, with their own grid, bounds and counter buffers
+// bound at the same binding points, happen between its steps; until its last step the output is
+// the previous run's.
+TEST(Grid, ARunInStepsWithOtherRunsBetweenEqualsOneRun) {
+  test::osmesa_context();
+  constexpr int W = 61, H = 47;
+  RandomFilterInputs a(W, H, 11), b(W, H, 12);
+  FilterParams p;
+  p.kind = FilterKind::Grid;
+  const float t = 0.1f;
+  FilterPass whole(W, H), stepped(W, H), other(W, H);
+  whole.run(a.inputs, a.guide, p, t);
+  stepped.run(b.inputs, b.guide, p, t);  // a previous run, of other inputs
+  const Image previous = stepped.filtered_image();
+
+  EXPECT_THROW(other.step(), Error);  // no run begun
+  stepped.begin(a.inputs, a.guide, p, t);
+  int steps = 0;
+  FilterParams other_params = p;
+  other_params.sigma_s *= 2.0f;
+  while (true) {
+    ASSERT_TRUE(stepped.in_progress());
+    const bool done = stepped.step();
+    ++steps;
+    if (done) break;
+    EXPECT_EQ(stepped.filtered_image().pixels, previous.pixels) << "the output changed before the run's last step";
+    other.run(b.inputs, b.guide, other_params, 0.5f * t);  // rebinds every buffer and texture unit
+  }
+  EXPECT_EQ(steps, GridFilter::kSteps);
+  EXPECT_FALSE(stepped.in_progress());
+  EXPECT_THROW(stepped.step(), Error);
+  EXPECT_EQ(stepped.filtered_image().pixels, whole.filtered_image().pixels);
+  EXPECT_EQ(stepped.raw_variance_image().pixels, whole.raw_variance_image().pixels);
+  EXPECT_EQ(stepped.centre_weight_image().pixels, whole.centre_weight_image().pixels);
+  EXPECT_EQ(stepped.filtered_pixels(), whole.filtered_pixels());
+  EXPECT_GT(whole.filtered_pixels(), 0u);
+  EXPECT_NE(whole.filtered_pixels(), static_cast<uint32_t>(W * H)) << "the skip should leave some pixels";
+
+  // The other variants are one step.
+  p.kind = FilterKind::Atrous;
+  stepped.begin(a.inputs, a.guide, p, t);
+  EXPECT_TRUE(stepped.step());
+  whole.run(a.inputs, a.guide, p, t);
+  EXPECT_EQ(stepped.filtered_image().pixels, whole.filtered_image().pixels);
 }
 
 }  // namespace

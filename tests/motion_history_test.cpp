@@ -3,11 +3,13 @@
 // never moved; while it moves, the history stands beside the fresh samples.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "app/explorer_camera.h"
 #include "app/preview.h"
 #include "app/render_output.h"
+#include "gl/grid_filter.h"
 #include "pathtracer/accumulation_state.h"
 #include "image/metrics.h"
 #include "tests/test_support.h"
@@ -204,3 +206,43 @@ TEST(MotionHistory, ASmallMoveKeepsMostOfTheImage) {
 }
 
 }  // namespace
+
+// The explorer runs a filter run in steps, one queued Filter step per call (the grid's four GL
+// steps after the run's upload), so that its frame budget can spread them. Between two of them the
+// views show the last whole run's L_f, and a camera change abandons the run: what follows is
+// exactly what follows a change after the whole run.
+TEST(MotionHistory, AFilterRunAbandonedBetweenItsStepsByACameraChangeChangesNothing) {
+  test_support::headless_context();
+  Scene scene = load_scene("cornell");
+  PreviewSettings settings;
+  settings.schedule = FilterSchedule::EveryFrame;
+  const Camera moved_to = orbited(scene, 30.0f);
+  std::vector<Layer> results[2];
+  for (const bool abandon : {false, true}) {
+    Preview preview(scene, settings, kSize, kSize);
+    const std::vector<Layer> before = render_at(preview, 4);
+    preview.trace_frame();
+    preview.queue_passes(false, true);
+    std::vector<PassStep> steps;
+    while (preview.passes_pending() && !(abandon && steps.size() == 3)) {
+      steps.push_back(preview.next_pass());
+      EXPECT_GE(preview.predict_pass_ms(steps.back()), 0.0);
+      preview.run_next_pass();
+    }
+    if (abandon) {
+      ASSERT_TRUE(preview.passes_pending());
+      EXPECT_EQ(preview.next_pass(), PassStep::Filter) << "the run is open: its grid steps are still queued";
+      // The views drawn between two steps show the last whole run's L_f.
+      EXPECT_EQ(layer_image(preview.buffers(), "hv_filtered").pixels, layer_image(before, "hv_filtered").pixels);
+    } else {
+      // RangeFrame (when its budget allows), the run's upload and its four grid steps, Display.
+      EXPECT_EQ(std::count(steps.begin(), steps.end(), PassStep::Filter), 1 + GridFilter::kSteps);
+      EXPECT_EQ(steps.back(), PassStep::Display);
+    }
+    preview.begin_camera_change(moved_to);
+    while (preview.passes_pending()) preview.run_next_pass();
+    results[abandon] = render_at(preview, 3);
+  }
+  for (const char* layer : {"final", "hv_filtered", "var_f"})
+    EXPECT_EQ(layer_image(results[0], layer).pixels, layer_image(results[1], layer).pixels) << layer;
+}
