@@ -1,12 +1,12 @@
 // The explorer's frame budget: no display frame blocks the UI for longer than kUiBudgetMs. The
 // path tracer runs on a worker thread (Preview::trace_frame), so what blocks the UI thread is the GL
-// work after each traced frame: one range-buffer frame, a filter run, the blend and tone map
+// work after each traced frame: one range-buffer frame, a filter run (itself in parts: its upload,
+// then the grid's GL steps, Preview::begin_filter_run), the blend and tone map
 // (Preview::queue_passes), and, with the reprojected history, each camera change (the view kept,
 // then a range-buffer frame and the reprojection as two more steps: Preview::begin_camera_change).
-// These steps are spread over display
-// frames: each display frame runs the queued steps whose predicted costs (a camera change's: the
-// last one's), added to the UI's own work (the last frame's drawing of the views and the window),
-// still fit the budget. A pure function of the predicted costs, so it is tested with a fake clock
+// These steps are spread over display frames: each display frame runs the queued steps whose
+// predicted costs (a camera change's: the last one's), added to the UI's own work (the drawing of
+// the views and the window, the longest of the last 8 frames'), still fit the budget. A pure function of the predicted costs, so it is tested with a fake clock
 // (app/frame_budget_test.cpp).
 #pragma once
 #include <vector>
@@ -21,7 +21,7 @@ constexpr double kUiBudgetMs = 100.0;
 // traced frame.
 enum class PassStep {
   RangeFrame,  // one antialiasing frame of the range buffer, if the pass budget allows
-  Filter,      // a filter run, if the schedule makes one due
+  Filter,      // a filter run, if the schedule makes one due: one part per step (stays queued until done)
   Display,     // upload, blend and tone map
   ViewRange,   // the new view's first range-buffer frame (its distances, for the reprojection)
   Reproject,   // the kept view reprojected into the new one, and the first frame's path counts
