@@ -361,7 +361,7 @@ class Explorer {
     ImGui::Text("    blend %.2f  tone map %.2f   filter runs %d (sigma s %.2f)%s", stage_ms_.blend, stage_ms_.tonemap,
                 preview_->filter_runs(), preview_->last_sigma_s(),
                 preview_->filter_stopped() ? " (stopped: all case 2)" : "");
-    const auto& counts = preview_->case_counts();
+    const auto& counts = preview_->shown_case_counts();  // the views' blend, also right after a move
     shown_case_counts_ = counts;
     std::string cases = "cases";  // every case code, so a new case cannot be left out of the line
     for (int c = 0; c < kBlendCaseCount; ++c) {
@@ -395,7 +395,7 @@ class Explorer {
 
   void legend(BufferView view) {
     if (view == BufferView::Case) {
-      const auto& counts = preview_->case_counts();
+      const auto& counts = preview_->shown_case_counts();
       for (int c = 0; c < kBlendCaseCount; ++c) {
         const CaseStyle& style = case_styles()[c];
         ImGui::ColorButton(style.label, ImVec4(style.r, style.g, style.b, 1), ImGuiColorEditFlags_NoTooltip, ImVec2(14, 14));

@@ -439,7 +439,7 @@ void Preview::blend_and_tonemap() {
   last_.blend += blend_.last_ms();
   tonemap_.run(blend_.output(), settings_.tonemap);
   last_.tonemap += tonemap_.last_ms();
-  case_counts_ = blend_.case_counts();
+  case_counts_ = shown_case_counts_ = blend_.case_counts();
   display_ms_ = last_.upload - upload_before + blend_.last_ms() + tonemap_.last_ms();
 }
 

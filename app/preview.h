@@ -188,7 +188,11 @@ class Preview {
   // Filter runs left out because HV's energy share was below kMinHvShare.
   int filter_runs_skipped_low_hv() const { return low_hv_skips_; }
   // Pixels per blend case (kCase* in shaders/pass_formulas.h) of the last displayed frame.
+  // 0 after a reset or a camera change, until the next blend.
   const std::array<uint32_t, kBlendCaseCount>& case_counts() const { return case_counts_; }
+  // The same of the blend that display_image() and the views show: the last blend, also after a
+  // reset or a camera change, until the next one (the explorer's status line and case legend).
+  const std::array<uint32_t, kBlendCaseCount>& shown_case_counts() const { return shown_case_counts_; }
 
   // GPU results for the explorer's views.
   // The inputs the filter and blend read: the fresh samples, or with the reprojected history
@@ -277,6 +281,7 @@ class Preview {
   int filtered_samples_ = -1;  // sample count of the newest L_f
   StageTimes last_, total_;
   std::array<uint32_t, kBlendCaseCount> case_counts_{};
+  std::array<uint32_t, kBlendCaseCount> shown_case_counts_{};  // not reset: the shown image's
   std::vector<double> recent_frame_ms_;  // path tracing of the last frames, for predictions
   double display_ms_ = 0;                // upload + blend + tone map of the newest display
   double reproject_ms_ = 0;              // the newest reprojection with its path-count plan

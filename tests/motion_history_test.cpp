@@ -246,3 +246,26 @@ TEST(MotionHistory, AFilterRunAbandonedBetweenItsStepsByACameraChangeChangesNoth
   for (const char* layer : {"final", "hv_filtered", "var_f"})
     EXPECT_EQ(layer_image(results[0], layer).pixels, layer_image(results[1], layer).pixels) << layer;
 }
+
+// A camera change resets the samples and their case counts, but the image and the views still show
+// the last blend until the new view's first display: the counts the explorer's status line and
+// case legend show are that blend's (they read 0 % everywhere while moving before).
+TEST(MotionHistory, TheShownCaseCountsStayTheShownBlendsAfterAMove) {
+  test_support::headless_context();
+  Scene scene = load_scene("cornell");
+  PreviewSettings settings;
+  Preview preview(scene, settings, kSize, kSize);
+  const std::vector<Layer> shown = render_at(preview, 4);
+  std::array<uint32_t, kBlendCaseCount> from_image{};
+  for (float code : layer_image(shown, "case").pixels) ++from_image[static_cast<int>(code)];
+  ASSERT_EQ(preview.shown_case_counts(), from_image);
+  const Image display = preview.display_image();
+
+  preview.begin_camera_change(orbited(scene, 30.0f));
+  EXPECT_EQ(preview.case_counts(), (std::array<uint32_t, kBlendCaseCount>{}));
+  EXPECT_EQ(preview.display_image().pixels, display.pixels) << "the shown image is still the last blend's";
+  EXPECT_EQ(preview.shown_case_counts(), from_image);
+  while (preview.passes_pending()) preview.run_next_pass();
+  preview.add_frame(false, true);
+  EXPECT_EQ(preview.shown_case_counts(), preview.case_counts()) << "the new view's first display";
+}
