@@ -6,8 +6,8 @@
 // then a range-buffer frame and the reprojection as two more steps: Preview::begin_camera_change).
 // These steps are spread over display frames: each display frame runs the queued steps whose
 // predicted costs (a camera change's: the last one's), added to the UI's own work (the drawing of
-// the views and the window, the longest of the last 8 frames'), still fit the budget. A pure function of the predicted costs, so it is tested with a fake clock
-// (app/frame_budget_test.cpp).
+// the views and the window, the longest of the last 8 frames'), still fit the budget. A pure
+// function of the predicted costs, so it is tested with a fake clock (app/frame_budget_test.cpp).
 #pragma once
 #include <vector>
 

@@ -26,6 +26,8 @@ void FilterPass::begin(const PreviewInputs& inputs, const Texture2D& guide, cons
   if (inputs.width() != width_ || inputs.height() != height_ || guide.width() != width_ || guide.height() != height_)
     throw Error("filter pass: input size differs from the pass size");
   staged_ = Staged{&inputs, &guide, p, t};
+  const uint32_t zero = 0;
+  counter_.upload(&zero, sizeof zero);
   if (p.kind == FilterKind::Grid) {
     if (!grid_) grid_ = std::make_unique<GridFilter>(width_, height_);
     grid_->begin(inputs, guide, p, t, fbo_);
@@ -35,11 +37,6 @@ void FilterPass::begin(const PreviewInputs& inputs, const Texture2D& guide, cons
 bool FilterPass::step() {
   if (!in_progress()) throw Error("filter pass: step() without a run in progress (begin() first)");
   timer_.begin();
-  if (!staged_.started) {
-    const uint32_t zero = 0;
-    counter_.upload(&zero, sizeof zero);
-    staged_.started = true;
-  }
   counter_.bind_storage(shared::kBufferCounts);  // another pass may have bound its own between steps
   const bool grid = staged_.params.kind == FilterKind::Grid;
   const bool done = grid ? grid_->step() : (run_whole_variant(*staged_.inputs, *staged_.guide, staged_.params, staged_.t), true);

@@ -25,9 +25,10 @@ class FilterPass {
   // skip. params.kind must not be FilterKind::None (throws pxf::Error).
   void run(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& params, float t);
   // The same run in steps, for a frame budget: the grid variant's four GL steps, the others' whole
-  // run as one. begin() checks the arguments (which must outlive the run) and runs nothing; each
-  // step() runs the next step, true after the last, when output() holds the new L_f. A begin()
-  // abandons a run in progress; until the last step output() keeps the previous run's result.
+  // run as one. begin() checks the arguments (which must outlive the run) and clears the
+  // filtered-pixel count, running no pass; each step() runs the next step, true after the last,
+  // when output() holds the new L_f. A begin() abandons a run in progress; until the last step
+  // output() keeps the previous run's result.
   void begin(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& params, float t);
   bool step();
   bool in_progress() const { return staged_.inputs != nullptr; }
@@ -84,7 +85,6 @@ class FilterPass {
     FilterParams params;
     float t = 0;
     double ms = 0;  // its steps so far
-    bool started = false;
   } staged_;
 };
 

@@ -18,13 +18,6 @@ void GridFilter::resize_grid(const GridLayout& layout) {
   layout_ = layout;
 }
 
-void GridFilter::run(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& p, float t,
-                     const Framebuffer& target) {
-  begin(inputs, guide, p, t, target);
-  while (!step()) {
-  }
-}
-
 void GridFilter::begin(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& p, float t,
                        const Framebuffer& target) {
   resize_grid(grid_layout(width_, height_, p));

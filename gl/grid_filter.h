@@ -15,21 +15,17 @@ namespace pxf {
 class GridFilter {
  public:
   GridFilter(int width, int height);
-  // Expects FilterPass's bindings: HV at texture unit 0, LV at 1, the guide at 2, the filtered-pixel
-  // counter at storage binding 0. Draws rgb L_f, a Var[L_f] into `target`; t: the blend threshold,
-  // for the case-2 skip.
-  // inputs: L_u (splat, slice) and L_lv (the slice's skip); guide: the range buffer.
-  void run(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& params, float t,
-           const Framebuffer& target);
-  // The same run one GL step at a time (the explorer's frame budget spreads them over display
-  // frames): begin() keeps the arguments, which must outlive the run; each step() runs the next step
-  // and binds all it reads (other passes may run between two steps), true after the slice. A begin()
-  // abandons a run in progress.
+  // A run one GL step at a time (FilterPass::step; the explorer's frame budget spreads them over
+  // display frames). begin() keeps the arguments, which must outlive the run: inputs: L_u (splat,
+  // slice) and L_lv (the slice's skip); guide: the range buffer; t: the blend threshold, for the
+  // case-2 skip. Each step() runs the next step and binds all it reads (other passes may run
+  // between two steps) but the filtered-pixel counter, which the caller binds at kBufferCounts;
+  // true after the slice, which draws rgb L_f, a Var[L_f] into `target`. A begin() abandons a run
+  // in progress.
   void begin(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& params, float t,
              const Framebuffer& target);
   bool step();
   static constexpr int kSteps = 4;
-  int next_step() const { return next_step_; }  // kSteps when no run is in progress
   // ms of the last run's steps (bounds, splat, blur, slice), measured as gl_timing() says.
   static constexpr const char* kStepNames[kSteps] = {"bounds", "splat", "blur", "slice"};
   const std::array<double, kSteps>& last_step_ms() const { return step_ms_; }
