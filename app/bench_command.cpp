@@ -644,6 +644,9 @@ int motion_mode(const Args& args, const std::string& summary) {
   h.cli().option("--motion-frames", &frames, "frames of the orbit (default 60)", 2, 100000);
   h.cli().option("--orbit-degrees", &orbit_degrees, "the whole orbit in degrees (default 90)", 0.0, 3600.0);
   h.cli().option("--reference-spp", &reference_spp, "samples of each frame's reference (default 1024)", 1, 1 << 20);
+  std::string camera_path;
+  h.cli().option("--camera-path", &camera_path, "FILE.json|turntable:N",
+                 "the views of a camera path (keyframes, as pxf render --camera-path) instead of the orbit");
   bool one_reference = false;
   h.cli().flag("--one-reference", &one_reference,
                "no second reference per frame (halves the references' time; the error is then not corrected "
@@ -656,6 +659,7 @@ int motion_mode(const Args& args, const std::string& summary) {
   mb.orbit_degrees = static_cast<float>(orbit_degrees);
   mb.reference_spp = reference_spp;
   mb.second_reference = !one_reference;
+  mb.camera_path = camera_path;
   run_motion_bench(mb);
   return 0;
 }

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "app/camera_path.h"
 #include "app/explorer_camera.h"
 #include "core/timing.h"
 #include "image/metrics.h"
@@ -16,10 +17,15 @@ namespace {
 
 constexpr float kOrbitRadiansPerPixel = 0.005f;  // CameraController::orbit
 
-std::vector<Camera> orbit_cameras(const MotionBenchSetup& b) {
+std::vector<Camera> bench_cameras(const MotionBenchSetup& b) {
+  std::vector<Camera> cameras;
+  if (!b.camera_path.empty()) {
+    const CameraPath path = camera_path_for(b.camera_path, b.scene);
+    for (int f = 0; f < path.frame_count(); ++f) cameras.push_back(camera_on_path(path, f, b.scene.camera));
+    return cameras;
+  }
   CameraController control(b.scene.camera, scene_bounds(b.scene));
   const float step_px = glm::radians(b.orbit_degrees / static_cast<float>(b.frames)) / kOrbitRadiansPerPixel;
-  std::vector<Camera> cameras;
   for (int f = 0; f < b.frames; ++f) {
     cameras.push_back(control.camera());
     control.orbit(step_px, 0.0f);
@@ -34,12 +40,15 @@ std::string frame_file(const std::string& dir, const std::string& prefix, int fr
 }
 
 // Plain path tracing of each view with another seed (`which` 1 or 2: two independent references,
-// the second for the reference-noise correction), cached in --out.
+// the second for the reference-noise correction), cached in --out under a name that says which views.
 std::vector<Image> references(const MotionBenchSetup& b, const std::vector<Camera>& cameras, int which) {
-  const std::string dir = b.out + "/motion_reference" + (which == 1 ? std::string() : std::to_string(which)) + "_" + std::filesystem::path(b.scene_name).stem().string() + "_" +
-                          std::to_string(b.width) + "x" + std::to_string(b.height) + "_" + std::to_string(b.frames) +
-                          "f_" + std::to_string(static_cast<int>(b.orbit_degrees)) + "deg_" +
-                          std::to_string(b.reference_spp) + "spp";
+  const std::string views = b.camera_path.empty()
+                                ? std::to_string(b.frames) + "f_" + std::to_string(static_cast<int>(b.orbit_degrees)) + "deg_"
+                                : "path-" + std::filesystem::path(b.camera_path).stem().string() + "_" +
+                                      std::to_string(cameras.size()) + "f_";
+  const std::string dir = b.out + "/motion_reference" + (which == 1 ? std::string() : std::to_string(which)) + "_" +
+                          std::filesystem::path(b.scene_name).stem().string() + "_" + std::to_string(b.width) + "x" +
+                          std::to_string(b.height) + "_" + views + std::to_string(b.reference_spp) + "spp";
   std::filesystem::create_directories(dir);
   std::vector<Image> refs;
   TraceParams params = b.settings.trace;
@@ -170,7 +179,7 @@ RunFigures figures(const MotionRun& run, const std::vector<Image>& refs, const s
 
 void run_motion_bench(const MotionBenchSetup& b) {
   std::filesystem::create_directories(b.out);
-  const std::vector<Camera> cameras = orbit_cameras(b);
+  const std::vector<Camera> cameras = bench_cameras(b);
   const std::vector<Image> refs = references(b, cameras, 1);
   std::vector<double> reference_pair;  // display NRMSE of the second reference against the first
   if (b.second_reference) {
@@ -213,8 +222,12 @@ void run_motion_bench(const MotionBenchSetup& b) {
   }
 
   std::vector<double> today_spp(today.spp.begin(), today.spp.end());
-  std::printf("motion: %s %dx%d, %d frames over %.0f degrees of orbit, references %d spp (another seed)\n",
-              b.scene_name.c_str(), b.width, b.height, b.frames, b.orbit_degrees, b.reference_spp);
+  if (b.camera_path.empty())
+    std::printf("motion: %s %dx%d, %d frames over %.0f degrees of orbit, references %d spp (another seed)\n",
+                b.scene_name.c_str(), b.width, b.height, b.frames, b.orbit_degrees, b.reference_spp);
+  else
+    std::printf("motion: %s %dx%d, camera path %s (%zu frames), references %d spp (another seed)\n",
+                b.scene_name.c_str(), b.width, b.height, b.camera_path.c_str(), cameras.size(), b.reference_spp);
   std::printf("  frame time: history + filter median %.1f ms, longest %.1f ms (frames 2+); history passes %.2f ms a frame\n",
               history_frame_ms, timed.empty() ? 0.0 : *std::max_element(timed.begin(), timed.end()),
               history.history_ms / b.frames);

@@ -1,4 +1,4 @@
-// pxf bench --motion (issue 37): a camera orbit, one path per pixel per frame, with the reprojected
+// pxf bench --motion (issue 37): a camera orbit or a camera path, one path per pixel per frame, with the reprojected
 // history and the filter every frame, against today's explorer behaviour during motion (restart
 // plus unfiltered) at equal frame time. Not a test: prints a table and writes motion.csv and frames
 // into --out.
@@ -23,6 +23,8 @@ struct MotionBenchSetup {
   std::string out;
   int frames = 60;              // of the orbit
   float orbit_degrees = 90.0f;  // the whole orbit, around the explorer's orbit target
+  // A camera path (app/camera_path.h: a JSON file or turntable:N) instead of the orbit: its frames.
+  std::string camera_path{};
   int reference_spp = 1024;
   // A second reference per frame (another seed) for the error less the references' own noise.
   bool second_reference = true;

@@ -6,6 +6,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 
 #include "image/image.h"
@@ -71,6 +72,20 @@ TEST(CameraPathCli, BadFlagsAndFilesAreRefusedWithOneLine) {
   expect_one_line_refusal("render --size 16x16 --camera-path turntable:x", "turntable:N");
   expect_one_line_refusal("render --size 16x16 --camera-path " + write_path_file("{\"keyframes\": ["), "not valid JSON");
   expect_one_line_refusal("render --size 16x16 --camera-path /nonexistent.json", "cannot be read");
+  expect_one_line_refusal("bench --motion --size 16x16 --camera-path " + write_path_file("{\"keyframes\": ["),
+                          "not valid JSON");
+}
+
+// pxf bench --motion measures a camera path's views (one reference per frame, cached by the path's name).
+TEST(CameraPathCli, MotionBenchFollowsThePath) {
+  const std::string out = test_support::temp_dir("camera_path", "motion_bench");
+  const Result r = run("bench --motion --one-reference --size 16x16 --camera-path turntable:3 --reference-spp 2 --out " + out);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("camera path turntable:3 (3 frames)"), std::string::npos) << r.out;
+  std::ifstream csv(out + "/motion.csv");
+  const std::string text((std::istreambuf_iterator<char>(csv)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 4) << text;  // the header and three frames
+  EXPECT_TRUE(fs::exists(out + "/motion_reference_cornell_16x16_path-turntable:3_3f_2spp/reference_0002.exr"));
 }
 
 }  // namespace
