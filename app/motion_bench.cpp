@@ -230,7 +230,7 @@ void run_motion_bench(const MotionBenchSetup& b) {
                 b.scene_name.c_str(), b.width, b.height, b.camera_path.c_str(), cameras.size(), b.reference_spp);
   std::printf("  frame time: history + filter median %.1f ms, longest %.1f ms (frames 2+); history passes %.2f ms a frame\n",
               history_frame_ms, timed.empty() ? 0.0 : *std::max_element(timed.begin(), timed.end()),
-              history.history_ms / b.frames);
+              history.history_ms / cameras.size());
   std::printf("  today (restart, unfiltered) at equal frame time: median %.1f ms, median %.0f spp a frame\n",
               median(today.ms), median(today_spp));
   const double eh = median(h.error), et = median(t.error);

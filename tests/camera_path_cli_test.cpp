@@ -6,7 +6,6 @@
 
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 #include <nlohmann/json.hpp>
 
 #include "image/image.h"
@@ -82,8 +81,7 @@ TEST(CameraPathCli, MotionBenchFollowsThePath) {
   const Result r = run("bench --motion --one-reference --size 16x16 --camera-path turntable:3 --reference-spp 2 --out " + out);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("camera path turntable:3 (3 frames)"), std::string::npos) << r.out;
-  std::ifstream csv(out + "/motion.csv");
-  const std::string text((std::istreambuf_iterator<char>(csv)), std::istreambuf_iterator<char>());
+  const std::string text = test_support::slurp(out + "/motion.csv");
   EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 4) << text;  // the header and three frames
   EXPECT_TRUE(fs::exists(out + "/motion_reference_cornell_16x16_path-turntable:3_3f_2spp/reference_0002.exr"));
 }
