@@ -1,6 +1,7 @@
 #include "pathtracer/guiding_lobes.h"
 
 #include <algorithm>
+#include <cfloat>
 #include <cmath>
 
 namespace pxf {
@@ -26,12 +27,12 @@ bool kept_before(const GuidingLobeRecord& a, const GuidingLobeRecord& b) {
 }
 
 // An orthonormal frame around a unit vector (Duff et al. 2017).
-void tangents(const glm::dvec3& n, glm::dvec3* t, glm::dvec3* b) {
-  const double sign = std::copysign(1.0, n.z);
-  const double a = -1.0 / (sign + n.z);
-  const double c = n.x * n.y * a;
-  *t = glm::dvec3(1.0 + sign * n.x * n.x * a, sign * c, -sign * n.x);
-  *b = glm::dvec3(c, sign + n.y * n.y * a, -n.y);
+void tangents(const glm::vec3& n, glm::vec3* t, glm::vec3* b) {
+  const float sign = std::copysign(1.0f, n.z);
+  const float a = -1.0f / (sign + n.z);
+  const float c = n.x * n.y * a;
+  *t = glm::vec3(1.0f + sign * n.x * n.x * a, sign * c, -sign * n.x);
+  *b = glm::vec3(c, sign + n.y * n.y * a, -n.y);
 }
 
 glm::dvec3 unit_or(const glm::dvec3& v, const glm::dvec3& fallback) {
@@ -228,14 +229,15 @@ double vmf_pdf(const glm::dvec3& mean, double kappa, const glm::dvec3& w) {
   return std::exp(vmf_log(mean, kappa, vmf_log_normalisation(kappa), w)) / kTwoPi;
 }
 
-glm::dvec3 vmf_sample(const glm::dvec3& mean, double kappa, glm::dvec2 u) {
-  // cos theta = 1 + log(u + (1 - u) e^-2kappa) / kappa, inverted from the CDF of cos theta.
-  const double x = std::max(u.x + (1.0 - u.x) * std::exp(-2.0 * kappa), 1e-300);
-  const double one_minus_cos = std::min(std::max(-std::log(x) / kappa, 0.0), 2.0);
-  const double cos_theta = 1.0 - one_minus_cos;
-  const double sin_theta = std::sqrt(std::max(0.0, one_minus_cos * (2.0 - one_minus_cos)));
-  const double phi = kTwoPi * u.y;
-  glm::dvec3 t, b;
+glm::vec3 vmf_sample(const glm::vec3& mean, float kappa, glm::vec2 u) {
+  // 1 - cos theta = -log(1 + (1 - u) (e^-2kappa - 1)) / kappa, inverted from the CDF of cos theta;
+  // log1p and expm1 keep it accurate in float for both small and large kappa (u = 0 gives 2).
+  const float one_minus_cos =
+      std::min(std::max(-std::log1p((1.0f - u.x) * std::expm1(-2.0f * kappa)) / kappa, 0.0f), 2.0f);
+  const float cos_theta = 1.0f - one_minus_cos;
+  const float sin_theta = std::sqrt(std::max(0.0f, one_minus_cos * (2.0f - one_minus_cos)));
+  const float phi = float(kTwoPi) * u.y;
+  glm::vec3 t, b;
   tangents(mean, &t, &b);
   return glm::normalize(cos_theta * mean + sin_theta * (std::cos(phi) * t + std::sin(phi) * b));
 }
@@ -243,6 +245,8 @@ glm::dvec3 vmf_sample(const glm::dvec3& mean, double kappa, glm::dvec2 u) {
 LobeMixture::LobeMixture(const std::vector<GuidingLobe>& lobes, const glm::vec3& point, float uniform_fraction,
                          const glm::vec3& normal, float min_kappa)
     : uniform_fraction_(uniform_fraction) {
+  // Built once per guided vertex: squared distances and one reciprocal square root per lobe, no
+  // division, because this runs for every camera path's first diffuse vertex.
   float total = 0.0f;
   for (const GuidingLobe& lobe : lobes) {
     if (count_ == kMaxGuidingLobes) break;
@@ -251,11 +255,12 @@ LobeMixture::LobeMixture(const std::vector<GuidingLobe>& lobes, const glm::vec3&
     float kappa = lobe.kappa;
     if (lobe.distance != 0.0f) {
       const glm::vec3 to_source = lobe.source - point;
-      const float distance = glm::length(to_source), reference = std::abs(lobe.distance);
-      if (distance > 1e-6f * reference && std::isfinite(distance)) {
-        mean = (lobe.distance > 0.0f ? 1.0f : -1.0f) * to_source / distance;
-        const float ratio = distance / reference;
-        kappa = std::min(kMaxLobeKappa, kappa * std::min(4.0f, std::max(0.25f, ratio * ratio)));
+      const float distance_squared = glm::dot(to_source, to_source), reference_squared = lobe.distance * lobe.distance;
+      if (distance_squared > 1e-12f * reference_squared && distance_squared <= FLT_MAX) {
+        const float inverse_distance = 1.0f / std::sqrt(distance_squared);
+        mean = (lobe.distance > 0.0f ? inverse_distance : -inverse_distance) * to_source;
+        const float ratio_squared = distance_squared / reference_squared;
+        kappa = std::min(kMaxLobeKappa, kappa * std::min(4.0f, std::max(0.25f, ratio_squared)));
       }
     }
     if (kappa < min_kappa) continue;
@@ -274,43 +279,44 @@ LobeMixture::LobeMixture(const std::vector<GuidingLobe>& lobes, const glm::vec3&
     share_ = 0.0f;
     return;
   }
+  const float inverse_total = 1.0f / total;
   for (int j = 0; j < count_; ++j) {
     const float kappa = kappa_[j];
     // 1 - e^-2kappa, which rounds to 1 in float from kappa = 9 on: most lobes skip the exponential.
     const float normalisation = kappa < 9.0f ? -std::expm1(-2.0f * kappa) : 1.0f;
-    weight_[j] = weight_[j] / total * kappa / (float(kTwoPi) * normalisation);
-    cumulative_[j] /= total;
+    weight_[j] = weight_[j] * inverse_total * kappa / (float(kTwoPi) * normalisation);
+    cumulative_[j] *= inverse_total;
   }
   cumulative_[count_ - 1] = 1.0f;
 }
 
 glm::vec3 LobeMixture::sample(glm::vec2 u, float* pdf_out) const {
-  double x = std::min(std::max(double(u.x), 0.0), 0x1.fffffffffffffp-1);
-  const double y = std::min(std::max(double(u.y), 0.0), 0x1.fffffffffffffp-1);
-  glm::dvec3 direction;
+  constexpr float kBelowOne = 0x1.fffffep-1f;
+  float x = std::min(std::max(u.x, 0.0f), kBelowOne);
+  const float y = std::min(std::max(u.y, 0.0f), kBelowOne);
+  glm::vec3 direction;
   if (count_ == 0 || x < uniform_fraction_) {
-    const double z = count_ == 0 ? 1.0 - 2.0 * x : 1.0 - 2.0 * (x / uniform_fraction_);
-    const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
-    direction = glm::dvec3(r * std::cos(kTwoPi * y), r * std::sin(kTwoPi * y), z);
+    const float z = count_ == 0 ? 1.0f - 2.0f * x : 1.0f - 2.0f * (x / uniform_fraction_);
+    const float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
+    direction = glm::vec3(r * std::cos(float(kTwoPi) * y), r * std::sin(float(kTwoPi) * y), z);
   } else {
-    x = (x - uniform_fraction_) / (1.0 - uniform_fraction_);
+    x = std::min((x - uniform_fraction_) / (1.0f - uniform_fraction_), kBelowOne);
     int j = 0;
     while (j < count_ - 1 && x >= cumulative_[j]) ++j;
-    const double lo = j == 0 ? 0.0 : cumulative_[j - 1];
-    const double width = cumulative_[j] - lo;
-    const double within = width > 0.0 ? std::min(std::max((x - lo) / width, 0.0), 0x1.fffffffffffffp-1) : 0.5;
-    direction = vmf_sample(glm::dvec3(mean_[j]), kappa_[j], glm::dvec2(within, y));
+    const float lo = j == 0 ? 0.0f : cumulative_[j - 1];
+    const float width = cumulative_[j] - lo;
+    const float within = width > 0.0f ? std::min(std::max((x - lo) / width, 0.0f), kBelowOne) : 0.5f;
+    direction = vmf_sample(mean_[j], kappa_[j], glm::vec2(within, y));
   }
-  const glm::vec3 d(direction);
-  if (pdf_out) *pdf_out = pdf(d);  // the same function as every MIS weight of this direction uses
-  return d;
+  if (pdf_out) *pdf_out = pdf(direction);  // the same function as every MIS weight of this direction uses
+  return direction;
 }
 
 float LobeMixture::pdf(const glm::vec3& direction) const {
-  const double length = glm::length(glm::dvec3(direction));
-  if (!(length > 0.0) || !std::isfinite(length)) return 0.0f;
+  const float length_squared = glm::dot(direction, direction);
+  if (!(length_squared > 0.0f) || !(length_squared <= FLT_MAX)) return 0.0f;
   if (count_ == 0) return static_cast<float>(kInvFourPi);
-  const glm::vec3 w = glm::vec3(glm::dvec3(direction) / length);
+  const glm::vec3 w = direction * (1.0f / std::sqrt(length_squared));
   float lobes = 0.0f;
   for (int j = 0; j < count_; ++j) {
     const glm::vec3 d = mean_[j] - w;  // kappa (cos - 1) = -kappa |mean - w|^2 / 2, exact near the mean
@@ -318,7 +324,7 @@ float LobeMixture::pdf(const glm::vec3& direction) const {
     // Beyond e^-60 a lobe adds less than 1e-21 of its peak (at most 1e5 / 2 pi): nothing next to the uniform part.
     if (exponent < 60.0f) lobes += weight_[j] * std::exp(-exponent);
   }
-  return static_cast<float>(uniform_fraction_ * kInvFourPi + (1.0 - uniform_fraction_) * double(lobes));
+  return uniform_fraction_ * float(kInvFourPi) + (1.0f - uniform_fraction_) * lobes;
 }
 
 }  // namespace pxf

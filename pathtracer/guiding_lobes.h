@@ -79,7 +79,7 @@ float best_guided_share(const std::vector<GuidingLobe>& lobes, const std::vector
 
 // The vMF density on the unit sphere, stable for large kappa.
 double vmf_pdf(const glm::dvec3& mean, double kappa, const glm::dvec3& direction);
-glm::dvec3 vmf_sample(const glm::dvec3& mean, double kappa, glm::dvec2 u);
+glm::vec3 vmf_sample(const glm::vec3& mean, float kappa, glm::vec2 u);  // in float: sampled per guided vertex
 
 // The lobes of a region as seen from one point: what sampling and pdf evaluation use at a vertex. A
 // lobe with a source aims at it (away from it for a focus), its concentration scaled by the square of the distance ratio (a

@@ -79,7 +79,7 @@ TEST(GuidingLobes, VmfSamplesFollowItsPdf) {
     double sum = 0.0;
     const stat::ChiSquareResult r = chi_square_around(
         mean, [&](glm::vec3 d) { return vmf_pdf(mean, kappa, glm::dvec3(d)); },
-        [&](glm::vec2 u) { return glm::vec3(vmf_sample(mean, kappa, glm::dvec2(u))); }, 200000, &sum);
+        [&](glm::vec2 u) { return vmf_sample(glm::vec3(mean), float(kappa), u); }, 200000, &sum);
     EXPECT_NEAR(sum, 1.0, 2e-3);
     EXPECT_TRUE(r.problem.empty()) << r.problem;
     EXPECT_GT(r.p_value, 0.01) << "chi2 " << r.statistic << " dof " << r.dof;
