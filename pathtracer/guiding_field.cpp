@@ -229,6 +229,9 @@ uint32_t float_bits(float f) {
 
 // A total order: equal records are identical, so any order of arrival sorts to the same sequence.
 bool record_before(const GuidingRecord& a, const GuidingRecord& b) {
+  // (leaf, key) decides all but repeated keys; the full tuple is built only for those.
+  if (a.leaf != b.leaf) return a.leaf < b.leaf;
+  if (a.key != b.key) return a.key < b.key;
   const auto bits = [](const GuidingRecord& r) {
     return std::make_tuple(r.leaf, r.key, float_bits(r.u), float_bits(r.v), float_bits(r.energy), float_bits(r.position.x),
                            float_bits(r.position.y), float_bits(r.position.z), float_bits(r.source.x),
@@ -462,8 +465,13 @@ void GuidingField::record(uint64_t key, const glm::vec3& position, const glm::ve
   // float(uv) may round up to 1: kept below, the square's half-open range.
   const float u = std::min(static_cast<float>(uv.x), kBelowOneF), v = std::min(static_cast<float>(uv.y), kBelowOneF);
   const glm::vec3 unit = glm::vec3(direction_of(uv));
-  const uint32_t leaf = find_leaf(position);
-  const bool at_infinity = distance == 0.0f || !std::isfinite(distance);
+  Box box;
+  const uint32_t leaf = find_leaf(position, &box);
+  // A focus ahead of the record nearer than its leaf is wide (a lens's caustic on the surface it
+  // converges to) moves with the receiving point: from elsewhere in the leaf it lies in another
+  // direction altogether, so only the light's direction is kept.
+  const bool near_focus = distance < 0.0f && -distance < glm::length(box.hi - box.lo);
+  const bool at_infinity = distance == 0.0f || !std::isfinite(distance) || near_focus;
   const glm::vec3 source = at_infinity ? unit : position + distance * glm::normalize(direction);
   if (!std::isfinite(source.x) || !std::isfinite(source.y) || !std::isfinite(source.z)) return;
   const uint32_t kind = at_infinity ? kSourceAtInfinity : distance > 0.0f ? kSourceBehind : kSourceAhead;
