@@ -292,6 +292,37 @@ TEST(GuidingLobes, ReservoirKeepsTheSameRecordsWhateverTheOrder) {
   EXPECT_GT(heavy, 128 / 5 + 10);
 }
 
+TEST(GuidingLobes, AFocusNearerThanItsLeafIsKeptAsADirection) {
+  // Records over a patch of one leaf (the box's diagonal 3.46), their light arriving straight down
+  // (from +y) from a point `distance` along it: behind the record (> 0) or a focus ahead (< 0). A
+  // focus within the leaf's size moves with the receiving point, so the field keeps only the
+  // direction; a farther focus and a source behind keep their points.
+  const auto largest_lobe = [](float distance) {
+    GuidingSettings settings;
+    settings.spatial_threshold = 1e9f;  // one leaf
+    settings.parallax_lobes = 8;
+    GuidingField field(glm::vec3(-1.0f), glm::vec3(1.0f), settings);
+    Rng rng(3, 4, 5);
+    for (uint64_t k = 0; k < 400; ++k) {
+      const glm::vec2 u = rng.next_2d();
+      const glm::vec3 position(0.6f * u.x - 0.3f, -0.5f, 0.6f * u.y - 0.3f);
+      field.record(k, position, glm::vec3(0.0f, 1.0f, 0.0f), 1.0f, 1.0f, distance, glm::vec3(0.0f, 1.0f, 0.0f));
+    }
+    field.end_iteration();
+    const std::vector<GuidingLobe>& lobes = field.lobes(glm::vec3(0.0f, -0.5f, 0.0f));
+    EXPECT_FALSE(lobes.empty());
+    return lobes.empty() ? GuidingLobe{} : *std::max_element(lobes.begin(), lobes.end(), [](const GuidingLobe& a, const GuidingLobe& b) {
+      return a.share < b.share;
+    });
+  };
+  const GuidingLobe near_focus = largest_lobe(-0.2f);
+  EXPECT_EQ(near_focus.distance, 0.0f);
+  EXPECT_GT(glm::dot(near_focus.direction, glm::vec3(0.0f, 1.0f, 0.0f)), 0.999f);
+  EXPECT_GT(near_focus.kappa, 1000.0f);  // one direction for the whole patch
+  EXPECT_LT(largest_lobe(-5.0f).distance, 0.0f);   // a focus beyond the leaf: still a point
+  EXPECT_GT(largest_lobe(0.2f).distance, 0.0f);    // a near source behind: still a point
+}
+
 TEST(GuidingLobes, FieldWithLobesGuidesEveryPointOfALeafToTheLight) {
   // One leaf (a high split threshold) lit by a small light: the field's lobes aim at the light from
   // every point; its quadtree, learned from the same records, spreads over the directions the light
