@@ -1,8 +1,8 @@
 // The allocation of adaptive sampling (app/adaptive.h) under fake variance images: the need is the
 // final pixel's perceived variance over its own threshold, decided for each pixel by the others in
-// its box; the paths follow its standard deviation (goal Error) or what it lacks of the count its
-// neighbours predict (goal Clean), water-filled to a uniform frame's paths; the floor, the cap, the
-// minimum and the dilation hold.
+// its box; the paths follow its standard deviation, water-filled to a uniform frame's paths (goal
+// Error), or go to the pixels that lack least of the counts their neighbours predict first (goal
+// Clean); the floor, the cap, the minimum and the dilation hold.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -87,14 +87,23 @@ TEST(AdaptiveNeighbourhood, APixelsOwnNeedNeverDecidesItsWeight) {
     std::vector<float> need(w * h, 0.3f);
     need[2 * w + 2] = 6.0f;
     const size_t centre = 3 * w + 3;
-    std::vector<std::vector<float>> weights;
+    std::vector<std::vector<float>> weights, typical;  // goal Clean: the full and the typical lacks
     for (float own : {0.0f, 1.0f, 50.0f, kInf}) {
       need[centre] = own;
-      weights.push_back(goal == AdaptiveGoal::Error
-                            ? allocation_weights(neighbourhood_need(need, w, h, params.dilation_radius), paths, params)
-                            : clean_shortfall(need, paths, w, h, params));
+      if (goal == AdaptiveGoal::Error) {
+        weights.push_back(allocation_weights(neighbourhood_need(need, w, h, params.dilation_radius), paths, params));
+        continue;
+      }
+      std::vector<float> full, typ;
+      for (const CleanLack& lack : clean_lacks(need, paths, w, h, params)) {
+        full.push_back(lack.full);
+        typ.push_back(lack.typical);
+      }
+      weights.push_back(full);
+      typical.push_back(typ);
     }
     for (const auto& wt : weights) EXPECT_EQ(wt[centre], weights[0][centre]);
+    for (const auto& typ : typical) EXPECT_EQ(typ[centre], typical[0][centre]);
     EXPECT_LT(weights[0][5 * w + 5], weights[2][5 * w + 5]);  // a neighbour's weight does follow it
   }
 }
@@ -136,9 +145,9 @@ TEST(AdaptiveRates, ForTheErrorSamplesFollowTheStandardDeviation) {
 }
 
 // Goal Clean: each pixel lacks clean_margin times the largest count x_q = r_q n_q among the others
-// of its box, less its own paths; the pixels short of paths take them in proportion to what they
-// lack, the others sit at the floor.
-TEST(AdaptiveRates, ForCleanEachPixelGetsWhatItLacksOfItsNeighboursCount) {
+// of its box (the full count), and the median of them (the typical count), less its own paths, and
+// at least the minimum.
+TEST(AdaptiveRates, ForCleanEachPixelLacksItsNeighboursCounts) {
   AdaptiveParams params;
   params.goal = AdaptiveGoal::Clean;
   params.dilation_radius = 1;
@@ -146,24 +155,69 @@ TEST(AdaptiveRates, ForCleanEachPixelGetsWhatItLacksOfItsNeighboursCount) {
     // x = r n:                      2000  400   1000  100   100   3000  100   100
   const std::vector<float> need = {2.0f, 0.4f, 1.0f, 0.1f, 0.1f, 3.0f, 0.1f, 0.1f};
   const std::vector<uint32_t> paths(need.size(), 1000);
-  const std::vector<float> shortfall = clean_shortfall(need, paths, w, h, params);
+  const std::vector<CleanLack> lacks = clean_lacks(need, paths, w, h, params);
   const float m = params.clean_margin;
   const std::vector<float> expected = {m * 400 - 1000, m * 2000 - 1000, m * 400 - 1000, m * 1000 - 1000,
                                        m * 3000 - 1000, m * 100 - 1000, m * 3000 - 1000, m * 100 - 1000};
-  for (size_t p = 0; p < need.size(); ++p) EXPECT_FLOAT_EQ(shortfall[p], std::max(0.0f, expected[p])) << p;
-  const std::vector<float> rates = allocation_rates(need, paths, w, h, params);
-  EXPECT_NEAR(sum_of(rates), need.size() * params.frame_paths, 1e-3);
-  EXPECT_NEAR(rates[4] / rates[1], (m * 3000 - 1000) / (m * 2000 - 1000), 1e-4);
-  EXPECT_EQ(rates[6], rates[4]);
-  EXPECT_NEAR(rates[3] / rates[1], (m * 1000 - 1000) / (m * 2000 - 1000), 1e-4);
-  for (size_t p : {0, 2, 5, 7}) EXPECT_EQ(rates[p], params.floor_rate) << p;  // enough paths: the floor
+  // In a row each pixel has one or two others: the median is the upper one, the largest.
+  const std::vector<float> typical = {0, 1000, 0, 0, 2000, 0, 2000, 0};
+  for (size_t p = 0; p < need.size(); ++p) {
+    EXPECT_FLOAT_EQ(lacks[p].full, std::max(0.0f, expected[p])) << p;
+    EXPECT_FLOAT_EQ(lacks[p].typical, typical[p]) << p;
+  }
   // The pixel's own count is what it has: twice the paths, less lacking.
   std::vector<uint32_t> more = paths;
   more[1] = 2000;
-  EXPECT_FLOAT_EQ(clean_shortfall(need, more, w, h, params)[1], m * 2000 - 2000);
+  EXPECT_FLOAT_EQ(clean_lacks(need, more, w, h, params)[1].full, m * 2000 - 2000);
   // Below the minimum a pixel lacks at least the minimum, whatever its neighbours.
   const std::vector<uint32_t> young(need.size(), params.min_samples - 10);
-  EXPECT_FLOAT_EQ(clean_shortfall(std::vector<float>(need.size(), 0.0f), young, w, h, params)[3], 10.0f);
+  const CleanLack young_lack = clean_lacks(std::vector<float>(need.size(), 0.0f), young, w, h, params)[3];
+  EXPECT_FLOAT_EQ(young_lack.full, 10.0f);
+  EXPECT_FLOAT_EQ(young_lack.typical, 10.0f);
+  // In a box of nine, the typical count is the median of the eight others (the upper one).
+  std::vector<float> square(9, 0.0f);
+  for (int q = 0; q < 9; ++q) square[q] = 0.1f * static_cast<float>(q + 1);  // x = 100, 200, ... 900
+  const std::vector<uint32_t> square_paths(9, 1000);
+  EXPECT_FLOAT_EQ(clean_lacks(square, square_paths, 3, 3, params)[4].typical, 0.0f);  // median 600 < 1000
+  EXPECT_FLOAT_EQ(neighbourhood_median(square, 3, 3, 1)[4], 0.6f);
+  EXPECT_FLOAT_EQ(neighbourhood_median(square, 3, 3, 1)[0], 0.4f);  // a corner's others: 0.2, 0.4, 0.5
+}
+
+// Shortest lack first: what the pixels lack of their typical counts, least first, then what they
+// lack of their full counts beyond that, least full lack first, each share taken over the horizon
+// (a pixel at most at the cap), until the budget is spent; the rest at the floor; a budget left
+// after every lack raises the floor.
+TEST(AdaptiveRates, ForCleanTheShortestLacksAreServedFirst) {
+  const float floor_rate = 0.0625f, cap = 32.0f;
+  //                                 typical, full
+  const std::vector<CleanLack> lacks = {{0, 0}, {40, 400}, {0, 100}, {20, 900}, {0, 0}, {0, 50}, {200, 300}, {0, 0}};
+  const double horizon = 10.0;
+  // A budget of 8 paths a frame: the floor takes 0.5, pixel 3 (typical lack 20) 2 more, pixel 1 (40)
+  // 4, and pixel 6 (200: 20 a frame) the last 1.5; the full lacks wait.
+  const std::vector<float> rates = shortest_lack_first(lacks, 8.0, floor_rate, cap, horizon);
+  EXPECT_NEAR(sum_of(rates), 8.0, 1e-5);
+  EXPECT_NEAR(rates[3], floor_rate + 2.0f, 1e-6f);
+  EXPECT_NEAR(rates[1], floor_rate + 4.0f, 1e-6f);
+  EXPECT_NEAR(rates[6], floor_rate + 1.5f, 1e-5f);
+  for (size_t p : {0, 2, 4, 5, 7}) EXPECT_EQ(rates[p], floor_rate) << p;
+  // 50 paths: the typical lacks (26 a frame), then the full ones, least first: pixel 5 (5 a
+  // frame), pixel 2 (10), and what is left (8.5) to pixel 6's last 100.
+  const std::vector<float> more = shortest_lack_first(lacks, 50.0, floor_rate, cap, horizon);
+  EXPECT_NEAR(more[5], floor_rate + 5.0f, 1e-5f);
+  EXPECT_NEAR(more[2], floor_rate + 10.0f, 1e-5f);
+  EXPECT_NEAR(more[6], floor_rate + 20.0f + 8.5f, 1e-4f);
+  EXPECT_NEAR(more[1], floor_rate + 4.0f, 1e-5f);
+  EXPECT_NEAR(more[3], floor_rate + 2.0f, 1e-5f);
+  EXPECT_NEAR(sum_of(more), 50.0, 1e-4);
+  // Past every lack, the rest goes to every pixel alike; the cap holds.
+  const std::vector<float> ample = shortest_lack_first(lacks, 150.0, floor_rate, cap, horizon);
+  EXPECT_NEAR(sum_of(ample), 150.0, 1e-3);
+  EXPECT_EQ(ample[3], cap);  // 900 / 10 = 90 a frame, capped
+  EXPECT_EQ(ample[1], cap);  // 40 a frame, capped
+  EXPECT_NEAR(ample[0], 11.1875f, 1e-4f);  // the floor risen until the rates add up
+  EXPECT_EQ(ample[0], ample[7]);
+  // Nothing lacking: uniform.
+  for (float r : shortest_lack_first(std::vector<CleanLack>(10), 10.0, floor_rate, cap, horizon)) EXPECT_NEAR(r, 1.0f, 1e-5f);
 }
 
 TEST(AdaptiveRates, WaterFillingKeepsTheCapAndTheFloorAndSpendsTheBudget) {
@@ -234,14 +288,19 @@ TEST(AdaptiveRates, APixelBelowTheMinimumIsNotRetired) {
   for (AdaptiveGoal goal : {AdaptiveGoal::Error, AdaptiveGoal::Clean}) {
     AdaptiveParams params;
     params.goal = goal;
-    const std::vector<float> need = {0.0f, 0.0f, 0.0f, 0.0f};
-    const std::vector<uint32_t> paths = {params.min_samples - 1, params.min_samples, params.min_samples,
-                                         params.min_samples};
-    const std::vector<float> weights = goal == AdaptiveGoal::Error ? allocation_weights(need, paths, params)
-                                                                    : clean_shortfall(need, paths, 4, 1, params);
+    const std::vector<float> need(16, 0.0f);
+    std::vector<uint32_t> paths(16, params.min_samples);
+    paths[0] = params.min_samples - 1;
+    std::vector<float> weights = allocation_weights(need, paths, params);
+    if (goal == AdaptiveGoal::Clean) {
+      weights.clear();
+      for (const CleanLack& lack : clean_lacks(need, paths, 4, 4, params)) weights.push_back(lack.full);
+    }
     EXPECT_GT(weights[0], 0.0f);  // counts as at the threshold
     EXPECT_EQ(weights[1], 0.0f);  // at the minimum: may retire
-    const std::vector<float> rates = allocation_rates(need, paths, 4, 1, params);
+    // Unsampled, it takes the frame's paths while the others sit at the floor.
+    paths[0] = 0;
+    const std::vector<float> rates = allocation_rates(need, paths, 4, 4, params);
     EXPECT_GT(rates[0], params.floor_rate);
     EXPECT_EQ(rates[1], params.floor_rate);
   }
@@ -250,8 +309,9 @@ TEST(AdaptiveRates, APixelBelowTheMinimumIsNotRetired) {
 TEST(AdaptiveRates, ACausticKeepsItselfAndItsQuietNeighboursSampled) {
   // The chain from a fake need image to the path counts: a 2x2 caustic (need 40) among clean
   // pixels (0.1) past the minimum. The caustic's pixels keep each other traced, and so is every
-  // pixel within 2 of it, sqrt(400) = 20 times as often as the rest (goal Error), or every clean
-  // pixel is at the floor (goal Clean).
+  // pixel within 2 of it: sqrt(400) = 20 times as often as the rest (goal Error), or, as all of
+  // them lack the same count, they take every path the floor leaves, at the cap in order
+  // (goal Clean).
   const int w = 12, h = 10;
   for (AdaptiveGoal goal : {AdaptiveGoal::Error, AdaptiveGoal::Clean}) {
     AdaptiveParams params;
@@ -263,13 +323,22 @@ TEST(AdaptiveRates, ACausticKeepsItselfAndItsQuietNeighboursSampled) {
     const std::vector<int> traced = traced_over(rates, 32);
     const int near_count = 36, far_count = w * h - near_count;
     const double far_rate = goal == AdaptiveGoal::Error ? w * h / (near_count * 20.0 + far_count) : params.floor_rate;
-    const double near_rate = goal == AdaptiveGoal::Error ? 20.0 * far_rate
-                                                          : (w * h - far_count * params.floor_rate) / near_count;
+    const double near_rate = 20.0 * far_rate;
+    double near_sum = 0;
     for (int y = 0; y < h; ++y)
       for (int x = 0; x < w; ++x) {
         const bool near = x >= 4 && x <= 9 && y >= 3 && y <= 8;
-        EXPECT_NEAR(traced[y * w + x], 32 * (near ? near_rate : far_rate), 1.0) << x << "," << y;
+        if (near) near_sum += rates[y * w + x];
+        if (goal == AdaptiveGoal::Error || !near) {
+          EXPECT_NEAR(traced[y * w + x], 32 * (near ? near_rate : far_rate), 1.0) << x << "," << y;
+        } else {
+          EXPECT_LE(rates[y * w + x], params.max_rate);
+        }
       }
+    EXPECT_NEAR(near_sum, w * h - far_count * far_rate, 1e-3);
+    if (goal == AdaptiveGoal::Clean) {
+      EXPECT_EQ(rates[3 * w + 4], params.max_rate);  // the first near pixel
+    }
   }
 }
 
