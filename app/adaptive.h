@@ -33,8 +33,9 @@
 //     that a pixel beside one hard neighbour is not funded to that neighbour's count before the
 //     others are funded to theirs. Measured against the rule before it, which water-filled the
 //     lacks to N_p (so that every pixel reached its count at once): cornell 128^2, t = 0.01, seed 5,
-//     clean share 0.68 against 0.43 after 112 frames and 99 % after about 7600 frames against 6500;
-//     kitchen clean after 2525 frames against 3156 (seeds 5, 6); docs/sampling.md has the rest.
+//     clean share 0.68 against 0.43 after 112 frames, 99 % after about 7200 frames against 6200;
+//     kitchen clean after the same number of frames at the median of five seeds (3156);
+//     docs/sampling.md has the rest.
 //     Not a rate from r_p alone: a rate in proportion to the
 //     deviation (the rule of goal Error) went on sampling the neighbours of a pixel that one rare
 //     path had made noisy, at 32 paths a frame, long after they were clean, and left that pixel at
