@@ -29,7 +29,12 @@ std::vector<float> final_pixel_need(const Image& lv, const Image& hv, const Imag
   return need;
 }
 
-std::vector<float> neighbourhood_median(const std::vector<float>& values, int width, int height, int radius) {
+namespace {
+
+// For each pixel, `reduce` of the values of the OTHER pixels of the (2 radius + 1)^2 box around it.
+template <typename Reduce>
+std::vector<float> over_the_others(const std::vector<float>& values, int width, int height, int radius,
+                                   Reduce reduce) {
   std::vector<float> out(values.size());
   std::vector<float> others;
   for (int y = 0; y < height; ++y)
@@ -38,28 +43,28 @@ std::vector<float> neighbourhood_median(const std::vector<float>& values, int wi
       for (int qy = std::max(0, y - radius); qy <= std::min(height - 1, y + radius); ++qy)
         for (int qx = std::max(0, x - radius); qx <= std::min(width - 1, x + radius); ++qx)
           if (qx != x || qy != y) others.push_back(values[static_cast<size_t>(qy) * width + qx]);
-      float median = 0.0f;
-      if (!others.empty()) {
-        const auto middle = others.begin() + static_cast<std::ptrdiff_t>(others.size() / 2);
-        std::nth_element(others.begin(), middle, others.end());
-        median = *middle;
-      }
-      out[static_cast<size_t>(y) * width + x] = median;
+      out[static_cast<size_t>(y) * width + x] = reduce(others);
     }
   return out;
 }
 
+}  // namespace
+
+std::vector<float> neighbourhood_median(const std::vector<float>& values, int width, int height, int radius) {
+  return over_the_others(values, width, height, radius, [](std::vector<float>& others) {
+    if (others.empty()) return 0.0f;
+    const auto middle = others.begin() + static_cast<std::ptrdiff_t>(others.size() / 2);
+    std::nth_element(others.begin(), middle, others.end());
+    return *middle;
+  });
+}
+
 std::vector<float> neighbourhood_need(const std::vector<float>& need, int width, int height, int radius) {
-  std::vector<float> out(need.size());
-  for (int y = 0; y < height; ++y)
-    for (int x = 0; x < width; ++x) {
-      float m = 0.0f;
-      for (int qy = std::max(0, y - radius); qy <= std::min(height - 1, y + radius); ++qy)
-        for (int qx = std::max(0, x - radius); qx <= std::min(width - 1, x + radius); ++qx)
-          if (qx != x || qy != y) m = std::max(m, need[static_cast<size_t>(qy) * width + qx]);
-      out[static_cast<size_t>(y) * width + x] = m;
-    }
-  return out;
+  return over_the_others(need, width, height, radius, [](const std::vector<float>& others) {
+    float m = 0.0f;
+    for (float v : others) m = std::max(m, v);
+    return m;
+  });
 }
 
 namespace {

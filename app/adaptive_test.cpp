@@ -342,6 +342,42 @@ TEST(AdaptiveRates, ACausticKeepsItselfAndItsQuietNeighboursSampled) {
   }
 }
 
+// Goal Clean over a whole render: a caustic's pixels and their neighbours all lack the same count,
+// and the queue serves them in turn until each has it. The fake need falls as 1 / n, as a real
+// one does, so the counts the neighbours predict stay put.
+TEST(AdaptiveRates, ForCleanACausticIsServedUntilEachPixelHasItsCount) {
+  const int w = 12, h = 10;
+  AdaptiveParams params;
+  params.goal = AdaptiveGoal::Clean;
+  std::vector<float> per_path(w * h, 0.1f * 500);  // r n: the count each pixel needs
+  for (int y = 5; y <= 6; ++y)
+    for (int x = 6; x <= 7; ++x) per_path[y * w + x] = 40.0f * 500;
+  std::vector<uint32_t> paths(w * h, 500);
+  std::vector<float> credit;
+  GrowingSchedule replans(500, params.replan_divisor);
+  std::vector<float> rates;
+  for (int frame = 500; frame < 20000; ++frame) {
+    if (rates.empty() || replans.due(frame)) {
+      std::vector<float> need(w * h);
+      for (size_t p = 0; p < need.size(); ++p) need[p] = per_path[p] / static_cast<float>(paths[p]);
+      rates = allocation_rates(need, paths, w, h, params);
+      replans.done(frame);
+    }
+    const std::vector<uint8_t> counts = select_active(rates, credit);
+    for (size_t p = 0; p < paths.size(); ++p) paths[p] += counts[p];
+  }
+  const float full = params.clean_margin * 40.0f * 500;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const bool near = x >= 4 && x <= 9 && y >= 3 && y <= 8;
+      if (near) {
+        EXPECT_GE(paths[y * w + x], full) << x << "," << y;
+      } else {
+        EXPECT_LT(paths[y * w + x], 0.5f * full) << x << "," << y;
+      }
+    }
+}
+
 TEST(AdaptiveCounts, MeanMinAndMax) {
   const SampleCounts c = sample_counts({4, 8, 16, 4});
   EXPECT_DOUBLE_EQ(c.mean, 8.0);
