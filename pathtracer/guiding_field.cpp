@@ -32,7 +32,7 @@ constexpr int kMaxSpatialDepth = 60;  // 20 halvings per axis: cells of a millio
 constexpr double kBelowOne = 0x1.fffffffffffffp-1;
 constexpr float kBelowOneF = 0x1.fffffep-1f;
 constexpr char kMagic[8] = {'P', 'X', 'F', 'G', 'U', 'I', 'D', 'E'};
-constexpr uint32_t kFormatVersion = 2;
+constexpr uint32_t kFormatVersion = 3;
 constexpr int kMaxIterations = 1 << 20;
 
 static_assert(sizeof(GuidingSamplingNode) == 24 && sizeof(GuidingBuildingNode) == 40, "the paper's compact nodes");
@@ -210,9 +210,13 @@ std::vector<GuidingBuildingNode> refined_tree(const std::vector<GuidingBuildingN
 
 // What a leaf's lobes and reservoir may take, counted whether they hold it yet or not (the lobes
 // are refitted and the reservoir fills every iteration).
+size_t delta_records_capacity(const GuidingSettings& settings) {
+  return settings.delta_lobes > 0 ? std::max<size_t>(settings.lobe_records / 2, kMinDeltaLobeRecords) : 0;
+}
+
 size_t lobe_reserve_bytes(const GuidingSettings& settings) {
   return settings.parallax_lobes > 0 ? settings.parallax_lobes * sizeof(GuidingLobe) +
-                                           settings.lobe_records * sizeof(GuidingLobeRecord)
+                                           (settings.lobe_records + delta_records_capacity(settings)) * sizeof(GuidingLobeRecord)
                                      : 0;
 }
 
@@ -236,7 +240,7 @@ bool record_before(const GuidingRecord& a, const GuidingRecord& b) {
     return std::make_tuple(r.leaf, r.key, float_bits(r.u), float_bits(r.v), float_bits(r.energy), float_bits(r.position.x),
                            float_bits(r.position.y), float_bits(r.position.z), float_bits(r.source.x),
                            float_bits(r.source.y), float_bits(r.source.z), r.kind, float_bits(r.normal.x), float_bits(r.normal.y),
-                           float_bits(r.normal.z));
+                           float_bits(r.normal.z), r.through_delta);
   };
   return bits(a) < bits(b);
 }
@@ -330,6 +334,31 @@ void get_arrival(ByteReader& r, const char* what, Record* rec) {
   if (rec->kind > kSourceAhead) throw Error(std::string("guiding field has an invalid source kind in its ") + what);
 }
 
+// A reservoir in key order: the bytes do not depend on arrival.
+void put_reservoir(ByteWriter& w, const std::vector<GuidingLobeRecord>& unordered) {
+  std::vector<GuidingLobeRecord> reservoir = unordered;
+  std::sort(reservoir.begin(), reservoir.end(), [](const auto& a, const auto& b) { return a.key < b.key; });
+  w.put(static_cast<uint64_t>(reservoir.size()));
+  for (const GuidingLobeRecord& rec : reservoir) {
+    w.put(rec.key);
+    w.put(rec.priority);
+    put_arrival(w, rec);
+  }
+}
+
+std::vector<GuidingLobeRecord> get_reservoir(ByteReader& r, size_t capacity) {
+  const size_t records = r.get_count(52, "lobe records");  // the bytes put_reservoir writes per record
+  if (records > capacity) throw Error("guiding field has more lobe records than its settings allow");
+  std::vector<GuidingLobeRecord> reservoir(records);
+  for (GuidingLobeRecord& rec : reservoir) {
+    rec.key = r.get<uint64_t>("lobe records");
+    rec.priority = r.get<float>("lobe records");
+    get_arrival(r, "lobe records", &rec);
+    if (!(rec.priority <= 0.0f)) throw Error("guiding field has an invalid lobe record");
+  }
+  return reservoir;
+}
+
 void put_lobes(ByteWriter& w, const GuidingLeaf& leaf) {
   w.put(static_cast<uint64_t>(leaf.lobes.size()));
   for (const GuidingLobe& lobe : leaf.lobes) {
@@ -340,20 +369,17 @@ void put_lobes(ByteWriter& w, const GuidingLeaf& leaf) {
     w.put(lobe.share);
   }
   w.put(leaf.alpha);
-  std::vector<GuidingLobeRecord> reservoir = leaf.reservoir;  // in key order: the bytes do not depend on arrival
-  std::sort(reservoir.begin(), reservoir.end(), [](const auto& a, const auto& b) { return a.key < b.key; });
-  w.put(static_cast<uint64_t>(reservoir.size()));
-  for (const GuidingLobeRecord& rec : reservoir) {
-    w.put(rec.key);
-    w.put(rec.priority);
-    put_arrival(w, rec);
-  }
+  put_reservoir(w, leaf.reservoir);
+  put_reservoir(w, leaf.delta_reservoir);
+  w.put(leaf.energy);
+  w.put(leaf.delta_energy);
 }
 
 void get_lobes(ByteReader& r, const GuidingSettings& settings, GuidingLeaf* leaf) {
   const size_t count = r.get_count(sizeof(GuidingLobe), "lobes");
   if (count > size_t(settings.parallax_lobes)) throw Error("guiding field has more lobes than its settings allow");
   leaf->lobes.resize(count);
+  float total_share = 0.0f;
   for (GuidingLobe& lobe : leaf->lobes) {
     lobe.direction = get_vec3(r, "lobes");
     lobe.source = get_vec3(r, "lobes");
@@ -363,19 +389,18 @@ void get_lobes(ByteReader& r, const GuidingSettings& settings, GuidingLeaf* leaf
     if (std::abs(glm::length(lobe.direction) - 1.0f) > 1e-3f || !std::isfinite(lobe.distance) ||
         !(lobe.kappa > 0.0f && lobe.kappa <= kMaxLobeKappa) || !(lobe.share >= 0.0f && lobe.share <= 1.0f))
       throw Error("guiding field has an invalid lobe");
+    total_share += lobe.share;
   }
+  if (!(total_share <= 1.001f)) throw Error("guiding field has lobes whose shares add up to more than 1");
   leaf->alpha = r.get<float>("lobes");
   if (!(leaf->alpha >= 0.0f && leaf->alpha <= 1.0f)) throw Error("guiding field has an invalid guided share");
-  const size_t records = r.get_count(52, "lobe records");  // the bytes put_lobes writes per record
-  if (records > (settings.parallax_lobes > 0 ? settings.lobe_records : 0))
-    throw Error("guiding field has more lobe records than its settings allow");
-  leaf->reservoir.resize(records);
-  for (GuidingLobeRecord& rec : leaf->reservoir) {
-    rec.key = r.get<uint64_t>("lobe records");
-    rec.priority = r.get<float>("lobe records");
-    get_arrival(r, "lobe records", &rec);
-    if (!(rec.priority <= 0.0f)) throw Error("guiding field has an invalid lobe record");
-  }
+  leaf->reservoir = get_reservoir(r, settings.parallax_lobes > 0 ? settings.lobe_records : 0);
+  leaf->delta_reservoir = get_reservoir(r, settings.parallax_lobes > 0 ? delta_records_capacity(settings) : 0);
+  leaf->energy = r.get<double>("lobes");
+  leaf->delta_energy = r.get<double>("lobes");
+  if (!non_negative_finite(leaf->energy) || !non_negative_finite(leaf->delta_energy) ||
+      leaf->delta_energy > leaf->energy)
+    throw Error("guiding field has an invalid leaf energy");
 }
 
 }  // namespace
@@ -416,6 +441,8 @@ void GuidingField::validate_settings() const {
     throw Error("guiding field energy threshold must be in (0, 1]");
   if (s.max_directional_depth < 1 || s.max_directional_depth > kMaxDirectionalDepth)
     throw Error("guiding field directional depth must be in 1.." + std::to_string(kMaxDirectionalDepth));
+  if (s.delta_lobes < 0 || (s.parallax_lobes > 0 ? s.delta_lobes >= s.parallax_lobes : s.delta_lobes != 0))
+    throw Error("guiding field delta lobes must be below its parallax lobes (0 without lobes)");
   if (s.max_bytes < kMinBytes + lobe_reserve_bytes(s))
     throw Error("guiding field memory bound " + std::to_string(s.max_bytes) + " is below the minimum " +
                 std::to_string(kMinBytes + lobe_reserve_bytes(s)));
@@ -456,7 +483,7 @@ GuidingField::Box GuidingField::leaf_box(const glm::vec3& position) const {
 }
 
 void GuidingField::record(uint64_t key, const glm::vec3& position, const glm::vec3& direction, float radiance,
-                          float weight, float distance, const glm::vec3& normal) {
+                          float weight, float distance, const glm::vec3& normal, bool through_delta) {
   if (!(radiance >= 0.0f) || !(weight >= 0.0f) || !std::isfinite(radiance) || !std::isfinite(weight)) return;
   if (!std::isfinite(position.x) || !std::isfinite(position.y) || !std::isfinite(position.z)) return;
   glm::dvec2 uv;
@@ -477,7 +504,8 @@ void GuidingField::record(uint64_t key, const glm::vec3& position, const glm::ve
   const uint32_t kind = at_infinity ? kSourceAtInfinity : distance > 0.0f ? kSourceBehind : kSourceAhead;
   const float normal_length = glm::length(normal);
   const glm::vec3 unit_normal = normal_length > 0.0f && std::isfinite(normal_length) ? normal / normal_length : glm::vec3(0.0f);
-  buffers_->per_thread.local().push_back({key, leaf, u, v, energy, position, source, kind, unit_normal});
+  buffers_->per_thread.local().push_back(
+      {key, leaf, u, v, energy, position, source, kind, unit_normal, through_delta && settings_.delta_lobes > 0 ? 1u : 0u});
 }
 
 size_t GuidingField::pending_records() const {
@@ -511,16 +539,53 @@ void GuidingField::apply_records() {
     leaf.records += starts[group + 1] - starts[group];
     for (size_t i = starts[group]; i < starts[group + 1]; ++i) add_energy(leaf.building, pending_[i]);
     if (settings_.parallax_lobes > 0) {
-      std::vector<GuidingLobeRecord> incoming;
+      std::vector<GuidingLobeRecord> incoming, incoming_delta;
       for (size_t i = starts[group]; i < starts[group + 1]; ++i) {
         const GuidingRecord& r = pending_[i];
-        if (r.energy > 0.0f)
-          incoming.push_back({r.key, lobe_record_priority(r.key, r.energy), r.position, r.source, r.kind, r.normal});
+        if (!(r.energy > 0.0f)) continue;
+        (r.through_delta ? incoming_delta : incoming)
+            .push_back({r.key, lobe_record_priority(r.key, r.energy), r.position, r.source, r.kind, r.normal});
+        leaf.energy += r.energy;
+        if (r.through_delta) leaf.delta_energy += r.energy;
       }
       merge_into_reservoir(leaf.reservoir, incoming, settings_.lobe_records);
+      if (!incoming_delta.empty()) merge_into_reservoir(leaf.delta_reservoir, incoming_delta, delta_records_capacity(settings_));
     }
   });
   std::vector<GuidingRecord>().swap(pending_);
+}
+
+// The lobes of the next iteration from this one's reservoirs, and the guided share the lobes of this
+// one earn on records they were not fitted to.
+void GuidingField::end_lobe_iteration(GuidingLeaf& leaf) const {
+  if (settings_.delta_lobes == 0) {
+    if (!leaf.lobes.empty())
+      leaf.alpha = best_guided_share(leaf.lobes, leaf.reservoir, settings_.uniform_fraction, settings_.min_lobe_kappa, leaf.alpha);
+    std::vector<GuidingLobe> lobes = fit_guiding_lobes(leaf.reservoir, settings_.parallax_lobes);
+    if (!lobes.empty()) leaf.lobes = std::move(lobes);  // too few records: the leaf keeps what it knew
+  } else {
+    // Each reservoir is an energy-weighted sample of its own kind of light: a record stands for its
+    // kind's energy over its reservoir's size.
+    const double delta_share = leaf.energy > 0.0 ? leaf.delta_energy / leaf.energy : 0.0;
+    std::vector<GuidingLobeRecord> records = leaf.reservoir;
+    records.insert(records.end(), leaf.delta_reservoir.begin(), leaf.delta_reservoir.end());
+    std::vector<double> weights(records.size());
+    for (size_t r = 0; r < records.size(); ++r)
+      weights[r] = r < leaf.reservoir.size() ? (1.0 - delta_share) / double(leaf.reservoir.size())
+                                             : delta_share / double(leaf.delta_reservoir.size());
+    if (!leaf.lobes.empty())
+      leaf.alpha = best_guided_share(leaf.lobes, records, settings_.uniform_fraction, settings_.min_lobe_kappa,
+                                     leaf.alpha, weights);
+    std::vector<GuidingLobe> lobes = fit_guiding_lobes(leaf.reservoir, settings_.parallax_lobes - settings_.delta_lobes);
+    std::vector<GuidingLobe> delta = fit_guiding_lobes(leaf.delta_reservoir, settings_.delta_lobes, kMinDeltaLobeRecords);
+    for (GuidingLobe& lobe : lobes) lobe.share *= static_cast<float>(1.0 - delta_share);
+    for (GuidingLobe& lobe : delta) lobe.share *= static_cast<float>(delta_share);
+    lobes.insert(lobes.end(), delta.begin(), delta.end());
+    if (!lobes.empty()) leaf.lobes = std::move(lobes);  // too few records: the leaf keeps what it knew
+  }
+  leaf.reservoir.clear();
+  leaf.delta_reservoir.clear();
+  leaf.energy = leaf.delta_energy = 0.0;
 }
 
 void GuidingField::end_iteration() {
@@ -531,14 +596,7 @@ void GuidingField::end_iteration() {
     if (total > 0.0) leaf.sampling = sampling_tree(leaf.building, total);
   }
   if (settings_.parallax_lobes > 0) {
-    tbb::parallel_for(size_t(0), leaves_.size(), [&](size_t i) {
-      GuidingLeaf& leaf = leaves_[i];
-      if (!leaf.lobes.empty())  // judged on records the lobes were not fitted to
-        leaf.alpha = best_guided_share(leaf.lobes, leaf.reservoir, settings_.uniform_fraction, settings_.min_lobe_kappa, leaf.alpha);
-      std::vector<GuidingLobe> lobes = fit_guiding_lobes(leaf.reservoir, settings_.parallax_lobes);
-      if (!lobes.empty()) leaf.lobes = std::move(lobes);  // too few records: the leaf keeps what it knew
-      leaf.reservoir.clear();
-    });
+    tbb::parallel_for(size_t(0), leaves_.size(), [&](size_t i) { end_lobe_iteration(leaves_[i]); });
   }
   refine_directions();
   split_leaves(double(settings_.spatial_threshold) * std::pow(2.0, 0.5 * iteration_));
@@ -682,6 +740,7 @@ std::vector<uint8_t> GuidingField::serialize() const {
   w.put(static_cast<int32_t>(settings_.parallax_lobes));
   w.put(settings_.lobe_records);
   w.put(settings_.min_lobe_kappa);
+  w.put(static_cast<int32_t>(settings_.delta_lobes));
   for (int a = 0; a < 3; ++a) w.put(box_lo_[a]);
   for (int a = 0; a < 3; ++a) w.put(box_hi_[a]);
   w.put(static_cast<int32_t>(iteration_));
@@ -706,6 +765,7 @@ std::vector<uint8_t> GuidingField::serialize() const {
     w.put(r.v);
     w.put(r.energy);
     put_arrival(w, r);
+    w.put(r.through_delta);
   }
   w.put(fnv1a64(w.bytes.data(), w.bytes.size()));
   return std::move(w.bytes);
@@ -734,6 +794,7 @@ GuidingField GuidingField::deserialize(const uint8_t* data, size_t size) {
   f.settings_.parallax_lobes = r.get<int32_t>("settings");
   f.settings_.lobe_records = r.get<uint32_t>("settings");
   f.settings_.min_lobe_kappa = r.get<float>("settings");
+  f.settings_.delta_lobes = r.get<int32_t>("settings");
   f.validate_settings();
   for (int a = 0; a < 3; ++a) f.box_lo_[a] = r.get<float>("box");
   for (int a = 0; a < 3; ++a) f.box_hi_[a] = r.get<float>("box");
@@ -781,7 +842,7 @@ GuidingField GuidingField::deserialize(const uint8_t* data, size_t size) {
     leaf.building = get_tree<GuidingBuildingNode>(r, f.settings_.max_directional_depth, "building");
     get_lobes(r, f.settings_, &leaf);
   }
-  f.pending_.resize(r.get_count(64, "records"));  // the bytes serialize() writes per record
+  f.pending_.resize(r.get_count(68, "records"));  // the bytes serialize() writes per record
   for (GuidingRecord& rec : f.pending_) {
     rec.key = r.get<uint64_t>("records");
     rec.leaf = r.get<uint32_t>("records");
@@ -789,6 +850,8 @@ GuidingField GuidingField::deserialize(const uint8_t* data, size_t size) {
     rec.v = r.get<float>("records");
     rec.energy = r.get<float>("records");
     get_arrival(r, "records", &rec);
+    rec.through_delta = r.get<uint32_t>("records");
+    if (rec.through_delta > (f.settings_.delta_lobes > 0 ? 1u : 0u)) throw Error("guiding field has an invalid record");
     if (rec.leaf >= leaf_count || !(rec.u >= 0.0f && rec.u < 1.0f) || !(rec.v >= 0.0f && rec.v < 1.0f) ||
         !non_negative_finite(rec.energy))
       throw Error("guiding field has an invalid record");

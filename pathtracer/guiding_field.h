@@ -69,6 +69,12 @@ struct GuidingSettings {
   // serves such light about as well, so the guided samples go to concentrated light only, and the
   // renderer scales its guided share by the lobes' share that is left (Distribution::share()).
   float min_lobe_kappa = 10.0f;
+  // Of the parallax_lobes, how many are fitted to the records whose light came through delta
+  // bounces (a mirror's or a lens's caustic), kept in a reservoir of their own of lobe_records / 2:
+  // in one reservoir they are outweighed by the leaf's other light, and the leaf fits no lobe to
+  // them (docs/guiding.md). Each part's lobes are weighted by its share of the leaf's energy. 0:
+  // one reservoir for all. Below parallax_lobes.
+  int delta_lobes = 0;
 };
 
 // The parts of a GuidingField (its internals, shown for the serialized format and for tests).
@@ -92,6 +98,10 @@ struct GuidingLeaf {
   // Parallax lobes (settings.parallax_lobes > 0): the sampling lobes and this iteration's reservoir.
   std::vector<GuidingLobe> lobes;
   std::vector<GuidingLobeRecord> reservoir;
+  // With delta_lobes: this iteration's records whose light came through delta bounces (the
+  // reservoir then holds the others), and the energy of each kind that arrived.
+  std::vector<GuidingLobeRecord> delta_reservoir;
+  double energy = 0.0, delta_energy = 0.0;
   // The guided share of the leaf's vertices: Müller et al.'s fixed 0.5 until the lobes have been
   // judged, then what best_guided_share() finds for the lobes of the last iteration on the records
   // of this one (records they were not fitted to).
@@ -110,6 +120,7 @@ struct GuidingRecord {
   glm::vec3 source;  // where the light seems to come from (see kind)
   uint32_t kind;     // GuidingSourceKind
   glm::vec3 normal;  // of the receiving surface, toward the light's side (0: unknown)
+  uint32_t through_delta;  // 1: the light came through delta bounces (GuidingSettings::delta_lobes)
 };
 
 class GuidingField {
@@ -142,9 +153,10 @@ class GuidingField {
   // `distance`: how far along `direction` the light seems to come from (the previous vertex, or its
   // image through delta bounces), for the parallax lobes; negative: from a focus that far the
   // other way; 0 or not finite: unknown or at infinity. `normal`: of the receiving surface (either
-  // side; 0: unknown), for the lobes' guided share.
+  // side; 0: unknown), for the lobes' guided share. `through_delta`: the light came through delta
+  // bounces since its last non-delta vertex (GuidingSettings::delta_lobes).
   void record(uint64_t key, const glm::vec3& position, const glm::vec3& direction, float radiance, float weight,
-              float distance = 0.0f, const glm::vec3& normal = glm::vec3(0.0f));
+              float distance = 0.0f, const glm::vec3& normal = glm::vec3(0.0f), bool through_delta = false);
   // Adds the buffered records to the building trees (see the determinism note above).
   void apply_records();
   // Ends the iteration (iteration() counts the ended ones): see the notes above.
@@ -199,7 +211,7 @@ class GuidingField {
   float pdf(const glm::vec3& position, const glm::vec3& direction) const { return distribution(position).pdf(direction); }
 
   // --- Inspection.
-  static constexpr uint64_t kMinBytes = 184;  // one leaf with one node per tree
+  static constexpr uint64_t kMinBytes = 224;  // one leaf with one node per tree
   size_t memory_bytes() const;
   Stats stats() const;
   Box bounds() const { return {box_lo_, box_hi_}; }
@@ -221,6 +233,7 @@ class GuidingField {
   void validate_settings() const;
   uint32_t find_leaf(const glm::vec3& position, Box* leaf_box = nullptr) const;
   std::vector<GuidingRecord> sorted_pending() const;
+  void end_lobe_iteration(GuidingLeaf& leaf) const;
   void refine_directions();
   void split_leaves(double threshold);
   size_t planned_bytes() const;

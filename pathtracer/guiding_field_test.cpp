@@ -420,6 +420,15 @@ TEST(GuidingField, RejectsBadSettings) {
   bad = s;
   bad.spatial_threshold = kNaN;
   EXPECT_THROW(make(bad), std::runtime_error);
+  bad = s;
+  bad.delta_lobes = 1;  // delta lobes without lobes
+  EXPECT_THROW(make(bad), std::runtime_error);
+  bad.parallax_lobes = 4;
+  EXPECT_NO_THROW(make(bad));
+  bad.delta_lobes = 4;  // none left for the other light
+  EXPECT_THROW(make(bad), std::runtime_error);
+  bad.delta_lobes = -1;
+  EXPECT_THROW(make(bad), std::runtime_error);
 }
 
 TEST(GuidingField, IterationsDoubleInLength) {

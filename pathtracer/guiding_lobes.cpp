@@ -92,18 +92,20 @@ glm::vec3 record_direction(const GuidingLobeRecord& r) {
 }
 
 float best_guided_share(const std::vector<GuidingLobe>& lobes, const std::vector<GuidingLobeRecord>& records,
-                        float uniform_fraction, float min_kappa, float fallback) {
+                        float uniform_fraction, float min_kappa, float fallback, const std::vector<double>& weights) {
   constexpr int kSteps = 10;  // alpha = 0, 0.1, ..., 0.9: the BSDF keeps at least a tenth
   struct Densities {
-    double guide, cosine, share;
+    double guide, cosine, share, weight;
   };
   std::vector<Densities> at;
-  for (const GuidingLobeRecord& r : records) {
+  for (size_t i = 0; i < records.size(); ++i) {
+    const GuidingLobeRecord& r = records[i];
     const glm::vec3 d = record_direction(r);
     const float cosine = glm::dot(d, r.normal);
     if (!(cosine > 0.0f)) continue;  // no normal, or light from behind: not a sample of L_i cos
     const LobeMixture mixture(lobes, r.position, uniform_fraction, r.normal, min_kappa);
-    at.push_back({mixture.empty() ? 0.0 : double(mixture.pdf(d)), cosine / 3.14159265358979323846, mixture.share()});
+    at.push_back({mixture.empty() ? 0.0 : double(mixture.pdf(d)), cosine / 3.14159265358979323846, mixture.share(),
+                  weights.empty() ? 1.0 : weights[i]});
   }
   if (at.size() < kMinLobeRecords) return fallback;
   int best = 0;
@@ -111,7 +113,8 @@ float best_guided_share(const std::vector<GuidingLobe>& lobes, const std::vector
   for (int step = 0; step < kSteps; ++step) {
     const double alpha = step / double(kSteps);
     double divergence = 0.0;  // minus the sum of log p_mixture
-    for (const Densities& x : at) divergence -= std::log(alpha * x.share * x.guide + (1.0 - alpha * x.share) * x.cosine);
+    for (const Densities& x : at)
+      divergence -= x.weight * std::log(alpha * x.share * x.guide + (1.0 - alpha * x.share) * x.cosine);
     if (step == 0 || divergence < best_divergence) {
       best = step;
       best_divergence = divergence;
@@ -135,8 +138,10 @@ void merge_into_reservoir(std::vector<GuidingLobeRecord>& reservoir, const std::
   reservoir.assign(all.begin(), all.begin() + std::min(capacity, all.size()));
 }
 
-std::vector<GuidingLobe> fit_guiding_lobes(const std::vector<GuidingLobeRecord>& unordered, int max_lobes) {
-  if (unordered.size() < kMinLobeRecords || max_lobes < 1) return {};
+std::vector<GuidingLobe> fit_guiding_lobes(const std::vector<GuidingLobeRecord>& unordered, int max_lobes,
+                                           size_t min_records) {
+  min_records = std::max<size_t>(min_records, 1);
+  if (unordered.size() < min_records || max_lobes < 1) return {};
   std::vector<GuidingLobeRecord> records = unordered;  // in key order: the fit does not depend on arrival
   std::sort(records.begin(), records.end(), [](const auto& a, const auto& b) { return a.key < b.key; });
   const size_t n = records.size();
@@ -159,7 +164,7 @@ std::vector<GuidingLobe> fit_guiding_lobes(const std::vector<GuidingLobeRecord>&
   }
 
   // Weighted EM of a vMF mixture (every kept record weighs the same: the reservoir sampled by energy).
-  std::vector<glm::dvec3> mean = seed_means(v, std::min<int>(max_lobes, std::max<int>(1, int(n / kMinLobeRecords))));
+  std::vector<glm::dvec3> mean = seed_means(v, std::min<int>(max_lobes, std::max<int>(1, int(n / min_records))));
   const size_t k = mean.size();
   std::vector<double> kappa(k, 10.0), share(k, 1.0 / double(k));
   std::vector<double> resp(n * k);

@@ -30,7 +30,7 @@ struct GuidingLobe {
   // converges toward source (a focus ahead), so it arrives from the side opposite to it.
   float distance = 0.0f;
   float kappa = 1.0f;      // vMF concentration seen from the region's mean position, in (0, kMaxLobeKappa]
-  float share = 0.0f;      // of the lobes' energy; the lobes of a region add up to 1
+  float share = 0.0f;      // of the region's energy; the lobes of a region add up to at most 1
 };
 
 // Where a record's light seems to come from (GuidingRecord::source).
@@ -63,19 +63,26 @@ float lobe_record_priority(uint64_t key, float energy);
 void merge_into_reservoir(std::vector<GuidingLobeRecord>& reservoir, const std::vector<GuidingLobeRecord>& incoming,
                           size_t capacity);
 
-// The lobes that fit a reservoir (at most max_lobes; none when it holds fewer than kMinLobeRecords),
-// their directions and distances seen from the records' mean position.
+// The lobes that fit a reservoir (at most max_lobes, one per min_records records; none when it holds
+// fewer than min_records), their directions and distances seen from the records' mean position.
 constexpr size_t kMinLobeRecords = 16;
-std::vector<GuidingLobe> fit_guiding_lobes(const std::vector<GuidingLobeRecord>& records, int max_lobes);
+// The light that arrives through delta bounces (a mirror's or a lens's caustic) is fitted from as
+// few as this many records: it is concentrated, so few records place its lobe, and a leaf meets
+// few such photons (GuidingSettings::delta_lobes).
+constexpr size_t kMinDeltaLobeRecords = 4;
+std::vector<GuidingLobe> fit_guiding_lobes(const std::vector<GuidingLobeRecord>& records, int max_lobes,
+                                           size_t min_records = kMinLobeRecords);
 
 // The guided share alpha (of 0, 0.1, ..., 0.9) whose mixture alpha s p_lobes + (1 - alpha s) p_cos
 // is closest to the light the records show, with p_lobes the LobeMixture at each record's point and
 // normal, s its share() and p_cos = cos / pi: the records are distributed like that light (L_i cos),
 // so the mean of log p_mixture over them is, up to a constant, minus the KL divergence from it
 // (Müller et al. 2019 learn their selection probability by the same divergence). `fallback` where
-// fewer than kMinLobeRecords records have a normal.
+// fewer than kMinLobeRecords records have a normal. `weights` (empty: all 1) weigh the records where
+// they are not one sample of that light alike (two reservoirs, each sampled by energy within itself).
 float best_guided_share(const std::vector<GuidingLobe>& lobes, const std::vector<GuidingLobeRecord>& records,
-                        float uniform_fraction, float min_kappa, float fallback);
+                        float uniform_fraction, float min_kappa, float fallback,
+                        const std::vector<double>& weights = {});
 
 // The vMF density on the unit sphere, stable for large kappa.
 double vmf_pdf(const glm::dvec3& mean, double kappa, const glm::dvec3& direction);

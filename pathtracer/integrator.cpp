@@ -516,7 +516,8 @@ void PathTracer::trace_guiding_photon(uint32_t frame, uint32_t index, const Trac
         distance = closest_approach(sp.position, -ray.direction, companion_sp.position, -companion_ray.direction);
       }
       const glm::vec3 n = glm::dot(sp.geometric_normal, ray.direction) < 0.0f ? sp.geometric_normal : -sp.geometric_normal;
-      guiding_->record(key + static_cast<uint64_t>(surface), sp.position, -ray.direction, luminance(flux), 1.0f, distance, n);
+      guiding_->record(key + static_cast<uint64_t>(surface), sp.position, -ray.direction, luminance(flux), 1.0f, distance, n,
+                       chain_has_delta);
     }
     BsdfSample bs;
     const float u_lobe = rng.next_float();
