@@ -576,9 +576,8 @@ void GuidingField::end_lobe_iteration(GuidingLeaf& leaf) const {
     if (!leaf.lobes.empty())
       leaf.alpha = best_guided_share(leaf.lobes, records, settings_.uniform_fraction, settings_.min_lobe_kappa,
                                      leaf.alpha, weights);
-    // The other light takes the lobes the delta light does not: all of them in a leaf without it.
+    std::vector<GuidingLobe> lobes = fit_guiding_lobes(leaf.reservoir, settings_.parallax_lobes - settings_.delta_lobes);
     std::vector<GuidingLobe> delta = fit_guiding_lobes(leaf.delta_reservoir, settings_.delta_lobes, kMinDeltaLobeRecords);
-    std::vector<GuidingLobe> lobes = fit_guiding_lobes(leaf.reservoir, settings_.parallax_lobes - int(delta.size()));
     for (GuidingLobe& lobe : lobes) lobe.share *= static_cast<float>(1.0 - delta_share);
     for (GuidingLobe& lobe : delta) lobe.share *= static_cast<float>(delta_share);
     lobes.insert(lobes.end(), delta.begin(), delta.end());

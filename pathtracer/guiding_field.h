@@ -69,12 +69,11 @@ struct GuidingSettings {
   // serves such light about as well, so the guided samples go to concentrated light only, and the
   // renderer scales its guided share by the lobes' share that is left (Distribution::share()).
   float min_lobe_kappa = 10.0f;
-  // Of the parallax_lobes, at most how many are fitted to the records whose light came through
-  // delta bounces (a mirror's or a lens's caustic), kept in a reservoir of their own of
-  // lobe_records / 2: in one reservoir they are outweighed by the leaf's other light, and the leaf
-  // fits no lobe to them (docs/guiding.md). The other light takes the lobes they leave. Each part's
-  // lobes are weighted by its share of the leaf's energy. 0: one reservoir for all. Below
-  // parallax_lobes.
+  // Of the parallax_lobes, how many are fitted to the records whose light came through delta
+  // bounces (a mirror's or a lens's caustic), kept in a reservoir of their own of lobe_records / 2:
+  // in one reservoir they are outweighed by the leaf's other light, and the leaf fits no lobe to
+  // them (docs/guiding.md). Each part's lobes are weighted by its share of the leaf's energy. 0:
+  // one reservoir for all. Below parallax_lobes.
   int delta_lobes = 0;
 };
 
