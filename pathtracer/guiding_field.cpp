@@ -208,12 +208,13 @@ std::vector<GuidingBuildingNode> refined_tree(const std::vector<GuidingBuildingN
   return tree;
 }
 
-// What a leaf's lobes and reservoir may take, counted whether they hold it yet or not (the lobes
-// are refitted and the reservoir fills every iteration).
+// The capacity of a leaf's reservoir of records whose light came through delta bounces.
 size_t delta_records_capacity(const GuidingSettings& settings) {
   return settings.delta_lobes > 0 ? std::max<size_t>(settings.lobe_records / 2, kMinDeltaLobeRecords) : 0;
 }
 
+// What a leaf's lobes and reservoirs may take, counted whether they hold it yet or not (the lobes
+// are refitted and the reservoirs fill every iteration).
 size_t lobe_reserve_bytes(const GuidingSettings& settings) {
   return settings.parallax_lobes > 0 ? settings.parallax_lobes * sizeof(GuidingLobe) +
                                            (settings.lobe_records + delta_records_capacity(settings)) * sizeof(GuidingLobeRecord)
@@ -558,31 +559,26 @@ void GuidingField::apply_records() {
 // The lobes of the next iteration from this one's reservoirs, and the guided share the lobes of this
 // one earn on records they were not fitted to.
 void GuidingField::end_lobe_iteration(GuidingLeaf& leaf) const {
-  if (settings_.delta_lobes == 0) {
-    if (!leaf.lobes.empty())
-      leaf.alpha = best_guided_share(leaf.lobes, leaf.reservoir, settings_.uniform_fraction, settings_.min_lobe_kappa, leaf.alpha);
-    std::vector<GuidingLobe> lobes = fit_guiding_lobes(leaf.reservoir, settings_.parallax_lobes);
-    if (!lobes.empty()) leaf.lobes = std::move(lobes);  // too few records: the leaf keeps what it knew
-  } else {
-    // Each reservoir is an energy-weighted sample of its own kind of light: a record stands for its
-    // kind's energy over its reservoir's size.
-    const double delta_share = leaf.energy > 0.0 ? leaf.delta_energy / leaf.energy : 0.0;
-    std::vector<GuidingLobeRecord> records = leaf.reservoir;
+  // Each reservoir is an energy-weighted sample of its own kind of light, so a record stands for its
+  // kind's energy over its reservoir's size. Without delta records (or delta_lobes = 0) the one
+  // reservoir's records weigh alike and its lobes take every share.
+  const double delta_share = leaf.energy > 0.0 ? leaf.delta_energy / leaf.energy : 0.0;
+  std::vector<GuidingLobeRecord> records = leaf.reservoir;
+  std::vector<double> weights;
+  if (!leaf.delta_reservoir.empty()) {
     records.insert(records.end(), leaf.delta_reservoir.begin(), leaf.delta_reservoir.end());
-    std::vector<double> weights(records.size());
-    for (size_t r = 0; r < records.size(); ++r)
-      weights[r] = r < leaf.reservoir.size() ? (1.0 - delta_share) / double(leaf.reservoir.size())
-                                             : delta_share / double(leaf.delta_reservoir.size());
-    if (!leaf.lobes.empty())
-      leaf.alpha = best_guided_share(leaf.lobes, records, settings_.uniform_fraction, settings_.min_lobe_kappa,
-                                     leaf.alpha, weights);
-    std::vector<GuidingLobe> lobes = fit_guiding_lobes(leaf.reservoir, settings_.parallax_lobes - settings_.delta_lobes);
-    std::vector<GuidingLobe> delta = fit_guiding_lobes(leaf.delta_reservoir, settings_.delta_lobes, kMinDeltaLobeRecords);
-    for (GuidingLobe& lobe : lobes) lobe.share *= static_cast<float>(1.0 - delta_share);
-    for (GuidingLobe& lobe : delta) lobe.share *= static_cast<float>(delta_share);
-    lobes.insert(lobes.end(), delta.begin(), delta.end());
-    if (!lobes.empty()) leaf.lobes = std::move(lobes);  // too few records: the leaf keeps what it knew
+    weights.assign(leaf.reservoir.size(), (1.0 - delta_share) / double(leaf.reservoir.size()));
+    weights.resize(records.size(), delta_share / double(leaf.delta_reservoir.size()));
   }
+  if (!leaf.lobes.empty())  // judged on records the lobes were not fitted to
+    leaf.alpha = best_guided_share(leaf.lobes, records, settings_.uniform_fraction, settings_.min_lobe_kappa, leaf.alpha,
+                                   weights);
+  std::vector<GuidingLobe> lobes = fit_guiding_lobes(leaf.reservoir, settings_.parallax_lobes - settings_.delta_lobes);
+  std::vector<GuidingLobe> delta = fit_guiding_lobes(leaf.delta_reservoir, settings_.delta_lobes, kMinDeltaLobeRecords);
+  for (GuidingLobe& lobe : lobes) lobe.share *= static_cast<float>(1.0 - delta_share);
+  for (GuidingLobe& lobe : delta) lobe.share *= static_cast<float>(delta_share);
+  lobes.insert(lobes.end(), delta.begin(), delta.end());
+  if (!lobes.empty()) leaf.lobes = std::move(lobes);  // too few records: the leaf keeps what it knew
   leaf.reservoir.clear();
   leaf.delta_reservoir.clear();
   leaf.energy = leaf.delta_energy = 0.0;
