@@ -105,6 +105,7 @@ class Bsdf {
 
   bool is_perfectly_specular() const { return !has_nondelta_; }
   bool has_nondelta() const { return has_nondelta_; }
+  float eta() const { return front_face_ ? ior_ : 1.0f / ior_; }  // eta_t / eta_i across the surface
   // The probability that sample() picks a non-delta lobe (1 for a BSDF without delta lobes).
   float nondelta_probability() const {
     return p_diffuse_ + (glossy_delta_ ? 0.0f : p_glossy_) + p_sheen_ + (coat_delta_ ? 0.0f : p_coat_) +
@@ -139,7 +140,6 @@ class Bsdf {
   bool sample_smooth_glass(glm::vec2 u, BsdfSample* out) const;
   bool sample_rough_glass(float u_choice, glm::vec2 u, BsdfSample* out) const;
   bool finish_nondelta_sample(glm::vec3 wi, bool transmitted, BsdfSample* out) const;
-  float eta() const { return front_face_ ? ior_ : 1.0f / ior_; }  // eta_t / eta_i across the surface
   // The rough glass's Fresnel reflectance at a microfacet seen at cos_oh (Walter et al. 2007).
   float glass_fresnel(float cos_oh) const;
 

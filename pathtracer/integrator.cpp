@@ -205,12 +205,35 @@ PathTracer::PathTracer(const Scene& scene) : geometry_(scene), lights_(scene) {
       const double sphere_area = 4.0 * kPi * double(target.radius) * double(target.radius);
       if (area >= kNearSpecularMinFill * sphere_area)
         target.near_distance2 = target.radius * target.radius * kNearSpecularDistance2PerRadius2;
+      SphereCaster caster;
+      if (fit_sphere_caster(mesh.positions, mesh.normals, &caster)) {
+        const Material& m = scene.materials[mesh.material];
+        caster.mirror = material_is_perfect_mirror(m);
+        caster.ior = m.ior;
+        target.caster = static_cast<int>(casters_.size());
+        casters_.push_back(caster);
+      }
       if (std::isfinite(target.radius) && target.radius > 0.0f) {
         specular_targets_.push_back(target);
         has_near_targets_ |= target.near_distance2 > 0.0f;
       }
     }
   }
+  if (!casters_.empty()) set_up_solved_chains();
+}
+
+void PathTracer::set_up_solved_chains() {
+  const size_t count = lights_.emissive_triangle_count();
+  if (count == 0 || count > kMaxSolvedChainEmitters) return;
+  std::vector<SphereCausticSampler::Emitter> emitters;
+  std::vector<float> powers;
+  for (size_t i = 0; i < count; ++i) {
+    const LightSampler::EmissiveTriangle& t = lights_.triangle(i);
+    emitters.push_back({glm::dvec3(t.p0), glm::dvec3(t.e1), glm::dvec3(t.e2), double(t.area)});
+    powers.push_back(luminance(t.material->emissive) * t.area);
+  }
+  caustics_ = SphereCausticSampler(std::move(emitters), powers);
+  if (!caustics_.empty()) solved_chain_share_ = lights_.has_environment() ? kSolvedChainShareWithEnvironment : 1.0f;
 }
 
 const BsdfMaterial& PathTracer::bsdf_material_at(const SurfacePoint& sp, BsdfMaterial* scratch) const {
@@ -256,8 +279,13 @@ float PathTracer::specular_pdf(glm::vec3 p, glm::vec3 wi, bool near_only) const 
     ++candidates;
     glm::vec3 axis;
     float cos_max;
-    if (target_cone(t.center, t.radius, p, &axis, &cos_max) && glm::dot(wi, axis) >= cos_max)
-      sum += 1.0f / (2.0f * kPi * (1.0f - cos_max));
+    if (!target_cone(t.center, t.radius, p, &axis, &cos_max) || glm::dot(wi, axis) < cos_max) continue;
+    const float cone = 1.0f / (2.0f * kPi * (1.0f - cos_max));
+    if (t.caster < 0 || solved_chain_share_ == 0.0f) {
+      sum += cone;
+    } else {  // every solved direction meets the analytic sphere, inside the bounding one: in the cone
+      sum += (1.0f - solved_chain_share_) * cone + solved_chain_share_ * caustics_.pdf(casters_[t.caster], p, wi);
+    }
   }
   return candidates > 0 ? sum / static_cast<float>(candidates) : 0.0f;
 }
@@ -272,7 +300,10 @@ glm::vec3 PathTracer::specular_chain_light(const SurfacePoint& sp, const Bsdf& b
   const glm::vec2 u = numbers.direction;
   // The target: candidate number k (every specular object, or the near ones), chosen uniformly.
   const int n = candidates;
-  int k = std::min(n - 1, static_cast<int>(u_select * static_cast<float>(n)));
+  const int chosen = std::min(n - 1, static_cast<int>(u_select * static_cast<float>(n)));
+  // u_select rescaled within the choice: it picks the strategy, then the emitter and the path.
+  float u_rest = std::min(std::max(u_select * static_cast<float>(n) - static_cast<float>(chosen), 0.0f), 0x1.fffffep-1f);
+  int k = chosen;
   const SpecularTarget* target = nullptr;
   for (const SpecularTarget& t : specular_targets_)
     if ((!near_only || t.near(sp.position)) && k-- == 0) {
@@ -282,9 +313,15 @@ glm::vec3 PathTracer::specular_chain_light(const SurfacePoint& sp, const Bsdf& b
   glm::vec3 axis;
   float cos_max;
   if (!target_cone(target->center, target->radius, sp.position, &axis, &cos_max)) return glm::vec3(0.0f);
-  const float cos_t = 1.0f - u.x * (1.0f - cos_max), sin_t = std::sqrt(std::max(0.0f, 1.0f - cos_t * cos_t));
-  const float phi = 2.0f * kPi * u.y;
-  const glm::vec3 wi = glm::normalize(Frame::from_normal(axis).to_world(glm::vec3(std::cos(phi) * sin_t, std::sin(phi) * sin_t, cos_t)));
+  glm::vec3 wi;
+  if (target->caster >= 0 && u_rest < solved_chain_share_) {
+    if (!caustics_.sample(casters_[target->caster], sp.position, u_rest / solved_chain_share_, u, &wi))
+      return glm::vec3(0.0f);
+  } else {
+    const float cos_t = 1.0f - u.x * (1.0f - cos_max), sin_t = std::sqrt(std::max(0.0f, 1.0f - cos_t * cos_t));
+    const float phi = 2.0f * kPi * u.y;
+    wi = glm::normalize(Frame::from_normal(axis).to_world(glm::vec3(std::cos(phi) * sin_t, std::sin(phi) * sin_t, cos_t)));
+  }
   float bsdf_pdf;
   const glm::vec3 f = bsdf.eval(wi, &bsdf_pdf);
   const float pdf = specular_pdf(sp.position, wi, near_only);
@@ -723,6 +760,10 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
     }
   }
   s.throughput *= bs.weight;
+  // Radiance is compressed by eta^2 inside a denser medium (Bsdf's transmitted weight): roulette
+  // judges the throughput without that factor (pbrt-v4's etaScale), or it would end about 1 - 1/eta^2
+  // of the paths entering glass and give the survivors eta^2 times their weight.
+  if (bs.transmitted) s.roulette_scale *= bsdf.eta() * bsdf.eta();
   if (!bs.delta)
     s.chain_mis = specular_sampling ? power_heuristic(bs.pdf, specular_pdf(sp.position, bs.wi, near_only)) : 1.0f;
   else if (!material_is_perfect_specular(material))

@@ -10,6 +10,7 @@
 #include "pathtracer/lights.h"
 #include "pathtracer/pathtracer.h"
 #include "pathtracer/sampler.h"
+#include "pathtracer/sphere_caustics.h"
 
 namespace pxf {
 
@@ -136,6 +137,7 @@ class PathTracer {
     glm::vec3 center{0.0f};
     float radius = 0.0f;
     float near_distance2 = 0.0f;  // squared distance from the center within which p is near
+    int caster = -1;               // index into casters_ when the mesh is a sphere: its light is solved for
     bool near(glm::vec3 p) const;  // outside the sphere, and it subtends >= kNearSpecularSolidAngle
   };
   int chain_target_count(glm::vec3 p, bool near_only) const;
@@ -160,6 +162,15 @@ class PathTracer {
   };
   std::vector<PrecomputedBsdfMaterial> precomputed_materials_;  // per scene material
   std::vector<SpecularTarget> specular_targets_;
+  // The chains toward a sphere target are drawn toward the emissive triangles by solving for the
+  // path through the sphere (pathtracer/sphere_caustics.h, docs/sampling.md): all of them, or
+  // kSolvedChainShareWithEnvironment where an environment needs the cone's chains too.
+  static constexpr size_t kMaxSolvedChainEmitters = 64;  // the pdf visits every emitter
+  static constexpr float kSolvedChainShareWithEnvironment = 0.5f;
+  void set_up_solved_chains();
+  std::vector<SphereCaster> casters_;
+  SphereCausticSampler caustics_;
+  float solved_chain_share_ = 0.0f;
   bool has_perfect_specular_ = false;
   bool has_near_targets_ = false;  // a target that fills its bounding sphere enough for near chains
   GuidingField* guiding_ = nullptr;
