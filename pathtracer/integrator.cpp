@@ -211,9 +211,11 @@ PathTracer::PathTracer(const Scene& scene) : geometry_(scene), lights_(scene) {
         caster.mirror = material_is_perfect_mirror(m);
         caster.ior = m.ior;
         target.caster = static_cast<int>(casters_.size());
+        target.mirror_caster = caster.mirror;
         casters_.push_back(caster);
       }
       if (std::isfinite(target.radius) && target.radius > 0.0f) {
+        mirror_caster_targets_ += target.mirror_caster;
         specular_targets_.push_back(target);
         has_near_targets_ |= target.near_distance2 > 0.0f;
       }
@@ -264,18 +266,37 @@ bool PathTracer::SpecularTarget::near(glm::vec3 p) const {
   return d2 <= near_distance2 && d2 > radius * radius;
 }
 
-int PathTracer::chain_target_count(glm::vec3 p, bool near_only) const {
-  if (!near_only) return static_cast<int>(specular_targets_.size());
-  int n = 0;
-  for (const SpecularTarget& t : specular_targets_) n += t.near(p);
-  return n;
+bool PathTracer::ChainPlan::includes(const SpecularTarget& t, glm::vec3 p) const {
+  return targets == Targets::All || (targets == Targets::Near ? t.near(p) : t.mirror_caster);
 }
 
-float PathTracer::specular_pdf(glm::vec3 p, glm::vec3 wi, bool near_only) const {
+PathTracer::ChainPlan PathTracer::chain_plan(glm::vec3 p, const TraceParams& params, bool first_vertex) const {
+  ChainPlan plan;
+  if (specular_targets_.empty()) return plan;
+  if (params.specular_sampling) {
+    plan.candidates = static_cast<int>(specular_targets_.size());
+    return plan;
+  }
+  if (!params.near_specular_sampling || !first_vertex) return plan;
+  if (has_near_targets_) {
+    plan.targets = ChainPlan::Targets::Near;
+    for (const SpecularTarget& t : specular_targets_) plan.candidates += t.near(p);
+    if (plan.candidates > 0) return plan;
+  }
+  if (solved_chain_share_ > 0.0f && mirror_caster_targets_ > 0) {
+    plan.targets = ChainPlan::Targets::Casters;
+    plan.candidates = mirror_caster_targets_;
+    plan.probability = kFarCasterChainProbability;
+  }
+  return plan;
+}
+
+float PathTracer::specular_pdf(glm::vec3 p, glm::vec3 wi, const ChainPlan& plan, const SpecularTarget* drawn_from,
+                               float drawn_pdf) const {
   float sum = 0.0f;
   int candidates = 0;
   for (const SpecularTarget& t : specular_targets_) {
-    if (near_only && !t.near(p)) continue;
+    if (!plan.includes(t, p)) continue;
     ++candidates;
     glm::vec3 axis;
     float cos_max;
@@ -284,29 +305,32 @@ float PathTracer::specular_pdf(glm::vec3 p, glm::vec3 wi, bool near_only) const 
     if (t.caster < 0 || solved_chain_share_ == 0.0f) {
       sum += cone;
     } else {  // every solved direction meets the analytic sphere, inside the bounding one: in the cone
-      sum += (1.0f - solved_chain_share_) * cone + solved_chain_share_ * caustics_.pdf(casters_[t.caster], p, wi);
+      const float solved = &t == drawn_from ? drawn_pdf : caustics_.pdf(casters_[t.caster], p, wi);
+      sum += (1.0f - solved_chain_share_) * cone + solved_chain_share_ * solved;
     }
   }
-  return candidates > 0 ? sum / static_cast<float>(candidates) : 0.0f;
+  return candidates > 0 ? plan.probability * sum / static_cast<float>(candidates) : 0.0f;
 }
 
 glm::vec3 PathTracer::specular_chain_light(const SurfacePoint& sp, const Bsdf& bsdf, const GuidingMixture& mixture,
-                                           glm::vec3 throughput, int vertex, bool near_only, int candidates,
+                                           glm::vec3 throughput, int vertex, const ChainPlan& plan,
                                            PathSampler& sampler, const TraceParams& params, uint32_t* rays,
                                            bool* through_glass) const {
   const Scene& scene = geometry_.scene();
   const PathSampler::SpecularNumbers numbers = sampler.specular_numbers(vertex);
-  const float u_select = numbers.select;
+  float u_select = numbers.select;
   const glm::vec2 u = numbers.direction;
-  // The target: candidate number k (every specular object, or the near ones), chosen uniformly.
-  const int n = candidates;
+  if (u_select >= plan.probability) return glm::vec3(0.0f);  // not traced this time
+  u_select /= plan.probability;
+  // The target: candidate number k of the plan's, chosen uniformly.
+  const int n = plan.candidates;
   const int chosen = std::min(n - 1, static_cast<int>(u_select * static_cast<float>(n)));
   // u_select rescaled within the choice: it picks the strategy, then the emitter and the path.
   float u_rest = std::min(std::max(u_select * static_cast<float>(n) - static_cast<float>(chosen), 0.0f), 0x1.fffffep-1f);
   int k = chosen;
   const SpecularTarget* target = nullptr;
   for (const SpecularTarget& t : specular_targets_)
-    if ((!near_only || t.near(sp.position)) && k-- == 0) {
+    if (plan.includes(t, sp.position) && k-- == 0) {
       target = &t;
       break;
     }
@@ -314,9 +338,12 @@ glm::vec3 PathTracer::specular_chain_light(const SurfacePoint& sp, const Bsdf& b
   float cos_max;
   if (!target_cone(target->center, target->radius, sp.position, &axis, &cos_max)) return glm::vec3(0.0f);
   glm::vec3 wi;
+  const SpecularTarget* drawn_from = nullptr;
+  float drawn_pdf = 0.0f;
   if (target->caster >= 0 && u_rest < solved_chain_share_) {
-    if (!caustics_.sample(casters_[target->caster], sp.position, u_rest / solved_chain_share_, u, &wi))
+    if (!caustics_.sample(casters_[target->caster], sp.position, u_rest / solved_chain_share_, u, &wi, &drawn_pdf))
       return glm::vec3(0.0f);
+    drawn_from = target;
   } else {
     const float cos_t = 1.0f - u.x * (1.0f - cos_max), sin_t = std::sqrt(std::max(0.0f, 1.0f - cos_t * cos_t));
     const float phi = 2.0f * kPi * u.y;
@@ -324,7 +351,7 @@ glm::vec3 PathTracer::specular_chain_light(const SurfacePoint& sp, const Bsdf& b
   }
   float bsdf_pdf;
   const glm::vec3 f = bsdf.eval(wi, &bsdf_pdf);
-  const float pdf = specular_pdf(sp.position, wi, near_only);
+  const float pdf = specular_pdf(sp.position, wi, plan, drawn_from, drawn_pdf);
   if (!(max_component(f) > 0.0f) || !(pdf > 0.0f)) return glm::vec3(0.0f);
   glm::vec3 t = throughput * f / pdf;
   const float w = power_heuristic(pdf, mixture.pdf(bsdf_pdf, wi));
@@ -696,15 +723,11 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
   // diffuse vertex toward every specular object (params.specular_sampling), else at the first one
   // toward the specular objects that fill much of its view (params.near_specular_sampling).
   const bool room = !specular_targets_.empty() && bsdf.has_nondelta() && vertex + 2 <= params.max_vertices;
-  const bool near_only = !params.specular_sampling;
-  const int candidates =
-      room && (params.specular_sampling || (params.near_specular_sampling && has_near_targets_ && s.nonspecular == 0))
-          ? chain_target_count(sp.position, near_only)
-          : 0;
-  const bool specular_sampling = candidates > 0;
+  const ChainPlan plan = room ? chain_plan(sp.position, params, s.nonspecular == 0) : ChainPlan{};
+  const bool specular_sampling = plan.candidates > 0;
   if (specular_sampling) {
     bool through_glass = false;
-    const glm::vec3 light = specular_chain_light(sp, bsdf, mixture, s.throughput, vertex, near_only, candidates,
+    const glm::vec3 light = specular_chain_light(sp, bsdf, mixture, s.throughput, vertex, plan,
                                                  sampler, params, &out.rays, &through_glass);
     if (max_component(light) > 0.0f) {
       out.hv += light;
@@ -765,7 +788,7 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
   // of the paths entering glass and give the survivors eta^2 times their weight.
   if (bs.transmitted) s.roulette_scale *= bsdf.eta() * bsdf.eta();
   if (!bs.delta)
-    s.chain_mis = specular_sampling ? power_heuristic(bs.pdf, specular_pdf(sp.position, bs.wi, near_only)) : 1.0f;
+    s.chain_mis = specular_sampling ? power_heuristic(bs.pdf, specular_pdf(sp.position, bs.wi, plan)) : 1.0f;
   else if (!material_is_perfect_specular(material))
     s.chain_mis = 1.0f;  // a delta lobe of a surface the specular chains stop at
   if (!bs.delta) ++s.nonspecular;

@@ -186,10 +186,11 @@ int solve_sphere_caster(const SphereCaster& c, const glm::dvec3& x, const glm::d
   };
   int count = 0;
   // Steps even in the entry angle (b = r sin a): the paths bend fastest near the rim.
-  const auto scan_point = [&](int i) { return r * std::sin(kHalfPi * (-1.0 + (2.0 * i + 1.0) / kSphereCasterScan)); };
+  const int scan = c.mirror ? kMirrorScan : kGlassScan;
+  const auto scan_point = [&](int i) { return r * std::sin(kHalfPi * (-1.0 + (2.0 * i + 1.0) / scan)); };
   double b_prev = scan_point(0), g_prev = 0.0;
   bool valid_prev = miss(b_prev, &g_prev);
-  for (int i = 1; i < kSphereCasterScan && count < kMaxSphereCasterPaths; ++i) {
+  for (int i = 1; i < scan && count < kMaxSphereCasterPaths; ++i) {
     const double b_next = scan_point(i);
     double g_next = 0.0;
     const bool valid_next = miss(b_next, &g_next);
@@ -214,23 +215,29 @@ SphereCausticSampler::SphereCausticSampler(std::vector<Emitter> emitters, const 
 }
 
 bool SphereCausticSampler::sample(const SphereCaster& caster, glm::vec3 x, float u_select, glm::vec2 u_point,
-                                  glm::vec3* w) const {
+                                  glm::vec3* w, float* pdf) const {
   if (emitters_.empty()) return false;
   float u_path;
-  const Emitter& e = emitters_[choice_.sample(u_select, &u_path)];
+  const size_t emitter = choice_.sample(u_select, &u_path);
+  const Emitter& e = emitters_[emitter];
   const double root = std::sqrt(double(u_point.x));
   const glm::dvec3 y = e.p0 + (1.0 - root) * e.e1 + (double(u_point.y) * root) * e.e2;
   glm::dvec3 paths[kMaxSphereCasterPaths];
   const int count = solve_sphere_caster(caster, glm::dvec3(x), y, paths);
   if (count == 0) return false;
   *w = glm::vec3(paths[std::min(count - 1, static_cast<int>(u_path * float(count)))]);
+  *pdf = density(caster, glm::dvec3(x), glm::normalize(glm::dvec3(*w)), static_cast<int>(emitter), count);
   return true;
 }
 
 float SphereCausticSampler::pdf(const SphereCaster& caster, glm::vec3 x, glm::vec3 w) const {
-  const glm::dvec3 xd(x), wd = glm::normalize(glm::dvec3(w));
+  return density(caster, glm::dvec3(x), glm::normalize(glm::dvec3(w)), -1, 0);
+}
+
+float SphereCausticSampler::density(const SphereCaster& caster, const glm::dvec3& x, const glm::dvec3& w, int known,
+                                    int known_count) const {
   glm::dvec3 o, d;
-  if (emitters_.empty() || !trace_sphere_caster(caster, xd, wd, &o, &d)) return 0.0f;
+  if (emitters_.empty() || !trace_sphere_caster(caster, x, w, &o, &d)) return 0.0f;
   // Solutions closer than this to w are w: the solver's are exact to ~1e-13, a float direction to ~1e-7.
   constexpr double kSame = 1e-5;
   double density = 0.0;
@@ -238,12 +245,15 @@ float SphereCausticSampler::pdf(const SphereCaster& caster, glm::vec3 x, glm::ve
     const Emitter& e = emitters_[i];
     glm::dvec3 y;
     if (!hit_emitter(e, o, d, &y)) continue;
-    glm::dvec3 paths[kMaxSphereCasterPaths];
-    const int count = solve_sphere_caster(caster, xd, y, paths);
-    bool found = false;
-    for (int k = 0; k < count && !found; ++k) found = glm::length(paths[k] - wd) < kSame;
-    if (!found) continue;
-    density += double(choice_.pmf(i)) / e.area * area_per_solid_angle(caster, xd, wd, e) / count;
+    int count = known_count;
+    if (static_cast<int>(i) != known) {  // is w among the paths to this emitter's point too?
+      glm::dvec3 paths[kMaxSphereCasterPaths];
+      count = solve_sphere_caster(caster, x, y, paths);
+      bool found = false;
+      for (int k = 0; k < count && !found; ++k) found = glm::length(paths[k] - w) < kSame;
+      if (!found) continue;
+    }
+    density += double(choice_.pmf(i)) / e.area * area_per_solid_angle(caster, x, w, e) / count;
   }
   return static_cast<float>(density);
 }

@@ -40,15 +40,16 @@ bool trace_sphere_caster(const SphereCaster& caster, const glm::dvec3& x, const 
 // The directions from x whose analytic path passes through y, at most kMaxSphereCasterPaths, in
 // a fixed order. A path stays in the plane of x, the centre and y, so they are the roots of a
 // function of one variable (the ray's signed distance from the centre), bracketed by a scan of
-// kSphereCasterScan steps and refined by bisection; two roots within one step are missed, which
-// the pdf accounts for (it counts only the paths this function finds). None when x, the centre
-// and y are on one line, or x or y is inside the sphere.
+// kGlassScan steps (kMirrorScan for a mirror, whose one reflection bends the function less)
+// even in the entry angle and refined by the Illinois method; two roots within one step are
+// missed, which the pdf accounts for (it counts only the paths this function finds). None when
+// x, the centre and y are on one line, or x or y is inside the sphere.
 // Paths that meet the sphere farther than kSphereCasterRim x radius from its centre's line are
 // left to the other strategies: toward the silhouette the map from directions to the light bends
 // without bound, and its pdf with it.
 constexpr double kSphereCasterRim = 0.95;
 constexpr int kMaxSphereCasterPaths = 8;
-constexpr int kSphereCasterScan = 96;
+constexpr int kGlassScan = 96, kMirrorScan = 24;
 int solve_sphere_caster(const SphereCaster& caster, const glm::dvec3& x, const glm::dvec3& y, glm::dvec3* directions);
 
 class SphereCausticSampler {
@@ -64,14 +65,18 @@ class SphereCausticSampler {
 
   // A direction from x toward the emitters through the caster: emitter by power (u_select), a
   // point uniform on it (u_point), one of the paths to it chosen uniformly (u_select rescaled).
-  // False when there is none; the direction's density is pdf().
-  bool sample(const SphereCaster& caster, glm::vec3 x, float u_select, glm::vec2 u_point, glm::vec3* w) const;
+  // False when there is none; *pdf: the direction's density, pdf(w), without solving again for
+  // the point it was drawn for.
+  bool sample(const SphereCaster& caster, glm::vec3 x, float u_select, glm::vec2 u_point, glm::vec3* w,
+              float* pdf) const;
   // The solid-angle density with which sample() draws w: over every emitter point y the analytic
   // path along w crosses, p(y) |dA_y / d omega| / (the number of paths solve finds to y), where
   // solve finds w itself among them.
   float pdf(const SphereCaster& caster, glm::vec3 x, glm::vec3 w) const;
 
  private:
+  // pdf(), with emitter `known` (>= 0) crossed at a point whose paths are known: `known_count` of them.
+  float density(const SphereCaster& caster, const glm::dvec3& x, const glm::dvec3& w, int known, int known_count) const;
   std::vector<Emitter> emitters_;
   Distribution1D choice_;
 };

@@ -126,10 +126,13 @@ TEST(SphereCaustics, SamplingMatchesItsPdf) {
     for (int i = 0; i < kSamples; ++i) {
       glm::vec3 w;
       const float u0 = rng.next_float(), u1 = rng.next_float(), u2 = rng.next_float();
-      if (!light.sample(c, test.x, u0, glm::vec2(u1, u2), &w)) {
+      float pdf;
+      if (!light.sample(c, test.x, u0, glm::vec2(u1, u2), &w, &pdf)) {
         observed[failure_bin] += 1.0;
         continue;
       }
+      const float evaluated = light.pdf(c, test.x, w);  // sample() did not solve again: the same density
+      EXPECT_NEAR(pdf, evaluated, 1e-3f * evaluated);
       const int bin = bin_of(glm::dvec3(w));
       ASSERT_GE(bin, 0) << "a solved direction outside the sphere's cone";
       observed[bin] += 1.0;
