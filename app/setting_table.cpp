@@ -158,14 +158,16 @@ std::vector<SettingDescriptor> make_table() {
   t.push_back(integer("rr_start_vertex", "--rr-start", "Russian roulette from this vertex on", 2, 1024,
                       [](PreviewSettings& s) -> int& { return s.trace.rr_start_vertex; }, E::Retrace));
   t.push_back(on_off("specular_sampling", "--specular-sampling",
-                     "also sample the cones of mirror and glass objects at diffuse vertices, MIS-combined with BSDF\n"
-                     "sampling: unbiased, fewer caustic fireflies, more rays (docs/sampling.md#fireflies)",
+                     "also trace chains toward mirror and glass objects at diffuse vertices (toward a sphere solved\n"
+                     "for the light's path), MIS-combined with BSDF sampling: unbiased, fewer caustic fireflies, more\n"
+                     "rays (docs/sampling.md#fireflies)",
                      [](PreviewSettings& s) -> bool& { return s.trace.specular_sampling; }, E::Retrace,
                      "specular sampling", /*bare_flag=*/true));
   SettingDescriptor near = on_off(
       "near_specular_sampling", "--near-specular",
       "the same at the first diffuse vertex only, toward mirror and glass objects that fill at least pi sr\n"
-      "of its view: the focus a glass object throws on the floor it stands on (docs/sampling.md#near-specular-sampling)",
+      "of its view (the focus a glass object throws on the floor it stands on), else toward a mirror sphere\n"
+      "in 1 of 20 paths (its caustic on every wall; docs/sampling.md#near-specular-sampling)",
       [](PreviewSettings& s) -> bool& { return s.trace.near_specular_sampling; }, E::Retrace, "near specular sampling");
   near.same = [](const PreviewSettings& a, const PreviewSettings& b) {
     return specular_sampling_mode(a.trace) == specular_sampling_mode(b.trace);
