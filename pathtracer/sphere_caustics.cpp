@@ -244,7 +244,7 @@ float SphereCausticSampler::density(const SphereCaster& caster, const glm::dvec3
   for (size_t i = 0; i < emitters_.size(); ++i) {
     const Emitter& e = emitters_[i];
     glm::dvec3 y;
-    if (!hit_emitter(e, o, d, &y)) continue;
+    if (choice_.pmf(i) == 0.0f || !(e.area > 0.0) || !hit_emitter(e, o, d, &y)) continue;  // never drawn
     int count = known_count;
     if (static_cast<int>(i) != known) {  // is w among the paths to this emitter's point too?
       glm::dvec3 paths[kMaxSphereCasterPaths];
