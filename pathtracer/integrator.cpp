@@ -277,8 +277,8 @@ PathTracer::ChainPlan PathTracer::chain_plan(glm::vec3 p, const TraceParams& par
     plan.candidates = static_cast<int>(specular_targets_.size());
     return plan;
   }
-  if (!params.near_specular_sampling || !first_vertex) return plan;
-  if (has_near_targets_) {
+  if (!params.near_specular_sampling) return plan;
+  if (has_near_targets_ && first_vertex) {
     plan.targets = ChainPlan::Targets::Near;
     for (const SpecularTarget& t : specular_targets_) plan.candidates += t.near(p);
     if (plan.candidates > 0) return plan;

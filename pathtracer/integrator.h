@@ -142,9 +142,10 @@ class PathTracer {
     bool near(glm::vec3 p) const;  // outside the sphere, and it subtends >= kNearSpecularSolidAngle
   };
   // Which targets a vertex's chain aims at (one of them, chosen uniformly) and the probability
-  // that it is traced at all: every target with params.specular_sampling; else, at the first
-  // non-delta vertex, the near ones, or where none is near the mirror spheres with
-  // kFarCasterChainProbability: their solved chains find a mirror's caustic anywhere.
+  // that it is traced at all: every target with params.specular_sampling; else the near ones at
+  // the first non-delta vertex, and elsewhere (deeper vertices too) the mirror spheres with
+  // kFarCasterChainProbability: their solved chains find a mirror's caustic anywhere, also where
+  // the camera sees it after a diffuse bounce (the ceiling under cornell's mirror ball).
   struct ChainPlan {
     enum class Targets { All, Near, Casters } targets = Targets::All;
     int candidates = 0;  // 0: no chain
