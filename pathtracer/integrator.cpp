@@ -232,7 +232,7 @@ void PathTracer::set_up_solved_chains() {
   for (size_t i = 0; i < count; ++i) {
     const LightSampler::EmissiveTriangle& t = lights_.triangle(i);
     emitters.push_back({glm::dvec3(t.p0), glm::dvec3(t.e1), glm::dvec3(t.e2), double(t.area)});
-    powers.push_back(luminance(t.material->emissive) * t.area);
+    powers.push_back(lights_.triangle_power_pmf(i));
   }
   caustics_ = SphereCausticSampler(std::move(emitters), powers);
   if (!caustics_.empty()) solved_chain_share_ = lights_.has_environment() ? kSolvedChainShareWithEnvironment : 1.0f;

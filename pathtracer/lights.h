@@ -65,6 +65,8 @@ class LightSampler {
   // The probability of picking emissive triangle `light` among the triangles, seen from `from`
   // (near-field selection, below); without near-field selection it is its share of the power.
   float triangle_selection_pmf(size_t light, glm::vec3 from) const;
+  // Its share of the emissive triangles' power (the selection without near-field selection).
+  float triangle_power_pmf(size_t light) const { return triangle_dist_.pmf(light); }
   // Samples a point on the emissive triangles for a shading point at `from`: returns the light
   // index and the area pdf (incl. the triangle's selection, not the category's).
   size_t sample_triangle_point(glm::vec3 from, float u_select, glm::vec2 u, glm::vec3* point, glm::vec2* barycentrics,

@@ -232,8 +232,8 @@ bool SphereCausticSampler::sample(const SphereCaster& caster, glm::vec3 x, float
   float u_path;
   const size_t emitter = choice_.sample(u_select, &u_path);
   const Emitter& e = emitters_[emitter];
-  const double root = std::sqrt(double(u_point.x));
-  const glm::dvec3 y = e.p0 + (1.0 - root) * e.e1 + (double(u_point.y) * root) * e.e2;
+  const glm::dvec2 b(sample_triangle_barycentrics(u_point));
+  const glm::dvec3 y = e.p0 + b.x * e.e1 + b.y * e.e2;
   glm::dvec3 paths[kMaxSphereCasterPaths];
   const int count = solve_sphere_caster(caster, glm::dvec3(x), y, paths);
   if (count == 0) return false;
