@@ -1,7 +1,7 @@
 // pxf bench: run time against error (README "Current figures", docs/measurements.md). Not a
 // test: it prints figures and writes CSV and SVG plots into --out. One mode per run, chosen by its
 // flag (bench_modes() below: the default tables, --pathtracer, --sampler-error, --variance-ratio,
-// --variants, --stage-table, --threshold-fidelity, --guiding-ab, --adaptive, --demodulation-ab,
+// --variants, --stage-table, --threshold-fidelity, --guiding-ab, --guiding-bound, --adaptive, --demodulation-ab,
 // --motion); each mode is a small entry point over the shared harness (app/bench_harness.h) that
 // declares its own options and defaults.
 #include <algorithm>
@@ -597,6 +597,27 @@ int guiding_mode(const Args& args, const std::string& summary) {
   return 0;
 }
 
+int guiding_bound_mode(const Args& args, const std::string& summary) {
+  BenchHarness h("--guiding-bound", summary);
+  GuidingBoundSettings settings;
+  h.cli().option("--points", &settings.points, "first vertices (default 48)", 1, 100000);
+  h.cli().option("--cells", &settings.face_cells, "cells along a cube face's edge (default 24; even)", 2, 512);
+  h.cli().option("--paths", &settings.paths_per_cell, "paths per cell (default 32)", 1, 1 << 20);
+  h.cli().option("--frames", &settings.train_frames, "frames of the field's training (default 31)", 1, 1 << 16);
+  h.cli().option("--floor-directions", &settings.floor_directions, "directions per point for the floor (default 256)", 1,
+                 1 << 20);
+  h.cli().option("--floor-paths", &settings.floor_paths, "paths in each of them (default 256)", 2, 1 << 16);
+  int lv_hv_spp = 32;
+  h.cli().option("--spp", &lv_hv_spp, "samples of the two renders that split the error into LV and HV (default 32)", 1,
+                 1 << 16);
+  if (!h.parse(args)) return 0;
+  if (settings.face_cells % 2 != 0) throw UsageError("--cells must be even (a side face's upper half is traced)");
+  const BenchSetup b = h.setup(/*needs_filter=*/false);
+  settings.seed = b.plain.trace.seed;
+  run_guiding_bound_bench({b.scene, b.plain.trace, b.width, b.height, b.out, lv_hv_spp}, settings);
+  return 0;
+}
+
 int adaptive_mode(const Args& args, const std::string& summary) {
   BenchHarness h("--adaptive", summary);
   AdaptiveBenchPlan plan;
@@ -708,6 +729,14 @@ const std::vector<BenchMode>& bench_modes() {
        "path guiding against none, unfiltered (app/guiding_bench.h): ms per frame at equal spp (--frames), and\n"
        "HDR and display NRMSE at equal wall time of --budgets seconds, median of --rounds alternating rounds",
        guiding_mode},
+      {"--guiding-bound", "how far first-vertex guiding can go: the field against the light known exactly",
+       "at --points first vertices drawn over the image (app/guiding_bench.h, pathtracer/guiding_bound.h): the\n"
+       "variance of the indirect light's estimate under cosine sampling, the field trained for --frames frames,\n"
+       "the light known exactly (from --paths paths in each of the hemisphere's cells), the least any choice of\n"
+       "cells gives, and a floor under every guide, however fine (from --floor-paths paths in each of\n"
+       "--floor-directions exact directions); per point and summed, then what the floor means for the image's\n"
+       "HDR error (the LV/HV split of two --spp renders' error)",
+       guiding_bound_mode},
       {"--adaptive", "adaptive against uniform sampling: equal time, time to clean, throughput",
        "adaptive against uniform sampling, both filtered (app/adaptive_bench.h): paths/s at 100/50/10 %\n"
        "active pixels, display and HDR NRMSE at equal wall time (--budgets, --rounds), starved dark pixels,\n"

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "image/image.h"
+#include "pathtracer/guiding_bound.h"
 #include "pathtracer/pathtracer.h"
 
 namespace pxf {
@@ -30,5 +31,22 @@ struct GuidingBenchPlan {
 };
 
 void run_guiding_bench(const GuidingBenchSetup& b, const GuidingBenchPlan& plan);
+
+// pxf bench --guiding-bound (docs/guiding.md, "How far first-vertex guiding can go"): at first
+// vertices drawn over the image, the variance of the indirect light's estimate under cosine
+// sampling, the trained field, the light known exactly and the least any guide can give
+// (pathtracer/guiding_bound.h); per point and summed over the points (as the HDR error sums
+// pixels). Then the image: guiding changes only the HV part of a pixel (its direct light, LV, is
+// NEE's), so with HV's share of the error variance of two unguided renders of two seeds, the HDR
+// error ratio at equal samples is at least sqrt(LV share + HV share x the floor) for any guide of
+// the first vertices, at no cost. Prints a table and writes guiding_bound.csv into --out.
+struct GuidingBoundBenchSetup {
+  const Scene& scene;
+  TraceParams params;
+  int width = 0, height = 0;
+  std::string out;
+  int lv_hv_spp = 32;  // samples of the two renders that split the image's error into LV and HV
+};
+void run_guiding_bound_bench(const GuidingBoundBenchSetup& b, const GuidingBoundSettings& settings);
 
 }  // namespace pxf

@@ -81,7 +81,8 @@ TEST(Cli, BenchModesHaveTheirOwnOptions) {
   const Result list = run("bench --help");
   ASSERT_EQ(list.code, 0);
   for (const char* mode : {"--pathtracer", "--sampler-error", "--variance-ratio", "--variants", "--stage-table",
-                           "--threshold-fidelity", "--guiding-ab", "--adaptive", "--demodulation-ab", "--motion"})
+                           "--threshold-fidelity", "--guiding-ab", "--guiding-bound", "--adaptive", "--demodulation-ab",
+                           "--motion"})
     EXPECT_NE(list.out.find(std::string("\n  ") + mode + " "), std::string::npos) << mode;
   const Result adaptive = run("bench --adaptive --help");
   ASSERT_EQ(adaptive.code, 0);
@@ -91,6 +92,25 @@ TEST(Cli, BenchModesHaveTheirOwnOptions) {
   for (const char* other : {"--variant-spp", "--motion-frames", "--timed-frames"})
     EXPECT_EQ(adaptive.out.find(other), std::string::npos) << other;
   EXPECT_NE(run("bench --adaptive --variant-spp 3").err.find("--variant-spp"), std::string::npos);
+}
+
+// The guiding bound end to end, tiny: every point's row in the CSV, the summary and the image's
+// bound printed; an odd cell count is refused in one line.
+TEST(Cli, GuidingBoundWritesItsTable) {
+  const std::string out = temp_dir("guiding_bound");
+  const Result r = run("bench --guiding-bound --scene atrium --size 32x18 --points 3 --cells 4 --paths 2 --frames 1 "
+                       "--floor-directions 4 --floor-paths 2 --spp 2 --out " + out);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("floor of any guide"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("at least"), std::string::npos) << r.out;
+  std::ifstream csv(out + "/guiding_bound.csv");
+  std::string line;
+  int rows = 0;
+  while (std::getline(csv, line)) ++rows;
+  EXPECT_EQ(rows, 4);  // the header and 3 points
+  const Result odd = run("bench --guiding-bound --cells 5 --out " + out);
+  EXPECT_EQ(odd.code, 2);
+  EXPECT_EQ(lines(odd.err), 1u) << odd.err;
 }
 
 TEST(Cli, SceneListPrintsTheBuiltins) {
