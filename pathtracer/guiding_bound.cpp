@@ -109,15 +109,35 @@ Camera cube_face_camera(glm::vec3 origin, glm::vec3 forward, glm::vec3 up) {
   return camera;
 }
 
-// The paths of a point are one vertex shorter than the render's: its first vertex is where they start.
-TraceParams cell_path_params(const TraceParams& params) {
-  TraceParams full = params;
-  full.guiding = false;
-  full.sampler = SamplerType::Independent;
-  full.max_vertices = std::max(2, params.max_vertices - 1);
-  full.rr_start_vertex = std::max(2, params.rr_start_vertex - 1);
-  return full;
-}
+// The indirect light of camera paths that start at a point: each path's light less the light its
+// first segment sees directly (NEE's at the point), both traced with the same random numbers. The
+// paths are one vertex shorter than the render's, since the point is their first vertex.
+class IndirectLight {
+ public:
+  IndirectLight(const PathTracer& tracer, const TraceParams& params) : tracer_(tracer), full_(params) {
+    full_.guiding = false;
+    full_.sampler = SamplerType::Independent;
+    full_.max_vertices = std::max(2, params.max_vertices - 1);
+    full_.rr_start_vertex = std::max(2, params.rr_start_vertex - 1);
+    direct_ = full_;
+    direct_.max_vertices = 2;
+  }
+  // out[i]: the luminance of the i-th pixel's path of `rect` (frame `frame`, seed `seed`).
+  void trace(const Camera& camera, int width, int height, const PixelRect& rect, uint32_t frame, uint64_t seed,
+             double* out) const {
+    std::vector<PathSample> with(static_cast<size_t>(rect.count())), without(with.size());
+    TraceParams full = full_, direct = direct_;
+    full.seed = direct.seed = seed;
+    tracer_.trace_pixels(camera, width, height, rect, frame, full, with.data());
+    tracer_.trace_pixels(camera, width, height, rect, frame, direct, without.data());
+    for (size_t i = 0; i < with.size(); ++i)
+      out[i] = double(luminance(with[i].lv + with[i].hv)) - luminance(without[i].lv + without[i].hv);
+  }
+
+ private:
+  const PathTracer& tracer_;
+  TraceParams full_, direct_;
+};
 
 // Directions drawn by cosine sampling, each with floor_paths paths in exactly that direction (a
 // camera of negligible field of view, one pixel per path along its row): per direction the mean of
@@ -126,9 +146,7 @@ void trace_floor_directions(const PathTracer& tracer, const BoundPoint& p, const
                             const GuidingBoundSettings& s, std::vector<double>* second_moments, std::vector<double>* means) {
   const Frame frame = Frame::from_normal(p.normal);
   const glm::vec3 origin = offset_ray_origin(p.position, p.geometric_normal, p.normal);
-  const TraceParams full = cell_path_params(params);
-  TraceParams direct = full;
-  direct.max_vertices = 2;
+  const IndirectLight indirect(tracer, params);
   const int k = s.floor_paths;
   second_moments->assign(static_cast<size_t>(s.floor_directions), 0.0);
   means->assign(static_cast<size_t>(s.floor_directions), 0.0);
@@ -138,15 +156,10 @@ void trace_floor_directions(const PathTracer& tracer, const BoundPoint& p, const
     const glm::vec3 side = std::abs(d.y) < 0.9f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0);
     Camera camera = cube_face_camera(origin, d, glm::normalize(glm::cross(glm::cross(d, side), d)));
     camera.yfov = 1e-6f;
-    std::vector<PathSample> with(k), without(k);
-    TraceParams a = full, b = direct;
-    a.seed = b.seed = s.seed * 7919u + 104729u + static_cast<uint64_t>(i);
-    const PixelRect rect{0, 0, k, 1};
-    tracer.trace_pixels(camera, k, 1, rect, 0, a, with.data());
-    tracer.trace_pixels(camera, k, 1, rect, 0, b, without.data());
+    std::vector<double> light(static_cast<size_t>(k));
+    indirect.trace(camera, k, 1, PixelRect{0, 0, k, 1}, 0, s.seed * 7919u + 104729u + static_cast<uint64_t>(i), light.data());
     double sum = 0.0, sum2 = 0.0;
-    for (int j = 0; j < k; ++j) {
-      const double l = double(luminance(with[j].lv + with[j].hv)) - luminance(without[j].lv + without[j].hv);
+    for (double l : light) {
       sum += l;
       sum2 += l * l;
     }
@@ -162,9 +175,7 @@ std::vector<DirectionCell> trace_cells(const PathTracer& tracer, const GuidingFi
   const glm::vec3 origin = offset_ray_origin(p.position, p.geometric_normal, p.normal);
   const glm::vec3 forward[5] = {frame.n, frame.t, -frame.t, frame.b, -frame.b};
   const glm::vec3 up[5] = {frame.t, frame.n, frame.n, frame.n, frame.n};
-  const TraceParams full = cell_path_params(params);
-  TraceParams direct = full;  // the light a direction sees directly (NEE's), left out
-  direct.max_vertices = 2;
+  const IndirectLight indirect(tracer, params);
   const GuidingField::Distribution guide = field.trained() ? field.distribution(p.position, p.geometric_normal)
                                                            : GuidingField::Distribution();
   const bool guided = field.trained() && guide.learned();
@@ -177,17 +188,13 @@ std::vector<DirectionCell> trace_cells(const PathTracer& tracer, const GuidingFi
     const int rows = f == 0 ? n : n / 2;  // a side face's upper half looks above the surface
     std::vector<DirectionCell> face(static_cast<size_t>(rows) * n);
     tbb::parallel_for(0, rows, [&](int row) {
-      std::vector<PathSample> with(n), without(n);
-      const PixelRect rect{0, row, n, row + 1};
-      TraceParams a = full, b = direct;
+      std::vector<double> light(static_cast<size_t>(n));
       for (int k = 0; k < s.paths_per_cell; ++k) {
-        a.seed = b.seed = s.seed * 7919u + static_cast<uint64_t>(k);
-        tracer.trace_pixels(camera, n, n, rect, static_cast<uint32_t>(k), a, with.data());
-        tracer.trace_pixels(camera, n, n, rect, static_cast<uint32_t>(k), b, without.data());
+        indirect.trace(camera, n, n, PixelRect{0, row, n, row + 1}, static_cast<uint32_t>(k),
+                       s.seed * 7919u + static_cast<uint64_t>(k), light.data());
         for (int i = 0; i < n; ++i) {
-          const double l = double(luminance(with[i].lv + with[i].hv)) - luminance(without[i].lv + without[i].hv);
-          face[size_t(row) * n + i].mean += l;
-          face[size_t(row) * n + i].second_moment += l * l;
+          face[size_t(row) * n + i].mean += light[i];
+          face[size_t(row) * n + i].second_moment += light[i] * light[i];
         }
       }
     });
