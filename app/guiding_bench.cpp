@@ -122,18 +122,20 @@ namespace {
 struct ErrorShares {
   double lv = 0.0, hv = 0.0;  // of the variance of LV + HV
 };
+// The two renders' seeds: this past the bench's seed, and the next.
+constexpr uint64_t kErrorShareSeedOffset = 1000;
 
 ErrorShares lv_hv_error_shares(const GuidingBoundBenchSetup& b, int spp) {
   Accumulation acc[2];
   for (int i = 0; i < 2; ++i) {
     TraceParams params = b.params;
     params.guiding = false;
-    params.seed = b.params.seed + 1000 + static_cast<uint64_t>(i);
+    params.seed = b.params.seed + kErrorShareSeedOffset + static_cast<uint64_t>(i);
     ProgressiveRenderer renderer(b.scene, params, b.width, b.height);
     for (int f = 0; f < spp; ++f) renderer.add_frame();
     acc[i] = renderer.accumulation();
   }
-  const auto lum = [](const glm::vec3& c) { return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b; };
+  const auto lum = [](const glm::vec3& c) { return double(luminance(c.r, c.g, c.b)); };
   double lv = 0.0, hv = 0.0, total = 0.0;
   for (size_t p = 0; p < acc[0].lv_mean.size(); ++p) {
     const double dl = lum(acc[0].lv_mean[p]) - lum(acc[1].lv_mean[p]), dh = lum(acc[0].hv_mean[p]) - lum(acc[1].hv_mean[p]);
@@ -183,7 +185,8 @@ void run_guiding_bound_bench(const GuidingBoundBenchSetup& b, const GuidingBound
     const ErrorShares shares = lv_hv_error_shares(b, b.lv_hv_spp);
     const double floor = sum.floor / sum.cosine, field = sum.field / sum.cosine;
     std::printf("error variance of %d-spp unguided renders (seeds %llu, %llu): LV %.3f, HV %.3f of LV + HV\n", b.lv_hv_spp,
-                static_cast<unsigned long long>(b.params.seed + 1000), static_cast<unsigned long long>(b.params.seed + 1001),
+                static_cast<unsigned long long>(b.params.seed + kErrorShareSeedOffset),
+                static_cast<unsigned long long>(b.params.seed + kErrorShareSeedOffset + 1),
                 shares.lv, shares.hv);
     std::printf("HDR error at equal samples against unguided, every first vertex guided, at no cost: at least %.3f with any "
                 "guide (sqrt(LV + HV x floor)); %.3f with the field\n",

@@ -169,5 +169,22 @@ TEST(GuidingBound, GlowingRoomHasItsSeriesOfBounces) {
   }
 }
 
+// Where the renderer's first vertices also trace specular chains, the bound says it leaves them out.
+TEST(GuidingBound, SaysWhenItLeavesTheChainsOut) {
+  const Scene scene = make_cornell_box(true);
+  TraceParams params;
+  params.threads = 2;
+  GuidingBoundSettings tiny;
+  tiny.points = 1;
+  tiny.face_cells = 2;
+  tiny.paths_per_cell = 1;
+  tiny.train_frames = 1;
+  tiny.floor_directions = 1;
+  tiny.floor_paths = 2;
+  EXPECT_TRUE(measure_guiding_bound(scene, params, 8, 8, tiny).chains_left_out);
+  params.near_specular_sampling = false;
+  EXPECT_FALSE(measure_guiding_bound(scene, params, 8, 8, tiny).chains_left_out);
+}
+
 }  // namespace
 }  // namespace pxf

@@ -103,11 +103,7 @@ TEST(Cli, GuidingBoundWritesItsTable) {
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("floor of any guide"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("at least"), std::string::npos) << r.out;
-  std::ifstream csv(out + "/guiding_bound.csv");
-  std::string line;
-  int rows = 0;
-  while (std::getline(csv, line)) ++rows;
-  EXPECT_EQ(rows, 4);  // the header and 3 points
+  EXPECT_EQ(lines(slurp(out + "/guiding_bound.csv")), 4u);  // the header and 3 points
   const Result odd = run("bench --guiding-bound --cells 5 --out " + out);
   EXPECT_EQ(odd.code, 2);
   EXPECT_EQ(lines(odd.err), 1u) << odd.err;
