@@ -25,16 +25,19 @@ struct PathFrameRecord {
   bool history = false;  // the reprojected history had weight in it
 };
 
-// Renders every frame of `path` in order on one Preview (the camera changes, the history
+// Renders the frames of `path` in order on one Preview (the camera changes, the history
 // reprojects) and calls `on_frame(frame, preview)` after each frame's display. Each frame: the
 // camera, the range buffer to convergence (so that the frames do not depend on timing), the traced
-// frames, then Preview::finish (the last-frame filter run, blend, tone map).
-template <class OnFrame>
+// frames, then Preview::finish (the last-frame filter run, blend, tone map). Before each frame after
+// the first, `should_stop()` can end the path: the frame under way is always finished.
+template <class OnFrame, class ShouldStop>
 std::vector<PathFrameRecord> render_path(Preview& preview, const CameraPath& path, const Camera& base,
-                                         const PathRenderOptions& options, OnFrame&& on_frame);
+                                         const PathRenderOptions& options, OnFrame&& on_frame,
+                                         ShouldStop&& should_stop);
 
 // The command: PNG frames and DIR/path.json (settings, per-frame samples and times), written as one
-// set (app/output_set.h). Returns the exit status.
+// set (app/output_set.h). Ctrl-C, SIGTERM or SIGHUP finishes the frame under way and commits the
+// frames done so far, path.json saying "interrupted"; returns the exit status (128 + the signal then).
 // Needs a current GL context.
 int run_camera_path_render(const Scene& scene, const std::string& scene_name, const PreviewSettings& settings,
                            int width, int height, const CameraPath& path, const PathRenderOptions& options);

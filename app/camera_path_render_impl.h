@@ -1,14 +1,15 @@
-// render_path's body (a template: the bench and the command pass their own per-frame work).
+// render_path's body (a template: the caller passes its own per-frame work and stop test).
 #pragma once
 #include "core/timing.h"
 
 namespace pxf {
 
-template <class OnFrame>
+template <class OnFrame, class ShouldStop>
 std::vector<PathFrameRecord> render_path(Preview& preview, const CameraPath& path, const Camera& base,
-                                         const PathRenderOptions& options, OnFrame&& on_frame) {
+                                         const PathRenderOptions& options, OnFrame&& on_frame,
+                                         ShouldStop&& should_stop) {
   std::vector<PathFrameRecord> records;
-  for (int frame = 0; frame < path.frame_count(); ++frame) {
+  for (int frame = 0; frame < path.frame_count() && (frame == 0 || !should_stop()); ++frame) {
     const auto start = BenchClock::now();
     preview.set_camera(camera_on_path(path, frame, base));
     preview.converge_range_buffer();

@@ -12,6 +12,7 @@
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 
 #include "core/error.h"
 #include "image/image.h"
@@ -70,24 +71,48 @@ bool is_own_temporary_file(const std::string& entry, const std::vector<std::stri
   return false;
 }
 
-// Removes a set folder's own files (the set's names and their temporaries) and then the folder if
-// nothing else is in it: a file someone else put there stays, and so does the folder.
-void remove_set_folder(const std::string& folder, const std::vector<std::string>& names) {
+std::string read_link(const std::string& path) {
+  char target[4096];
+  const ssize_t n = ::readlink(path.c_str(), target, sizeof(target) - 1);
+  return n > 0 ? std::string(target, static_cast<size_t>(n)) : std::string();
+}
+
+// The names a set folder (or DIR, without links) was committed with: its manifest, one a line.
+// A line that could reach outside the folder is not a name pxf wrote, and is skipped.
+std::vector<std::string> read_manifest(const std::string& folder) {
+  std::vector<std::string> names;
+  std::ifstream in(folder + "/" + kSetManifest);
+  for (std::string line; std::getline(in, line);)
+    if (!line.empty() && line != "." && line != ".." && line.find('/') == std::string::npos) names.push_back(line);
+  return names;
+}
+
+void write_manifest(const std::string& folder, const std::vector<std::string>& names) {
+  std::string text;
+  for (const std::string& name : names) text += name + "\n";
+  write_file_completely(folder + "/" + kSetManifest, text.data(), text.size());
+}
+
+bool contains(const std::vector<std::string>& names, const std::string& name) {
+  return std::find(names.begin(), names.end(), name) != names.end();
+}
+
+// Removes a set folder's own files (the names of its manifest and `names`, their temporaries and
+// the manifest) and then the folder if nothing else is in it: a file someone else put there stays,
+// and so does the folder.
+void remove_set_folder(const std::string& folder, std::vector<std::string> names) {
+  for (const std::string& name : read_manifest(folder))
+    if (!contains(names, name)) names.push_back(name);
+  names.push_back(kSetManifest);
   std::error_code ec;
   for (const auto& entry : fs::directory_iterator(folder, ec)) {
     const std::string name = entry.path().filename().string();
-    const bool own = std::find(names.begin(), names.end(), name) != names.end() ||
+    const bool own = contains(names, name) ||
                      std::any_of(names.begin(), names.end(),
                                  [&](const std::string& n) { return starts_with(name, n + ".tmp-"); });
     if (own && !entry.is_directory(ec)) ::unlink(entry.path().c_str());
   }
   ::rmdir(folder.c_str());
-}
-
-std::string read_link(const std::string& path) {
-  char target[4096];
-  const ssize_t n = ::readlink(path.c_str(), target, sizeof(target) - 1);
-  return n > 0 ? std::string(target, static_cast<size_t>(n)) : std::string();
 }
 
 // An exclusive flock on the output folder for the scope, so that two commits into one folder do
@@ -137,6 +162,39 @@ std::string make_set_folder(const std::string& dir, const std::vector<std::strin
 
 std::string current_link_target(const std::string& name) { return std::string(kCurrentSetLink) + "/" + name; }
 
+// What DIR/.pxf-output points at when pxf made it: one of its set folders, beside it.
+bool is_own_set_link_target(const std::string& target) {
+  return starts_with(target, kSetPrefix) && target.find('/') == std::string::npos;
+}
+
+// Throws unless DIR/.pxf-output is absent or a link pxf made: a user's folder or file of that name
+// is neither used nor replaced.
+void refuse_foreign_current_link(const std::string& dir) {
+  const std::string path = dir + "/" + kCurrentSetLink;
+  struct stat st {};
+  if (::lstat(path.c_str(), &st) != 0) {
+    if (errno == ENOENT) return;
+    throw Error(path + ": cannot read: " + system_error(errno));
+  }
+  if (S_ISLNK(st.st_mode) && is_own_set_link_target(read_link(path))) return;
+  const char* what = S_ISDIR(st.st_mode) ? "a folder" : S_ISLNK(st.st_mode) ? "a link" : "a file";
+  throw Error(path + ": " + what + " that pxf did not make; pxf writes its output set there, so move it away or choose "
+              "another output folder");
+}
+
+// After the switch, the links DIR/<x> -> .pxf-output/<x> of the replaced set whose name the new set
+// lacks point at nothing: they go (only pxf makes a link of exactly that form).
+void remove_links_outside(const std::string& dir, const std::vector<std::string>& names) {
+  std::error_code ec;
+  std::vector<std::string> dangling;
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (!contains(names, name) && entry.is_symlink(ec) && read_link(entry.path().string()) == current_link_target(name))
+      dangling.push_back(entry.path().string());
+  }
+  for (const std::string& path : dangling) ::unlink(path.c_str());
+}
+
 // DIR/.pxf-link-<host>-<pid>-<use>: the temporary link that is renamed over DIR/.pxf-output.
 std::string commit_link_path(const std::string& dir, int use) {
   return dir + "/" + kCommitLinkPrefix + host_field() + "-" + std::to_string(::getpid()) + "-" + std::to_string(use);
@@ -170,14 +228,26 @@ void remove_stale_temporaries(const std::string& dir, const std::vector<std::str
   }
 }
 
+void check_output_folder(const std::string& dir) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw Error(dir + ": cannot create output folder: " + ec.message());
+  refuse_foreign_current_link(dir);
+  // A probe of the commit link's name (a set folder's would take a set's sequence number).
+  const std::string probe = commit_link_path(dir, 2);
+  if (::mkdir(probe.c_str(), 0777) != 0 && errno != EEXIST)
+    throw Error(dir + ": cannot write into the output folder: " + system_error(errno));
+  ::rmdir(probe.c_str());
+}
+
 OutputSetWriter::OutputSetWriter(std::string dir, std::vector<std::string> names)
     : dir_(std::move(dir)), names_(std::move(names)) {
-  std::error_code ec;
-  fs::create_directories(dir_, ec);
-  if (ec) throw Error(dir_ + ": cannot create output folder: " + ec.message());
+  check_output_folder(dir_);
   set_name_ = make_set_folder(dir_, names_);
   staging_ = dir_ + "/" + set_name_;
 }
+
+void OutputSetWriter::set_names(std::vector<std::string> names) { names_ = std::move(names); }
 
 OutputSetWriter::~OutputSetWriter() {
   if (!committed_) remove_set_folder(staging_, names_);
@@ -186,9 +256,13 @@ OutputSetWriter::~OutputSetWriter() {
 void OutputSetWriter::commit() {
   for (const std::string& name : names_) {
     struct stat st {};
+    if (::lstat((staging_ + "/" + name).c_str(), &st) != 0 || !S_ISREG(st.st_mode))
+      throw Error(staging_ + "/" + name + ": not written, so the set is not committed");
     if (::lstat((dir_ + "/" + name).c_str(), &st) == 0 && !S_ISREG(st.st_mode) && !S_ISLNK(st.st_mode))
       throw Error(dir_ + "/" + name + ": cannot replace: not a file");
   }
+  refuse_foreign_current_link(dir_);
+  write_manifest(staging_, names_);
   sync_folder(staging_);
   const FolderLock lock(dir_);
   const std::string commit_link = commit_link_path(dir_, 0);
@@ -208,8 +282,8 @@ void OutputSetWriter::commit() {
   }
   sync_folder(dir_);
   committed_ = true;
-  if (starts_with(previous, kSetPrefix) && previous.find('/') == std::string::npos && previous != set_name_)
-    remove_set_folder(dir_ + "/" + previous, names_);
+  remove_links_outside(dir_, names_);
+  if (is_own_set_link_target(previous) && previous != set_name_) remove_set_folder(dir_ + "/" + previous, names_);
   remove_stale_temporaries(dir_, names_);
 }
 
@@ -253,11 +327,22 @@ void OutputSetWriter::link_every_name() {
 }
 
 // The fallback without symbolic links: each file is renamed over its name, never removed first.
+// DIR's own manifest then names the current set, so that the next commit removes the names it
+// lacks.
 void OutputSetWriter::replace_file_by_file() {
   for (const std::string& name : names_) {
     const std::string from = staging_ + "/" + name, to = dir_ + "/" + name;
     if (::rename(from.c_str(), to.c_str()) != 0)
       throw Error(to + ": cannot move into place: " + system_error(errno));
+  }
+  const std::vector<std::string> previous = read_manifest(dir_);
+  const std::string manifest = std::string(staging_) + "/" + kSetManifest;
+  if (::rename(manifest.c_str(), (dir_ + "/" + kSetManifest).c_str()) != 0)
+    throw Error(dir_ + "/" + kSetManifest + ": cannot move into place: " + system_error(errno));
+  for (const std::string& name : previous) {
+    struct stat st {};
+    const std::string path = dir_ + "/" + name;
+    if (!contains(names_, name) && ::lstat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode)) ::unlink(path.c_str());
   }
   sync_folder(dir_);
   committed_ = true;

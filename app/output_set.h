@@ -10,8 +10,14 @@
 // symbolic links (FAT, some network shares), each file is renamed over its name instead: every
 // name then always holds a complete file, but a kill between two renames can leave a mix.
 //
+// A set owns its names: each set folder holds a manifest (.pxf-names) of the names it was committed
+// with, and a commit removes the links of the set it replaces that the new set lacks (a 3-frame
+// camera path after a 6-frame one leaves no frame-0003..5.png), then that set's folder, whole.
+//
 // pxf removes only what it names itself (see is_stale_temporary): a set folder, link or
 // temporary file of a process that is gone, and in a set folder only the set's own file names.
+// A .pxf-output that pxf did not make (the user's folder or file) is refused before anything in
+// DIR is touched.
 #pragma once
 #include <string>
 #include <vector>
@@ -20,7 +26,8 @@ namespace pxf {
 
 class OutputSetWriter {
  public:
-  // Creates DIR if needed and an empty staging folder inside it; throws pxf::Error naming DIR.
+  // Creates DIR if needed and an empty staging folder inside it; throws pxf::Error naming DIR, or
+  // naming DIR/.pxf-output where that is not pxf's (check_output_folder).
   OutputSetWriter(std::string dir, std::vector<std::string> names);
   ~OutputSetWriter();  // removes the staging folder unless committed
   OutputSetWriter(const OutputSetWriter&) = delete;
@@ -32,6 +39,9 @@ class OutputSetWriter {
   // temporaries of pxf's are in DIR; throws pxf::Error naming the file that failed, with the
   // previous set still in place.
   void commit();
+  // Narrows the set to `names` before commit(), for a job that was stopped before it wrote every
+  // name it planned (a camera path stopped after some frames): only these are committed.
+  void set_names(std::vector<std::string> names);
 
  private:
   void link_every_name();
@@ -45,6 +55,13 @@ class OutputSetWriter {
 
 // The link that names the current set, relative to DIR.
 inline const char* const kCurrentSetLink = ".pxf-output";
+// The manifest in each set folder (and in DIR on a file system without links): one name a line.
+inline const char* const kSetManifest = ".pxf-names";
+
+// Creates DIR if needed and checks, before any work, that an output set can be committed there:
+// DIR/.pxf-output is absent or pxf's own link, and DIR takes a new folder. Throws pxf::Error with
+// one line naming the path.
+void check_output_folder(const std::string& dir);
 
 // ".pxf-set-<host>-<pid>-<sequence>": the folder that the sequence-th set of process pid on this
 // host is written into.

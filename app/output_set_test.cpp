@@ -34,9 +34,9 @@ std::string read_text(const std::string& path) {
 
 void write_text(const std::string& path, const std::string& text) { std::ofstream(path) << text; }
 
-void commit_set(const std::string& dir, const std::string& text) {
-  OutputSetWriter writer(dir, kNames);
-  for (const std::string& name : kNames) write_text(writer.staging() + "/" + name, text + " " + name);
+void commit_set(const std::string& dir, const std::string& text, const std::vector<std::string>& names = kNames) {
+  OutputSetWriter writer(dir, names);
+  for (const std::string& name : names) write_text(writer.staging() + "/" + name, text + " " + name);
   writer.commit();
 }
 
@@ -133,6 +133,86 @@ TEST(OutputSet, CleanUpRemovesOnlyTheSetsOwnFiles) {
   EXPECT_FALSE(fs::exists(foreign + "/a.txt"));
   EXPECT_EQ(read_text(dir + "/thesis.tmp-99999/chapter1.tex"), "the user's");
   EXPECT_EQ(read_text(dir + "/report.docx.tmp-4000001"), "the user's");
+}
+
+// A set of other names replaces one: the old names the new set lacks go with the old set, and no
+// set folder is left behind (a render after a camera path, a 3-frame path after a 6-frame one).
+TEST(OutputSet, ASetOfOtherNamesLeavesNoDanglingNameAndNoOrphanFolder) {
+  const std::string dir = fresh_dir("other_names");
+  commit_set(dir, "six", {"f0", "f1", "f2", "f3", "f4", "f5", "path.json"});
+  commit_set(dir, "three", {"f0", "f1", "f2", "path.json"});
+  EXPECT_EQ(entries(dir).size(), 6u);  // f0..f2, path.json, .pxf-output and one set folder
+  EXPECT_FALSE(fs::is_symlink(dir + "/f3"));
+  EXPECT_EQ(read_text(dir + "/f2"), "three f2");
+  commit_set(dir, "render");
+  EXPECT_EQ(entries(dir), (std::set<std::string>{"a.txt", "b.txt", kCurrentSetLink,
+                                                 fs::read_symlink(dir + "/" + kCurrentSetLink).string()}));
+  EXPECT_EQ(read_text(dir + "/b.txt"), "render b.txt");
+}
+
+// A user's name of the same form that is not one of pxf's links stays.
+TEST(OutputSet, ANewSetKeepsTheUsersOwnFilesBesideIt) {
+  const std::string dir = fresh_dir("users_beside");
+  commit_set(dir, "first", {"a.txt", "c.txt"});
+  fs::remove(dir + "/c.txt");
+  write_text(dir + "/c.txt", "the user's");
+  fs::create_symlink("a.txt", dir + "/mine.txt");
+  commit_set(dir, "second");
+  EXPECT_EQ(read_text(dir + "/c.txt"), "the user's");
+  EXPECT_TRUE(fs::is_symlink(dir + "/mine.txt"));
+}
+
+TEST(OutputSet, OnlyTheNamesWrittenAreCommittedAndAMissingOneIsRefused) {
+  const std::string dir = fresh_dir("set_names");
+  {
+    OutputSetWriter writer(dir, {"f0", "f1", "f2"});
+    write_text(writer.staging() + "/f0", "frame 0");
+    writer.set_names({"f0"});
+    writer.commit();
+  }
+  EXPECT_EQ(read_text(dir + "/f0"), "frame 0");
+  EXPECT_FALSE(fs::exists(dir + "/f1"));
+  OutputSetWriter writer(dir, {"f0", "f1"});
+  write_text(writer.staging() + "/f0", "frame 0 again");
+  EXPECT_THROW(writer.commit(), Error);
+  EXPECT_EQ(read_text(dir + "/f0"), "frame 0");
+}
+
+// DIR/.pxf-output as the user's folder, file or link: refused before any name is touched, and
+// left as it was.
+TEST(OutputSet, AForeignCurrentSetNameIsRefusedBeforeAnythingIsTouched) {
+  for (const std::string kind : {"folder", "file", "link"}) {
+    const std::string dir = fresh_dir("foreign_" + kind), current = dir + "/" + kCurrentSetLink;
+    if (kind == "folder") {
+      fs::create_directory(current);
+      write_text(current + "/a.txt", "the user's");
+    } else if (kind == "file") {
+      write_text(current, "the user's");
+    } else {
+      fs::create_symlink("/tmp", current);
+    }
+    const std::set<std::string> before = entries(dir);
+    try {
+      commit_set(dir, "new");
+      FAIL() << kind << " was used";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(current + ": a " + kind + " that pxf did not make"), std::string::npos)
+          << e.what();
+    }
+    EXPECT_EQ(entries(dir), before) << kind;
+    if (kind == "folder") EXPECT_EQ(read_text(current + "/a.txt"), "the user's");
+    if (kind == "file") EXPECT_EQ(read_text(current), "the user's");
+    EXPECT_THROW(check_output_folder(dir), Error);
+  }
+}
+
+// The same writer's check, up front: a folder that takes no new entry is refused.
+TEST(OutputSet, AFolderThatTakesNoNewEntryIsRefusedUpFront) {
+  EXPECT_THROW(check_output_folder("/proc/self"), Error);
+  const std::string dir = fresh_dir("check");
+  EXPECT_NO_THROW(check_output_folder(dir + "/new/folder"));
+  EXPECT_TRUE(fs::is_directory(dir + "/new/folder"));
+  EXPECT_TRUE(entries(dir + "/new/folder").empty());
 }
 
 }  // namespace

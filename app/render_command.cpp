@@ -1,10 +1,7 @@
 // pxf render: headless progressive capture with pixel filtering (issue 4 item 6).
 #include <algorithm>
-#include <atomic>
 #include <chrono>
-#include <csignal>
 #include <cstdio>
-#include <iterator>
 #include <unistd.h>
 
 #include "app/camera_path_render.h"
@@ -13,48 +10,15 @@
 #include "app/first_frame.h"
 #include "app/options.h"
 #include "app/preview.h"
+#include "app/output_set.h"
 #include "app/render_output.h"
+#include "app/stop_signal.h"
 #include "core/timing.h"
 #include "gl/context.h"
 
 namespace pxf {
 
 namespace {
-
-// The stop signal that arrived (SIGINT, SIGTERM or SIGHUP), or 0. The render then finishes its
-// frame and writes every output; the exit status is 128 + that signal, as a shell reports it.
-std::atomic<int> g_stop_signal{0};
-const int kStopSignals[] = {SIGINT, SIGTERM, SIGHUP};
-
-extern "C" void on_stop_signal(int signal_number) {
-  g_stop_signal = signal_number;
-  // A second stop signal ends the process at once; the output set stays whole (output_set.h).
-  for (int s : kStopSignals) std::signal(s, SIG_DFL);
-}
-
-// Installs on_stop_signal for each stop signal that is not ignored (a background job of a shell
-// script must stay immune to the terminal's Ctrl-C, a nohup'ed one to SIGHUP); the previous
-// dispositions come back at scope exit. A process-directed signal may reach any thread (TBB's,
-// llvmpipe's): the handler only sets a flag, so whichever runs it is fine.
-class StopSignalHandlers {
- public:
-  StopSignalHandlers() {
-    for (size_t i = 0; i < std::size(kStopSignals); ++i) {
-      struct sigaction current {};
-      sigaction(kStopSignals[i], nullptr, &current);
-      ignored_[i] = current.sa_handler == SIG_IGN;
-      if (!ignored_[i]) previous_[i] = std::signal(kStopSignals[i], on_stop_signal);
-    }
-  }
-  ~StopSignalHandlers() {
-    for (size_t i = 0; i < std::size(kStopSignals); ++i)
-      if (!ignored_[i]) std::signal(kStopSignals[i], previous_[i]);
-  }
-
- private:
-  bool ignored_[std::size(kStopSignals)] = {};
-  void (*previous_[std::size(kStopSignals)])(int) = {};
-};
 
 // "[#######.....]  12/64 spp  1.2 s elapsed  ETA 5.1 s" on stderr, at most ~10 times a second.
 class ProgressBar {
@@ -138,6 +102,7 @@ int run_render(const Args& args) {
     path_options.out = out;
     path_options.quiet = quiet;
     Scene scene = load_scene_for(scene_options, preview_settings, cli);
+    check_output_folder(out);  // before the path's cameras are made and traced
     const CameraPath path = camera_path_for(camera_path, scene);
     set_gl_timing(scene_options.stage_timing);
     auto context = create_gl_context(parse_gl_backend(scene_options.gl));
@@ -159,6 +124,7 @@ int run_render(const Args& args) {
   Scene scene = load_scene_for(scene_options, preview_settings, cli);
   const double load_ms = elapsed_ms(start);
   if (!reference.empty()) check_reference(reference, scene_options.width, scene_options.height);  // before tracing
+  check_output_folder(out);  // a folder that cannot take the outputs is refused before the tracing
   set_gl_timing(scene_options.stage_timing);
   auto context = create_gl_context(parse_gl_backend(scene_options.gl));
   // The first frame traces whatever the budget: refused up front when even it cannot fit.
@@ -169,7 +135,6 @@ int run_render(const Args& args) {
                             frames);
   checkpointer.start(preview);
 
-  g_stop_signal = 0;
   const StopSignalHandlers stop_handlers;  // kept through the writes: a stop then still gives 128 + signal
   const int total = static_cast<int>(frames.count());
   ProgressBar progress(total);
@@ -177,7 +142,7 @@ int run_render(const Args& args) {
   RenderReport report;
   report.until_clean = until_clean;
   GrowingSchedule checks = clean_checks(first);
-  for (int i = first; i < total && !g_stop_signal; ++i) {
+  for (int i = first; i < total && !stop_signal(); ++i) {
     // The first frame always traces; the next ones only while they and the finish fit the budget.
     if (i > first && !next_frame_fits(preview.predict_next_frame(budget_ms, elapsed_ms(start)))) break;
     // With a budget the first frame is displayed: that measures the finish's blend and tone map.
@@ -202,7 +167,7 @@ int run_render(const Args& args) {
   if (!quiet) progress.finish();
 
   report.scene = &scene_options;
-  report.interrupted = g_stop_signal != 0;
+  report.interrupted = stop_signal() != 0;
   report.gl_backend = context->backend_name();
   report.gl_renderer = context->gl_renderer();
   report.reference_path = reference;
@@ -232,7 +197,7 @@ int run_render(const Args& args) {
     std::fprintf(stderr, "pxf render: %s\n", state_error.c_str());
     return 1;
   }
-  return g_stop_signal ? 128 + g_stop_signal : 0;
+  return stop_signal() ? 128 + stop_signal() : 0;
 }
 
 }  // namespace pxf

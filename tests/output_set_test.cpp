@@ -234,6 +234,155 @@ TEST(OutputSet, WithoutSymlinksEachFileIsReplacedWhole) {
     for (const char* name : kOutputs) EXPECT_FALSE(fs::is_symlink(out + "/" + name)) << name;
     EXPECT_EQ(check_set(out).width, width) << check_set(out).problem;
     for (const auto& entry : fs::directory_iterator(out))
-      EXPECT_NE(entry.path().filename().string().rfind(".pxf-", 0), 0u) << entry.path();
+      if (entry.path().filename() != kSetManifest) {
+        EXPECT_NE(entry.path().filename().string().rfind(".pxf-", 0), 0u) << entry.path();
+      }
+  }
+  // A camera path after the render: the render's names go, the frames stay plain files.
+  const std::string command = "LD_PRELOAD=" + std::string(PXF_NO_SYMLINKS_SHIM) + " " + PXF_EXECUTABLE +
+                              " render --size 16x16 --camera-path turntable:2 --quiet --out " + out + " >/dev/null 2>&1";
+  ASSERT_EQ(std::system(command.c_str()), 0) << command;
+  for (const char* name : kOutputs) EXPECT_FALSE(fs::exists(out + "/" + name)) << name;
+  EXPECT_TRUE(fs::is_regular_file(out + "/frame-0001.png"));
+}
+
+namespace {
+
+// A child process running `pxf ARGS...` with its stderr in `err_file` and stdout thrown away.
+pid_t start_pxf(const std::vector<std::string>& args, const std::string& err_file) {
+  std::ofstream(err_file, std::ios::trunc);  // empty before the child starts: no earlier run's lines
+  const pid_t pid = fork();
+  if (pid == 0) {
+    std::freopen(err_file.c_str(), "w", stderr);
+    std::freopen("/dev/null", "w", stdout);
+    std::vector<char*> argv{const_cast<char*>("pxf")};
+    for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    execv(PXF_EXECUTABLE, argv.data());
+    _exit(127);
+  }
+  return pid;
+}
+
+// The frames a camera-path render has reported finished on stderr ("\rframe K/N"): K of the last.
+int frames_reported(const std::string& err_file) {
+  const std::string err = test_support::slurp(err_file);
+  const size_t at = err.rfind("frame ");
+  return at == std::string::npos ? 0 : std::atoi(err.c_str() + at + 6);
+}
+
+// What a camera-path output folder holds: every frame path.json lists, each a whole PNG, and none
+// past them; returns the frame count, or -1 with `problem` set.
+int check_path_set(const std::string& out, std::string* problem) {
+  const auto path = nlohmann::json::parse(test_support::slurp(out + "/path.json"), nullptr, false);
+  if (path.is_discarded() || !path.contains("frames")) return *problem = "path.json is missing or not whole", -1;
+  const int frames = static_cast<int>(path["frames"].size());
+  for (int f = 0; f < frames; ++f) {
+    char name[32];
+    std::snprintf(name, sizeof name, "/frame-%04d.png", f);
+    try {
+      if (read_ldr_or_hdr(out + name).width != 16) return *problem = std::string(name) + " has another size", -1;
+    } catch (const std::exception& e) {
+      return *problem = std::string(name) + " is not whole: " + e.what(), -1;
+    }
+  }
+  char next[32];
+  std::snprintf(next, sizeof next, "/frame-%04d.png", frames);
+  if (fs::exists(out + next)) return *problem = std::string(next) + " is past path.json's frames", -1;
+  return frames;
+}
+
+}  // namespace
+
+// Ctrl-C (or SIGTERM) at random moments of a long camera path, after its first frame: the render
+// finishes the frame under way, commits every finished frame with path.json, and exits 128 + the
+// signal. No frame that the render reported finished is lost. PXF_STRESS_TRIALS sets the count
+// (docs/robustness.md quotes 100).
+TEST(OutputSet, StopSignalsDuringACameraPathLoseNoFinishedFrame) {
+  const std::string out = test_support::temp_dir("output_set", "path_signals");
+  const std::string err_file = test_support::temp_dir("output_set", "path_signals_err") + ".txt";
+  const int trials = env_count("PXF_STRESS_TRIALS", 12);
+  std::mt19937 rng(59);
+  int frames_kept = 0;
+  for (int trial = 0; trial < trials; ++trial) {
+    const int signal_number = trial % 3 == 2 ? SIGTERM : SIGINT;
+    const pid_t pid = start_pxf({"render", "--size", "16x16", "--camera-path", "turntable:400", "--out", out}, err_file);
+    ASSERT_GT(pid, 0);
+    int status = 0;
+    while (frames_reported(err_file) == 0 && waitpid(pid, &status, WNOHANG) == 0)
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    std::this_thread::sleep_for(std::chrono::milliseconds(std::uniform_int_distribution<int>(0, 400)(rng)));
+    const int reported_before = frames_reported(err_file);
+    kill(pid, signal_number);
+    status = wait_status(pid);
+    ASSERT_TRUE(WIFEXITED(status)) << "trial " << trial << ": killed by signal " << WTERMSIG(status);
+    ASSERT_EQ(WEXITSTATUS(status), 128 + signal_number) << "trial " << trial;
+    std::string problem;
+    const int frames = check_path_set(out, &problem);
+    ASSERT_GE(frames, 0) << "trial " << trial << ": " << problem;
+    ASSERT_GE(frames, reported_before) << "trial " << trial << ": frames lost";
+    ASSERT_GE(frames, frames_reported(err_file)) << "trial " << trial << ": frames lost";
+    const auto path = nlohmann::json::parse(test_support::slurp(out + "/path.json"));
+    EXPECT_TRUE(path["interrupted"].get<bool>());
+    EXPECT_EQ(path["frames_planned"].get<int>(), 400);
+    frames_kept += frames;
+  }
+  std::printf("%d stops of a 400-frame path: %d finished frames kept, none lost\n", trials, frames_kept);
+  EXPECT_TRUE(leftovers(out).empty()) << leftovers(out).front();
+}
+
+// A render, then a camera path, then a shorter path, then a render into one folder: each set shows
+// its own names only, no link dangles and one set folder is left.
+TEST(OutputSet, SetsOfOtherNamesReplaceEachOtherWithoutDanglingNames) {
+  const std::string out = test_support::temp_dir("output_set", "other_names");
+  const auto expect_no_dangling = [&](const std::string& step) {
+    for (const auto& entry : fs::directory_iterator(out))
+      if (entry.is_symlink()) {
+        EXPECT_TRUE(fs::exists(entry.path())) << step << ": " << entry.path() << " dangles";
+      }
+    EXPECT_TRUE(leftovers(out).empty()) << step << ": " << leftovers(out).front();
+  };
+  ASSERT_EQ(WEXITSTATUS(wait_status(start_render(out, 16))), 0);
+  const std::string err_file = out + "-err.txt";
+  for (const char* frames : {"turntable:6", "turntable:3"}) {
+    ASSERT_EQ(WEXITSTATUS(wait_status(
+                  start_pxf({"render", "--size", "16x16", "--camera-path", frames, "--quiet", "--out", out}, err_file))),
+              0);
+    expect_no_dangling(frames);
+    for (const char* name : kOutputs) EXPECT_FALSE(fs::exists(out + "/" + name)) << name;
+  }
+  std::string problem;
+  EXPECT_EQ(check_path_set(out, &problem), 3) << problem;
+  ASSERT_EQ(WEXITSTATUS(wait_status(start_render(out, 16))), 0);
+  expect_no_dangling("render");
+  EXPECT_FALSE(fs::exists(out + "/frame-0000.png"));
+  EXPECT_EQ(check_set(out).problem, "");
+}
+
+// A .pxf-output of the user's (a folder or a file) is refused with one line before the tracing,
+// and nothing of the folder changes.
+TEST(OutputSet, AForeignCurrentSetNameIsRefusedByTheCommands) {
+  for (const bool folder : {true, false}) {
+    for (const char* mode : {"render", "path"}) {
+      const std::string out = test_support::temp_dir("output_set", std::string("foreign_") + mode + (folder ? "_dir" : "_file"));
+      fs::create_directories(out);
+      const std::string current = out + "/" + kCurrentSetLink;
+      if (folder) {
+        fs::create_directory(current);
+        std::ofstream(current + "/final.png") << "the user's";
+      } else {
+        std::ofstream(current) << "the user's";
+      }
+      const std::string args = std::string(mode) == "render" ? "render --size 16x16 --spp 100000 --out " + out
+                                                              : "render --size 16x16 --camera-path turntable:100000 --out " + out;
+      const test_support::PxfResult r = test_support::run_pxf(args, "output_set");
+      EXPECT_EQ(r.code, 1) << mode << ": " << r.err;
+      EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+      EXPECT_NE(r.err.find("that pxf did not make"), std::string::npos) << r.err;
+      size_t entries = 0;
+      for ([[maybe_unused]] const auto& entry : fs::directory_iterator(out)) ++entries;
+      EXPECT_EQ(entries, 1u) << mode;
+      EXPECT_EQ(test_support::slurp(folder ? current + "/final.png" : current), "the user's");
+    }
   }
 }
