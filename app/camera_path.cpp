@@ -3,14 +3,15 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
-#include <fstream>
-#include <sstream>
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <nlohmann/json.hpp>
 
+#include "app/cli.h"
 #include "app/explorer_camera.h"
 #include "core/error.h"
+#include "core/json_depth.h"
+#include "image/input_file.h"
 
 namespace pxf {
 
@@ -37,6 +38,9 @@ glm::vec3 read_point(const json& key, const char* field, const std::string& sour
     const json& v = (*it)[c];
     if (!v.is_number() || !std::isfinite(v.get<double>()))
       refuse(source, where + ": \"" + field + "\" must be an array of 3 finite numbers");
+    // In doubles and after narrowing: 1e300 is finite as a double and infinite as a float.
+    if (!(std::abs(v.get<double>()) <= kMaxPathCoordinate) || !std::isfinite(v.get<float>()))
+      refuse(source, where + ": \"" + field + "\" must lie within +-1e12");
     p[c] = v.get<float>();
   }
   return p;
@@ -103,11 +107,12 @@ CameraPath parse_camera_path(const std::string& json_text, const std::string& so
 }
 
 CameraPath read_camera_path(const std::string& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw Error("camera path " + file + ": cannot be read");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse_camera_path(text.str(), file);
+  // The one input reader (image/input_file.h): a FIFO or /dev/zero is refused, not read.
+  const std::vector<unsigned char> bytes = read_input_file(file, kMaxPathFileBytes);
+  const std::string text(bytes.begin(), bytes.end());
+  if (json_nesting_depth(text.data(), text.size()) > kMaxJsonDepth)
+    refuse(file, "JSON nested deeper than " + std::to_string(kMaxJsonDepth) + " levels");
+  return parse_camera_path(text, file);
 }
 
 CameraPath turntable_path(const Scene& scene, int frames) {
@@ -137,30 +142,89 @@ CameraPath turntable_path(const Scene& scene, int frames) {
 
 CameraPath camera_path_for(const std::string& spec, const Scene& scene) {
   const std::string prefix = "turntable:";
-  if (spec.rfind(prefix, 0) != 0) return read_camera_path(spec);
-  const std::string count = spec.substr(prefix.size());
-  char* end = nullptr;
-  const long frames = std::strtol(count.c_str(), &end, 10);
-  if (count.empty() || *end != '\0') throw Error("camera path " + spec + ": expected turntable:N, N a frame count");
-  return turntable_path(scene, static_cast<int>(std::min<long>(frames, kMaxPathFrames + 1L)));
+  CameraPath path;
+  if (spec.rfind(prefix, 0) != 0) {
+    path = read_camera_path(spec);
+  } else {
+    // A bad N is a bad flag value (exit 2), like any other.
+    const std::string count = spec.substr(prefix.size());
+    char* end = nullptr;
+    const long frames = std::strtol(count.c_str(), &end, 10);
+    if (count.empty() || *end != '\0' || frames < 1 || frames > kMaxPathFrames)
+      throw UsageError("--camera-path " + spec + ": expected turntable:N, N a frame count in [1, " +
+                       std::to_string(kMaxPathFrames) + "]");
+    path = turntable_path(scene, static_cast<int>(frames));
+  }
+  check_path_cameras(path, scene.camera, spec);
+  return path;
+}
+
+namespace {
+
+// Where a path's camera is and looks at `t` (0..1) along keyframe `segment` to the next.
+struct PathPose {
+  glm::vec3 position, target;
+  float fov_degrees;
+};
+
+PathPose pose_in_segment(const CameraPath& path, int segment, float t, const Camera& base) {
+  const std::vector<CameraKeyframe>& k = path.keyframes;
+  const int last = static_cast<int>(k.size()) - 1;
+  const CameraKeyframe& a = k[segment];
+  const CameraKeyframe& b = k[std::min(segment + 1, last)];
+  const float fov_a = a.fov_degrees > 0 ? a.fov_degrees : glm::degrees(base.yfov);
+  const float fov_b = b.fov_degrees > 0 ? b.fov_degrees : glm::degrees(base.yfov);
+  const float fov = fov_a + (fov_b - fov_a) * t;
+  if (!path.spline) return {glm::mix(a.position, b.position, t), glm::mix(a.target, b.target, t), fov};
+  const CameraKeyframe& before = k[std::max(segment - 1, 0)];
+  const CameraKeyframe& after = k[std::min(segment + 2, last)];
+  return {catmull_rom(before.position, a.position, b.position, after.position, t),
+          catmull_rom(before.target, a.target, b.target, after.target, t), fov};
+}
+
+float segment_t(const CameraPath& path, int segment, int frame_in_segment) {
+  const int frames = path.keyframes[segment].frames;
+  return frames > 0 ? std::clamp(static_cast<float>(frame_in_segment) / frames, 0.0f, 1.0f) : 0.0f;
+}
+
+float largest_magnitude(glm::vec3 v) { return std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)}); }
+
+// What is wrong with a pose as a camera (finite, within the bound, position and target apart, a
+// finite frame), or "" when nothing is. The spline can leave the keyframes' bounds, and two
+// keyframes can cross, so every frame is checked, not only the keyframes.
+std::string pose_problem(const PathPose& pose, const Camera& base) {
+  for (const glm::vec3& p : {pose.position, pose.target})
+    if (!(largest_magnitude(p) <= static_cast<float>(kMaxPathCoordinate))) return "the camera leaves +-1e12";
+  const float scale = std::max({1.0f, largest_magnitude(pose.position), largest_magnitude(pose.target)});
+  if (!(glm::length(pose.target - pose.position) > 1e-6f * scale)) return "position and target meet";
+  if (!(pose.fov_degrees > 0.0f && pose.fov_degrees < 180.0f)) return "the field of view leaves (0, 180) degrees";
+  const glm::mat4 m = look_at(base, pose.position, pose.target, pose.fov_degrees).camera_to_world;
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r)
+      if (!std::isfinite(m[c][r])) return "the camera frame is not finite";
+  return "";
+}
+
+}  // namespace
+
+void check_path_cameras(const CameraPath& path, const Camera& base, const std::string& source) {
+  int frame = 0;
+  for (int segment = 0; segment < static_cast<int>(path.keyframes.size()); ++segment) {
+    const bool last = segment + 1 == static_cast<int>(path.keyframes.size());
+    const int frames = last ? 1 : path.keyframes[segment].frames;
+    for (int i = 0; i < frames; ++i, ++frame) {
+      const std::string problem = pose_problem(pose_in_segment(path, segment, segment_t(path, segment, i), base), base);
+      if (!problem.empty()) refuse(source, "frame " + std::to_string(frame) + ": " + problem);
+    }
+  }
 }
 
 Camera camera_on_path(const CameraPath& path, int frame, const Camera& base) {
   const std::vector<CameraKeyframe>& k = path.keyframes;
   int segment = 0, start = 0;
   while (segment + 1 < static_cast<int>(k.size()) - 1 && frame >= start + k[segment].frames) start += k[segment++].frames;
-  const int last = static_cast<int>(k.size()) - 1;
-  const float t = k[segment].frames > 0 ? std::clamp(static_cast<float>(frame - start) / k[segment].frames, 0.0f, 1.0f) : 0.0f;
-  const CameraKeyframe& a = k[segment];
-  const CameraKeyframe& b = k[std::min(segment + 1, last)];
-  const float fov_a = a.fov_degrees > 0 ? a.fov_degrees : glm::degrees(base.yfov);
-  const float fov_b = b.fov_degrees > 0 ? b.fov_degrees : glm::degrees(base.yfov);
-  const float fov = fov_a + (fov_b - fov_a) * t;
-  if (!path.spline) return look_at(base, glm::mix(a.position, b.position, t), glm::mix(a.target, b.target, t), fov);
-  const CameraKeyframe& before = k[std::max(segment - 1, 0)];
-  const CameraKeyframe& after = k[std::min(segment + 2, last)];
-  return look_at(base, catmull_rom(before.position, a.position, b.position, after.position, t),
-                 catmull_rom(before.target, a.target, b.target, after.target, t), fov);
+  const PathPose pose = pose_in_segment(path, segment, segment_t(path, segment, frame - start), base);
+  return look_at(base, pose.position, pose.target, pose.fov_degrees);
 }
 
 }  // namespace pxf

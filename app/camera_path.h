@@ -7,6 +7,7 @@
 // last. The path has sum(frames) + 1 frames: frame 0 is the first keyframe, the last the last one.
 // `pxf render --camera-path turntable:N` is a turntable of N frames around the scene (turntable_path).
 #pragma once
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -33,13 +34,24 @@ struct CameraPath {
 // non-finite field, fewer than two keyframes, position == target, fov outside (0, 180), frames
 // outside [1, kMaxPathFrames] or a total above it).
 CameraPath parse_camera_path(const std::string& json_text, const std::string& source);
+// Through the one input reader (image/input_file.h), at most kMaxPathFileBytes, JSON nested at most
+// kMaxJsonDepth levels; the same refusals.
 CameraPath read_camera_path(const std::string& file);
 constexpr int kMaxPathFrames = 100000;
+constexpr uint64_t kMaxPathFileBytes = 64ull << 20;  // 100,000 keyframes of about 100 bytes, and room
+// Every camera position and target of a path, as the scene's cameras (docs/robustness.md, "Scenes").
+constexpr double kMaxPathCoordinate = 1e12;
+
+// Checks the camera of every frame of `path` over `base` as the scene's cameras are checked: finite,
+// within +-kMaxPathCoordinate, position and target apart, a finite camera frame. Throws pxf::Error,
+// one line naming `source`, the frame and the problem.
+void check_path_cameras(const CameraPath& path, const Camera& base, const std::string& source);
 
 // A full turn of `frames` frames around the scene's bounds center, at the scene camera's distance
 // from it and height above it (looking at the center), one keyframe a frame.
 CameraPath turntable_path(const Scene& scene, int frames);
-// "turntable:N" -> turntable_path(scene, N); anything else is a file. Throws pxf::Error.
+// "turntable:N" -> turntable_path(scene, N); anything else is a file; then check_path_cameras.
+// Throws UsageError for a bad N, pxf::Error for a bad file or camera.
 CameraPath camera_path_for(const std::string& spec, const Scene& scene);
 
 // The camera of frame `frame` (0 .. frame_count() - 1): `base` (the scene's camera, for its

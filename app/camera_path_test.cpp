@@ -82,6 +82,38 @@ TEST(CameraPath, MalformedFilesAreRefusedWithOneLine) {
                  "more than");
 }
 
+TEST(CameraPath, PositionsBeyondTheBoundAreRefusedInDoublesAndAfterNarrowing) {
+  expect_refused(R"({"keyframes": [{"position": [1e300,0,1], "target": [0,0,0], "frames": 2}, {"position": [1,0,1], "target": [0,0,0]}]})",
+                 "within +-1e12");
+  expect_refused(R"({"keyframes": [{"position": [1e20,0,1], "target": [0,0,0], "frames": 2}, {"position": [1,0,1], "target": [0,0,0]}]})",
+                 "within +-1e12");
+  expect_refused(R"({"keyframes": [{"position": [0,0,1], "target": [0,0,-2e12], "frames": 2}, {"position": [1,0,1], "target": [0,0,0]}]})",
+                 "within +-1e12");
+}
+
+// Keyframes that are fine alone can still give a bad camera between them: position and target
+// that cross in the middle of a segment, a spline that overshoots the bound.
+TEST(CameraPath, EveryFramesCameraIsChecked) {
+  const Camera base;
+  const CameraPath crossing = parse_camera_path(R"({"keyframes": [
+    {"position": [0,0,1], "target": [0,0,-1], "frames": 2},
+    {"position": [0,0,-1], "target": [0,0,1]}]})", "cross.json");
+  try {
+    check_path_cameras(crossing, base, "cross.json");
+    FAIL() << "position and target meet at frame 1";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("camera path cross.json: frame 1: position and target meet"), std::string::npos)
+        << e.what();
+  }
+  const CameraPath overshoot = parse_camera_path(R"({"interpolation": "spline", "keyframes": [
+    {"position": [0,0,1], "target": [0,0,0], "frames": 25},
+    {"position": [9.9e11,0,1], "target": [0,0,0], "frames": 25},
+    {"position": [-9.9e11,0,1], "target": [0,0,0]}]})", "overshoot.json");  // 1.009e12 near frame 23
+  EXPECT_THROW(check_path_cameras(overshoot, base, "overshoot.json"), Error);
+  const CameraPath fine = parse_camera_path(kTwoKeys, "fine.json");
+  EXPECT_NO_THROW(check_path_cameras(fine, base, "fine.json"));
+}
+
 TEST(CameraPath, AnUnreadableFileIsRefusedWithOneLine) {
   EXPECT_THROW(read_camera_path("/nonexistent/path.json"), Error);
 }

@@ -175,7 +175,13 @@ int run_render(const Args& args) {
   report.used_ms = used_ms;
   report.wall_ms = elapsed_ms(start);
   report.load_ms = load_ms;
-  write_render_outputs(out, preview, report);
+  try {
+    write_render_outputs(out, preview, report);
+  } catch (const Error&) {
+    // Both failed (a full disk): the state's line first, then the outputs' (main prints it).
+    if (!state_error.empty()) std::fprintf(stderr, "pxf render: %s\n", state_error.c_str());
+    throw;
+  }
 
   const StageTimes& t = preview.total_times();
   std::printf("%s: %dx%d, %d spp%s, %.2f s (path tracing %.0f ms, upload %.0f, range %.0f, filter %.0f in %d runs, "

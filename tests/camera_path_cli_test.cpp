@@ -65,12 +65,26 @@ void expect_one_line_refusal(const std::string& args, const std::string& expecte
   EXPECT_FALSE(fs::exists(out + "/frame-0000.png")) << args;
 }
 
+// A bad turntable count is a bad flag value: exit 2, like every other.
+TEST(CameraPathCli, ABadTurntableCountIsAUsageError) {
+  for (const char* spec : {"turntable:0", "turntable:x", "turntable:-3", "turntable:100001"}) {
+    const Result r = run(std::string("render --size 16x16 --camera-path ") + spec + " --out " +
+                         test_support::temp_dir("camera_path", "turntable_count"));
+    EXPECT_EQ(r.code, 2) << spec << ": " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  }
+}
+
 TEST(CameraPathCli, BadFlagsAndFilesAreRefusedWithOneLine) {
   expect_one_line_refusal("render --size 16x16 --spp-per-frame 2", "needs --camera-path");
   expect_one_line_refusal("render --size 16x16 --camera-path turntable:2 --spp 4", "does not go with --camera-path");
   expect_one_line_refusal("render --size 16x16 --camera-path turntable:x", "turntable:N");
   expect_one_line_refusal("render --size 16x16 --camera-path " + write_path_file("{\"keyframes\": ["), "not valid JSON");
-  expect_one_line_refusal("render --size 16x16 --camera-path /nonexistent.json", "cannot be read");
+  expect_one_line_refusal("render --size 16x16 --camera-path /nonexistent.json", "no such file");
+  expect_one_line_refusal("render --size 16x16 --camera-path " + write_path_file(std::string(300, '[')), "nested deeper");
+  expect_one_line_refusal("render --size 16x16 --camera-path " + write_path_file(R"({"keyframes": [
+    {"position": [0.5,0.5,2], "target": [0.5,0.5,0], "frames": 2}, {"position": [0.5,0.5,0], "target": [0.5,0.5,2]}]})"),
+                          "frame 1: position and target meet");
   expect_one_line_refusal("bench --motion --size 16x16 --camera-path " + write_path_file("{\"keyframes\": ["),
                           "not valid JSON");
 }

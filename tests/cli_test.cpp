@@ -760,6 +760,22 @@ TEST(Cli, FullDiskKeepsThePreviousOutputSetAndNamesTheFile) {
   EXPECT_TRUE(leftovers(out).empty());
 }
 
+// The same limit with a checkpoint: the final state write and the output write both fail, and
+// each names its file on a line of its own.
+TEST(Cli, FullDiskReportsBothTheStateAndTheOutputs) {
+  const std::string out = temp_dir("full_disk_state");
+  const std::string limited = "sh -c \"ulimit -f 8; trap '' XFSZ; exec " + std::string(PXF_EXECUTABLE) +
+                              " render --size 64x64 --spp 3 --checkpoint 1000 --quiet --out " + out + "\"";
+  const std::string base = temp_dir("io_full_state");
+  fs::create_directories(base);
+  const int status = std::system((limited + " 2>" + base + "/err").c_str());
+  const std::string err = slurp(base + "/err");
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 1) << err;
+  EXPECT_EQ(lines(err), 2u) << err;
+  EXPECT_NE(err.find("state.pxfs"), std::string::npos) << err;
+  EXPECT_NE(err.find("cannot write"), std::string::npos) << err;
+}
+
 TEST(Cli, StaleTemporariesOfDeadProcessesAreRemoved) {
   const std::string out = temp_dir("stale");
   fs::create_directories(out + "/.pxf-staging-999999999");  // an earlier pxf's staging folder

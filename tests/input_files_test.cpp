@@ -159,6 +159,17 @@ TEST(InputFiles, FifoAsStatsJsonBesideDiffReference) {
 
 // -- /dev/zero: a character device that never ends (it used to be read until memory ran out) --
 
+TEST(InputFiles, FifoAsCameraPath) {
+  const std::string dir = folder("fifo_camera_path");
+  make_fifo(dir + "/path.json");
+  expect_refused(run_in(dir, "render --size 16x16 --camera-path path.json --out out"), "path.json", kFifo);
+}
+
+TEST(InputFiles, DevZeroAsCameraPath) {
+  const std::string dir = folder("zero_camera_path");
+  expect_refused(run_in(dir, "render --size 16x16 --camera-path /dev/zero --out out"), "/dev/zero", kCharacterDevice);
+}
+
 TEST(InputFiles, DevZeroAsDiffTest) {
   const std::string dir = folder("zero_diff");
   write_image(dir + "/ref.exr");
