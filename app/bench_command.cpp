@@ -22,6 +22,7 @@
 #include "app/options.h"
 #include "app/plot.h"
 #include "app/fidelity_bench.h"
+#include "app/files_bench.h"
 #include "app/sampler_bench.h"
 #include "app/preview.h"
 #include "gl/context.h"
@@ -751,6 +752,12 @@ const std::vector<BenchMode>& bench_modes() {
        "reprojected history and the filter every frame against restart + unfiltered at equal frame time:\n"
        "error, flicker, disocclusions, frame times (app/motion_bench.h)",
        motion_mode},
+      {"files", "the equal-time table over a list of scene files, each with its light",
+       "for each file of --list (one 'NAME SCENE [ENV]' a line) and each --times budget in seconds: plain\n"
+       "path tracing against the preview at equal wall time of the whole job (the file's load taken off both),\n"
+       "--rounds alternating rounds, display and HDR NRMSE and LDR-FLIP against a --reference-spp reference of\n"
+       "another seed (cached in --out); writes files.csv and files_sheet.png (app/files_bench.h)",
+       files_bench_mode},
   };
   return modes;
 }

@@ -34,12 +34,23 @@ bool BenchHarness::parse(const std::vector<std::string>& args) {
 }
 
 BenchSetup BenchHarness::setup(bool needs_filter) {
+  BenchSetup b = setup_scene(scene_.scene, scene_.env, std::filesystem::path(scene_.scene).stem().string(), needs_filter);
+  scene_.width = b.width;  // the scene's own size where --size was not given
+  scene_.height = b.height;
+  return b;
+}
+
+BenchSetup BenchHarness::setup_scene(const std::string& scene, const std::string& env, const std::string& name,
+                                     bool needs_filter) const {
+  SceneOptions options = scene_;
+  options.scene = scene;
+  options.env = env;
   BenchSetup b;
   b.filtered = settings_;
-  b.scene = load_scene_for(scene_, b.filtered, cli_);
-  b.scene_name = std::filesystem::path(scene_.scene).stem().string();
-  b.width = scene_.width;
-  b.height = scene_.height;
+  b.scene = load_scene_for(options, b.filtered, cli_);
+  b.scene_name = name;
+  b.width = options.width;
+  b.height = options.height;
   b.out = out_;
   if (needs_filter && !b.filtered.filtering()) throw UsageError("--filter none: nothing to compare against");
   b.plain = b.filtered;

@@ -40,12 +40,17 @@ class BenchHarness {
   // Loads the scene and creates --out. `needs_filter`: --filter none is a usage error (the mode
   // compares filtered against unfiltered).
   BenchSetup setup(bool needs_filter);
+  // The same for another scene and light than the command line's (`env` "" for the scene's own),
+  // named `name` in the cache and the CSV.
+  BenchSetup setup_scene(const std::string& scene, const std::string& env, const std::string& name,
+                         bool needs_filter) const;
   std::unique_ptr<GlContext> gl_context() const;
   // --reference, else a --reference-spp plain render of another seed, cached in --out. `layer`
   // "hv": the HV buffer alone (layer hv of a given file). Throws pxf::Error on another size.
   Image reference(const BenchSetup& b, const std::string& layer = "") const;
 
   const SceneOptions& scene_options() const { return scene_; }
+  const std::string& out() const { return out_; }
   const PreviewSettings& settings() const { return settings_; }
   int reference_spp() const { return reference_spp_; }
 

@@ -109,6 +109,26 @@ TEST(Cli, GuidingBoundWritesItsTable) {
   EXPECT_EQ(lines(odd.err), 1u) << odd.err;
 }
 
+// The files bench end to end, tiny: a row per file and budget in the CSV, a contact sheet of a row
+// per file and two columns per budget plus the reference; a bad list is refused in one line.
+TEST(Cli, FilesBenchWritesItsTableAndSheet) {
+  const std::string out = temp_dir("files_bench");
+  fs::create_directories(out);
+  std::ofstream(out + "/list.txt") << "# name scene [env]\ncornell cornell\nbox cornell -\n";
+  const Result r = run("bench files --list " + out + "/list.txt --size 16x12 --times 0.2,0.3 --rounds 2 "
+                       "--reference-spp 4 --out " + out);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(lines(slurp(out + "/files.csv")), 5u);  // the header, 2 files x 2 budgets
+  const Image sheet = read_ldr_or_hdr(out + "/files_sheet.png");
+  EXPECT_EQ(sheet.width, 5 * (16 + 2));
+  EXPECT_EQ(sheet.height, 2 * (12 + 2));
+  std::ofstream(out + "/bad.txt") << "a cornell\na cornell\n";
+  const Result bad = run("bench files --list " + out + "/bad.txt --out " + out);
+  EXPECT_EQ(bad.code, 1);
+  EXPECT_EQ(lines(bad.err), 1u) << bad.err;
+  EXPECT_NE(bad.err.find("bad.txt:2: the name 'a' is used twice"), std::string::npos) << bad.err;
+}
+
 TEST(Cli, SceneListPrintsTheBuiltins) {
   const Result r = run("render --scene list");
   EXPECT_EQ(r.code, 0);
