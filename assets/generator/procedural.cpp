@@ -305,7 +305,7 @@ TextureSet paint_brushed_metal(int size, glm::vec3 tint, uint32_t seed) {
     const float scratch = scratches({x, y}, 40, 0.25f, 0.0025f, seed + 3);
     Texel t;
     t.albedo = tint * (0.9f + 0.07f * fine + 0.06f * coarse) * (0.96f + 0.08f * wear);
-    t.roughness = 0.1f + 0.12f * coarse + 0.22f * smoothstep(0.45f, 0.75f, wear) + 0.3f * scratch;
+    t.roughness = 0.2f + 0.12f * coarse + 0.2f * smoothstep(0.45f, 0.75f, wear) + 0.3f * scratch;
     t.height = 0.25f * fine + 0.15f * coarse - scratch;
     return t;
   });
@@ -325,7 +325,7 @@ TextureSet paint_smudged(int size, glm::vec3 tint, uint32_t seed) {
     const float dust = smoothstep(0.83f, 0.86f, tileable_fbm(x, y, 128, 2, 0.5f, seed + 2));
     Texel t;
     t.albedo = tint * (0.97f + 0.03f * smudge) * (1.0f - 0.5f * dust);
-    t.roughness = 0.04f + 0.22f * smudge + 0.25f * print + 0.5f * dust;
+    t.roughness = 0.07f + 0.22f * smudge + 0.25f * print + 0.5f * dust;
     t.height = 0.2f * print + 0.5f * dust;
     return t;
   });

@@ -1,10 +1,12 @@
-// A product shot: a sci-fi helmet on a lacquered plinth, lit only by a daylight environment
+// A product shot: a sci-fi helmet floating in a daylight environment, its only light
 // (environment.exr: a cloudy sky with the sun as a small, very bright disc, so direct light is
 // noisy through every glossy lobe). It stands for the most common public glTF file, a textured,
-// normal-mapped PBR asset under an HDR sky (issue 57): several materials, each with fine texture
-// and normal detail: a clear-coated painted shell with panel seams, rivets, stencils, grime and
-// chipped paint (metallic where chipped), brushed metal trim with a roughness map and scratches, a
-// gold visor with smudges and fingerprints, and a dark lacquered plinth.
+// normal-mapped PBR asset under an HDR sky, shown as viewers show it (issue 57): nearly all of its
+// light is direct light at the first surface, so with no ground under it, it has almost no
+// indirect light. Several materials, each with fine texture and normal detail: a clear-coated
+// painted shell with panel seams, rivets, stencils, grime and chipped paint (metallic where
+// chipped), brushed metal trim with a roughness map and scratches, a gold visor with smudges and
+// fingerprints.
 #include <glm/gtc/constants.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -19,10 +21,7 @@ namespace {
 // The helmet is built around the centre of its shell (an ellipsoid) and facing +Z.
 const glm::vec3 kShell(0.155f, 0.165f, 0.155f);  // semi-axes, meters
 constexpr float kShellRim = 1.95f;                 // polar angle of the open lower rim
-constexpr float kPlinthTop = 0.06f;
-constexpr float kNeckBottom = -0.125f;             // lowest point of the neck ring (local y)
-const glm::vec3 kHelmetPosition(0.0f, kPlinthTop - kNeckBottom, 0.0f);
-const glm::vec3 kSunDirection = glm::normalize(glm::vec3(0.55f, -0.62f, -0.5f));  // travel direction
+const glm::vec3 kSunDirection = glm::normalize(glm::vec3(0.45f, -0.8f, -0.4f));  // travel direction
 
 // The visor's outline: a superellipse in (azimuth, elevation) around the helmet's front.
 constexpr float kVisorAzimuth = 0.95f, kVisorElevation = 0.36f, kVisorCentre = -0.03f;
@@ -106,18 +105,10 @@ MeshData make_ear_pod(bool left) {
 
 MeshData make_antenna() {
   MeshData antenna;
-  const glm::mat4 base = glm::rotate(glm::translate(glm::mat4(1.0f), {-0.172f, 0.02f, -0.02f}), -0.45f, {1, 0, 0});
+  const glm::mat4 base = glm::rotate(glm::translate(glm::mat4(1.0f), {0.172f, 0.02f, -0.02f}), -0.45f, {1, 0, 0});
   antenna.append(make_cylinder({0, 0, 0}, 0.0025f, 0.17f, 16), base);
   antenna.append(make_cylinder({0, 0, 0}, 0.006f, 0.012f, 24), base);
   return antenna;
-}
-
-MeshData make_plinth() {
-  // A rounded upper edge; the repeated point keeps the flat top's normals straight up.
-  const std::vector<glm::vec2> profile = {{0.3f, 0.0f},     {0.3f, 0.045f},          {0.297f, 0.054f},
-                                          {0.29f, 0.0595f}, {0.284f, kPlinthTop},    {0.284f, kPlinthTop},
-                                          {0.0f, kPlinthTop}};
-  return make_lathe(profile, 128, 1.0f);
 }
 
 }  // namespace
@@ -133,19 +124,8 @@ void write_product(const std::string& dir) {
       add_texture_set(scene, paint_brushed_metal(512, {0.8f, 0.79f, 0.77f}, 83), "brushed_metal", 0.002f, glm::vec2(1.0f), 1.0f));
   const int visor = scene.add_material(
       add_texture_set(scene, paint_smudged(256, {1.0f, 0.76f, 0.33f}, 85), "visor", 0.002f, glm::vec2(1.0f), 1.0f));
-  MaterialDesc lacquer = plain_material("plinth_lacquer", {0.025f, 0.03f, 0.04f}, 0.35f);
-  lacquer.clearcoat = 1.0f;
-  lacquer.clearcoat_roughness = 0.02f;
-  const int plinth = scene.add_material(lacquer);
   const int tip = scene.add_material(plain_material("antenna_tip", {0.6f, 0.03f, 0.02f}, 0.25f));
-  const int ground = scene.add_material(plain_material("ground", {0.32f, 0.31f, 0.29f}, 0.8f));
 
-  const glm::mat4 place = glm::translate(glm::mat4(1.0f), kHelmetPosition);
-  auto placed = [&](const MeshData& mesh) {
-    MeshData out;
-    out.append(mesh, place);
-    return out;
-  };
   MeshData trim = make_visor_trim();
   trim.append(make_neck_ring());
   trim.append(make_crown_vent());
@@ -153,17 +133,15 @@ void write_product(const std::string& dir) {
   trim.append(make_ear_pod(true));
   trim.append(make_antenna());
   MeshData antenna_tip;
-  const glm::mat4 base = glm::rotate(glm::translate(glm::mat4(1.0f), {-0.172f, 0.02f, -0.02f}), -0.45f, {1, 0, 0});
+  const glm::mat4 base = glm::rotate(glm::translate(glm::mat4(1.0f), {0.172f, 0.02f, -0.02f}), -0.45f, {1, 0, 0});
   antenna_tip.append(make_sphere({0.0f, 0.17f, 0.0f}, 0.007f, 24, 12), base);
 
-  scene.add_object("ground", make_disc({0, 0, 0}, 40.0f, 128), ground);
-  scene.add_object("plinth", make_plinth(), plinth);
-  scene.add_object("helmet_shell", placed(make_shell()), hull);
-  scene.add_object("helmet_visor", placed(make_visor()), visor);
-  scene.add_object("helmet_trim", placed(trim), metal);
-  scene.add_object("antenna_tip", placed(antenna_tip), tip);
+  scene.add_object("helmet_shell", make_shell(), hull);
+  scene.add_object("helmet_visor", make_visor(), visor);
+  scene.add_object("helmet_trim", trim, metal);
+  scene.add_object("antenna_tip", antenna_tip, tip);
 
-  scene.set_camera({0.52f, 0.5f, 0.8f}, {0.0f, 0.19f, 0.0f}, 0.5f, 16.0f / 9.0f);
+  scene.set_camera({0.55f, -0.03f, 0.78f}, {0.0f, 0.035f, 0.0f}, 0.5f, 16.0f / 9.0f);
   scene.set_render_defaults(false, 960, 540);
   scene.write(dir);
   DaylightSky sky;
