@@ -35,6 +35,8 @@ const std::vector<Expectation>& expectations() {
       {"atrium", 5000, 300000, false, true, true, false},
       {"kitchen", 2000, 300000, true, false, false, false},
       {"envmap", 10000, 300000, false, false, true, false},
+      {"product", 10000, 300000, false, false, true, false},
+      {"window", 2000, 300000, false, false, true, false},
   };
   return table;
 }

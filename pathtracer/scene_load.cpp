@@ -74,6 +74,8 @@ const BuiltinInfo kBuiltins[] = {
     {"atrium", "Atrium with columns, mostly indirect light from a skylight"},
     {"kitchen", "Kitchen interior with glossy, textured and glass materials"},
     {"envmap", "Objects lit only by an environment map (renders with all_hv)"},
+    {"product", "Textured, normal-mapped glossy helmet under a sky with a bright sun"},
+    {"window", "Furnished room lit only by the sky and sun through one window"},
 };
 
 std::string builtin_path(const std::string& name) {

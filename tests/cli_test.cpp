@@ -132,7 +132,7 @@ TEST(Cli, FilesBenchWritesItsTableAndSheet) {
 TEST(Cli, SceneListPrintsTheBuiltins) {
   const Result r = run("render --scene list");
   EXPECT_EQ(r.code, 0);
-  for (const char* name : {"cornell", "atrium", "kitchen", "envmap"}) EXPECT_NE(r.out.find(name), std::string::npos);
+  for (const char* name : {"cornell", "atrium", "kitchen", "envmap", "product", "window"}) EXPECT_NE(r.out.find(name), std::string::npos);
 }
 
 TEST(Cli, BadSceneIsOneLineNamingTheFileAndWritesNothing) {

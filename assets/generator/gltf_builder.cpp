@@ -142,6 +142,11 @@ int SceneBuilder::add_material(const MaterialDesc& d) {
     }
     m.extensions["KHR_materials_specular"] = tinygltf::Value(specular);
   }
+  if (d.clearcoat > 0.0f) {
+    use_extension("KHR_materials_clearcoat");
+    m.extensions["KHR_materials_clearcoat"] = tinygltf::Value(Object{
+        {"clearcoatFactor", number(d.clearcoat)}, {"clearcoatRoughnessFactor", number(d.clearcoat_roughness)}});
+  }
   m.doubleSided = d.doubleSided;
   if (d.alpha_mask) {
     m.alphaMode = "MASK";

@@ -34,6 +34,8 @@ struct MaterialDesc {
   float specular = 1.0f;
   int specular_texture = -1;           // A channel
   glm::vec3 specular_color{1.0f};
+  float clearcoat = 0.0f;              // KHR_materials_clearcoat when > 0 (a lacquer over the base)
+  float clearcoat_roughness = 0.0f;
   glm::vec2 uv_scale{1.0f};            // KHR_texture_transform on every texture when != 1
   bool doubleSided = false;
   bool alpha_mask = false;

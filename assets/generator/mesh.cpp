@@ -176,6 +176,13 @@ MeshData make_swept_tube(const std::function<glm::vec3(float)>& center, float ra
   return mesh;
 }
 
+MeshData make_surface(int cols, int rows, const std::function<SurfacePoint(float, float)>& point) {
+  return make_grid(cols, rows, [&](MeshData& mesh, float u, float v) {
+    const SurfacePoint p = point(u, v);
+    push_vertex(mesh, p.position, p.normal, p.uv);
+  });
+}
+
 MeshData make_disc(const glm::vec3& center, float radius, int segments, float uv_per_meter) {
   MeshData mesh;
   const glm::vec3 up(0, 1, 0);

@@ -46,6 +46,17 @@ MeshData make_swept_tube(const std::function<glm::vec3(float)>& center, float ra
                          int radial_segments, glm::vec2 uv_repeat,
                          const std::function<float(float, float)>& radial_offset = nullptr);
 
+// One vertex of a parametric surface: position, normal (need not be unit length) and UV.
+struct SurfacePoint {
+  glm::vec3 position;
+  glm::vec3 normal;
+  glm::vec2 uv;
+};
+
+// A (cols + 1) x (rows + 1) grid of `point(u, v)`, u and v in [0, 1]; each triangle is wound to
+// agree with the normals, and zero-area ones (a pole, a fan's centre) are dropped.
+MeshData make_surface(int cols, int rows, const std::function<SurfacePoint(float, float)>& point);
+
 // A flat disc in the XZ plane facing +Y.
 MeshData make_disc(const glm::vec3& center, float radius, int segments, float uv_per_meter = 1.0f);
 

@@ -16,6 +16,7 @@ struct TextureSet {
   Image height;     // 1 channel, any range; slopes scaled by normal_strength
   Image roughness;  // 1 channel
   Image specular;   // 1 channel or empty (no KHR_materials_specular texture)
+  Image metallic;   // 1 channel or empty (add_texture_set's `metallic` everywhere)
 };
 
 struct TileStyle {
@@ -48,6 +49,22 @@ TextureSet paint_stone(int size, glm::vec3 tint, uint32_t seed);
 TextureSet paint_wood(int size, int planks, glm::vec3 light, glm::vec3 dark, uint32_t seed);
 // Overlapping fish scales (`rows` x `rows` per tile), glazed in two colors.
 TextureSet paint_scales(int size, int rows, uint32_t seed);
+// Painted hull panels (two rows of two per tile, the lower row offset): recessed seams, rivets,
+// off-white stencilled markings, grime streaks running down, an orange-peel finish and chipped paint that
+// shows bare metal (the metallic map is 1 there). `accent` paints about a quarter of the panels.
+TextureSet paint_hull_panels(int size, glm::vec3 paint_color, glm::vec3 accent, uint32_t seed);
+// Brushed metal: fine streaks along x, blotchy wear and scattered scratches (rougher, recessed).
+// `tint` is the metal's albedo (F0).
+TextureSet paint_brushed_metal(int size, glm::vec3 tint, uint32_t seed);
+// A smooth metal or glass face with smudges, fingerprints and dust: mostly roughness detail.
+TextureSet paint_smudged(int size, glm::vec3 tint, uint32_t seed);
+// A plain-weave fabric of `threads` x `threads` threads per tile, near white (tint it with the
+// material's base colour).
+TextureSet paint_fabric(int size, int threads, uint32_t seed);
+// A woven rug covering the texture once: borders and a diamond lattice in four colours, deep pile.
+TextureSet paint_rug(int size, uint32_t seed);
+// Trowelled plaster: faint blotches and a soft relief.
+TextureSet paint_plaster(int size, glm::vec3 color, uint32_t seed);
 // An ornamental wrought-iron grille: albedo alpha is 1 on the bars, 0 in the openings.
 TextureSet paint_grille(int size, int bars);
 

@@ -6,7 +6,7 @@
 namespace pxf::scenegen {
 
 const std::vector<std::string>& scene_names() {
-  static const std::vector<std::string> names = {"cornell", "atrium", "kitchen", "envmap"};
+  static const std::vector<std::string> names = {"cornell", "atrium", "kitchen", "envmap", "product", "window"};
   return names;
 }
 
@@ -16,6 +16,8 @@ void write_scene(const std::string& name, const std::string& assets_root) {
   if (name == "atrium") return write_atrium(dir);
   if (name == "kitchen") return write_kitchen(dir);
   if (name == "envmap") return write_envmap(dir);
+  if (name == "product") return write_product(dir);
+  if (name == "window") return write_window(dir);
   throw Error("unknown scene '" + name + "'");
 }
 

@@ -13,6 +13,8 @@ void write_cornell(const std::string& dir);
 void write_atrium(const std::string& dir);
 void write_kitchen(const std::string& dir);
 void write_envmap(const std::string& dir);
+void write_product(const std::string& dir);
+void write_window(const std::string& dir);
 
 // Scene names in generation order.
 const std::vector<std::string>& scene_names();

@@ -105,7 +105,8 @@ ByteImage encode_normal_map(const Image& normals) {
   return out;
 }
 
-ByteImage pack_metallic_roughness(const Image& roughness, float metallic, const Image* specular) {
+ByteImage pack_metallic_roughness(const Image& roughness, float metallic, const Image* specular,
+                                  const Image* metallic_map) {
   const int channels = specular ? 4 : 3;
   ByteImage out{roughness.width, roughness.height, channels, {}};
   out.data.resize(size_t(roughness.width) * roughness.height * channels);
@@ -114,7 +115,7 @@ ByteImage pack_metallic_roughness(const Image& roughness, float metallic, const 
       uint8_t* texel = &out.data[(size_t(y) * roughness.width + x) * channels];
       texel[0] = 255;
       texel[1] = to_byte(roughness.at(x, y, 0));
-      texel[2] = to_byte(metallic);
+      texel[2] = to_byte(metallic_map ? metallic_map->at(x, y, 0) : metallic);
       if (specular) texel[3] = to_byte(specular->at(x, y, 0));
     }
   }

@@ -52,7 +52,8 @@ ByteImage encode_normal_map(const Image& normals);
 
 // Packs roughness (G), metallic (B) and an optional specular factor (A, KHR_materials_specular)
 // into one RGBA texture; R (occlusion) is left at 1. Pass an empty `specular` for RGB only.
+// A `metallic_map` (1 channel) replaces the constant `metallic` texel by texel.
 ByteImage pack_metallic_roughness(const Image& roughness, float metallic,
-                                  const Image* specular = nullptr);
+                                  const Image* specular = nullptr, const Image* metallic_map = nullptr);
 
 }  // namespace pxf::scenegen

@@ -10,6 +10,7 @@
 #include "../gltf_builder.h"
 #include "../procedural.h"
 #include "../scenes.h"
+#include "../sky.h"
 
 namespace pxf::scenegen {
 namespace {
@@ -100,21 +101,6 @@ glm::vec3 sky_radiance(const glm::vec3& d) {
   return glm::mix(zenith, horizon, t) + glm::vec3(1.0f, 0.9f, 0.7f) * glow;
 }
 
-Image paint_sky(int width, int height) {
-  Image sky = Image::rgb(width, height);
-  for (int j = 0; j < height; ++j) {
-    const float theta = (j + 0.5f) / height * glm::pi<float>();
-    for (int i = 0; i < width; ++i) {
-      // Inverse of u = 0.5 + atan2(d.x, -d.z) / (2 pi), v = acos(d.y) / pi.
-      const float phi = ((i + 0.5f) / width - 0.5f) * glm::two_pi<float>();
-      const glm::vec3 d(std::sin(theta) * std::sin(phi), std::cos(theta), -std::sin(theta) * std::cos(phi));
-      const glm::vec3 radiance = sky_radiance(d);
-      sky.at(i, j, 0) = radiance.r, sky.at(i, j, 1) = radiance.g, sky.at(i, j, 2) = radiance.b;
-    }
-  }
-  return sky;
-}
-
 }  // namespace
 
 void write_atrium(const std::string& dir) {
@@ -162,7 +148,7 @@ void write_atrium(const std::string& dir) {
   scene.set_camera({8.6f, 1.7f, 5.7f}, {-10.0f, 2.9f, 3.0f}, 1.0f, 16.0f / 9.0f);
   scene.set_render_defaults(false, 960, 540);
   scene.write(dir);
-  write_environment(dir, paint_sky(1024, 512));
+  write_environment(dir, paint_equirect(1024, 512, sky_radiance));
 }
 
 }  // namespace pxf::scenegen

@@ -9,6 +9,7 @@
 #include "../gltf_builder.h"
 #include "../procedural.h"
 #include "../scenes.h"
+#include "../sky.h"
 
 namespace pxf::scenegen {
 namespace {
@@ -62,21 +63,6 @@ glm::vec3 studio_radiance(const glm::vec3& d) {
   return radiance;
 }
 
-Image paint_studio(int width, int height) {
-  Image studio = Image::rgb(width, height);
-  for (int j = 0; j < height; ++j) {
-    const float theta = (j + 0.5f) / height * glm::pi<float>();
-    for (int i = 0; i < width; ++i) {
-      // Inverse of u = 0.5 + atan2(d.x, -d.z) / (2 pi), v = acos(d.y) / pi.
-      const float phi = ((i + 0.5f) / width - 0.5f) * glm::two_pi<float>();
-      const glm::vec3 d(std::sin(theta) * std::sin(phi), std::cos(theta), -std::sin(theta) * std::cos(phi));
-      const glm::vec3 radiance = studio_radiance(d);
-      studio.at(i, j, 0) = radiance.r, studio.at(i, j, 1) = radiance.g, studio.at(i, j, 2) = radiance.b;
-    }
-  }
-  return studio;
-}
-
 }  // namespace
 
 void write_envmap(const std::string& dir) {
@@ -94,7 +80,7 @@ void write_envmap(const std::string& dir) {
   scene.set_camera({0.2f, 1.35f, 3.9f}, {0.15f, 0.7f, 0.0f}, 0.7f, 16.0f / 9.0f);
   scene.set_render_defaults(false, 960, 540);
   scene.write(dir);
-  write_environment(dir, paint_studio(2048, 1024));
+  write_environment(dir, paint_equirect(2048, 1024, studio_radiance));
 }
 
 }  // namespace pxf::scenegen
