@@ -9,7 +9,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <nlohmann/json.hpp>
 
-#include "app/explorer_camera.h"
+#include "app/explorer/explorer_camera.h"
 #include "core/error.h"
 
 namespace pxf {

@@ -12,7 +12,7 @@
 #include "app/commands.h"
 #include "app/first_frame.h"
 #include "app/options.h"
-#include "app/preview.h"
+#include "preview/preview.h"
 #include "app/render_output.h"
 #include "core/timing.h"
 #include "gl/context.h"
