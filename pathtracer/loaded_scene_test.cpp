@@ -1,5 +1,6 @@
 // The tracer on scenes the glTF loader read: what the loader's tests (scene/scene_load_test.cpp)
-// cannot see without tracing, a mapped coat normal at a surface point and the default light.
+// cannot see without tracing, a mapped coat normal at a surface point and the default light's
+// environment lighting a bare model.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -44,13 +45,16 @@ TEST(LoadedScene, ClearcoatNormalMapTiltsTheCoatNormalOnly) {
   EXPECT_NEAR(std::abs(sp.clearcoat_normal.x), std::sqrt(0.5f), 0.01f);
 }
 
-TEST(LoadedScene, TheDefaultLightLightsABareModel) {
+TEST(SceneLoadDefaultLight, SceneWithoutLightsGetsTheBuiltInEnvironmentAndRendersLit) {
   std::string dir = temp_dir();
   GltfBuilder b;
   b.add_quad_scene(b.material({{"pbrMetallicRoughness", {{"metallicFactor", 0.0}}}}));
   std::string path = b.write_gltf(dir + "/bare.gltf");
   for (DefaultLight light : {DefaultLight::Sky, DefaultLight::Studio}) {
     const Scene scene = load_scene(path, "", 1.0f, light);
+    ASSERT_TRUE(scene.environment.has_value()) << default_light_name(light);
+    ASSERT_EQ(scene.notes.size(), 1u);
+    EXPECT_NE(scene.notes[0].find("built-in " + default_light_name(light)), std::string::npos) << scene.notes[0];
     TraceParams params;
     params.threads = 1;
     ProgressiveRenderer renderer(scene, params, 8, 8);

@@ -1218,19 +1218,6 @@ TEST(SceneLoadMaterial, KhrMaterialsClearcoatReadsItsFactorsTexturesAndNormalMap
 // ----------------------------------------------------------------------------------------------
 // Default light
 
-TEST(SceneLoadDefaultLight, SceneWithoutLightsGetsTheBuiltInEnvironment) {
-  std::string dir = temp_dir();
-  GltfBuilder b;
-  b.add_quad_scene(b.material({{"pbrMetallicRoughness", {{"metallicFactor", 0.0}}}}));
-  std::string path = b.write_gltf(dir + "/bare.gltf");
-  for (DefaultLight light : {DefaultLight::Sky, DefaultLight::Studio}) {
-    Scene scene = load_scene(path, "", 1.0f, light);
-    ASSERT_TRUE(scene.environment.has_value()) << default_light_name(light);
-    ASSERT_EQ(scene.notes.size(), 1u);
-    EXPECT_NE(scene.notes[0].find("built-in " + default_light_name(light)), std::string::npos) << scene.notes[0];
-  }
-}
-
 TEST(SceneLoadDefaultLight, NoneKeepsTheSceneDarkAndWarns) {
   std::string dir = temp_dir();
   GltfBuilder b;
