@@ -4,6 +4,8 @@
 // sampler-error, variance-ratio, variants, stage-table, threshold-fidelity, guiding-ab,
 // guiding-bound, adaptive, demodulation-ab, motion); each mode is a small entry point over the
 // shared harness (bench/bench_harness.h) that declares its own options and defaults.
+#include "bench/bench_command.h"
+
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -13,7 +15,6 @@
 #include <fstream>
 #include <sstream>
 
-#include "app/commands.h"
 #include "app/options.h"
 #include "bench/adaptive_bench.h"
 #include "bench/bench_harness.h"
