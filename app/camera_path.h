@@ -13,7 +13,7 @@
 
 #include <glm/glm.hpp>
 
-#include "pathtracer/scene.h"
+#include "scene/scene.h"
 
 namespace pxf {
 

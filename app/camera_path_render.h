@@ -5,7 +5,7 @@
 #include <string>
 
 #include "app/camera_path.h"
-#include "app/preview.h"
+#include "preview/preview.h"
 
 namespace pxf {
 

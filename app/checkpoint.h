@@ -6,8 +6,8 @@
 
 #include "app/cli.h"
 #include "app/options.h"
-#include "app/preview.h"
 #include "pathtracer/accumulation_state.h"
+#include "preview/preview.h"
 
 namespace pxf {
 

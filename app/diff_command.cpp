@@ -10,12 +10,12 @@
 
 #include "app/cli.h"
 #include "app/commands.h"
-#include "app/setting_table.h"
 #include "core/json_depth.h"
 #include "gl/cpu_reference.h"
 #include "image/image.h"
 #include "image/input_file.h"
 #include "image/metrics.h"
+#include "preview/setting_table.h"
 
 namespace pxf {
 

@@ -6,7 +6,7 @@
 #pragma once
 #include <string>
 
-#include "app/preview.h"
+#include "preview/preview.h"
 
 namespace pxf {
 

@@ -6,6 +6,7 @@
 
 #include "app/cli.h"
 #include "app/commands.h"
+#include "bench/bench_command.h"
 #include "image/image.h"
 
 namespace {

@@ -6,9 +6,9 @@
 #include "app/checkpoint.h"
 #include "app/commands.h"
 #include "app/options.h"
-#include "app/preview.h"
 #include "app/render_output.h"
 #include "gl/context.h"
+#include "preview/preview.h"
 
 namespace pxf {
 

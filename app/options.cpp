@@ -3,10 +3,10 @@
 #include <cstdio>
 #include <string>
 
-#include "app/setting_table.h"
 #include "gl/context.h"
-#include "pathtracer/auto_camera.h"
 #include "pathtracer/pathtracer.h"
+#include "preview/setting_table.h"
+#include "scene/auto_camera.h"
 
 namespace pxf {
 
@@ -47,9 +47,8 @@ std::string default_text(const SettingDescriptor& d) {
 }
 }  // namespace
 
-void add_preview_options(CommandLine& cli, PreviewSettings& s, bool adaptive_option) {
+void add_preview_options(CommandLine& cli, PreviewSettings& s) {
   for (const SettingDescriptor& d : setting_table()) {
-    if (!adaptive_option && std::string(d.key) == "adaptive") continue;
     const std::string help = d.help + (d.bare_flag ? "" : " (default " + default_text(d) + ")");
     switch (d.type) {
       case SettingType::Float: cli.option(d.flag, &d.float_field(s), help, static_cast<float>(d.min), static_cast<float>(d.max)); break;

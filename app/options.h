@@ -3,10 +3,11 @@
 #include <string>
 
 #include "app/cli.h"
-#include "app/preview.h"
 #include "gl/resources.h"
 #include "pathtracer/pathtracer.h"
-#include "pathtracer/scene.h"
+#include "preview/preview.h"
+#include "scene/load.h"
+#include "scene/scene.h"
 
 namespace pxf {
 
@@ -37,8 +38,7 @@ constexpr FilterKind kAllHvFilter = FilterKind::Atrous;
 
 void add_scene_options(CommandLine& cli, SceneOptions& options, bool headless);
 // Binds the command line to the one PreviewSettings (enums through their name tables).
-// adaptive_option false: without --adaptive (pxf bench, whose --adaptive compares both).
-void add_preview_options(CommandLine& cli, PreviewSettings& settings, bool adaptive_option = true);
+void add_preview_options(CommandLine& cli, PreviewSettings& settings);
 
 // Prints the built-in scenes when options.scene == "list" (returns true: nothing else to do).
 bool print_scene_list_if_asked(const SceneOptions& options);

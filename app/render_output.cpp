@@ -1,6 +1,6 @@
 #include "app/render_output.h"
 
-#include "app/setting_table.h"
+#include "preview/setting_table.h"
 #include "core/timing.h"
 
 #include <filesystem>

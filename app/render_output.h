@@ -6,7 +6,7 @@
 #include <optional>
 #include <string>
 
-#include "app/preview.h"
+#include "preview/preview.h"
 #include "app/options.h"
 #include "image/image.h"
 

@@ -1,8 +1,8 @@
-// The setting table (app/setting_table.h) is the one declaration of every preview setting: each
+// The setting table (preview/setting_table.h) is the one declaration of every preview setting: each
 // entry reaches the command line, stats.json and its read-back, the state file exactly when it
 // changes the samples, and the preview's change detection; explorer ranges stay inside the
 // command line's. A setting missing from any of them fails here.
-#include "app/setting_table.h"
+#include "preview/setting_table.h"
 
 #include <gtest/gtest.h>
 

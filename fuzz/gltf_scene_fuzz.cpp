@@ -7,6 +7,7 @@
 
 #include "fuzz/fuzz_target.h"
 #include "pathtracer/pathtracer.h"
+#include "scene/load.h"
 
 namespace {
 constexpr int kSide = 4;

@@ -1,4 +1,4 @@
-// Writes compressed glTF files with the libraries' own encoders (pathtracer/gltf_compressed_fixtures.h),
+// Writes compressed glTF files with the libraries' own encoders (testing/gltf_compressed_fixtures.h),
 // which fuzz/make_seeds.py (standard library only) cannot:
 //   make_compressed_gltf seeds DIR
 //       the gltf_scene fuzz seeds of issue 35: Draco, meshopt (every mode and filter, instancing),
@@ -18,7 +18,7 @@
 #include <iterator>
 #include <string>
 
-#include "pathtracer/gltf_compressed_fixtures.h"
+#include "testing/gltf_compressed_fixtures.h"
 
 namespace {
 

@@ -14,7 +14,7 @@
 #pragma once
 #include "gl/inputs.h"
 #include "gl/resources.h"
-#include "pathtracer/scene.h"
+#include "scene/scene.h"
 #include "shaders/history_formulas.h"
 
 namespace pxf {

@@ -4,7 +4,7 @@
 // A, L_u with Var[L_u] in A, guides with the distance in A; the fresh L_lv with the threshold factor in A.
 #pragma once
 #include "image/image.h"
-#include "pathtracer/scene.h"
+#include "scene/scene.h"
 
 namespace pxf {
 

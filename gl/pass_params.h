@@ -45,7 +45,7 @@ static_assert(kMaxInput == kMaxTonemapInput);
 // None: no filter (plain path tracing); the preview never runs the filter pass with it.
 enum class FilterKind { BilateralDepth, Bilateral, Separable, Atrous, Subsampled, Grid, None };
 // "bilateral-depth", "bilateral", "separable", "atrous", "subsampled", "grid": the filter pass's variants
-// (FilterKind::None is named "none" by filter_kind_name and app/preview.h's filter_option_names).
+// (FilterKind::None is named "none" by filter_kind_name and preview/preview.h's filter_option_names).
 const std::vector<std::string>& filter_kind_names();
 const char* filter_kind_name(FilterKind kind);
 FilterKind parse_filter_kind(const std::string& name);  // throws pxf::Error listing the names

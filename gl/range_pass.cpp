@@ -3,7 +3,8 @@
 #include <cstring>
 #include "gl/gl.h"
 #include "gl/pass_params.h"
-#include "pathtracer/camera.h"
+#include "scene/camera.h"
+#include "scene/material.h"
 
 namespace pxf {
 namespace {

@@ -18,15 +18,17 @@
 #include <vector>
 #include "gl/reduction.h"
 #include "gl/resources.h"
-#include "pathtracer/pathtracer.h"
-#include "pathtracer/scene.h"
+#include "scene/range.h"
+#include "scene/scene.h"
 
 namespace pxf {
 
 struct RangeSettings {
   int max_frames = 32;      // frame cap of the accumulation
   int min_frames = 8;        // so that the jitter sequence's mean is near the pixel center
-  float tolerance = 5e-4f;  // (decays about as 1/frames where there are edges)  // mean over pixels of the per-frame change (color, relative distance)
+  // The mean over pixels of the per-frame change (color, relative distance) below which the
+  // accumulation has converged; the change decays about as 1/frames where there are edges.
+  float tolerance = 5e-4f;
 };
 
 class RangePass {

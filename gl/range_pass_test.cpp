@@ -7,9 +7,8 @@
 #include "gl/pass_params.h"
 #include "gl/range_pass.h"
 #include "gl/test_util.h"
-#include "pathtracer/camera.h"
-#include "pathtracer/lights.h"
-#include "pathtracer/texture.h"
+#include "scene/camera.h"
+#include "scene/texture.h"
 
 namespace pxf {
 namespace {

@@ -7,7 +7,7 @@
 namespace pxf::test {
 
 // The blend threshold t the pass tests give the filter's case-2 skip where the test is not about t
-// (the production value is PreviewSettings::threshold, app/preview.h).
+// (the production value is PreviewSettings::threshold, preview/preview.h).
 constexpr float kTestThreshold = 0.01f;
 
 inline GlContext& osmesa_context() {

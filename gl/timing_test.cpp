@@ -10,13 +10,14 @@
 #include <random>
 #include <string>
 #include <vector>
+#include "core/timing.h"
 #include "gl/blend_pass.h"
 #include "gl/filter_pass.h"
 #include "gl/inputs.h"
 #include "gl/range_pass.h"
 #include "gl/test_util.h"
 #include "gl/tonemap_pass.h"
-#include "core/timing.h"
+#include "scene/load.h"
 
 namespace pxf {
 namespace {

@@ -13,6 +13,7 @@
 #include "image/input_file.h"
 #include "pathtracer/byte_io.h"
 #include "pathtracer/guiding_field.h"
+#include "scene/load.h"
 
 namespace pxf {
 

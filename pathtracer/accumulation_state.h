@@ -45,7 +45,7 @@ struct SampleSettings {
   uint32_t replicates = 1;         // TraceParams::replicates (which scrambled sequence frame k uses)
   uint32_t specular_sampling = 0;  // 0 none, 1 at every diffuse vertex, 2 near only (the default)
   // 1: adaptive sampling (--adaptive on) for the least error, 2: for clean (--until-clean; the
-  // allocation's goal, app/adaptive.h): pixels are traced unevenly, each at its own sample index.
+  // allocation's goal, preview/adaptive.h): pixels are traced unevenly, each at its own sample index.
   // Not a property of a sample, but a resume must continue the same allocation, and a merge of
   // adaptive and uniform shards would be a render neither option describes.
   uint32_t adaptive = 0;
@@ -65,7 +65,7 @@ struct AccumulationState {
   // Pixel p used the sample indices [begin, begin + traced[p]) of each range it was traced in; in a
   // uniform state every entry is frame_count().
   std::vector<uint32_t> traced;
-  // Adaptive sampling's allocation (settings.adaptive only, else empty; app/adaptive.h): each
+  // Adaptive sampling's allocation (settings.adaptive only, else empty; preview/adaptive.h): each
   // pixel's rate (paths per frame) of the last recomputation, 0 before the first; its credit after
   // the last planned frame and that frame's path counts (0 = not traced next), so that a resumed render traces
   // exactly what the uninterrupted one would. A merged state keeps zeros and ones: it is not resumed

@@ -11,7 +11,7 @@
 
 #include "pathtracer/integrator.h"
 #include "pathtracer/rng.h"
-#include "pathtracer/shapes.h"
+#include "testing/shapes.h"
 
 namespace pxf {
 namespace {

@@ -6,7 +6,7 @@
 #include <memory>
 
 #include "pathtracer/integrator.h"
-#include "pathtracer/shapes.h"
+#include "testing/shapes.h"
 
 namespace pxf {
 namespace {

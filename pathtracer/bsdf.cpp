@@ -5,7 +5,7 @@
 
 #include "pathtracer/ggx_albedo.h"
 #include "pathtracer/sheen.h"
-#include "pathtracer/texture.h"
+#include "scene/texture.h"
 
 namespace pxf {
 namespace {
@@ -75,30 +75,6 @@ glm::vec3 eval_emission(const Scene& scene, const Material& m, glm::vec2 uv0, gl
 
 float eval_opacity(const Scene& scene, const Material& m, glm::vec2 uv0, glm::vec2 uv1, float vertex_alpha) {
   return m.base_color.a * eval_texture(scene, m.base_color_texture, uv0, uv1).a * vertex_alpha;
-}
-
-// No clearcoat, or a smooth one (a delta lobe).
-static bool coat_is_delta_or_absent(const Material& m) {
-  return !(m.clearcoat > 0.0f) || (constant(m.clearcoat_roughness_texture) && m.clearcoat_roughness < kDeltaRoughness);
-}
-
-// A sheen is never a delta lobe.
-static bool has_sheen(const Material& m) { return max_component(m.sheen_color) > 0.0f; }
-
-bool material_is_perfect_mirror(const Material& m) {
-  return constant(m.metallic_roughness_texture) && m.roughness < kDeltaRoughness && m.metallic >= 1.0f - 1e-3f &&
-         coat_is_delta_or_absent(m) && !has_sheen(m);
-}
-
-// Exactly the materials whose BSDF has delta lobes only (a constant-factor mirror or glass), so
-// that the specular chains, the range buffer and the LV/HV split agree about every surface.
-bool material_is_perfect_specular(const Material& m) {
-  if (!constant(m.metallic_roughness_texture)) return false;
-  if (material_is_perfect_mirror(m)) return true;
-  // Glass is smooth below the delta roughness, or at any roughness without refraction (ior 1).
-  const bool smooth = m.roughness < kDeltaRoughness || std::abs(m.ior - 1.0f) < 1e-3f;
-  return smooth && constant(m.transmission_texture) && m.transmission >= 1.0f - 1e-3f && m.metallic <= 1e-3f &&
-         coat_is_delta_or_absent(m) && !has_sheen(m);
 }
 
 float ggx_d(glm::vec3 h, float alpha) {

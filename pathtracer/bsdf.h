@@ -17,11 +17,11 @@
 #include <glm/glm.hpp>
 #include "pathtracer/pathtracer.h"  // SurfaceLobe
 #include "pathtracer/sampling.h"
-#include "pathtracer/scene.h"
+#include "scene/material.h"  // kDeltaRoughness
+#include "scene/scene.h"
 
 namespace pxf {
 
-constexpr float kDeltaRoughness = 1e-3f;
 constexpr float kMinAlpha = 1e-3f;  // GGX alpha floor for near-smooth (but not delta) surfaces
 
 // Material parameters at one surface point (textures, vertex colors applied).
@@ -106,11 +106,6 @@ class Bsdf {
   bool is_perfectly_specular() const { return !has_nondelta_; }
   bool has_nondelta() const { return has_nondelta_; }
   float eta() const { return front_face_ ? ior_ : 1.0f / ior_; }  // eta_t / eta_i across the surface
-  // The probability that sample() picks a non-delta lobe (1 for a BSDF without delta lobes).
-  float nondelta_probability() const {
-    return p_diffuse_ + (glossy_delta_ ? 0.0f : p_glossy_) + p_sheen_ + (coat_delta_ ? 0.0f : p_coat_) +
-           (glass_delta_ ? 0.0f : p_glass_);
-  }
   // The probability that sample() picks the diffuse lobe.
   float diffuse_probability() const { return p_diffuse_; }
   // sample() reads u_lobe only when more than one lobe can be picked, or when the rough glass lobe
@@ -127,7 +122,6 @@ class Bsdf {
 
  private:
   glm::vec3 eval_local(glm::vec3 wi, float* pdf) const;
-  glm::vec3 eval_glass_reflection(glm::vec3 wi, float* pdf) const;
   glm::vec3 eval_glass_transmission(glm::vec3 wi, float* pdf) const;
   glm::vec3 eval_coat(glm::vec3 wi_coat, float* pdf) const;  // adds the coat's pdf to *pdf
   float set_up_coat(const BsdfMaterial& material, glm::vec3 coat_normal, glm::vec3 wo);

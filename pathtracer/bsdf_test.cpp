@@ -7,8 +7,8 @@
 #include "pathtracer/bsdf.h"
 #include "pathtracer/ggx_albedo.h"
 #include "pathtracer/rng.h"
-#include "pathtracer/shapes.h"
-#include "pathtracer/stat_tests.h"
+#include "testing/shapes.h"
+#include "testing/stat_tests.h"
 
 namespace pxf {
 namespace {

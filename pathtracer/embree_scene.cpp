@@ -8,7 +8,7 @@
 
 #include "image/image.h"
 #include "pathtracer/bsdf.h"
-#include "pathtracer/texture.h"
+#include "scene/texture.h"
 
 namespace pxf {
 namespace {

@@ -9,8 +9,8 @@
 #include <vector>
 #include <embree3/rtcore.h>
 #include <glm/glm.hpp>
-#include "pathtracer/camera.h"
-#include "pathtracer/scene.h"
+#include "scene/camera.h"
+#include "scene/scene.h"
 
 namespace pxf {
 

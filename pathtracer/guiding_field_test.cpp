@@ -14,7 +14,7 @@
 
 #include "pathtracer/rng.h"
 #include "pathtracer/sampling.h"
-#include "pathtracer/stat_tests.h"
+#include "testing/stat_tests.h"
 
 namespace pxf {
 namespace {

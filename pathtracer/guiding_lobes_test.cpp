@@ -9,7 +9,7 @@
 
 #include "pathtracer/guiding_field.h"
 #include "pathtracer/rng.h"
-#include "pathtracer/stat_tests.h"
+#include "testing/stat_tests.h"
 
 namespace pxf {
 namespace {

@@ -12,7 +12,7 @@
 #include "pathtracer/accumulation_state.h"
 #include "pathtracer/guiding_field.h"
 #include "pathtracer/integrator.h"
-#include "pathtracer/shapes.h"
+#include "testing/shapes.h"
 
 namespace pxf {
 namespace {

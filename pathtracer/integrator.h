@@ -5,12 +5,12 @@
 #include <vector>
 #include <glm/glm.hpp>
 #include "pathtracer/bsdf.h"
-#include "pathtracer/camera.h"
 #include "pathtracer/embree_scene.h"
 #include "pathtracer/lights.h"
 #include "pathtracer/pathtracer.h"
 #include "pathtracer/sampler.h"
 #include "pathtracer/sphere_caustics.h"
+#include "scene/camera.h"
 
 namespace pxf {
 
@@ -196,12 +196,5 @@ class PathTracer {
   bool has_near_targets_ = false;  // a target that fills its bounding sphere enough for near chains
   GuidingField* guiding_ = nullptr;
 };
-
-// Adds one accepted sample to pixel `pixel`: running means of LV/HV RGB and Welford (double) of
-// the HV luminance, running mean of the albedo. The caller has already rejected non-finite samples.
-// `replicate` is the sample's replicate (frame mod acc.replicates).
-void accumulate_sample(Accumulation& acc, size_t pixel, glm::vec3 lv, glm::vec3 hv, int replicate = 0,
-                       glm::vec3 albedo = glm::vec3(1.0f));
-void resize_accumulation(Accumulation& acc, int width, int height, int replicates = 1);  // and clear
 
 }  // namespace pxf

@@ -9,13 +9,14 @@
 #include <cstring>
 #include <limits>
 
+#include "image/image.h"
+#include "image/metrics.h"
 #include "pathtracer/bsdf.h"
 #include "pathtracer/integrator.h"
 #include "pathtracer/lights.h"
-#include "pathtracer/texture.h"
-#include "pathtracer/shapes.h"
-#include "image/image.h"
-#include "image/metrics.h"
+#include "scene/load.h"
+#include "scene/texture.h"
+#include "testing/shapes.h"
 
 namespace pxf {
 namespace {
@@ -732,23 +733,6 @@ TEST(Integrator, AlbedoFollowsVertexColorsAndTextures) {
   expect_albedo(38, glm::vec3(0.7f, 0.3f, 0.1f));
 }
 
-}  // namespace
-}  // namespace pxf
-
-// Throughput figures, not a pass/fail test (tests never assert wall time). Run with
-//   pathtracer_tests --gtest_also_run_disabled_tests --gtest_filter=IntegratorBench.*
-#include "pathtracer/bench.h"
-namespace pxf {
-namespace {
-TEST(IntegratorBench, DISABLED_CornellBox512) {
-  const char* name = std::getenv("PXF_BENCH_SCENE");
-  Scene scene = load_scene(name ? name : "cornell");
-  TraceParams params;  // 6 vertices, RR from vertex 3, all cores unless PXF_BENCH_THREADS
-  if (const char* threads = std::getenv("PXF_BENCH_THREADS")) params.threads = std::atoi(threads);
-  BenchResult r = run_benchmark(scene, 512, 512, params, 3, 20);
-  std::printf("%s: %s\n", name ? name : "cornell", format_benchmark(r).c_str());
-  EXPECT_GT(r.paths_per_s, 0.0);
-}
 }  // namespace
 }  // namespace pxf
 

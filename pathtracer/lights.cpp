@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "pathtracer/bsdf.h"
-#include "pathtracer/texture.h"
+#include "scene/texture.h"
 
 namespace pxf {
 namespace {
@@ -82,18 +82,6 @@ double LightSampler::punctual_power(const PunctualLight& light, float scene_radi
     case PunctualLight::Type::Directional: return kPi * scene_radius * scene_radius * intensity;
   }
   return 0.0;
-}
-
-glm::vec2 equirect_uv(glm::vec3 d) {
-  float u = 0.5f + std::atan2(d.x, -d.z) * (0.5f * kInvPi);
-  float v = std::acos(std::min(std::max(d.y, -1.0f), 1.0f)) * kInvPi;
-  return glm::vec2(u - std::floor(u), v);
-}
-
-glm::vec3 equirect_direction(glm::vec2 uv) {
-  float theta = uv.y * kPi, phi = (uv.x - 0.5f) * 2.0f * kPi;
-  float s = std::sin(theta);
-  return glm::vec3(s * std::sin(phi), std::cos(theta), -s * std::cos(phi));
 }
 
 namespace {

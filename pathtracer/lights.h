@@ -10,7 +10,7 @@
 #include <vector>
 #include <glm/glm.hpp>
 #include "pathtracer/sampling.h"
-#include "pathtracer/scene.h"
+#include "scene/scene.h"
 
 namespace pxf {
 
@@ -22,10 +22,6 @@ struct LightSample {
   bool delta = false;
   glm::vec3 point{0.0f}, normal{0.0f};  // the sampled point (finite distance); normal 0 off surfaces
 };
-
-// Direction <-> equirect coordinates (scene.h convention).
-glm::vec2 equirect_uv(glm::vec3 direction);
-glm::vec3 equirect_direction(glm::vec2 uv);
 
 // A light path's start (path guiding's training light, docs/guiding.md): it leaves `origin` along
 // `direction` carrying `flux` (the power it stands for: the lights' total over the number drawn).

@@ -10,8 +10,9 @@
 
 #include "pathtracer/lights.h"
 #include "pathtracer/rng.h"
-#include "pathtracer/shapes.h"
-#include "pathtracer/stat_tests.h"
+#include "scene/texture.h"
+#include "testing/shapes.h"
+#include "testing/stat_tests.h"
 
 namespace pxf {
 namespace {

@@ -21,31 +21,18 @@
 
 #include "image/image.h"
 #include "pathtracer/bsdf.h"
-#include "pathtracer/camera.h"
 #include "pathtracer/ggx_albedo.h"
 #include "pathtracer/integrator.h"
 #include "pathtracer/pathtracer.h"
-#include "pathtracer/shapes.h"
+#include "scene/camera.h"
+#include "scene/load.h"
+#include "testing/gltf_builder.h"
+#include "testing/shapes.h"
 
 namespace pxf {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string to_base64(const std::vector<uint8_t>& data) {
-  static const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  for (size_t i = 0; i < data.size(); i += 3) {
-    uint32_t v = static_cast<uint32_t>(data[i]) << 16;
-    if (i + 1 < data.size()) v |= static_cast<uint32_t>(data[i + 1]) << 8;
-    if (i + 2 < data.size()) v |= data[i + 2];
-    out += table[(v >> 18) & 63];
-    out += table[(v >> 12) & 63];
-    out += i + 1 < data.size() ? table[(v >> 6) & 63] : '=';
-    out += i + 2 < data.size() ? table[v & 63] : '=';
-  }
-  return out;
-}
 
 template <typename T>
 void append_bytes(std::vector<uint8_t>& bin, const T* data, size_t count) {
@@ -94,7 +81,7 @@ std::string write_sphere_gltf(const std::string& material_json, float camera_z, 
     << R"({"buffer":0,"byteOffset":)" << normals_offset << R"(,"byteLength":)" << indices_offset - normals_offset << "},"
     << R"({"buffer":0,"byteOffset":)" << indices_offset << R"(,"byteLength":)" << bin.size() - indices_offset << "}],"
     << R"("buffers":[{"byteLength":)" << bin.size() << R"(,"uri":"data:application/octet-stream;base64,)"
-    << to_base64(bin) << "\"}]";
+    << test::base64(bin) << "\"}]";
   if (!extensions_used.empty()) j << R"(,"extensionsUsed":[)" << extensions_used << "]";
   j << "}";
   fs::path path = test_dir() / "sphere.gltf";

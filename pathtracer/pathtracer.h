@@ -8,12 +8,11 @@
 #include <string>
 #include <vector>
 #include <glm/glm.hpp>
-#include "core/memory.h"  // available_memory_bytes, which LoadLimits defaults to
 #include "image/image.h"
-#include "pathtracer/default_light.h"
+#include "pathtracer/accumulation.h"
 #include "pathtracer/sampler.h"
-#include "pathtracer/scene.h"
-#include "shaders/range_formulas.h"
+#include "scene/range.h"
+#include "scene/scene.h"
 
 namespace pxf {
 
@@ -75,64 +74,6 @@ inline int accumulated_replicates(SamplerType sampler, int replicates) {
   return sampler == SamplerType::Sobol ? std::max(replicates, 1) : 1;
 }
 
-// What a scene may demand. The loader counts the instanced triangles (every mesh once per node
-// that references it) and reads the used images' headers before it reads any geometry or decodes
-// any texture; over a cap, or with an estimate over the available memory, it refuses.
-struct LoadLimits {
-  static constexpr int kDefaultMaxTextureSize = 16384;
-  static constexpr uint64_t kDefaultMaxTriangles = 100'000'000;
-  int max_texture_size = kDefaultMaxTextureSize;  // texels, per side
-  uint64_t max_triangles = kDefaultMaxTriangles;  // instanced triangles in the whole scene
-  uint64_t available_memory = 0;                  // bytes; 0 = what the system reports now
-};
-
-
-// The loader's memory estimate for a scene, in bytes: what the loaded scene, the BVH, the raster
-// pass's copies and the decoding need at the peak (docs/scenes.md, "Resource limits").
-struct LoadEstimate {
-  uint64_t vertices = 0, triangles = 0;  // instanced
-  uint64_t meshes = 0;                   // instanced primitives: each a Mesh, a BVH geometry, a draw
-  uint64_t lights = 0;                   // instanced punctual lights
-  uint64_t texture_bytes = 0;            // stored texels of the used textures
-  uint64_t largest_decode_bytes = 0;     // the largest image's decoding buffers
-  uint64_t environment_texels = 0;       // the environment map's (--env or the scene's own)
-  uint64_t bytes() const;
-};
-
-// The glTF/GLB file and the files its uris name (buffers, images) are read up to 4 GiB - 1: tinygltf
-// takes a file's length as an unsigned int, and a GLB stores its lengths in 32 bits.
-constexpr uint64_t kMaxGltfFileBytes = 0xffffffff;
-
-// Loads a glTF/GLB file or a built-in scene name ("cornell", ...); throws pxf::Error naming the
-// file and the problem. `env_path` (optional) replaces the environment with an equirectangular
-// EXR or Radiance .hdr (checked before the scene loads). A scene without any light gets the
-// built-in `default_light` environment (Scene::notes says so); with None a warning says it is black.
-// Before anything large is allocated, the loader checks `limits` (see LoadLimits) and refuses
-// with a one-line error naming the file and the limit.
-Scene load_scene(const std::string& name_or_path, const std::string& env_path = "", float env_strength = 1.0f,
-                 DefaultLight default_light = DefaultLight::None, const LoadLimits& limits = {});
-// The same from a glTF/GLB already in memory (the fuzzer's entry point); `name` prefixes errors and
-// relative uris resolve against `base_dir`.
-Scene load_scene_from_memory(const std::vector<unsigned char>& bytes, const std::string& name,
-                             const std::string& base_dir, const LoadLimits& limits = {});
-// The built-in scenes: name and one-line description.
-struct BuiltinScene { std::string name, description, path; };
-std::vector<BuiltinScene> builtin_scenes();
-
-// The range-buffer colors of a surface and of the environment (docs/method.md section 1.2), which
-// the raster pass's shaders compute from the same source (shaders/range_formulas.h).
-using shared::range_environment_color;
-using shared::range_shading;
-
-// Result of following a perfectly specular chain from the camera (docs/method.md section 1.2).
-struct SpecularChainHit {
-  // hit: albedo x chain tint x range_shading at the first non-specular hit; escaped:
-  // range_environment_color(chain tint x environment radiance), black without an environment.
-  glm::vec3 range_color{0.0f};
-  float distance = 0.0f;  // total distance along the chain, scene units (hit only)
-  bool hit = false;       // false: the chain escaped (the range pass uses the background distance)
-};
-
 // The material under a pixel as the path tracer shades the camera ray's first surface (the
 // explorer's inspector, issue 35): its evaluated parameters there (textures and vertex colour
 // applied) and the lobes its BSDF samples from, each with the probability sample() picks it.
@@ -151,43 +92,6 @@ struct SurfaceMaterial {
   float sheen_roughness = 0.0f;
   glm::vec3 emission{0.0f};  // toward the camera (0 from the back of a one-sided emitter)
   std::vector<SurfaceLobe> lobes;
-};
-
-// Per-pixel accumulations, row-major, top row first.
-struct Accumulation {
-  int width = 0, height = 0;
-  std::vector<glm::vec3> lv_mean;      // mean RGB radiance of LV paths
-  std::vector<glm::vec3> hv_mean;      // mean RGB radiance of HV paths
-  std::vector<glm::vec3> albedo_mean;  // mean PathSample::albedo (first non-specular base color)
-  std::vector<double> hv_lum_mean;     // Welford state of HV luminance
-  std::vector<double> hv_lum_m2;
-  // Welford state of LV luminance: LV is never filtered, so its noise is part of what the viewer
-  // sees; adaptive sampling judges the final pixel L_lv + L_u by it (app/adaptive.h).
-  std::vector<double> lv_lum_mean;
-  std::vector<double> lv_lum_m2;
-  std::vector<uint32_t> samples;       // accepted samples per pixel (NaN/Inf samples dropped)
-  // Interleaved replicates (TraceParams::replicates, 1 = none): HV luminance sum and sample count
-  // of replicate r of pixel p at [p * replicates + r].
-  int replicates = 1;
-  std::vector<double> replicate_lum_sum;
-  std::vector<uint32_t> replicate_samples;
-
-  // Var[L_u] of the HV luminance mean; negative (-1) when n < 2 (unknown). Without replicates it is
-  // s^2 / n. With replicates (randomized QMC, where s^2 / n overestimates), it is s^2 / n times the
-  // QMC gain: the sum over the 3x3 neighbourhood of the replicate estimates divided by the sum of
-  // the s^2 / n estimates. Each replicate estimate alone has only K - 1 degrees of freedom; pooling
-  // the gain, which varies slowly across the image, keeps the n - 1 of s^2 / n.
-  float variance_of_mean(size_t pixel) const;
-  std::vector<float> variance_of_mean_image() const;  // variance_of_mean of every pixel, in O(pixels)
-  void variance_of_mean_image(float* out, size_t stride) const;  // the same into out[pixel * stride]
-  // 4 floats per pixel: rgb hv_mean, a variance_of_mean (-1 where n < 2). The preview uploads this
-  // buffer as its HV texture as it is.
-  void hv_and_variance_of_mean(float* rgba) const;
-  float per_sample_variance_of_mean(size_t pixel) const;  // s^2 / n, -1 when n < 2
-  // Var[L_lv] of the LV luminance mean, s^2 / n (no replicate gain); -1 when n < 2.
-  float lv_variance_of_mean(size_t pixel) const;
-  // K'/(K'-1) sum_r (n_r / n)^2 (m_r - m)^2 over the K' replicates with samples; -1 when K' < 2.
-  float replicate_variance_of_mean(size_t pixel) const;
 };
 
 struct TraceStats {

@@ -9,7 +9,7 @@
 
 #include "pathtracer/integrator.h"
 #include "pathtracer/sampler.h"
-#include "pathtracer/stat_tests.h"
+#include "testing/stat_tests.h"
 
 namespace pxf {
 namespace {

@@ -8,8 +8,8 @@
 #include <cstdio>
 
 #include "pathtracer/rng.h"
-#include "pathtracer/shapes.h"
-#include "pathtracer/stat_tests.h"
+#include "testing/shapes.h"
+#include "testing/stat_tests.h"
 
 namespace pxf {
 namespace {

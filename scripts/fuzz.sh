@@ -6,7 +6,7 @@
 #   scripts/fuzz.sh --replay [HARNESS...]                 every committed input once, under the sanitizers
 #   scripts/fuzz.sh --merge [HARNESS...]                  minimize: merge what the campaigns found
 #                                                         (build-fuzz/corpus/) into fuzz/corpus/
-#   scripts/fuzz.sh --unit-tests                          the image and path tracer unit tests, built in
+#   scripts/fuzz.sh --unit-tests                          the core, image, scene and path tracer unit tests, built in
 #                                                         the same folder, so under the same sanitizers
 #   scripts/fuzz.sh --available                           exit 0 when clang++ and libFuzzer work here
 # Harnesses: gltf_scene exr_reader png_reader hdr_reader state_reader. Each campaign reads the committed
@@ -76,9 +76,9 @@ if [ "$mode" = unit ]; then
   # Left out here, not in the normal build: three image statistics over thousands of paths (100 of
   # the 280 s these tests took under the sanitizers), whose code paths the furnace and
   # restored-field tests run here too.
-  cmake --build "$BUILD" -j "${PXF_JOBS:-$(nproc)}" --target image_tests pathtracer_tests
+  cmake --build "$BUILD" -j "${PXF_JOBS:-$(nproc)}" --target core_tests image_tests scene_tests pathtracer_tests
   ASAN_OPTIONS=detect_leaks=0 ctest --test-dir "$BUILD" --output-on-failure -j "$(nproc)" --timeout 900 \
-    -L 'image_tests|pathtracer_tests' \
+    -L 'core_tests|image_tests|scene_tests|pathtracer_tests' \
     -E '^(SpecularSampling.CornellMeansAgreeWithoutIt|Guiding.GuidedImageAgreesWithUnguidedReference|Guiding.TrainedFieldFindsTheMirrorCaustic)$'
   exit
 fi

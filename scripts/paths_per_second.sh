@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Paths/s of several pxf builds or settings, back to back: ROUNDS rounds, each running every
-# variant once in the order given (`pxf bench --pathtracer --size 128x128`, FRAMES timed frames,
+# variant once in the order given (`pxf bench pathtracer --size 128x128`, FRAMES timed frames,
 # default 150), then per variant the median over rounds and its ratio to the first variant's.
 # A shared machine drifts between minutes, so only ratios from one run of this script compare.
 # Usage: scripts/paths_per_second.sh ROUNDS SCENE LABEL=BINARY[:EXTRA FLAGS] ...
@@ -22,7 +22,7 @@ for round in $(seq "$rounds"); do
     extra=""
     [[ $rest == *:* ]] && extra=${rest#*:}
     # shellcheck disable=SC2086  # the extra flags are meant to split into words
-    line=$("$binary" bench --pathtracer --scene "$scene" --size 128x128 --timed-frames "${FRAMES:-150}" $extra \
+    line=$("$binary" bench pathtracer --scene "$scene" --size 128x128 --timed-frames "${FRAMES:-150}" $extra \
       --out "$tmp/bench" 2>&1 | grep -o '[0-9.]* M paths/s' | head -1) || { echo "$label: no paths/s from $binary" >&2; exit 1; }
     echo "$label ${line%% *}" | tee -a "$tmp/runs"
   done

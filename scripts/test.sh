@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Sets up and builds pxf, then runs the whole test suite with ctest. Then, where clang++ and
 # libFuzzer work, one clang build under AddressSanitizer + UndefinedBehaviorSanitizer (build-fuzz/,
-# scripts/fuzz.sh) runs the core libraries' unit tests (image, pathtracer; skip with
+# scripts/fuzz.sh) runs the core libraries' unit tests (core, image, scene, pathtracer; skip with
 # PXF_SKIP_SANITIZERS=1) and a short libFuzzer run of each harness in fuzz/ (PXF_FUZZ_SECONDS per
 # harness, default 10; skip with PXF_SKIP_FUZZ=1); any test failure, crash, leak, sanitizer report or
 # timeout fails the script. One sanitizer build serves both: a second one of the libraries was
@@ -19,7 +19,7 @@ if [ $((sanitizers + fuzz)) -gt 0 ] && ! scripts/fuzz.sh --available; then
   exit 0
 fi
 if [ $sanitizers = 1 ]; then
-  echo "== image and path tracer unit tests under AddressSanitizer + UndefinedBehaviorSanitizer (clang, build-fuzz/)"
+  echo "== core, image, scene and path tracer unit tests under AddressSanitizer + UndefinedBehaviorSanitizer (clang, build-fuzz/)"
   scripts/fuzz.sh --unit-tests
 fi
 if [ $fuzz = 1 ]; then

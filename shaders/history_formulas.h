@@ -11,7 +11,7 @@ PXF_SHARED_BEGIN
 
 // The history counts as at most this many samples (an exponential moving average of about this
 // length while the camera keeps moving), so that the lag and the blur of repeated resampling stay
-// short. pxf bench --motion, median display NRMSE and flicker against the references' own, for
+// short. pxf bench motion, median display NRMSE and flicker against the references' own, for
 // 4 / 8 / 16 (with one path everywhere, before kHistoryFirstFrameSamples): the helmet-like GLB
 // under the envmap (384x216, 60 frames over 90 degrees, 1024-spp references) 8.43 / 8.11 / 8.10 %
 // and 1.58 / 1.52 / 1.50x; cornell 128x128 (30 frames over 45 degrees) 14.74 / 14.77 / 14.73 % and
@@ -52,7 +52,7 @@ PXF_CONST int kHistoryOutside = 3;     // outside the previous view (or behind i
 
 // ---- Cameras ----
 
-// A camera as camera_ray (pathtracer/camera.cpp) uses it: origin, rotation (camera to world),
+// A camera as camera_ray (scene/camera.cpp) uses it: origin, rotation (camera to world),
 // tan(yfov / 2) or ymag, the image aspect and size in pixels.
 struct ViewCamera {
   vec3 origin;
@@ -250,7 +250,7 @@ PXF_SAMPLER_FN HistorySample reproject_history(sampler2D previous_lv, sampler2D 
 // paths together: one whose history holds less (disoccluded, outside the previous view, a partial
 // footprint) traces the difference, so that the pixels without history are not the noisiest of the
 // frame (in that frame their variance stays unknown: Preview::hide_first_frame_variances).
-// pxf bench --motion on the helmet-like GLB (as above), 1 / 2 / 4 / 8: median display NRMSE 8.11 /
+// pxf bench motion on the helmet-like GLB (as above), 1 / 2 / 4 / 8: median display NRMSE 8.11 /
 // 6.29 / 4.57 / 3.58 %, flicker 1.52 / 1.43 / 1.26 / 1.07x the references', rejected pixels'
 // display RMSE 0.226 / 0.165 / 0.108 / 0.070; the cost is 3 paths in each uncovered pixel (the
 // frame time of 1 and 4 alike within the machine's noise there; cornell 128x128, whose specular

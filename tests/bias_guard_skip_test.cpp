@@ -1,11 +1,12 @@
-// The preview leaves the bias guard's passes out once a filter run skipped every pixel (app/preview.cpp,
+// The preview leaves the bias guard's passes out once a filter run skipped every pixel (preview/preview.cpp,
 // blend_and_tonemap): every pixel is then case 2, where the guard changes nothing.
 #include <gtest/gtest.h>
 
-#include "app/preview.h"
 #include "gl/blend_pass.h"
 #include "pathtracer/integrator.h"
 #include "pathtracer/pathtracer.h"
+#include "preview/preview.h"
+#include "scene/load.h"
 #include "tests/test_support.h"
 
 using namespace pxf;

@@ -85,14 +85,14 @@ TEST(CameraPathCli, BadFlagsAndFilesAreRefusedWithOneLine) {
   expect_one_line_refusal("render --size 16x16 --camera-path " + write_path_file(R"({"keyframes": [
     {"position": [0.5,0.5,2], "target": [0.5,0.5,0], "frames": 2}, {"position": [0.5,0.5,0], "target": [0.5,0.5,2]}]})"),
                           "frame 1: position and target meet");
-  expect_one_line_refusal("bench --motion --size 16x16 --camera-path " + write_path_file("{\"keyframes\": ["),
+  expect_one_line_refusal("bench motion --size 16x16 --camera-path " + write_path_file("{\"keyframes\": ["),
                           "not valid JSON");
 }
 
-// pxf bench --motion measures a camera path's views (one reference per frame, cached by the path's name).
+// pxf bench motion measures a camera path's views (one reference per frame, cached by the path's name).
 TEST(CameraPathCli, MotionBenchFollowsThePath) {
   const std::string out = test_support::temp_dir("camera_path", "motion_bench");
-  const Result r = run("bench --motion --one-reference --size 16x16 --camera-path turntable:3 --reference-spp 2 --out " + out);
+  const Result r = run("bench motion --one-reference --size 16x16 --camera-path turntable:3 --reference-spp 2 --out " + out);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("camera path turntable:3 (3 frames)"), std::string::npos) << r.out;
   const std::string text = test_support::slurp(out + "/motion.csv");

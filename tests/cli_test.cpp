@@ -24,8 +24,9 @@
 #include "app/output_set.h"
 #include "gl/pass_params.h"
 #include "image/image.h"
-#include "tests/test_support.h"
 #include "pathtracer/pathtracer.h"
+#include "scene/load.h"
+#include "tests/test_support.h"
 
 namespace fs = std::filesystem;
 using namespace pxf;
@@ -54,8 +55,8 @@ void write_half_rgba(const std::string& path, const std::vector<float>& rgb, int
 TEST(Cli, UsageErrorsExitWithCode2AndOneLine) {
   for (const char* args : {"", "bogus", "render --nope", "render --spp 0", "render --spp", "render --size 3",
                            "render --threshold -1", "render --filter gauss", "render --gl window", "bench --budgets 4,x",
-                           "bench --variants --subsampled-taps 0", "bench --adaptive --motion",
-                           "bench --pathtracer --clean-cap 3",
+                           "bench variants --subsampled-taps 0", "bench adaptive motion", "bench bogus",
+                           "bench pathtracer --clean-cap 3", "bench --adaptive maybe",
                            "diff only-one.exr", "explore --sigma-s abc", "render --time 0", "render --time -3",
                            "render --time nan", "render --time 1e99", "render --time soon", "render --schedule x"}) {
     const Result r = run(args);
@@ -75,36 +76,39 @@ TEST(Cli, EveryCommandHasHelp) {
   EXPECT_EQ(run("--help").code, 0);
 }
 
-// Each bench mode is its own entry point (app/bench_command.cpp): pxf bench --help lists them, a
-// mode's --help shows its own options and not another's, and an option of another mode is an error.
+// Each bench mode is its own entry point (bench/bench_command.cpp), named by a word that is no
+// setting: pxf bench --help lists them, a mode's --help shows its own options and not another's,
+// and an option of another mode is an error. --adaptive is the setting in every mode.
 TEST(Cli, BenchModesHaveTheirOwnOptions) {
   const Result list = run("bench --help");
   ASSERT_EQ(list.code, 0);
-  for (const char* mode : {"--pathtracer", "--sampler-error", "--variance-ratio", "--variants", "--stage-table",
-                           "--threshold-fidelity", "--guiding-ab", "--guiding-bound", "--adaptive", "--demodulation-ab",
-                           "--motion"})
+  for (const char* mode : {"pathtracer", "sampler-error", "variance-ratio", "variants", "stage-table",
+                           "threshold-fidelity", "guiding-ab", "guiding-bound", "adaptive", "demodulation-ab", "motion"})
     EXPECT_NE(list.out.find(std::string("\n  ") + mode + " "), std::string::npos) << mode;
-  const Result adaptive = run("bench --adaptive --help");
+  const Result adaptive = run("bench adaptive --help");
   ASSERT_EQ(adaptive.code, 0);
-  EXPECT_NE(adaptive.out.find("usage: pxf bench --adaptive"), std::string::npos);
-  for (const char* own : {"--clean-cap", "--budgets", "--rounds", "--threshold", "--reference"})
+  EXPECT_NE(adaptive.out.find("usage: pxf bench adaptive"), std::string::npos);
+  for (const char* own : {"--clean-cap", "--budgets", "--rounds", "--threshold", "--reference", "--adaptive"})
     EXPECT_NE(adaptive.out.find(own), std::string::npos) << own;
   for (const char* other : {"--variant-spp", "--motion-frames", "--timed-frames"})
     EXPECT_EQ(adaptive.out.find(other), std::string::npos) << other;
-  EXPECT_NE(run("bench --adaptive --variant-spp 3").err.find("--variant-spp"), std::string::npos);
+  EXPECT_NE(run("bench adaptive --variant-spp 3").err.find("--variant-spp"), std::string::npos);
+  const Result setting = run("bench --adaptive on --help");
+  ASSERT_EQ(setting.code, 0) << setting.err;
+  EXPECT_NE(setting.out.find("usage: pxf bench [options]"), std::string::npos) << setting.out;
 }
 
 // The guiding bound end to end, tiny: every point's row in the CSV, the summary and the image's
 // bound printed; an odd cell count is refused in one line.
 TEST(Cli, GuidingBoundWritesItsTable) {
   const std::string out = temp_dir("guiding_bound");
-  const Result r = run("bench --guiding-bound --scene atrium --size 32x18 --points 3 --cells 4 --paths 2 --frames 1 "
+  const Result r = run("bench guiding-bound --scene atrium --size 32x18 --points 3 --cells 4 --paths 2 --frames 1 "
                        "--floor-directions 4 --floor-paths 2 --spp 2 --out " + out);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("floor of any guide"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("at least"), std::string::npos) << r.out;
   EXPECT_EQ(lines(slurp(out + "/guiding_bound.csv")), 4u);  // the header and 3 points
-  const Result odd = run("bench --guiding-bound --cells 5 --out " + out);
+  const Result odd = run("bench guiding-bound --cells 5 --out " + out);
   EXPECT_EQ(odd.code, 2);
   EXPECT_EQ(lines(odd.err), 1u) << odd.err;
 }
@@ -328,7 +332,7 @@ TEST(Cli, BenchVariantsTabulatesEveryFilterVariant) {
   // The reference's HV from the buffers.exr of an unfiltered render; a row and an image per variant.
   const std::string ref = temp_dir("variants_reference"), out = temp_dir("variants");
   ASSERT_EQ(run("render --size 24x16 --spp 32 --filter none --seed 9 --quiet --out " + ref).code, 0);
-  const Result r = run("bench --variants --size 24x16 --variant-rounds 1 --subsampled-taps 8 --reference " + ref +
+  const Result r = run("bench variants --size 24x16 --variant-rounds 1 --subsampled-taps 8 --reference " + ref +
                        "/buffers.exr --out " + out);
   ASSERT_EQ(r.code, 0) << r.err;
   const std::string csv = slurp(out + "/variants.csv");
@@ -346,7 +350,7 @@ TEST(Cli, BenchVariantsTabulatesEveryFilterVariant) {
 // unfiltered image's: LV's, of which the emitter pixels', HV's, of which its worst 1 % of pixels').
 TEST(Cli, BenchSamplerErrorSaysWhereTheErrorSits) {
   const std::string out = temp_dir("sampler_error");
-  const Result r = run("bench --pathtracer --sampler-error --size 24x24 --seeds 2 --spp 2,4 --reference-spp 32 "
+  const Result r = run("bench sampler-error --size 24x24 --seeds 2 --spp 2,4 --reference-spp 32 "
                        "--rounds 1 --out " + out);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("where the squared error sits"), std::string::npos) << r.out;
@@ -377,7 +381,7 @@ TEST(Cli, BenchThresholdFidelityTakesTheThreshold) {
   for (const std::string threshold : {"", "0.05"}) {
     SCOPED_TRACE(threshold);
     const std::string out = temp_dir("fidelity" + threshold);
-    const Result r = run("bench --threshold-fidelity --size 16x16 --seeds 2 --spp 16 " +
+    const Result r = run("bench threshold-fidelity --size 16x16 --seeds 2 --spp 16 " +
                          (threshold.empty() ? "" : "--threshold " + threshold + " ") + "--out " + out);
     ASSERT_EQ(r.code, 0) << r.err;
     std::istringstream csv(slurp(out + "/threshold_fidelity_cornell.csv"));

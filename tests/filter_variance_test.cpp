@@ -11,6 +11,7 @@
 
 #include "app/render_output.h"
 #include "pathtracer/pathtracer.h"
+#include "scene/load.h"
 #include "tests/test_support.h"
 
 using namespace pxf;

@@ -1,10 +1,11 @@
 // The preview leaves the filter out while HV carries less than kMinHvShare of the image's energy
-// (app/preview.h): HV's noise cannot matter next to LV's there, and a run would cost time only.
+// (preview/preview.h): HV's noise cannot matter next to LV's there, and a run would cost time only.
 #include <gtest/gtest.h>
 
-#include "app/preview.h"
 #include "pathtracer/integrator.h"
 #include "pathtracer/pathtracer.h"
+#include "preview/preview.h"
+#include "scene/load.h"
 #include "tests/test_support.h"
 
 using namespace pxf;

@@ -6,12 +6,13 @@
 #include <algorithm>
 #include <cmath>
 
-#include "app/explorer_camera.h"
-#include "app/preview.h"
+#include "app/explorer/explorer_camera.h"
 #include "app/render_output.h"
 #include "gl/grid_filter.h"
-#include "pathtracer/accumulation_state.h"
 #include "image/metrics.h"
+#include "pathtracer/accumulation_state.h"
+#include "preview/preview.h"
+#include "scene/load.h"
 #include "tests/test_support.h"
 
 using namespace pxf;
@@ -196,7 +197,7 @@ TEST(MotionHistory, ASmallMoveKeepsMostOfTheImage) {
   restart.set_camera(now);
   const std::vector<Layer> one = render_at(restart, 1);
   const Image target = unfiltered_image(converged);
-  // On display values, as pxf bench --motion measures: the HDR NRMSE is the fireflies' of the
+  // On display values, as pxf bench motion measures: the HDR NRMSE is the fireflies' of the
   // pixels that take no history (the glass and mirror spheres, silhouettes) in both.
   const double with_history = compare_display(preview.final_image(), target).display_nrmse_percent;
   const double restarted = compare_display(unfiltered_image(one), target).display_nrmse_percent;

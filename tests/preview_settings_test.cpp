@@ -5,8 +5,9 @@
 
 #include <functional>
 
-#include "app/preview.h"
 #include "pathtracer/pathtracer.h"
+#include "preview/preview.h"
+#include "scene/load.h"
 #include "tests/test_support.h"
 
 using namespace pxf;

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "pathtracer/pathtracer.h"
+#include "scene/load.h"
 #include "tests/test_support.h"
 
 using namespace pxf;

@@ -11,6 +11,7 @@
 #include <map>
 
 #include "pathtracer/pathtracer.h"
+#include "scene/load.h"
 
 namespace pxf::test_support {
 

@@ -4,8 +4,8 @@
 #include <memory>
 #include <string>
 
-#include "app/preview.h"
 #include "gl/context.h"
+#include "preview/preview.h"
 
 namespace pxf::test_support {
 

@@ -1,5 +1,5 @@
-// Compiled with pxf_preview's include directories only (tests/CMakeLists.txt): the preview core's
-// own headers do compile there (the control of layering.preview_sees_no_command).
-#include "app/pixel_probe.h"
-#include "app/preview.h"
-#include "app/setting_table.h"
+// The preview core's headers: they compile for the commands (and with the preview core's own
+// include directories, the control of the probe that finds no command there).
+#include "preview/pixel_probe.h"
+#include "preview/preview.h"
+#include "preview/setting_table.h"

@@ -1,0 +1,145 @@
+#include "pathtracer/accumulation.h"
+
+#include <algorithm>
+#include <limits>
+#include <utility>
+
+#include "pathtracer/sampling.h"
+
+namespace pxf {
+
+void resize_accumulation(Accumulation& acc, int width, int height, int replicates) {
+  size_t n = static_cast<size_t>(width) * static_cast<size_t>(height);
+  acc.width = width;
+  acc.height = height;
+  acc.lv_mean.assign(n, glm::vec3(0.0f));
+  acc.hv_mean.assign(n, glm::vec3(0.0f));
+  acc.albedo_mean.assign(n, glm::vec3(0.0f));
+  acc.hv_lum_mean.assign(n, 0.0);
+  acc.hv_lum_m2.assign(n, 0.0);
+  acc.lv_lum_mean.assign(n, 0.0);
+  acc.lv_lum_m2.assign(n, 0.0);
+  acc.samples.assign(n, 0u);
+  acc.replicates = std::max(1, replicates);
+  const size_t replicate_slots = acc.replicates > 1 ? n * static_cast<size_t>(acc.replicates) : 0;
+  acc.replicate_lum_sum.assign(replicate_slots, 0.0);
+  acc.replicate_samples.assign(replicate_slots, 0u);
+}
+
+void accumulate_sample(Accumulation& acc, size_t pixel, glm::vec3 lv, glm::vec3 hv, int replicate, glm::vec3 albedo) {
+  uint32_t n = ++acc.samples[pixel];
+  float inv_n = 1.0f / static_cast<float>(n);
+  acc.lv_mean[pixel] += (lv - acc.lv_mean[pixel]) * inv_n;
+  acc.hv_mean[pixel] += (hv - acc.hv_mean[pixel]) * inv_n;
+  acc.albedo_mean[pixel] += (albedo - acc.albedo_mean[pixel]) * inv_n;
+  double y = luminance(hv);
+  double delta = y - acc.hv_lum_mean[pixel];
+  acc.hv_lum_mean[pixel] += delta / static_cast<double>(n);
+  acc.hv_lum_m2[pixel] += delta * (y - acc.hv_lum_mean[pixel]);
+  const double y_lv = luminance(lv), delta_lv = y_lv - acc.lv_lum_mean[pixel];
+  acc.lv_lum_mean[pixel] += delta_lv / static_cast<double>(n);
+  acc.lv_lum_m2[pixel] += delta_lv * (y_lv - acc.lv_lum_mean[pixel]);
+  if (acc.replicates > 1) {
+    const size_t slot = pixel * static_cast<size_t>(acc.replicates) + static_cast<size_t>(replicate % acc.replicates);
+    acc.replicate_lum_sum[slot] += y;
+    ++acc.replicate_samples[slot];
+  }
+}
+
+namespace {
+// s^2 / n of a Welford state of n samples; -1 when n < 2.
+float welford_variance_of_mean(double m2, uint32_t n) {
+  if (n < 2) return -1.0f;
+  double var = m2 / static_cast<double>(n - 1) / static_cast<double>(n);
+  // Saturate rather than overflow: a very bright but finite input (luminance near the float limit)
+  // has a variance beyond float range, and an infinite variance would poison every later pass.
+  return static_cast<float>(std::clamp(var, 0.0, static_cast<double>(std::numeric_limits<float>::max())));
+}
+}  // namespace
+
+float Accumulation::per_sample_variance_of_mean(size_t pixel) const {
+  return welford_variance_of_mean(hv_lum_m2[pixel], samples[pixel]);
+}
+
+float Accumulation::lv_variance_of_mean(size_t pixel) const {
+  return welford_variance_of_mean(lv_lum_m2[pixel], samples[pixel]);
+}
+
+float Accumulation::replicate_variance_of_mean(size_t pixel) const {
+  if (replicates < 2) return -1.0f;
+  const double* sums = &replicate_lum_sum[pixel * static_cast<size_t>(replicates)];
+  const uint32_t* counts = &replicate_samples[pixel * static_cast<size_t>(replicates)];
+  int used = 0;
+  double total = 0, n = 0;
+  for (int r = 0; r < replicates; ++r) {
+    if (counts[r] == 0) continue;
+    ++used;
+    total += sums[r];
+    n += counts[r];
+  }
+  if (used < 2) return -1.0f;
+  const double mean = total / n;
+  double sum = 0;
+  for (int r = 0; r < replicates; ++r) {
+    if (counts[r] == 0) continue;
+    const double weight = counts[r] / n, d = sums[r] / counts[r] - mean;
+    sum += weight * weight * d * d;
+  }
+  return static_cast<float>(sum * used / (used - 1));
+}
+
+namespace {
+
+// s^2 / n of `pixel` times the QMC gain pooled over its 3x3 neighbourhood; estimates(q) gives the
+// replicate and the per-sample estimate of pixel q (-1: unknown). One formula for the per-pixel
+// query and the whole image, so both give the same bits.
+template <class Estimates>
+float pooled_gain_variance_of_mean(const Accumulation& acc, size_t pixel, const Estimates& estimates) {
+  const float own = estimates(pixel).second;
+  if (acc.replicates < 2 || own <= 0.0f) return own;
+  const int x = static_cast<int>(pixel % static_cast<size_t>(acc.width));
+  const int y = static_cast<int>(pixel / static_cast<size_t>(acc.width));
+  double replicate_sum = 0, per_sample_sum = 0;
+  for (int ny = std::max(0, y - 1); ny <= std::min(acc.height - 1, y + 1); ++ny)
+    for (int nx = std::max(0, x - 1); nx <= std::min(acc.width - 1, x + 1); ++nx) {
+      const auto [r, v] = estimates(static_cast<size_t>(ny) * static_cast<size_t>(acc.width) + static_cast<size_t>(nx));
+      if (r < 0.0f || v < 0.0f) continue;
+      replicate_sum += r;
+      per_sample_sum += v;
+    }
+  if (!(per_sample_sum > 0.0)) return own;
+  return static_cast<float>(own * (replicate_sum / per_sample_sum));
+}
+
+}  // namespace
+
+float Accumulation::variance_of_mean(size_t pixel) const {
+  return pooled_gain_variance_of_mean(*this, pixel, [this](size_t q) {
+    return std::make_pair(replicate_variance_of_mean(q), per_sample_variance_of_mean(q));
+  });
+}
+
+void Accumulation::variance_of_mean_image(float* out, size_t stride) const {
+  const size_t n = samples.size();
+  std::vector<std::pair<float, float>> estimates(n);
+  for (size_t q = 0; q < n; ++q) estimates[q] = {replicate_variance_of_mean(q), per_sample_variance_of_mean(q)};
+  for (size_t p = 0; p < n; ++p)
+    out[p * stride] = pooled_gain_variance_of_mean(*this, p, [&estimates](size_t q) { return estimates[q]; });
+}
+
+std::vector<float> Accumulation::variance_of_mean_image() const {
+  std::vector<float> out(samples.size());
+  variance_of_mean_image(out.data(), 1);
+  return out;
+}
+
+void Accumulation::hv_and_variance_of_mean(float* rgba) const {
+  for (size_t p = 0; p < hv_mean.size(); ++p) {
+    rgba[4 * p + 0] = hv_mean[p].x;
+    rgba[4 * p + 1] = hv_mean[p].y;
+    rgba[4 * p + 2] = hv_mean[p].z;
+  }
+  variance_of_mean_image(rgba + 3, 4);
+}
+
+}  // namespace pxf

@@ -1,0 +1,28 @@
+// Programmatic geometry for tests and benchmarks: spheres, quads, boxes, a look-at camera and a
+// small Cornell-like box scene. Meshes come out in world space like the loader's.
+#pragma once
+#include <glm/glm.hpp>
+#include "scene/scene.h"
+
+namespace pxf {
+
+// UV sphere with smooth normals; `inward` flips winding and normals (a closed room around a camera).
+Mesh make_sphere(glm::vec3 center, float radius, int material, int segments = 48, int rings = 24, bool inward = false);
+// Parallelogram corner, corner + u, corner + u + v, corner + v; the normal is normalize(cross(u, v)).
+Mesh make_quad(glm::vec3 corner, glm::vec3 u, glm::vec3 v, int material);
+// Axis-aligned box with flat outward faces.
+Mesh make_box(glm::vec3 min_corner, glm::vec3 max_corner, int material);
+
+Camera look_at_camera(glm::vec3 eye, glm::vec3 target, glm::vec3 up, float yfov);
+
+Material make_diffuse(glm::vec3 albedo);  // Lambertian (metallic 0, KHR specular 0)
+Material make_mirror(glm::vec3 tint = glm::vec3(1.0f));
+Material make_glass(float ior = 1.5f, glm::vec3 tint = glm::vec3(1.0f));
+Material make_conductor(glm::vec3 f0, float roughness);
+Material make_emitter(glm::vec3 radiance);  // black diffuse surface that emits from its front side
+
+// Cornell-like box ([-1,1]^3, open towards +z, ceiling light), optionally with a mirror and a glass
+// sphere; camera at z = 3.4 looking down -z.
+Scene make_cornell_box(bool with_specular_spheres);
+
+}  // namespace pxf
