@@ -73,6 +73,7 @@ void add_preview_options(CommandLine& cli, PreviewSettings& s) {
 
 bool print_scene_list_if_asked(const SceneOptions& options) {
   if (options.scene != "list") return false;
+  std::printf("built-in scenes (in %s):\n", builtin_assets_dir().c_str());
   for (const BuiltinScene& s : builtin_scenes()) std::printf("%-10s %s\n", s.name.c_str(), s.description.c_str());
   return true;
 }

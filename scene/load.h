@@ -52,5 +52,8 @@ Scene load_scene_from_memory(const std::vector<unsigned char>& bytes, const std:
 // The built-in scenes: name and one-line description.
 struct BuiltinScene { std::string name, description, path; };
 std::vector<BuiltinScene> builtin_scenes();
+// The folder of the built-in scenes: PREFIX/share/pxf/assets beside an installed pxf (found from
+// the running executable's path), else the source tree's assets/.
+std::string builtin_assets_dir();
 
 }  // namespace pxf

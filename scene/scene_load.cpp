@@ -38,6 +38,9 @@
 #include "scene/spec_gloss.h"
 #include "scene/texture.h"
 
+#ifndef PXF_ASSETS_FROM_BINDIR
+#define PXF_ASSETS_FROM_BINDIR "../share/pxf/assets"
+#endif
 #ifndef PXF_ASSETS_DIR
 #define PXF_ASSETS_DIR ""
 #endif
@@ -79,7 +82,7 @@ const BuiltinInfo kBuiltins[] = {
 };
 
 std::string builtin_path(const std::string& name) {
-  return std::string(PXF_ASSETS_DIR) + "/" + name + "/" + name + ".gltf";
+  return builtin_assets_dir() + "/" + name + "/" + name + ".gltf";
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1432,6 +1435,19 @@ uint64_t LoadEstimate::bytes() const {
   const uint64_t images = add(add(mul(texture_bytes, 2), largest_decode_bytes),
                               mul(environment_texels, kBytesPerEnvironmentTexel));
   return add(geometry, images);
+}
+
+std::string builtin_assets_dir() {
+  static const std::string dir = [] {
+    std::error_code ec;
+    const fs::path executable = fs::read_symlink("/proc/self/exe", ec);
+    if (!ec) {
+      const fs::path installed = (executable.parent_path() / PXF_ASSETS_FROM_BINDIR).lexically_normal();
+      if (fs::is_directory(installed, ec)) return installed.string();
+    }
+    return std::string(PXF_ASSETS_DIR);
+  }();
+  return dir;
 }
 
 std::vector<BuiltinScene> builtin_scenes() {
