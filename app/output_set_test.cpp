@@ -200,8 +200,11 @@ TEST(OutputSet, AForeignCurrentSetNameIsRefusedBeforeAnythingIsTouched) {
           << e.what();
     }
     EXPECT_EQ(entries(dir), before) << kind;
-    if (kind == "folder") EXPECT_EQ(read_text(current + "/a.txt"), "the user's");
-    if (kind == "file") EXPECT_EQ(read_text(current), "the user's");
+    if (kind == "folder") {
+      EXPECT_EQ(read_text(current + "/a.txt"), "the user's");
+    } else if (kind == "file") {
+      EXPECT_EQ(read_text(current), "the user's");
+    }
     EXPECT_THROW(check_output_folder(dir), Error);
   }
 }
