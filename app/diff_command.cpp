@@ -67,7 +67,9 @@ std::optional<StatsJson> read_stats_beside(const std::string& image_path) {
   try {
     read_settings_json(settings, stats.settings);
   } catch (const Error& e) {
-    throw fail(e.what());
+    std::string what = e.what();
+    if (what.rfind("stats.json ", 0) == 0) what.erase(0, 11);  // the file is named already
+    throw fail(what);
   }
   const auto count = [&](const nlohmann::json& object, const char* key, const std::string& where, double max) {
     if (!object.contains(key)) return -1.0;
