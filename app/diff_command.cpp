@@ -32,23 +32,73 @@ bool has_layer(const std::vector<Layer>& layers, const std::string& name) {
   return false;
 }
 
-// The stats.json a render wrote beside `image_path`; nullopt where there is none or it is not JSON.
-// Read like every named input (a FIFO there is refused, not waited on), up to 16 MiB: pxf writes a
-// few KB.
+// The stats.json a render wrote beside an image, read through one checked reader: read like every
+// named input (a FIFO there is refused, not waited on) up to 16 MiB (pxf writes a few KB); every
+// value pxf diff uses is checked for its type and range, and any problem is one line naming the
+// file. nullopt where there is none, or where it records no settings.
 constexpr uint64_t kMaxStatsJsonBytes = uint64_t{16} << 20;
+constexpr double kMaxStatsSpp = 2147483647.0;  // a state's frame cap
 std::string stats_path_beside(const std::string& image_path) {
   return (std::filesystem::path(image_path).parent_path() / "stats.json").string();
 }
-std::optional<nlohmann::json> stats_beside(const std::string& image_path) {
-  const std::string path = stats_path_beside(image_path);
+struct StatsJson {
+  std::string path;
+  PreviewSettings settings;  // what it records (read_settings_json), the defaults for the rest
+  double settings_spp = 0;   // settings.spp; 0: none
+  nlohmann::json compared;   // scene, width, height, the settings and spp (time_budget.spp_reached
+                             // where the run had a budget), as checked
+};
+std::optional<StatsJson> read_stats_beside(const std::string& image_path) {
+  StatsJson stats;
+  stats.path = stats_path_beside(image_path);
+  const std::string& path = stats.path;
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) return std::nullopt;
   const std::vector<unsigned char> bytes = read_input_file(path, kMaxStatsJsonBytes);
   // dump() recurses when a setting is quoted in an error: a deep file is refused before parsing.
   check_json_depth(reinterpret_cast<const char*>(bytes.data()), bytes.size(), path);
-  nlohmann::json json = nlohmann::json::parse(bytes.begin(), bytes.end(), nullptr, false);
-  if (json.is_discarded()) return std::nullopt;
-  return json;
+  const nlohmann::json json = nlohmann::json::parse(bytes.begin(), bytes.end(), nullptr, false);
+  const auto fail = [&](const std::string& problem) { return Error(path + ": " + problem); };
+  if (json.is_discarded()) throw fail("not valid JSON");
+  if (!json.is_object()) throw fail("not a JSON object");
+  if (!json.contains("settings")) return std::nullopt;
+  const nlohmann::json& settings = json["settings"];
+  if (!settings.is_object()) throw fail("\"settings\" is not an object");
+  try {
+    read_settings_json(settings, stats.settings);
+  } catch (const Error& e) {
+    std::string what = e.what();
+    if (what.rfind("stats.json ", 0) == 0) what.erase(0, 11);  // the file is named already
+    throw fail(what);
+  }
+  const auto count = [&](const nlohmann::json& object, const char* key, const std::string& where, double max) {
+    if (!object.contains(key)) return -1.0;
+    const nlohmann::json& v = object[key];
+    const double d = v.is_number() ? v.get<double>() : -1.0;
+    if (!(d >= 0 && d <= max && d == std::floor(d)))
+      throw fail(where + key + " (" + v.dump() + ") is not a count from 0 to " + std::to_string(static_cast<uint64_t>(max)));
+    return d;
+  };
+  stats.compared = nlohmann::json::object();
+  for (const SettingDescriptor& d : setting_table())
+    if (settings.contains(d.key)) stats.compared[d.key] = settings[d.key];
+  if (settings.contains("scene")) {
+    if (!settings["scene"].is_string()) throw fail("settings.scene is not a string");
+    stats.compared["scene"] = settings["scene"];
+  }
+  for (const char* key : {"width", "height"}) {
+    const double v = count(settings, key, "settings.", 16384);
+    if (v >= 0) stats.compared[key] = v;
+  }
+  const double spp = count(settings, "spp", "settings.", kMaxStatsSpp);
+  stats.settings_spp = std::max(0.0, spp);
+  if (spp >= 0) stats.compared["spp"] = spp;
+  if (json.contains("time_budget")) {
+    if (!json["time_budget"].is_object()) throw fail("\"time_budget\" is not an object");
+    const double reached = count(json["time_budget"], "spp_reached", "time_budget.", kMaxStatsSpp);
+    stats.compared["spp"] = reached >= 0 ? reached : std::max(0.0, spp);
+  }
+  return stats;
 }
 
 // The emitter mask: --mask FILE's "emitter" layer, else the reference's own when it is a
@@ -100,11 +150,11 @@ struct BlendSettings {
 };
 BlendSettings blend_settings_of(const std::string& buffers_path) {
   BlendSettings b;
-  const std::optional<nlohmann::json> json = stats_beside(buffers_path);
-  if (!json || !json->contains("settings")) return b;
-  read_settings_json((*json)["settings"], b.settings);
-  b.frames = (*json)["settings"].value("spp", 0.0f);
-  b.source = stats_path_beside(buffers_path);
+  const std::optional<StatsJson> stats = read_stats_beside(buffers_path);
+  if (!stats) return b;
+  b.settings = stats->settings;
+  b.frames = static_cast<float>(stats->settings_spp);
+  b.source = stats->path;
   return b;
 }
 
@@ -179,11 +229,9 @@ void print_perfect_filter(const std::string& test_path, const std::string& refer
 // compared); without them nothing can be checked, which is said.
 void check_second_reference(const std::string& reference_path, const std::string& second_path) {
   auto settings_of = [](const std::string& path) -> std::optional<nlohmann::json> {
-    const std::optional<nlohmann::json> json = stats_beside(path);
-    if (!json || !json->contains("settings")) return std::nullopt;
-    nlohmann::json s = (*json)["settings"];
-    if (json->contains("time_budget")) s["spp"] = (*json)["time_budget"].value("spp_reached", s.value("spp", 0));
-    return s;
+    const std::optional<StatsJson> stats = read_stats_beside(path);
+    if (!stats) return std::nullopt;
+    return stats->compared;
   };
   const std::optional<nlohmann::json> first = settings_of(reference_path), second = settings_of(second_path);
   if (!first || !second) {
@@ -266,13 +314,9 @@ int run_diff(const Args& args) {
 
   const Image test = read_exr(test_path, layer);
   const Image reference = read_exr(reference_path, reference_layer);
+  check_reference(reference, reference_path);
   const ImageMetrics m = compare_against(test, reference, reference_path);
   std::printf("%s\n", format_metrics(m).c_str());
-  if (m.reference_nonfinite > 0) {
-    std::fprintf(stderr, "pxf diff: %s has %zu non-finite samples; it cannot serve as a reference\n",
-                 reference_path.c_str(), m.reference_nonfinite);
-    return 1;
-  }
   if (m.nan_count + m.inf_count > 0) {
     std::fprintf(stderr, "pxf diff: %s has %zu non-finite samples\n", test_path.c_str(), m.nan_count + m.inf_count);
     return 1;
@@ -297,6 +341,7 @@ int run_diff(const Args& args) {
     if (!has_rgb(test) || !has_rgb(reference)) throw Error("--second-reference needs R,G,B images");
     check_second_reference(reference_path, second_path);
     const Image second = read_exr(second_path, reference_layer);
+    check_reference(second, second_path);
     print_noise_corrected(test, reference, second, display);
   }
   if (perfect_filter) print_perfect_filter(test_path, reference_path, display);

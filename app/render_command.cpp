@@ -116,6 +116,10 @@ int run_render(const Args& args) {
   }
   // Without a filter the blend has no case 2 to count.
   if (until_clean && !preview_settings.filtering()) throw UsageError("--until-clean needs a filter (not --filter none)");
+  // Case 2 is a variance of at most t: at t = 0 only a noiseless pixel gets there, so the render
+  // could never end.
+  if (until_clean && !(preview_settings.threshold > 0.0f))
+    throw UsageError("--until-clean needs --threshold above 0: at 0 no noisy pixel can become clean");
   if (until_clean) preview_settings.adaptive_params.goal = AdaptiveGoal::Clean;  // app/adaptive.h
 
   const FrameRange frames = render_frame_range(checkpoint_options, spp);  // a bad range before any load
@@ -156,8 +160,12 @@ int run_render(const Args& args) {
     }
     checkpointer.maybe_write(preview);
     if (!quiet) progress.update(i + 1, i + 1 == total);
-    if (check_clean && preview.case2_share() == 1.0) {
+    if (check_clean && preview.clean()) {
       report.clean_ms = elapsed_ms(start);
+      if (preview.case2_share() < 1.0)
+        std::printf("until-clean: clean at %d spp with no filter run: HV carries %.3g %% of the energy, below the "
+                    "%g %% the filter runs from, so every pixel is unfiltered and unbiased\n",
+                    preview.samples(), 100.0 * hv_energy_share(preview.renderer().accumulation()), 100.0 * kMinHvShare);
       break;
     }
   }

@@ -68,8 +68,9 @@ nlohmann::json stats_json(Preview& preview, const RenderReport& r) {
   const SampleCounts paths = sample_counts(preview.pixel_samples());
   j["samples_per_pixel"] = {{"mean", paths.mean}, {"min", paths.min}, {"max", paths.max}};
   j["interrupted"] = r.interrupted;
-  // Clean: the final blend shows every pixel in case 2, the unbiased image at threshold t.
-  j["clean"] = preview.case2_share() == 1.0;
+  // Clean: the final blend shows every pixel in case 2, the unbiased image at threshold t, or no
+  // filter ran and none was needed (Preview::clean).
+  j["clean"] = preview.clean();
   j["until_clean"] = {{"requested", r.until_clean},
                       {"time_to_clean_ms", r.clean_ms >= 0 ? nlohmann::json(r.clean_ms) : nlohmann::json(nullptr)},
                       {"case2_share_over_time", r.case2_share_over_time}};

@@ -65,6 +65,7 @@ Image BenchHarness::reference(const BenchSetup& b, const std::string& layer) con
   Image image;
   if (!reference_path_.empty()) {
     image = read_exr(reference_path_, layer);
+    check_reference(image, reference_path_);  // as pxf diff checks its reference
   } else {
     const auto cache_name = [&](const std::string& prefix) {
       return b.out + "/" + prefix + b.scene_name + "_" + std::to_string(b.width) + "x" + std::to_string(b.height) +

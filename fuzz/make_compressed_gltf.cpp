@@ -8,6 +8,9 @@
 //       triangles uncompressed, Draco-compressed losslessly and with Blender's default quantization
 //       (SIDE 152: 46,208 triangles, DamagedHelmet's count), for load-time and memory measurements
 //       (docs/gltf-extensions.md);
+//   make_compressed_gltf meshopt-bombs DIR
+//       meshopt files of about 1 MB whose views share their compressed bytes (used by accessors or
+//       not) or expand 64-fold, for the memory measurements of docs/robustness.md;
 //   make_compressed_gltf draco-glb IN.glb OUT.glb
 //       IN with every primitive (float attributes, uint32 or uint16 indices, triangles)
 //       Draco-compressed with Blender's default quantization and its uncompressed geometry dropped:
@@ -36,6 +39,56 @@ Bytes corrupted(Glb glb, double from) {
   return glb.bytes();
 }
 
+// `views` EXT_meshopt_compression views that all name one compressed block of `count` zero
+// vertices of 12 bytes (the codec's best case, about 64-fold); with `used` each has a POSITION
+// accessor and a mesh of one primitive per view draws them (non-indexed, all degenerate), else no
+// accessor names any of them.
+Glb meshopt_shared_views(size_t count, int views, bool used) {
+  const size_t stride = 12;
+  const Bytes zeros(count * stride, 0);
+  Bytes encoded(meshopt_encodeVertexBufferBound(count, stride));
+  encoded.resize(meshopt_encodeVertexBuffer(encoded.data(), encoded.size(), zeros.data(), count, stride));
+  Glb glb;
+  glb.bin = encoded;  // buffer 0 (Glb::bytes puts the BIN first); buffer 1 the empty fallback
+  glb.doc["buffers"] = json::array({{{"byteLength", count * stride}, {"extensions", {{"EXT_meshopt_compression", {{"fallback", true}}}}}}});
+  glb.require("EXT_meshopt_compression");
+  json primitives = json::array();
+  for (int v = 0; v < views; ++v) {
+    json ext = {{"buffer", 0}, {"byteOffset", 0}, {"byteLength", encoded.size()}, {"byteStride", stride},
+                {"count", count}, {"mode", "ATTRIBUTES"}};
+    glb.doc["bufferViews"].push_back({{"buffer", 1}, {"byteOffset", 0}, {"byteLength", count * stride},
+                                      {"byteStride", stride}, {"extensions", {{"EXT_meshopt_compression", ext}}}});
+    if (!used) continue;  // the views alone: nothing names them
+    const int accessor = glb.accessor(v, 5126, count - count % 3, "VEC3");
+    glb.doc["accessors"][accessor]["min"] = {0, 0, 0};
+    glb.doc["accessors"][accessor]["max"] = {0, 0, 0};
+    primitives.push_back({{"attributes", {{"POSITION", accessor}}}});
+  }
+  if (used) {
+    glb.doc["meshes"] = json::array({{{"primitives", primitives}}});
+    glb.single_node_scene();
+  }
+  return glb;
+}
+
+// Files for the memory measurements: about 1 MB each.
+void write_meshopt_bombs(const std::string& dir) {
+  const auto report = [&](const std::string& name, const Glb& glb) {
+    const Bytes bytes = glb.bytes();
+    write(dir + "/" + name, bytes);
+    std::printf("wrote %s/%s (%zu bytes)\n", dir.c_str(), name.c_str(), bytes.size());
+  };
+  // The attack: 4,000 views of one 16 KB block (64,000 zero vertices) each.
+  report("shared_unused.glb", meshopt_shared_views(87000, 4000, false));
+  report("shared_used.glb", meshopt_shared_views(87000, 4000, true));
+  // One view, expanded about 64-fold: 1 MB to 64 MB of vertices, drawn.
+  report("one_view_64x.glb", meshopt_shared_views(5600000, 1, true));
+  // An ordinary meshopt file: a grid of 2 x 300^2 triangles with every mode and filter.
+  const MeshoptPair grid = meshopt_grid_glbs(make_grid(300));
+  report("grid_300.glb", grid.compressed);
+  report("grid_300_plain.glb", grid.plain);
+}
+
 void write_seeds(const std::string& dir) {
   const GridMesh grid = make_grid(3);
   const std::string prefix = dir + "/compressed_";
@@ -57,6 +110,23 @@ void write_seeds(const std::string& dir) {
   write(prefix + "webp_corrupt.glb", corrupted(webp_only, 0.9));
   write(prefix + "webp_and_png.glb",
         textured_quad_glb({{"image/png", png}, {"image/webp", webp}}, {{"source", 0}, {"extensions", {{"EXT_texture_webp", {{"source", 1}}}}}}).bytes());
+  // Views that share their compressed bytes (a decompression bomb of the per-view bound), used by
+  // accessors and not, and a filter that is not a name.
+  write(prefix + "meshopt_shared_views.glb", meshopt_shared_views(64, 40, true).bytes());
+  write(prefix + "meshopt_shared_unused.glb", meshopt_shared_views(64, 40, false).bytes());
+  MeshoptPair numbered = meshopt_grid_glbs(grid);
+  numbered.compressed.doc["bufferViews"][0]["extensions"]["EXT_meshopt_compression"]["filter"] = 5;
+  write(prefix + "meshopt_filter_number.glb", numbered.compressed.bytes());
+  // A lossless WebP whose header declares 16384 x 16384 over 4 x 4 pixels of data.
+  Bytes huge = webp;
+  if (huge.size() < 25 || std::memcmp(huge.data() + 12, "VP8L", 4) != 0) throw std::runtime_error("not a VP8L WebP");
+  uint32_t bits = 0;
+  std::memcpy(&bits, huge.data() + 21, 4);
+  bits = (bits & 0xf0000000u) | 0x0fffffffu;  // width - 1 and height - 1: 14 bits each, all set
+  std::memcpy(huge.data() + 21, &bits, 4);
+  Glb huge_webp = textured_quad_glb({{"image/webp", huge}}, {{"extensions", {{"EXT_texture_webp", {{"source", 0}}}}}});
+  huge_webp.require("EXT_texture_webp");
+  write(prefix + "webp_huge_dimensions.glb", huge_webp.bytes());
   const Bytes ktx2 = {0xAB, 'K', 'T', 'X', ' ', '2', '0', 0xBB, '\r', '\n', 0x1A, '\n'};
   Glb basisu = textured_quad_glb({{"image/png", png}, {"image/ktx2", ktx2}},
                                  {{"source", 0}, {"extensions", {{"KHR_texture_basisu", {{"source", 1}}}}}});
@@ -168,10 +238,12 @@ int main(int argc, char** argv) {
       write_seeds(argv[2]);
     } else if (mode == "draco-pair" && argc == 4) {
       write_draco_pair(std::atoi(argv[2]), argv[3]);
+    } else if (mode == "meshopt-bombs" && argc == 3) {
+      write_meshopt_bombs(argv[2]);
     } else if (mode == "draco-glb" && argc == 4) {
       write_draco_glb(argv[2], argv[3]);
     } else {
-      std::fprintf(stderr, "usage: %s seeds DIR | draco-pair SIDE DIR | draco-glb IN.glb OUT.glb\n", argv[0]);
+      std::fprintf(stderr, "usage: %s seeds DIR | draco-pair SIDE DIR | meshopt-bombs DIR | draco-glb IN.glb OUT.glb\n", argv[0]);
       return 2;
     }
   } catch (const std::exception& e) {

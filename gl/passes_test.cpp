@@ -805,6 +805,33 @@ TEST(BlendVsCpu, NoFilteredValueMeansUnfiltered) {
   EXPECT_EQ(blend.case_counts()[kCaseNoFiltered], uint32_t(W * H));
 }
 
+// The tone-map pass stays finite for extreme finite inputs and matches its CPU reference there: a
+// bright pixel under a tiny log-average or white point is white, not black or NaN.
+TEST(TonemapPass, ExtremeFiniteInputsGiveFiniteDisplayValuesLikeTheCpu) {
+  test::osmesa_context();
+  Image hdr = Image::rgba(4, 1, 1.0f), rgb = Image::rgb(4, 1, 0.0f);
+  const float values[4] = {1e30f, 3.4e38f, 1e-30f, 0.0f};
+  for (int x = 0; x < 4; ++x)
+    for (int c = 0; c < 3; ++c) hdr.at(x, 0, c) = rgb.at(x, 0, c) = values[x];
+  hdr.at(3, 0, 0) = rgb.at(3, 0, 0) = 1e30f;
+  Texture2D texture(4, 1, TextureFormat::RGBA32F);
+  texture.upload(hdr);
+  TonemapPass pass(4, 1);
+  for (float log_average : {0.0f, 1e-20f})
+    for (float white : {0.0f, 1e-3f}) {
+      TonemapParams p;
+      p.log_average = log_average;
+      p.white = white;
+      pass.run(texture, p);
+      const Image display = pass.display_image();
+      const std::string what = "log_average " + std::to_string(log_average) + ", white " + std::to_string(white);
+      EXPECT_EQ(count_nonfinite(display), 0u) << what;
+      expect_close(display, cpu_tonemap(rgb, p), 2e-4f, 2e-5f, what.c_str());
+      EXPECT_NEAR(display.at(0, 0, 0), 1.0f, 1e-5f) << what;
+      EXPECT_NEAR(display.at(3, 0, 1), 0.0f, 1e-5f) << what;
+    }
+}
+
 TEST(FullChain, FilterBlendTonemapOnGpuMatchesCpu) {
   test::osmesa_context();
   Scenario s = make_scenario(21);

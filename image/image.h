@@ -112,6 +112,9 @@ struct ImageMetrics {
 // share no channel, or when the reference has no finite sample to compare against.
 ImageMetrics compare_images(const Image& test, const Image& reference, const Image* mask = nullptr);
 size_t count_nonfinite(const Image& image);
+// What every command that takes a reference (pxf diff, pxf bench --reference) checks before it
+// compares: no NaN or Inf sample in any channel. Throws pxf::Error naming `path` and the count.
+void check_reference(const Image& reference, const std::string& path);
 std::string format_metrics(const ImageMetrics& m);
 
 }  // namespace pxf

@@ -38,6 +38,12 @@ size_t count_nonfinite(const Image& image) {
   return count;
 }
 
+void check_reference(const Image& reference, const std::string& path) {
+  const size_t nonfinite = count_nonfinite(reference);
+  if (nonfinite > 0)
+    throw Error(path + ": " + std::to_string(nonfinite) + " non-finite samples (NaN or Inf); it cannot serve as a reference");
+}
+
 ImageMetrics compare_images(const Image& test, const Image& reference, const Image* mask) {
   check_same_size(test, reference, "image");
   if (mask) {

@@ -57,6 +57,31 @@ TEST(DisplayMetrics, UsesTheReferencesToneMap) {
   EXPECT_EQ(same.flip_mean, 0.0);
 }
 
+// The display tone map stays finite for any finite image and shows a bright pixel white: where k Y
+// overflowed (a small fixed log-average) or lm / white^2 did, the factor was 0 (black) or NaN.
+TEST(Tonemap, AnyFiniteImageGivesFiniteDisplayValuesAndBrightPixelsWhite) {
+  Image hdr = Image::rgb(4, 1, 0.0f);
+  const float values[4] = {1e30f, 3.4e38f, 1e-30f, 0.0f};
+  for (int x = 0; x < 4; ++x)
+    for (int c = 0; c < 3; ++c) hdr.at(x, 0, c) = values[x];
+  hdr.at(3, 0, 0) = 1e30f;  // a red pixel: green and blue stay 0, never 0 times an infinite factor
+  for (float log_average : {0.0f, 1e-20f, 1e-4f, 1e30f})
+    for (float white : {0.0f, 1e-3f, 1e-20f, 4.0f}) {
+      TonemapParams p;
+      p.log_average = log_average;
+      p.white = white;
+      const Image d = tonemap_reinhard(hdr, p);
+      const std::string what = "log_average " + std::to_string(log_average) + ", white " + std::to_string(white);
+      EXPECT_EQ(count_nonfinite(d), 0u) << what;
+      for (float v : d.pixels) EXPECT_TRUE(v >= 0.0f && v <= 1.0f) << what;
+      if (log_average == 1e30f) continue;  // the image's own brightness: mid-grey, not white
+      EXPECT_FLOAT_EQ(d.at(0, 0, 0), 1.0f) << what;
+      EXPECT_FLOAT_EQ(d.at(1, 0, 1), 1.0f) << what;
+      EXPECT_FLOAT_EQ(d.at(3, 0, 0), 1.0f) << what;
+      EXPECT_EQ(d.at(3, 0, 1), 0.0f) << what;
+    }
+}
+
 // The masked FLIP mean averages the FLIP map over the kept pixels only.
 TEST(DisplayMetrics, MaskAppliesToEveryMetric) {
   const Image ref = gradient(24, 24, 1.0f);

@@ -33,8 +33,7 @@ Image tonemap_reinhard(const Image& rgb, const TonemapParams& p) {
   for (int y = 0; y < rgb.height; ++y)
     for (int x = 0; x < rgb.width; ++x) {
       const Rgb c = display_input(rgb, x, y);
-      const float lm = k * c.luminance();
-      const float scale = shared::reinhard_scale(k, lm, p.white);
+      const float scale = shared::reinhard_scale(k, c.luminance(), p.white);
       for (int i = 0; i < 3; ++i) out.at(x, y, i) = srgb_from_linear(std::clamp(c.c[i] * scale, 0.0f, 1.0f));
     }
   return out;

@@ -400,6 +400,10 @@ double Preview::case2_share() const {
   return pixels > 0 ? case_counts_[kCaseUnfiltered] / pixels : 0.0;
 }
 
+bool Preview::filter_needed() const { return hv_energy_share(renderer_->accumulation()) >= kMinHvShare; }
+
+bool Preview::clean() const { return case2_share() == 1.0 || (!have_filtered_ && !filter_needed()); }
+
 bool Preview::filter_worthwhile() {
   if (hv_energy_share(renderer_->accumulation()) >= kMinHvShare) return true;
   ++low_hv_skips_;

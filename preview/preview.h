@@ -183,6 +183,12 @@ class Preview {
   bool filter_stopped() const { return schedule_.all_pixels_case2; }
   // The share of pixels in case 2 at the last blend (1 = clean: the unbiased image at threshold t).
   double case2_share() const;
+  // Whether the filter has anything to do: HV's energy share reaches kMinHvShare (none below it,
+  // no HV at all included). Computed from the accumulation now.
+  bool filter_needed() const;
+  // Clean: every pixel in case 2 at the last blend, or no filter run yet while none is needed, so
+  // that every pixel shows its unfiltered, unbiased value.
+  bool clean() const;
   // Filter runs left out because HV's energy share was below kMinHvShare.
   int filter_runs_skipped_low_hv() const { return low_hv_skips_; }
   // Pixels per blend case (kCase* in shaders/pass_formulas.h) of the last displayed frame.

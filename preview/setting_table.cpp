@@ -1,6 +1,8 @@
 #include "preview/setting_table.h"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <type_traits>
 
 #include "core/error.h"
@@ -237,9 +239,20 @@ void SettingDescriptor::from_json(PreviewSettings& s, const nlohmann::json& j) c
     case SettingType::Float:
     case SettingType::Int:
     case SettingType::Seed:
+    {
       if (!j.is_number()) throw wrong();
-      set_value(s, j.get<double>());
+      const double v = j.get<double>();
+      // The command line's range: a value outside it (a threshold of -1, a seed of 1e300) would be
+      // cast without a defined result or give settings no render can have.
+      if (!(v >= min && v <= max) || (type != SettingType::Float && v != std::floor(v))) {
+        char text[160];
+        std::snprintf(text, sizeof text, "stats.json setting '%s' is %.17g, not %s in [%g, %g]", key, v,
+                      type == SettingType::Float ? "a number" : "an integer", min, max);
+        throw Error(text);
+      }
+      set_value(s, v);
       return;
+    }
     case SettingType::Switch:
       if (!j.is_boolean()) throw wrong();
       switch_field(s) = j.get<bool>();

@@ -141,6 +141,66 @@ TEST(GltfMeshopt, MalformedDataIsAOneLineError) {
   EXPECT_NE(message.find("unknown mode 'SPLINES'"), std::string::npos) << message;
 }
 
+// Many views may name the same compressed bytes: the decoded bytes of all used views are bounded by
+// the distinct compressed bytes, each counted once (a 1 MB file used to decode to 1.4 GB).
+TEST(GltfMeshopt, ViewsSharingCompressedBytesAreBoundedTogether) {
+  MeshoptPair files = meshopt_grid_glbs(make_grid(10));
+  json& doc = files.compressed.doc;
+  const json view = doc["bufferViews"][0];
+  json accessor;
+  for (const json& a : doc["accessors"])
+    if (a.value("bufferView", -1) == 0) accessor = a;
+  ASSERT_FALSE(accessor.is_null());
+  for (int k = 0; k < 2000; ++k) {
+    accessor["bufferView"] = doc["bufferViews"].size();
+    doc["bufferViews"].push_back(view);
+    doc["accessors"].push_back(accessor);
+  }
+  const std::string message = error_of(files.compressed.bytes());
+  EXPECT_NE(message.find("EXT_meshopt_compression bufferViews claim"), std::string::npos) << message;
+  EXPECT_NE(message.find("distinct compressed bytes"), std::string::npos) << message;
+}
+
+// Only the views that accessors (or images) use are decoded, and their decoded bytes are in the
+// memory estimate, which is checked before they are decoded.
+TEST(GltfMeshopt, OnlyUsedViewsAreDecodedAndTheyAreInTheEstimate) {
+  MeshoptPair files = meshopt_grid_glbs(make_grid(10));
+  const Scene plain = load(files.plain.bytes());
+  const Scene compressed = load(files.compressed.bytes());
+  uint64_t decoded = 0;
+  for (const json& v : files.compressed.doc["bufferViews"])
+    decoded += v["extensions"]["EXT_meshopt_compression"]["count"].get<uint64_t>() *
+               v["extensions"]["EXT_meshopt_compression"]["byteStride"].get<uint64_t>();
+  EXPECT_EQ(compressed.estimated_load_bytes, plain.estimated_load_bytes + decoded);
+
+  // An unused view of garbage is never decoded; a used one is (MalformedDataIsAOneLineError).
+  Glb& glb = files.compressed;
+  json garbage = glb.doc["bufferViews"][3];
+  garbage["extensions"]["EXT_meshopt_compression"]["byteOffset"] = glb.bin.size();
+  glb.bin.insert(glb.bin.end(), garbage["extensions"]["EXT_meshopt_compression"]["byteLength"].get<size_t>(), 0xff);
+  glb.doc["bufferViews"].push_back(garbage);
+  EXPECT_EQ(canonical_triangles(load(glb.bytes())), canonical_triangles(plain));
+
+  // A decode that the memory available cannot hold is refused before it is decoded.
+  LoadLimits tight;
+  tight.available_memory = plain.estimated_load_bytes + decoded / 2;
+  const std::string message = error_of(files.compressed.bytes(), tight);
+  EXPECT_NE(message.find("of decoded meshopt data"), std::string::npos) << message;
+}
+
+// A filter or mode that is not a name is refused by name, not taken as NONE.
+TEST(GltfMeshopt, AFilterThatIsNotANameIsRefusedByName) {
+  MeshoptPair files = meshopt_grid_glbs(make_grid(6));
+  files.compressed.doc["bufferViews"][0]["extensions"]["EXT_meshopt_compression"]["filter"] = 5;
+  std::string message = error_of(files.compressed.bytes());
+  EXPECT_NE(message.find("test.glb: bufferView 0: filter 5 is not a name"), std::string::npos) << message;
+
+  files = meshopt_grid_glbs(make_grid(6));
+  files.compressed.doc["bufferViews"][0]["extensions"]["EXT_meshopt_compression"]["filter"] = "SPHERICAL";
+  message = error_of(files.compressed.bytes());
+  EXPECT_NE(message.find("unknown filter 'SPHERICAL'"), std::string::npos) << message;
+}
+
 // The 64-fold bound of gltf_meshopt.h holds for the most compressible data there is.
 TEST(GltfMeshopt, CodecsExpandAtMostTheBoundTheLoaderChecks) {
   const size_t count = 1 << 16, stride = 16;

@@ -30,6 +30,7 @@ struct LoadEstimate {
   uint64_t texture_bytes = 0;            // stored texels of the used textures
   uint64_t largest_decode_bytes = 0;     // the largest image's decoding buffers
   uint64_t environment_texels = 0;       // the environment map's (--env or the scene's own)
+  uint64_t decoded_buffer_bytes = 0;     // EXT_meshopt_compression views, decoded and kept while loading
   uint64_t bytes() const;
 };
 

@@ -89,6 +89,10 @@ std::string builtin_path(const std::string& name) {
 // Small conversions
 
 constexpr float kMaxCoordinate = 1e12f;
+// The brightest emission a material may have (emissiveFactor times emissiveStrength, per channel):
+// its paths' sums and squared sums stay far inside float over 2^24 frames, and inside the 1e30
+// that the blend and tone map clamp to.
+constexpr double kMaxEmission = 1e12;
 
 // Texture coordinates beyond 2^24 have no fraction left in float, so a repeating, mirrored or
 // clamped texture reads the same texel there as at 2^24. UVs and KHR_texture_transform's offset
@@ -121,6 +125,7 @@ void check_estimate(const LoadEstimate& estimate, const LoadLimits& limits, cons
   parts += ", " + mib_text(estimate.texture_bytes) + " of textures";
   if (estimate.environment_texels > 0)
     parts += ", an environment map of " + count_text(estimate.environment_texels) + " texels";
+  if (estimate.decoded_buffer_bytes > 0) parts += ", " + mib_text(estimate.decoded_buffer_bytes) + " of decoded meshopt data";
   throw Error(file + ": loading needs an estimated " + mib_text(needed) + " (" + parts + "), more than the " +
               mib_text(available) + " of memory available");
 }
@@ -256,11 +261,17 @@ class GltfLoader {
  private:
   Scene build() {
     check_extensions();
-    gltf::decode_meshopt_views(model_, file_);  // bounded by the file's size; images may be in such views
+    // Compressed views: all checked and counted first; the images' decoded before their headers
+    // are probed, the accessors' only once the whole estimate holds.
+    const gltf::MeshoptPlan meshopt = gltf::plan_meshopt_views(model_, file_);
+    estimate_.decoded_buffer_bytes = meshopt.decoded_bytes;
+    check_estimate(estimate_, limits_, file_);
+    gltf::decode_meshopt_views(model_, file_, meshopt.image_views);
     load_materials();    // registers the used textures; nothing is decoded yet
     count_instances();   // the triangle cap, before any geometry is read
     probe_textures();    // the texture size cap, from the image headers
     check_memory();      // the estimate against the available memory
+    gltf::decode_meshopt_views(model_, file_, meshopt.accessor_views);
     gltf::decode_draco_primitives(model_, file_);  // to the accessor counts just checked
     decode_textures();
     convert_spec_gloss();  // after decoding: textures are baked from their texels
@@ -662,8 +673,23 @@ class GltfLoader {
     m.normal_scale = finite_or(gm.normalTexture.scale, 1.0f);
     m.emissive = glm::max(vec3_or(gm.emissiveFactor, glm::vec3(0.0f)), glm::vec3(0.0f));
     m.emissive_texture = texture_ref(info_of(gm.emissiveTexture), true, m.name, "emissive");
-    if (const tinygltf::Value* ext = find_extension(gm.extensions, "KHR_materials_emissive_strength"))
-      m.emissive *= std::max(finite_or(number_or(ext->Get("emissiveStrength"), 1.0), 1.0f), 0.0f);
+    double strength = 1.0;  // in double: 1e300 is finite here and is clamped below, not dropped
+    if (const tinygltf::Value* ext = find_extension(gm.extensions, "KHR_materials_emissive_strength")) {
+      const double s = number_or(ext->Get("emissiveStrength"), 1.0);
+      strength = std::isfinite(s) ? std::max(s, 0.0) : 1.0;
+    }
+    const glm::dvec3 emission = glm::dvec3(m.emissive) * strength;
+    const double brightest = std::max({emission.x, emission.y, emission.z});
+    if (brightest > kMaxEmission) {
+      // Radiance this bright overflows the accumulated sums and variances (the blend and tone map
+      // clamp at 1e30): scaled down, hue kept, with a warning rather than a black image.
+      m.emissive = glm::vec3(emission * (kMaxEmission / brightest));
+      warn("material '" + m.name + "' emits " + format_number(brightest) +
+           ", more than the " + format_number(kMaxEmission) +
+           " pxf can represent; clamped to it (check emissiveStrength and the scene's units)");
+    } else {
+      m.emissive = glm::vec3(emission);
+    }
     if (const tinygltf::Value* ext = find_extension(gm.extensions, "KHR_materials_transmission")) {
       m.transmission = clamp01(number_or(ext->Get("transmissionFactor"), 0.0), 0.0f);
       m.transmission_texture = texture_ref(info_of(ext->Get("transmissionTexture")), false, m.name, "transmission");
@@ -985,8 +1011,14 @@ class GltfLoader {
     Camera& out = scene_.camera;
     out.camera_to_world = rigid_frame(world);
     check_magnitude(glm::vec3(out.camera_to_world[3]), "camera " + std::to_string(index));
-    float yfov = finite_or(p.yfov, 0.0f);
-    out.yfov = (yfov > 1e-4f && yfov < 3.1f) ? yfov : Camera{}.yfov;
+    const double yfov = p.yfov;
+    out.yfov = (yfov > 1e-4 && yfov < 3.1) ? static_cast<float>(yfov) : Camera{}.yfov;
+    if (out.yfov != static_cast<float>(yfov)) {
+      char text[160];
+      std::snprintf(text, sizeof text, "camera %d has a yfov of %.6g, outside (0.0001, 3.1) radians; using %.4g", index,
+                    yfov, static_cast<double>(out.yfov));
+      warn(text);
+    }
     float znear = finite_or(p.znear, 0.0f);
     out.znear = znear > 0.0f ? znear : Camera{}.znear;
     float zfar = finite_or(p.zfar, 0.0f);
@@ -1434,7 +1466,7 @@ uint64_t LoadEstimate::bytes() const {
                                 add(mul(meshes, kBytesPerMesh), mul(lights, kBytesPerLight)));
   const uint64_t images = add(add(mul(texture_bytes, 2), largest_decode_bytes),
                               mul(environment_texels, kBytesPerEnvironmentTexel));
-  return add(geometry, images);
+  return add(add(geometry, images), decoded_buffer_bytes);
 }
 
 std::string builtin_assets_dir() {

@@ -301,6 +301,28 @@ TEST(SceneLoadGeometry, TexcoordSet1AndVertexColors) {
 // ----------------------------------------------------------------------------------------------
 // Camera, lights, defaults
 
+// A yfov outside (1e-4, 3.1) radians gets the default field of view, and a warning says so.
+TEST(SceneLoadCamera, OutOfRangeYfovIsReplacedWithAWarning) {
+  std::string dir = temp_dir();
+  for (double yfov : {1e-30, 3.14159265358979, 4.0}) {
+    GltfBuilder b;
+    b.doc["cameras"] = {{{"type", "perspective"}, {"perspective", {{"yfov", yfov}, {"znear", 0.1}}}}};
+    int cam = b.node({{"camera", 0}, {"translation", {0, 0, 5}}});
+    int quad = b.node({{"mesh", b.mesh(b.quad_primitive())}});
+    b.scene({quad, cam});
+    Scene scene = load_scene(b.write_gltf(dir + "/yfov.gltf"));
+    EXPECT_FLOAT_EQ(scene.camera.yfov, Camera{}.yfov) << yfov;
+    EXPECT_TRUE(any_warning_contains(scene, "camera 0 has a yfov of")) << yfov << ": " << warnings_of(scene);
+  }
+  GltfBuilder b;
+  b.doc["cameras"] = {{{"type", "perspective"}, {"perspective", {{"yfov", 0.7}, {"znear", 0.1}}}}};
+  int cam = b.node({{"camera", 0}, {"translation", {0, 0, 5}}});
+  b.scene({b.node({{"mesh", b.mesh(b.quad_primitive())}}), cam});
+  Scene scene = load_scene(b.write_gltf(dir + "/fine.gltf"));
+  EXPECT_FLOAT_EQ(scene.camera.yfov, 0.7f);
+  EXPECT_FALSE(any_warning_contains(scene, "yfov")) << warnings_of(scene);
+}
+
 TEST(SceneLoadCamera, FirstCameraInHierarchyWithRigidWorldFrame) {
   std::string dir = temp_dir();
   GltfBuilder b;
@@ -428,6 +450,36 @@ TEST(SceneLoadMaterial, DefaultMaterialIsAppendedForPrimitivesWithout) {
   EXPECT_EQ(scene.materials[1].base_color, glm::vec4(1.0f));
   EXPECT_EQ(scene.materials[1].metallic, 0.0f);
   EXPECT_EQ(scene.materials[0].metallic, 1.0f);  // glTF's default metallicFactor
+}
+
+// Emission beyond what the accumulated sums and variances can hold (a closed box at 1e30 rendered
+// black, at 3.4e38 every layer 0) is clamped to 1e12, hue kept, with a warning naming the material.
+TEST(SceneLoadMaterial, UnrepresentableEmissionIsClampedWithAWarningNamingTheMaterial) {
+  std::string dir = temp_dir();
+  for (double strength : {1e30, 3.4e38, 1e300}) {
+    GltfBuilder b;
+    b.doc["extensionsUsed"] = {"KHR_materials_emissive_strength"};
+    int mat = b.material({{"name", "sunface"},
+                          {"emissiveFactor", {1, 0.5, 0}},
+                          {"extensions", {{"KHR_materials_emissive_strength", {{"emissiveStrength", strength}}}}}});
+    b.add_quad_scene(mat);
+    Scene scene = load_scene(b.write_gltf(dir + "/bright.gltf"));
+    const Material& m = scene.materials[0];
+    EXPECT_FLOAT_EQ(m.emissive.x, 1e12f) << strength;
+    EXPECT_FLOAT_EQ(m.emissive.y, 0.5e12f) << strength;
+    EXPECT_EQ(m.emissive.z, 0.0f) << strength;
+    EXPECT_TRUE(any_warning_contains(scene, "material 'sunface' emits")) << strength << ": " << warnings_of(scene);
+    EXPECT_TRUE(any_warning_contains(scene, "clamped")) << warnings_of(scene);
+  }
+  GltfBuilder b;  // bright but representable: as given, no warning
+  b.doc["extensionsUsed"] = {"KHR_materials_emissive_strength"};
+  int mat = b.material({{"name", "lamp"},
+                        {"emissiveFactor", {1, 1, 1}},
+                        {"extensions", {{"KHR_materials_emissive_strength", {{"emissiveStrength", 1e6}}}}}});
+  b.add_quad_scene(mat);
+  Scene scene = load_scene(b.write_gltf(dir + "/lamp.gltf"));
+  EXPECT_FLOAT_EQ(scene.materials[0].emissive.x, 1e6f);
+  EXPECT_FALSE(any_warning_contains(scene, "emits")) << warnings_of(scene);
 }
 
 TEST(SceneLoadMaterial, KhrExtensionsEmissiveStrengthTransmissionIorSpecular) {

@@ -9,7 +9,7 @@
 #   scripts/fuzz.sh --unit-tests                          the core, image, scene and path tracer unit tests, built in
 #                                                         the same folder, so under the same sanitizers
 #   scripts/fuzz.sh --available                           exit 0 when clang++ and libFuzzer work here
-# Harnesses: gltf_scene exr_reader png_reader hdr_reader state_reader. Each campaign reads the committed
+# Harnesses: gltf_scene exr_reader png_reader hdr_reader state_reader camera_path. Each campaign reads the committed
 # corpus (fuzz/corpus/H) and crashers (fuzz/crashers/H), writes new inputs to build-fuzz/corpus/H and
 # its log to build-fuzz/logs/H.log, and any finding to build-fuzz/artifacts/H/. The script exits
 # non-zero on any crash, leak, sanitizer report, timeout or out-of-memory.
@@ -17,7 +17,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-ALL=(gltf_scene exr_reader png_reader hdr_reader state_reader)
+ALL=(gltf_scene exr_reader png_reader hdr_reader state_reader camera_path)
 BUILD=build-fuzz
 RSS_MB="${PXF_FUZZ_RSS_MB:-2048}"
 TIMEOUT="${PXF_FUZZ_TIMEOUT:-10}"

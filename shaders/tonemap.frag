@@ -17,8 +17,7 @@ void main() {
   vec3 c = clamp(clean(texelFetch(hdr_tex, p, 0).rgb), vec3(0.0), vec3(kMaxInput));
   float lavg = log_average > 0.0 ? log_average : exp(result[0] / max(result[1], 1.0));
   float k = key / max(lavg, 1.0e-30);
-  float lm = k * luminance(c);
-  float scale = reinhard_scale(k, lm, white);
+  float scale = reinhard_scale(k, luminance(c), white);
   vec3 d = clamp(c * scale, vec3(0.0), vec3(1.0));
   out_display = vec4(srgb_encode(d.r), srgb_encode(d.g), srgb_encode(d.b), 1.0);
 }

@@ -700,6 +700,32 @@ TEST(Cli, VeryBrightFiniteInputGivesFiniteOutputs) {
   }
 }
 
+// A closed box whose every face emits 1e30 (or 3.4e38) rendered black with no word: the emission is
+// clamped to what can be represented, a warning names a material, and final.png shows the box.
+TEST(Cli, UnrepresentableEmissionIsClampedWithAWarningAndRendersVisibly) {
+  const std::string dir = temp_dir("huge_emission");
+  for (double strength : {1e30, 3.4e38}) {
+    const std::string scene = edited_cornell(dir + "/scene", [&](nlohmann::json& doc) {
+      doc["extensionsUsed"].push_back("KHR_materials_emissive_strength");
+      for (auto& m : doc["materials"]) {
+        m["emissiveFactor"] = {1, 1, 1};
+        m["extensions"]["KHR_materials_emissive_strength"] = {{"emissiveStrength", strength}};
+      }
+    });
+    if (scene.empty()) GTEST_SKIP() << "assets/cornell not generated";
+    const std::string out = dir + "/out";
+    const Result r = run("render --scene " + scene + " --size 16x16 --spp 2 --quiet --out " + out);
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.err.find("emits"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("clamped"), std::string::npos) << r.err;
+    expect_outputs_finite(out, "emission " + std::to_string(strength));
+    const Image png = read_ldr_or_hdr(out + "/final.png");
+    double sum = 0;
+    for (float v : png.pixels) sum += v;
+    EXPECT_GT(sum / png.pixels.size(), 0.1) << strength << ": final.png is (nearly) black";
+  }
+}
+
 // Radiance from 1e-30 to 1e30 in one scene, samples that overflow float among them: every layer of
 // every output is finite, and stats.json counts exactly the samples the `samples` layer lacks.
 TEST(Cli, ExtremeRadianceGivesFiniteOutputsAndAnExactDroppedSampleCount) {
