@@ -285,7 +285,7 @@ int run_variant_bench(const BenchSetup& b, const Image& reference_hv, int spp, i
     timing_tracer.add_frame();
     pt_ms.push_back(elapsed_ms(start));
     for (size_t k = 0; k < names.size(); ++k) {
-      filter.run(preview.inputs(), preview.range().guide(), params[k], b.filtered.threshold);
+      filter.run(preview.inputs(), preview.range().guide(), params[k], b.filtered.threshold, &preview.range().surface());
       if (round >= 0) ms[k].push_back(filter.last_ms());
       if (round >= 0 && params[k].kind == FilterKind::Grid)
         for (size_t i = 0; i < grid_step_ms.size(); ++i) grid_step_ms[i].push_back(filter.grid()->last_step_ms()[i]);

@@ -37,27 +37,33 @@ void BlendPass::run_bias_guard(const PreviewInputs& inputs, const Texture2D& fil
 }
 
 void BlendPass::run(const PreviewInputs& inputs, const FilterPass* filtered, const Texture2D& guide, float t,
-                    const BlendParams& params) {
+                    const BlendParams& params, const Texture2D* surface) {
   const bool has = filtered && filtered->has_output();
-  run(inputs, has ? &filtered->output() : nullptr, &guide, t, params, has ? filtered->centre_weight() : nullptr);
+  run(inputs, has ? &filtered->output() : nullptr, &guide, t, params, has ? filtered->centre_weight() : nullptr,
+      surface);
 }
 
 void BlendPass::run(const PreviewInputs& inputs, const Texture2D* filtered, const Texture2D* guide, float t,
-                    const BlendParams& params, const Texture2D* centre_weight) {
+                    const BlendParams& params, const Texture2D* centre_weight, const Texture2D* surface) {
   auto other_size = [&](const Texture2D* tex) { return tex && (tex->width() != width_ || tex->height() != height_); };
   if (inputs.width() != width_ || inputs.height() != height_ || other_size(filtered) || other_size(guide) ||
-      other_size(centre_weight))
+      other_size(centre_weight) || other_size(surface))
     throw Error("blend pass: input size differs from the pass size");
   timer_.begin();
   const bool guard = params.bias_guard && filtered;
   if (guard) run_bias_guard(inputs, *filtered);
-  last_ = LastRun{&inputs.hv(), &inputs.lv(), filtered, guide, filtered ? centre_weight : nullptr,
-                  shared::BlendSwitches{filtered != nullptr, guide != nullptr, guard, t, params.samples}, params.range};
+  if (!guide) surface = nullptr;
+  RangeWeights range = params.range;
+  if (!surface) range.k_n = range.k_r = 0.0f;  // no surface buffer: no surface terms
+  last_ = LastRun{&inputs.hv(), &inputs.lv(), filtered, guide, filtered ? centre_weight : nullptr, surface,
+                  shared::BlendSwitches{filtered != nullptr, guide != nullptr, guard, t, params.samples}, range};
   program_.set("has_filtered", last_.switches.has_filtered ? 1 : 0);
   program_.set("has_guide", last_.switches.has_guide ? 1 : 0);
   program_.set("has_centre_weight", last_.centre_weight ? 1 : 0);
-  program_.set("k_c", params.range.k_c);
-  program_.set("k_d", params.range.k_d);
+  program_.set("k_c", range.k_c);
+  program_.set("k_d", range.k_d);
+  program_.set("k_n", range.k_n);
+  program_.set("k_r", range.k_r);
   program_.set("t", t);
   program_.set("samples", last_.switches.samples);
   program_.set("bias_guard", last_.switches.bias_guard ? 1 : 0);
@@ -70,6 +76,7 @@ void BlendPass::run(const PreviewInputs& inputs, const Texture2D* filtered, cons
   // Unused units still get a texture, so every sampler is valid.
   program_.bind(shared::kUnitFiltered, filtered ? *filtered : inputs.hv());
   program_.bind(shared::kUnitGuide, guide ? *guide : inputs.hv());
+  program_.bind(shared::kUnitSurface, surface ? *surface : inputs.hv());
   program_.bind(shared::kUnitCentreWeight, centre_weight ? *centre_weight : inputs.hv());
   program_.bind(shared::kUnitGuardSums, guard_);
   quad_.draw(program_, fbo_, width_, height_);
@@ -90,7 +97,10 @@ namespace {
 struct TextureTexels {
   const Texture2D* texture;
 };
-glm::vec4 texelFetch(const TextureTexels& t, glm::ivec2 p, int) { return t.texture->texel(p.x, p.y); }
+// No texture: 0, an unknown surface (the surface terms are off then anyway).
+glm::vec4 texelFetch(const TextureTexels& t, glm::ivec2 p, int) {
+  return t.texture ? t.texture->texel(p.x, p.y) : glm::vec4(0.0f);
+}
 glm::ivec2 textureSize(const TextureTexels& t, int) { return {t.texture->width(), t.texture->height()}; }
 
 }  // namespace
@@ -106,8 +116,9 @@ BlendInspection BlendPass::inspect(int x, int y) const {
   i.variance_inputs = shared::blend_variance_inputs_none();
   if (shared::blend_compares_variances(i.texels, i.switches)) {
     if (last_.guide)
-      i.variance_inputs.var_u_pooled = shared::pooled_var_u(TextureTexels{last_.hv}, TextureTexels{last_.guide}, p,
-                                                             last_.range.k_c, last_.range.k_d);
+      i.variance_inputs.var_u_pooled =
+          shared::pooled_var_u(TextureTexels{last_.hv}, TextureTexels{last_.guide}, TextureTexels{last_.surface}, p,
+                               last_.range.k_c, last_.range.k_d, last_.range.k_n, last_.range.k_r);
     if (last_.centre_weight) i.variance_inputs.centre_weight = last_.centre_weight->texel(x, y).r;
     if (last_.switches.bias_guard) {
       const glm::vec4 g = guard_.texel(x, y);

@@ -32,14 +32,16 @@ class BlendPass {
   // filtered == nullptr (or without output): no L_f yet, s = 1 everywhere (kCaseNoFiltered).
   // guide: the range buffer (rgb color, a distance), for the 3x3 variance pooling of u. t: the
   // perceived-variance threshold (the filter's skip used the same).
+  // surface: the range pass's surface buffer (RangePass::surface()) for the pooling's surface
+  // terms; nullptr leaves them out.
   void run(const PreviewInputs& inputs, const FilterPass* filtered, const Texture2D& guide, float t,
-           const BlendParams& params);
+           const BlendParams& params, const Texture2D* surface = nullptr);
   // Same with a raw L_f texture (rgb L_f, a Var[L_f]); guide == nullptr: u from each pixel's own
   // variance (no pooling). Used by tests and custom filters.
   // centre_weight (r: the filter's normalized centre weight, FilterPass::centre_weight()) adds the
   // covariance of L_u and L_f to the blend's variance; nullptr leaves it out.
   void run(const PreviewInputs& inputs, const Texture2D* filtered, const Texture2D* guide, float t,
-           const BlendParams& params, const Texture2D* centre_weight = nullptr);
+           const BlendParams& params, const Texture2D* centre_weight = nullptr, const Texture2D* surface = nullptr);
 
   const Texture2D& output() const { return output_; }       // rgb L, a s
   const Texture2D& case_texture() const { return case_; }   // r: case code (kCase* in shaders/pass_formulas.h)
@@ -72,6 +74,7 @@ class BlendPass {
     const Texture2D* filtered = nullptr;
     const Texture2D* guide = nullptr;
     const Texture2D* centre_weight = nullptr;
+    const Texture2D* surface = nullptr;
     shared::BlendSwitches switches{};
     RangeWeights range;
   };

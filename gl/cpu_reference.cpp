@@ -40,11 +40,18 @@ glm::ivec2 textureSize(const TexelView& t, int) {
   return {im.width, im.height};
 }
 
-// The exponent of the range weight between pixels p and q (color and depth terms).
-double range_exponent(const Image& range_color, const Image& depth, int px, int py, int qx, int qy,
-                      const RangeWeights& range) {
+// The surface buffer (xyz shading normal, w roughness) as the shaders read it; none: every texel 0,
+// an unknown normal, which leaves the surface term out.
+TexelView surface_view(const Image* surface) { return TexelView{surface, nullptr, 0.0f}; }
+
+// The exponent of the range weight between pixels p and q (color, depth and surface terms).
+double range_exponent(const Image& range_color, const Image& depth, const Image* surface, int px, int py, int qx,
+                      int qy, const RangeWeights& range) {
   const TexelView guide{&range_color, &depth};
-  return shared::range_exponent(texelFetch(guide, {px, py}, 0), texelFetch(guide, {qx, qy}, 0), range.k_c, range.k_d);
+  const TexelView s = surface_view(surface);
+  return shared::range_exponent(texelFetch(guide, {px, py}, 0), texelFetch(guide, {qx, qy}, 0),
+                                texelFetch(s, {px, py}, 0), texelFetch(s, {qx, qy}, 0), range.k_c, range.k_d,
+                                range.k_n, range.k_r);
 }
 
 // One pixel's kernel sums (shared::KernelSums, in double here), accumulated from images.
@@ -66,15 +73,16 @@ struct KernelSums {
 }  // namespace
 
 bool case2_skip_decision(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
-                         const Image& depth, const FilterParams& p, float t, int x, int y) {
+                         const Image& depth, const FilterParams& p, float t, int x, int y, const Image* surface) {
   const RangeWeights range = range_weights(p);
   return shared::skip_as_case2(TexelView{&hv, &var_u}, lv_view(lv), TexelView{&range_color, &depth},
-                               glm::ivec2(x, y), range.k_c, range.k_d, t);
+                               surface_view(surface), glm::ivec2(x, y), range.k_c, range.k_d, range.k_n, range.k_r, t);
 }
 
 bool skip_as_case2(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
-                   const Image& depth, const FilterParams& p, float t, int x, int y, FilterOutput& out) {
-  if (!case2_skip_decision(hv, var_u, lv, range_color, depth, p, t, x, y)) return false;
+                   const Image& depth, const FilterParams& p, float t, int x, int y, FilterOutput& out,
+                   const Image* surface) {
+  if (!case2_skip_decision(hv, var_u, lv, range_color, depth, p, t, x, y, surface)) return false;
   const Px lu = rgb_at(hv, x, y);
   for (int c = 0; c < 3; ++c) out.filtered.at(x, y, c) = lu.c[c];
   out.variance.at(x, y, 0) = kVarSkipped;
@@ -82,9 +90,9 @@ bool skip_as_case2(const Image& hv, const Image& var_u, const Image& lv, const I
 }
 
 float pooled_var_u(const Image& var_u, const Image& range_color, const Image& depth, int x, int y,
-                   const RangeWeights& range) {
-  return shared::pooled_var_u(TexelView{nullptr, &var_u}, TexelView{&range_color, &depth}, glm::ivec2(x, y),
-                              range.k_c, range.k_d);
+                   const RangeWeights& range, const Image* surface) {
+  return shared::pooled_var_u(TexelView{nullptr, &var_u}, TexelView{&range_color, &depth}, surface_view(surface),
+                              glm::ivec2(x, y), range.k_c, range.k_d, range.k_n, range.k_r);
 }
 
 BlendDecision blend_decision(float u, float f, float t) {
@@ -104,8 +112,8 @@ namespace {
 // One bilateral pass over `signal` (rgb) with variance `signal_var`, kernel extent (ex, ey) times
 // the radius; skipping (final pass only) looks at the unfiltered hv / var_u.
 FilterOutput filter_once(const Image& signal, const Image& signal_var, const Image& hv, const Image& var_u,
-                         const Image& lv, const Image& range_color, const Image& depth, const FilterParams& p,
-                         float t, int ex, int ey, bool final_pass) {
+                         const Image& lv, const Image& range_color, const Image& depth, const Image* surface,
+                         const FilterParams& p, float t, int ex, int ey, bool final_pass) {
   const int w = hv.width, h = hv.height;
   FilterOutput out{Image::rgb(w, h), Image::gray(w, h), Image::gray(w, h, "Y", 1.0f)};
   const int radius = std::min(kMaxFilterRadius, static_cast<int>(std::ceil(3.0f * std::max(p.sigma_s, 0.0f))));
@@ -113,12 +121,12 @@ FilterOutput filter_once(const Image& signal, const Image& signal_var, const Ima
   const RangeWeights range = range_weights(p);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
-      if (final_pass && p.skip_case2 && skip_as_case2(hv, var_u, lv, range_color, depth, p, t, x, y, out)) continue;
+      if (final_pass && p.skip_case2 && skip_as_case2(hv, var_u, lv, range_color, depth, p, t, x, y, out, surface)) continue;
       KernelSums sums;
       for (int qy = std::max(0, y - radius * ey); qy <= std::min(h - 1, y + radius * ey); ++qy)
         for (int qx = std::max(0, x - radius * ex); qx <= std::min(w - 1, x + radius * ex); ++qx) {
           double e = double((qx - x) * (qx - x) + (qy - y) * (qy - y)) * ks +
-                     range_exponent(range_color, depth, x, y, qx, qy, range);
+                     range_exponent(range_color, depth, surface, x, y, qx, qy, range);
           sums.add(std::exp(-e), signal, signal_var, qx, qy);
         }
       sums.write(out, x, y);
@@ -132,21 +140,21 @@ FilterOutput filter_once(const Image& signal, const Image& signal_var, const Ima
 // `step`, weighted by h x the range weights (color, depth), taps outside the image left out (the
 // sums are normalized). Skipping (final pass only) looks at the unfiltered hv / var_u.
 FilterOutput atrous_pass(const Image& signal, const Image& signal_var, const Image& hv, const Image& var_u,
-                         const Image& lv, const Image& range_color, const Image& depth, const FilterParams& p,
-                         float t, int step, float variance_factor, bool final_pass) {
+                         const Image& lv, const Image& range_color, const Image& depth, const Image* surface,
+                         const FilterParams& p, float t, int step, float variance_factor, bool final_pass) {
   const int w = hv.width, h = hv.height;
   FilterOutput out{Image::rgb(w, h), Image::gray(w, h), Image{}};
   const RangeWeights range = range_weights(p);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
-      if (final_pass && p.skip_case2 && skip_as_case2(hv, var_u, lv, range_color, depth, p, t, x, y, out)) continue;
+      if (final_pass && p.skip_case2 && skip_as_case2(hv, var_u, lv, range_color, depth, p, t, x, y, out, surface)) continue;
       KernelSums sums;
       double h_sum = 0;
       for (int j = 0; j < 5; ++j)
         for (int i = 0; i < 5; ++i) {
           const int qx = x + (i - 2) * step, qy = y + (j - 2) * step;
           if (qx < 0 || qx >= w || qy < 0 || qy >= h) continue;
-          const double range_weight = std::exp(-range_exponent(range_color, depth, x, y, qx, qy, range));
+          const double range_weight = std::exp(-range_exponent(range_color, depth, surface, x, y, qx, qy, range));
           h_sum += double(shared::kB3[i]) * shared::kB3[j];
           sums.add(double(shared::kB3[i]) * shared::kB3[j] * range_weight, signal, signal_var, qx, qy);
         }
@@ -162,11 +170,11 @@ FilterOutput atrous_pass(const Image& signal, const Image& signal_var, const Ima
 // weights are 1 (Atrous.WhiteNoiseVarianceShrinksBySumOfSquaredWeights in gl/passes_test.cpp),
 // scaled per pixel by the share of the kernel its range weights keep (atrous_local_correction).
 FilterOutput cpu_atrous(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
-                        const Image& depth, const FilterParams& p, float t) {
+                        const Image& depth, const Image* surface, const FilterParams& p, float t) {
   const int passes = atrous_iterations(p.sigma_s);
   FilterOutput level{hv, var_u, Image{}};
   for (int i = 0; i < passes; ++i)
-    level = atrous_pass(level.filtered, level.variance, hv, var_u, lv, range_color, depth, p, t, 1 << i,
+    level = atrous_pass(level.filtered, level.variance, hv, var_u, lv, range_color, depth, surface, p, t, 1 << i,
                         atrous_variance_correction(i), i + 1 == passes);
   return level;
 }
@@ -177,20 +185,20 @@ FilterOutput cpu_atrous(const Image& hv, const Image& var_u, const Image& lv, co
 // its count x the range weights (the spatial weight is in the tap density), taps outside the image
 // left out. Mirrors shaders/subsampled.frag.
 FilterOutput cpu_subsampled(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
-                            const Image& depth, const FilterParams& p, float t) {
+                            const Image& depth, const Image* surface, const FilterParams& p, float t) {
   const int w = hv.width, h = hv.height;
   FilterOutput out{Image::rgb(w, h), Image::gray(w, h), Image{}};
   const RangeWeights range = range_weights(p);
   const SubsampledTapTable table = subsampled_tap_table(p.sigma_s, p.subsampled_taps > 0 ? p.subsampled_taps : kSubsampledTaps);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
-      if (p.skip_case2 && skip_as_case2(hv, var_u, lv, range_color, depth, p, t, x, y, out)) continue;
+      if (p.skip_case2 && skip_as_case2(hv, var_u, lv, range_color, depth, p, t, x, y, out, surface)) continue;
       KernelSums sums;
       const SubsampledTap* taps = &table.taps[static_cast<size_t>(subsampled_rotation(x, y)) * table.per_rotation];
       for (int i = 0; i < table.per_rotation && taps[i].count > 0; ++i) {
         const int qx = x + taps[i].dx, qy = y + taps[i].dy;
         if (qx < 0 || qx >= w || qy < 0 || qy >= h) continue;
-        const double weight = taps[i].count * std::exp(-range_exponent(range_color, depth, x, y, qx, qy, range));
+        const double weight = taps[i].count * std::exp(-range_exponent(range_color, depth, surface, x, y, qx, qy, range));
         sums.add(weight, hv, var_u, qx, qy);
       }
       sums.write(out, x, y);  // sum w >= 1: the centre tap is in every rotation
@@ -201,21 +209,21 @@ FilterOutput cpu_subsampled(const Image& hv, const Image& var_u, const Image& lv
 }  // namespace
 
 FilterOutput cpu_filter(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
-                        const Image& depth, const FilterParams& p, float t) {
+                        const Image& depth, const FilterParams& p, float t, const Image* surface) {
   if (p.kind == FilterKind::None) throw Error("cpu_filter: filter kind none");
-  if (p.kind == FilterKind::Atrous) return cpu_atrous(hv, var_u, lv, range_color, depth, p, t);
-  if (p.kind == FilterKind::Subsampled) return cpu_subsampled(hv, var_u, lv, range_color, depth, p, t);
-  if (p.kind == FilterKind::Grid) return cpu_grid_filter(hv, var_u, lv, range_color, depth, p, t);
-  if (p.kind != FilterKind::Separable) return filter_once(hv, var_u, hv, var_u, lv, range_color, depth, p, t, 1, 1, true);
-  FilterOutput rows = filter_once(hv, var_u, hv, var_u, lv, range_color, depth, p, t, 1, 0, false);
-  FilterOutput out = filter_once(rows.filtered, rows.variance, hv, var_u, lv, range_color, depth, p, t, 0, 1, true);
+  if (p.kind == FilterKind::Atrous) return cpu_atrous(hv, var_u, lv, range_color, depth, surface, p, t);
+  if (p.kind == FilterKind::Subsampled) return cpu_subsampled(hv, var_u, lv, range_color, depth, surface, p, t);
+  if (p.kind == FilterKind::Grid) return cpu_grid_filter(hv, var_u, lv, range_color, depth, p, t, surface);
+  if (p.kind != FilterKind::Separable) return filter_once(hv, var_u, hv, var_u, lv, range_color, depth, surface, p, t, 1, 1, true);
+  FilterOutput rows = filter_once(hv, var_u, hv, var_u, lv, range_color, depth, surface, p, t, 1, 0, false);
+  FilterOutput out = filter_once(rows.filtered, rows.variance, hv, var_u, lv, range_color, depth, surface, p, t, 0, 1, true);
   out.centre_weight = Image();  // the second pass's centre weight alone would understate it: none
   return out;
 }
 
 // shared::blend_pixel on the images; the guard's finding by the definition of its windows.
 BlendOutput cpu_blend(const Image& lv, const Image& hv, const Image& var_u, const FilterOutput* filtered, float t,
-                      const BlendParams& params, const Image* range_color, const Image* depth) {
+                      const BlendParams& params, const Image* range_color, const Image* depth, const Image* surface) {
   const bool pool = range_color && depth;
   const int w = hv.width, h = hv.height;
   BlendOutput out{Image::rgb(w, h), Image::gray(w, h), Image::gray(w, h)};
@@ -229,7 +237,7 @@ BlendOutput cpu_blend(const Image& lv, const Image& hv, const Image& var_u, cons
                                    texelFetch(filtered_texels, p, 0), pool ? depth->at(x, y, 0) : 0.0f};
       shared::BlendVarianceInputs v = shared::blend_variance_inputs_none();
       if (shared::blend_compares_variances(px, on)) {
-        if (pool) v.var_u_pooled = pooled_var_u(var_u, *range_color, *depth, x, y, params.range);
+        if (pool) v.var_u_pooled = pooled_var_u(var_u, *range_color, *depth, x, y, params.range, surface);
         if (!filtered->centre_weight.pixels.empty()) v.centre_weight = filtered->centre_weight.at(x, y, 0);
         if (params.bias_guard) v.guard = shared::bias_guard_estimate_at(hv_texels, filtered_texels, p);
       }
@@ -247,7 +255,8 @@ std::array<float, 3> demodulation_factor(float r, float g, float b) {
 }
 
 DemodulatedInputs cpu_demodulate(const Image& hv, const Image& var_u, const Image& lv, const Image& albedo,
-                                 const Image& range_color, const Image& depth, const FilterParams& p, float t) {
+                                 const Image& range_color, const Image& depth, const FilterParams& p, float t,
+                                 const Image* surface) {
   const int w = hv.width, h = hv.height;
   DemodulatedInputs out{Image::rgb(w, h), Image::gray(w, h), Image::rgb(w, h)};
   for (int y = 0; y < h; ++y)
@@ -258,7 +267,7 @@ DemodulatedInputs cpu_demodulate(const Image& hv, const Image& var_u, const Imag
       for (int c = 0; c < 3; ++c) out.hv.at(x, y, c) = lu.c[c] / a[c];
       const float v = clean_var(var_u.at(x, y, 0));
       out.var_u.at(x, y, 0) = shared::demodulated_var(v, k);
-      const bool skip = p.skip_case2 && case2_skip_decision(hv, var_u, lv, range_color, depth, p, t, x, y);
+      const bool skip = p.skip_case2 && case2_skip_decision(hv, var_u, lv, range_color, depth, p, t, x, y, surface);
       for (int c = 0; c < 3; ++c) out.lv.at(x, y, c) = skip ? kMaxInput : -kMaxInput;
     }
   return out;

@@ -41,7 +41,7 @@ inline float blend_factor(float u, float f, float t) { return blend_decision(u, 
 // the known (> 0) variances of its 3x3 neighbourhood. kVarUnknown where the own variance is
 // unknown (n < 2); 0 where it is 0 and no neighbour's is known.
 float pooled_var_u(const Image& var_u, const Image& range_color, const Image& depth, int x, int y,
-                   const RangeWeights& range);
+                   const RangeWeights& range, const Image* surface = nullptr);
 
 struct FilterOutput {
   Image filtered;  // "R,G,B": L_f (L_u where skipped)
@@ -50,19 +50,22 @@ struct FilterOutput {
   // kernel, 1 where skipped), for the blend's covariance term; empty for the other variants.
   Image centre_weight;
 };
-// t: the blend threshold, for the case-2 skip.
+// t: the blend threshold, for the case-2 skip. surface: the range pass's surface buffer ("X,Y,Z,R":
+// shading normal, roughness) for the range weight's surface terms; nullptr: none (terms left out).
 FilterOutput cpu_filter(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
-                        const Image& depth, const FilterParams& params, float t);
+                        const Image& depth, const FilterParams& params, float t, const Image* surface = nullptr);
 
 // The filter's case-2 skip (FilterParams::skip_case2, final pass only): the blend's u (pooled
 // variance) with the unfiltered background; a zero variance is not trusted. Writes the skip
 // (L_f = L_u, Var = kVarSkipped) into `out` and returns true where the pixel is skipped.
 bool skip_as_case2(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
-                   const Image& depth, const FilterParams& p, float t, int x, int y, FilterOutput& out);
+                   const Image& depth, const FilterParams& p, float t, int x, int y, FilterOutput& out,
+                   const Image* surface = nullptr);
 
 // The filter's case-2 skip decision alone (what skip_as_case2 tests): shared::skip_as_case2.
 bool case2_skip_decision(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
-                         const Image& depth, const FilterParams& p, float t, int x, int y);
+                         const Image& depth, const FilterParams& p, float t, int x, int y,
+                         const Image* surface = nullptr);
 
 // Albedo demodulation (gl/demodulation.h). The factor (shared::demodulation_factor): grey Y(albedo)
 // where that is at least kAlbedoEpsilon, else (1, 1, 1) (that pixel is not demodulated).
@@ -74,7 +77,8 @@ struct DemodulatedInputs {
 };
 // The filter's inputs under demodulation; albedo "R,G,B" (the mean first non-specular albedo).
 DemodulatedInputs cpu_demodulate(const Image& hv, const Image& var_u, const Image& lv, const Image& albedo,
-                                 const Image& range_color, const Image& depth, const FilterParams& params, float t);
+                                 const Image& range_color, const Image& depth, const FilterParams& params, float t,
+                                 const Image* surface = nullptr);
 // L_f = a L_f', Var[L_f] = Y(a)^2 Var[L_f'] (sentinels kept).
 FilterOutput cpu_remodulate(const FilterOutput& filtered, const Image& albedo);
 
@@ -84,8 +88,10 @@ struct BlendOutput {
   Image blend_case;  // "Y": case codes (kCase*)
 };
 // `filtered` empty = the filter never ran. range_color and depth both null: no variance pooling.
+// surface: as cpu_filter's, for the pooling's range weights.
 BlendOutput cpu_blend(const Image& lv, const Image& hv, const Image& var_u, const FilterOutput* filtered, float t,
-                      const BlendParams& params, const Image* range_color, const Image* depth);
+                      const BlendParams& params, const Image* range_color, const Image* depth,
+                      const Image* surface = nullptr);
 
 double cpu_log_average(const Image& rgb, float delta);
 Image cpu_tonemap(const Image& rgb, const TonemapParams& params);  // "R,G,B" display values in [0,1]

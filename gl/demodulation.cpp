@@ -15,19 +15,23 @@ Demodulation::Demodulation(int width, int height)
   remod_fbo_.check("remodulation");
 }
 
-void Demodulation::demodulate(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& p, float t) {
+void Demodulation::demodulate(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& p, float t,
+                              const Texture2D* surface) {
   if (inputs.width() != width_ || inputs.height() != height_ || guide.width() != width_ || guide.height() != height_)
     throw Error("demodulation: input size differs from the pass size");
   demod_timer_.begin();
   const RangeWeights range = range_weights(p);
   demod_program_.set("k_c", range.k_c);
   demod_program_.set("k_d", range.k_d);
+  demod_program_.set("k_n", surface ? range.k_n : 0.0f);
+  demod_program_.set("k_r", surface ? range.k_r : 0.0f);
   demod_program_.set("t", t);
   demod_program_.set("skip_case2", p.skip_case2 ? 1 : 0);
   demod_program_.use();
   demod_program_.bind(shared::kUnitHv, inputs.hv());
   demod_program_.bind(shared::kUnitLv, inputs.lv());
   demod_program_.bind(shared::kUnitGuide, guide);
+  demod_program_.bind(shared::kUnitSurface, surface ? *surface : guide);
   demod_program_.bind(shared::kUnitAlbedo, inputs.albedo());
   quad_.draw(demod_program_, demod_fbo_, width_, height_);
   demod_timer_.end();

@@ -30,7 +30,9 @@ class Demodulation {
   Demodulation(int width, int height);
   // inputs: L_u, Var[L_u], L_lv and the albedo (PreviewInputs::upload_albedo); guide: the range
   // buffer; params: the filter's (range weights, skip_case2); t: the blend threshold, for the skip decision.
-  void demodulate(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& params, float t);
+  // surface: the range pass's surface buffer for the skip's surface terms; nullptr leaves them out.
+  void demodulate(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& params, float t,
+                  const Texture2D* surface = nullptr);
   const PreviewInputs& filter_inputs() const { return filter_inputs_; }  // the filter's input
   // filtered: the filter's output on filter_inputs(); albedo from `inputs`.
   void remodulate(const Texture2D& filtered, const PreviewInputs& inputs);

@@ -15,22 +15,25 @@ FilterPass::FilterPass(int width, int height)
   fbo_.check("filter pass");
 }
 
-void FilterPass::run(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& p, float t) {
-  begin(inputs, guide, p, t);
+void FilterPass::run(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& p, float t,
+                     const Texture2D* surface) {
+  begin(inputs, guide, p, t, surface);
   while (!step()) {
   }
 }
 
-void FilterPass::begin(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& p, float t) {
+void FilterPass::begin(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& p, float t,
+                       const Texture2D* surface) {
   if (p.kind == FilterKind::None) throw Error("filter pass: filter kind none (the caller skips the filter)");
-  if (inputs.width() != width_ || inputs.height() != height_ || guide.width() != width_ || guide.height() != height_)
+  if (inputs.width() != width_ || inputs.height() != height_ || guide.width() != width_ || guide.height() != height_ ||
+      (surface && (surface->width() != width_ || surface->height() != height_)))
     throw Error("filter pass: input size differs from the pass size");
-  staged_ = Staged{&inputs, &guide, p, t};
+  staged_ = Staged{&inputs, &guide, surface, p, t};
   const uint32_t zero = 0;
   counter_.upload(&zero, sizeof zero);
   if (p.kind == FilterKind::Grid) {
     if (!grid_) grid_ = std::make_unique<GridFilter>(width_, height_);
-    grid_->begin(inputs, guide, p, t, fbo_);
+    grid_->begin(inputs, guide, p, t, fbo_, surface);
   }
 }
 
@@ -63,20 +66,25 @@ void FilterPass::run_whole_variant(const PreviewInputs& inputs, const Texture2D&
 
 namespace {
 // The uniforms every variant's shader shares: range weights and the case-2 skip with threshold t.
-void set_range_and_skip(Program& program, const FilterParams& p, float t) {
+// Without a surface buffer the surface terms are off.
+void set_range_and_skip(Program& program, const FilterParams& p, float t, const Texture2D* surface) {
   const RangeWeights range = range_weights(p);
   program.set("k_c", range.k_c);
   program.set("k_d", range.k_d);
+  program.set("k_n", surface ? range.k_n : 0.0f);
+  program.set("k_r", surface ? range.k_r : 0.0f);
   program.set("skip_case2", p.skip_case2 ? 1 : 0);
   program.set("t", t);
 }
-// Makes `program` current with the inputs every variant's shader reads: L_u, L_lv (the skip) and
-// the guide.
-void use_with_inputs(const Program& program, const PreviewInputs& inputs, const Texture2D& guide) {
+// Makes `program` current with the inputs every variant's shader reads: L_u, L_lv (the skip), the
+// guide and the surface buffer (the guide stands in where there is none: its terms are off).
+void use_with_inputs(const Program& program, const PreviewInputs& inputs, const Texture2D& guide,
+                     const Texture2D* surface) {
   program.use();
   program.bind(shared::kUnitHv, inputs.hv());
   program.bind(shared::kUnitLv, inputs.lv());
   program.bind(shared::kUnitGuide, guide);
+  program.bind(shared::kUnitSurface, surface ? *surface : guide);
 }
 }  // namespace
 
@@ -84,8 +92,8 @@ void FilterPass::run_bilateral(const PreviewInputs& inputs, const Texture2D& gui
   const int radius = std::min(kMaxFilterRadius, static_cast<int>(std::ceil(3.0f * std::max(p.sigma_s, 0.0f))));
   program_.set("radius", radius);
   program_.set("k_s", inv_two_sigma2(p.sigma_s));
-  set_range_and_skip(program_, p, t);
-  use_with_inputs(program_, inputs, guide);
+  set_range_and_skip(program_, p, t, staged_.surface);
+  use_with_inputs(program_, inputs, guide, staged_.surface);
   if (p.kind == FilterKind::Separable) {
     program_.set("extent", glm::ivec2(1, 0));
     program_.set("final_pass", 0);
@@ -106,8 +114,8 @@ void FilterPass::run_bilateral(const PreviewInputs& inputs, const Texture2D& gui
 // textures, the last writes output_ (and alone skips case-2 pixels and counts).
 void FilterPass::run_atrous(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& p, float t) {
   if (!atrous_program_.id()) atrous_program_ = Program::from_embedded("fullscreen.vert", "atrous.frag");
-  set_range_and_skip(atrous_program_, p, t);
-  use_with_inputs(atrous_program_, inputs, guide);
+  set_range_and_skip(atrous_program_, p, t, staged_.surface);
+  use_with_inputs(atrous_program_, inputs, guide, staged_.surface);
   const int passes = atrous_iterations(p.sigma_s);
   atrous_program_.bind(shared::kUnitSignal, inputs.hv());
   for (int i = 0; i < passes; ++i) {
@@ -132,10 +140,10 @@ void FilterPass::run_subsampled(const PreviewInputs& inputs, const Texture2D& gu
     subsampled_key_ = {p.sigma_s, taps};
   }
   subsampled_taps_.bind_storage(shared::kBufferTaps);
-  set_range_and_skip(subsampled_program_, p, t);
+  set_range_and_skip(subsampled_program_, p, t, staged_.surface);
   subsampled_program_.set("taps_per_rotation", table.per_rotation);
   subsampled_program_.set("rotations", kSubsampledRotations);
-  use_with_inputs(subsampled_program_, inputs, guide);
+  use_with_inputs(subsampled_program_, inputs, guide, staged_.surface);
   quad_.draw(subsampled_program_, fbo_, width_, height_);
 }
 

@@ -22,14 +22,18 @@ class FilterPass {
  public:
   FilterPass(int width, int height);
   // guide: rgb range color, a distance (RangePass::guide()); t: the blend threshold, for the case-2
-  // skip. params.kind must not be FilterKind::None (throws pxf::Error).
-  void run(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& params, float t);
+  // skip. params.kind must not be FilterKind::None (throws pxf::Error). surface: xyz shading normal,
+  // w roughness (RangePass::surface()), for the range weight's surface terms (sigma_n, sigma_r);
+  // nullptr leaves them out.
+  void run(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& params, float t,
+           const Texture2D* surface = nullptr);
   // The same run in steps, for a frame budget: the grid variant's four GL steps, the others' whole
   // run as one. begin() checks the arguments (which must outlive the run) and clears the
   // filtered-pixel count, running no pass; each step() runs the next step, true after the last,
   // when output() holds the new L_f. A begin() abandons a run in progress; until the last step
   // output() keeps the previous run's result.
-  void begin(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& params, float t);
+  void begin(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& params, float t,
+             const Texture2D* surface = nullptr);
   bool step();
   bool in_progress() const { return staged_.inputs != nullptr; }
 
@@ -82,6 +86,7 @@ class FilterPass {
   struct Staged {
     const PreviewInputs* inputs = nullptr;
     const Texture2D* guide = nullptr;
+    const Texture2D* surface = nullptr;
     FilterParams params;
     float t = 0;
     double ms = 0;  // its steps so far

@@ -19,9 +19,9 @@ void GridFilter::resize_grid(const GridLayout& layout) {
 }
 
 void GridFilter::begin(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& p, float t,
-                       const Framebuffer& target) {
+                       const Framebuffer& target, const Texture2D* surface) {
   resize_grid(grid_layout(width_, height_, p));
-  inputs_ = &inputs, guide_ = &guide, target_ = &target;
+  inputs_ = &inputs, guide_ = &guide, surface_ = surface, target_ = &target;
   params_ = p, t_ = t;
   next_step_ = 0;
 }
@@ -88,12 +88,15 @@ void GridFilter::run_slice() {
   slice_.set("min_cell_z", grid_min_cell_z(params_.sigma_c));
   slice_.set("k_c", range.k_c);
   slice_.set("k_d", range.k_d);
+  slice_.set("k_n", surface_ ? range.k_n : 0.0f);
+  slice_.set("k_r", surface_ ? range.k_r : 0.0f);
   slice_.set("skip_case2", params_.skip_case2 ? 1 : 0);
   slice_.set("t", t_);
   slice_.use();
   slice_.bind(shared::kUnitHv, inputs_->hv());
   slice_.bind(shared::kUnitLv, inputs_->lv());
   slice_.bind(shared::kUnitGuide, *guide_);
+  slice_.bind(shared::kUnitSurface, surface_ ? *surface_ : *guide_);
   bounds_buffer_.bind_storage(shared::kBufferGridBounds);
   grid_[0].bind_storage(shared::kBufferGrid);
   quad_.draw(slice_, *target_, width_, height_);

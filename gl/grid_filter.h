@@ -22,8 +22,10 @@ class GridFilter {
   // between two steps) but the filtered-pixel counter, which the caller binds at kBufferCounts;
   // true after the slice, which draws rgb L_f, a Var[L_f] into `target`. A begin() abandons a run
   // in progress.
+  // surface (RangePass::surface(), may be nullptr): for the skip's range weights only; the grid's
+  // kernel has one range axis, the guide's luminance, and no surface terms.
   void begin(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& params, float t,
-             const Framebuffer& target);
+             const Framebuffer& target, const Texture2D* surface = nullptr);
   bool step();
   static constexpr int kSteps = 4;
   // ms of the last run's steps (bounds, splat, blur, slice), measured as gl_timing() says.
@@ -48,6 +50,7 @@ class GridFilter {
   // The run in progress (begin()).
   const PreviewInputs* inputs_ = nullptr;
   const Texture2D* guide_ = nullptr;
+  const Texture2D* surface_ = nullptr;
   const Framebuffer* target_ = nullptr;
   FilterParams params_;
   float t_ = 0;

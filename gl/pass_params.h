@@ -55,6 +55,12 @@ struct FilterParams {
   float sigma_s = 8.0f;   // pixels; kernel radius ceil(3 sigma_s), at most kMaxFilterRadius
   float sigma_c = 0.02f;  // range color, Euclidean distance in linear RGB
   float sigma_d = 2.0f;   // depth, scene units
+  // The surface terms (shaders/pass_formulas.h surface_exponent, docs/method.md 2.1): the angle
+  // between shading normals, radians, and the roughness difference; 0 turns a term off. Tight
+  // enough that a normal map's bumps and a roughness map's pattern stop the kernel at any sigma_s,
+  // wide enough that a smooth curved surface still averages over several pixels.
+  float sigma_n = 0.15f;
+  float sigma_r = 0.1f;
   // Skip pixels in case 2 (u <= t, t the blend threshold every filter run is given): they need no
   // filtered value. u is computed with the *unfiltered* background L_b = Y(L_u) + Y(L_lv), so the
   // decision needs no history; a skipped pixel gets L_f = L_u and Var[L_f] = kVarSkipped, and the
@@ -89,13 +95,18 @@ constexpr float inv_two_sigma2(float sigma) {
   const float s = std::max(sigma, 1.0e-6f);
   return 1.0f / (2.0f * s * s);
 }
-// The range weight exp(-|R(p)-R(q)|^2 k_c - (d(p)-d(q))^2 k_d) of a filter: k_d = 0 for the
-// color-only variant. The blend's variance pooling uses the same weights as the filter.
+// The range weight exp(-|R(p)-R(q)|^2 k_c - (d(p)-d(q))^2 k_d - surface terms) of a filter: k_d = 0
+// for the color-only variant; k_n = 1 / sigma_n^2 and k_r = 1 / (2 sigma_r^2), 0 where that sigma is
+// 0 (term off). The blend's variance pooling uses the same weights as the filter.
 struct RangeWeights {
-  float k_c = 0.0f, k_d = 0.0f;
+  float k_c = 0.0f, k_d = 0.0f, k_n = 0.0f, k_r = 0.0f;
 };
+constexpr float inv_sigma2_or_off(float sigma, float factor) {
+  return sigma > 0.0f ? factor / (sigma * sigma) : 0.0f;
+}
 constexpr RangeWeights range_weights(const FilterParams& p) {
-  return {inv_two_sigma2(p.sigma_c), p.kind != FilterKind::Bilateral ? inv_two_sigma2(p.sigma_d) : 0.0f};
+  return {inv_two_sigma2(p.sigma_c), p.kind != FilterKind::Bilateral ? inv_two_sigma2(p.sigma_d) : 0.0f,
+          inv_sigma2_or_off(p.sigma_n, 1.0f), inv_sigma2_or_off(p.sigma_r, 0.5f)};
 }
 
 // Passes of the à-trous variant for sigma_s (rule in gl/pass_params.cpp), at least 1, and few

@@ -24,7 +24,26 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 struct Scenario {
   Image lv = Image::rgb(W, H), hv = Image::rgb(W, H), var = Image::gray(W, H);
   Image range = Image::rgb(W, H), depth = Image::gray(W, H);
+  Image surface = Image::rgba(W, H);  // xyz shading normal (0: unknown), w roughness
 };
+
+// The surface buffer of a scenario: three normal regions split vertically (across the color and
+// depth regions), a few shortened normals as at antialiased edges, a few unknown ones, and two
+// roughness bands. Its own random stream, so the other buffers are those of make_scenario alone.
+void fill_surface(Scenario& s, unsigned seed) {
+  std::mt19937 rng(seed ^ 0x5eedu);
+  std::uniform_real_distribution<float> u01(0.0f, 1.0f);
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      glm::vec3 n = x < W / 3 ? glm::vec3(0, 0, 1) : x < 2 * W / 3 ? glm::vec3(0.5f, 0, 1) : glm::vec3(0, -0.6f, 1);
+      n = glm::normalize(n + 0.1f * glm::vec3(u01(rng), u01(rng), u01(rng)));
+      const float r = u01(rng);
+      if (r < 0.1f) n *= 0.6f;                   // a mixed edge pixel
+      if (r > 0.96f) n = glm::vec3(0.0f);        // unknown
+      for (int c = 0; c < 3; ++c) s.surface.at(x, y, c) = n[c];
+      s.surface.at(x, y, 3) = (y % 7 < 3 ? 0.2f : 0.6f) + 0.05f * u01(rng);
+    }
+}
 
 // Two range-color regions split by a diagonal, two depth regions split horizontally, noisy HV
 // with known, unknown (n < 2) and zero (all samples equal) variance, a few L_b = 0 pixels.
@@ -48,6 +67,7 @@ Scenario make_scenario(unsigned seed) {
       if (r > 0.97f)  // all samples black: L_b = 0 unless the filter brings light
         for (int c = 0; c < 3; ++c) s.hv.at(x, y, c) = s.lv.at(x, y, c) = 0.0f;
     }
+  fill_surface(s, seed);
   return s;
 }
 
@@ -77,9 +97,11 @@ void expect_close(const Image& gpu, const Image& cpu, float rel, float abs, cons
 struct GpuFixture {
   PreviewInputs inputs{W, H};
   Texture2D guide{W, H, TextureFormat::RGBA32F};
+  Texture2D surface{W, H, TextureFormat::RGBA32F};
   explicit GpuFixture(const Scenario& s) {
     inputs.upload(s.lv, s.hv, s.var);
     guide.upload(guide_image(s));
+    surface.upload(s.surface);
   }
 };
 
@@ -107,9 +129,12 @@ TEST_P(FilterVsCpu, MatchesReference) {
   p.skip_case2 = skip;
   p.sigma_s = sigma_s;
   const float t = 0.05f;
+  // Without the surface buffer (its terms off), then with it (normal and roughness terms on).
+  for (bool with_surface : {false, true}) {
+  SCOPED_TRACE(with_surface ? "with surface" : "without surface");
   FilterPass filter(W, H);
-  filter.run(gpu.inputs, gpu.guide, p, t);
-  FilterOutput ref = cpu_filter(s.hv, s.var, s.lv, s.range, s.depth, p, t);
+  filter.run(gpu.inputs, gpu.guide, p, t, with_surface ? &gpu.surface : nullptr);
+  FilterOutput ref = cpu_filter(s.hv, s.var, s.lv, s.range, s.depth, p, t, with_surface ? &s.surface : nullptr);
   expect_close(filter.filtered_image(), ref.filtered, 1e-4f, 1e-7f, "L_f");
   expect_close(filter.raw_variance_image(), ref.variance, 1e-4f, 1e-12f, "Var[L_f]");
   // The centre weight for the blend's covariance term: the full-kernel variants only.
@@ -123,6 +148,7 @@ TEST_P(FilterVsCpu, MatchesReference) {
     EXPECT_GT(skipped, 0u);
   }
   EXPECT_EQ(filter.filtered_pixels(), W * H - skipped);
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Variants, FilterVsCpu,
@@ -465,13 +491,14 @@ TEST(BlendVsCpu, MatchesReferenceWithFilteredInput) {
     ref_f.centre_weight = Image();  // the blend below gets L_f as a plain texture, without a centre weight
     const Texture2D filtered = filtered_texture(ref_f);
     for (float t : {0.0f, 0.001f, 0.02f, 0.2f})
-      for (bool pool : {false, true})
+      for (int pool : {0, 1, 2})  // 2: pooling with the surface terms
         for (bool guard : {false, true}) {
       SCOPED_TRACE(testing::Message() << "t=" << t << " pool=" << pool << " skip=" << skip << " guard=" << guard);
       BlendPass blend(W, H);
       const BlendParams bp{range_weights(fp), guard};
-      blend.run(gpu.inputs, &filtered, pool ? &gpu.guide : nullptr, t, bp);
-      BlendOutput ref = cpu_blend(s.lv, s.hv, s.var, &ref_f, t, bp, pool ? &s.range : nullptr, pool ? &s.depth : nullptr);
+      blend.run(gpu.inputs, &filtered, pool ? &gpu.guide : nullptr, t, bp, nullptr, pool == 2 ? &gpu.surface : nullptr);
+      BlendOutput ref = cpu_blend(s.lv, s.hv, s.var, &ref_f, t, bp, pool ? &s.range : nullptr, pool ? &s.depth : nullptr,
+                                  pool == 2 ? &s.surface : nullptr);
       expect_close(blend.final_image(), ref.final_rgb, 1e-4f, 1e-6f, "final");
       expect_close(blend.s_image(), ref.s, 1e-4f, 1e-5f, "s");
       expect_close(blend.case_image(), ref.blend_case, 0.0f, 0.0f, "case");
@@ -972,18 +999,19 @@ TEST_P(DemodulationVsCpu, MatchesReference) {
   const float t = 0.05f;
   Demodulation demod(W, H);
   FilterPass filter(W, H);
-  demod.demodulate(gpu.inputs, gpu.guide, p, t);
-  filter.run(demod.filter_inputs(), gpu.guide, p, t);
+  // With the surface buffer throughout: its terms reach the skip decision and the filter.
+  demod.demodulate(gpu.inputs, gpu.guide, p, t, &gpu.surface);
+  filter.run(demod.filter_inputs(), gpu.guide, p, t, &gpu.surface);
   demod.remodulate(filter.output(), gpu.inputs);
 
-  const DemodulatedInputs d = cpu_demodulate(s.hv, s.var, s.lv, albedo, s.range, s.depth, p, t);
+  const DemodulatedInputs d = cpu_demodulate(s.hv, s.var, s.lv, albedo, s.range, s.depth, p, t, &s.surface);
   expect_close(demod.filter_inputs().hv_image(), d.hv, 1e-5f, 1e-7f, "L_u / a");
   expect_close(demod.filter_inputs().var_image(), [&] {
     Image v = d.var_u;
     for (float& x : v.pixels) x = x > 0 ? x : 0.0f;
     return v;
   }(), 1e-5f, 1e-12f, "Var[L_u] / Y(a)^2");
-  const FilterOutput ref = cpu_remodulate(cpu_filter(d.hv, d.var_u, d.lv, s.range, s.depth, p, t), albedo);
+  const FilterOutput ref = cpu_remodulate(cpu_filter(d.hv, d.var_u, d.lv, s.range, s.depth, p, t, &s.surface), albedo);
   expect_close(demod.filtered_image(), ref.filtered, 1e-4f, 1e-7f, "L_f");
   Image gpu_var = demod.output().download({"R", "G", "B", "A"});
   Image gpu_raw_var = Image::gray(W, H);
@@ -992,9 +1020,9 @@ TEST_P(DemodulationVsCpu, MatchesReference) {
 
   // The same pixels are skipped as without demodulation.
   FilterPass plain(W, H);
-  plain.run(gpu.inputs, gpu.guide, p, t);
+  plain.run(gpu.inputs, gpu.guide, p, t, &gpu.surface);
   EXPECT_EQ(filter.filtered_pixels(), plain.filtered_pixels());
-  const FilterOutput plain_ref = cpu_filter(s.hv, s.var, s.lv, s.range, s.depth, p, t);
+  const FilterOutput plain_ref = cpu_filter(s.hv, s.var, s.lv, s.range, s.depth, p, t, &s.surface);
   size_t skipped = 0;
   for (size_t i = 0; i < ref.variance.pixels.size(); ++i) {
     EXPECT_EQ(ref.variance.pixels[i] == kVarSkipped, plain_ref.variance.pixels[i] == kVarSkipped) << i;
@@ -1009,8 +1037,8 @@ TEST_P(DemodulationVsCpu, MatchesReference) {
   BlendPass blend(W, H);
   // The filter's centre weight (bilateral variants) is unchanged by demodulation: Cov[L_u, L_f] =
   // w Var[L_u] with a grey factor.
-  blend.run(gpu.inputs, &demod.output(), &gpu.guide, t, bp, filter.centre_weight());
-  const BlendOutput rb = cpu_blend(s.lv, s.hv, s.var, &ref, t, bp, &s.range, &s.depth);
+  blend.run(gpu.inputs, &demod.output(), &gpu.guide, t, bp, filter.centre_weight(), &gpu.surface);
+  const BlendOutput rb = cpu_blend(s.lv, s.hv, s.var, &ref, t, bp, &s.range, &s.depth, &s.surface);
   expect_close(blend.final_image(), rb.final_rgb, 2e-4f, 1e-6f, "final");
   expect_close(blend.case_image(), rb.blend_case, 0.0f, 0.0f, "case");
 }
@@ -1100,6 +1128,90 @@ TEST(Demodulation, TexturedConstantIrradiancePlaneKeepsItsTexture) {
     }
     EXPECT_GT(blurred, 0.5);  // without demodulation the checkerboard is averaged away
     EXPECT_LT(kept, 1e-5);    // with it every texel comes back
+  }
+}
+
+// A normal-mapped plane under a directional light: its radiance varies with the shading normal
+// alone (flat range color, one depth), as the path tracer sees a normal-mapped wall. With the
+// normal term the filter keeps the bumps at a kernel far wider than they are; without it, it
+// averages them away. Measured on the high-frequency part (the image less its 5x5 box mean)
+// against the noise-free image's.
+TEST(SurfaceTerms, NormalMappedPlaneKeepsItsNormalDetail) {
+  test::osmesa_context();
+  const glm::vec3 light = glm::normalize(glm::vec3(0.4f, 0.3f, 1.0f));
+  const float two_pi = 6.28318530718f;
+  std::mt19937 rng(5);
+  std::normal_distribution<float> gauss(0.0f, 1.0f);
+  Scenario s;
+  Image clean = Image::rgb(W, H);
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      const glm::vec3 n = glm::normalize(glm::vec3(0.5f * std::sin(two_pi * x / 6.0f), 0.5f * std::cos(two_pi * y / 5.0f), 1.0f));
+      const float radiance = 3.0f * 0.6f * std::max(glm::dot(n, light), 0.0f);
+      const float noisy = radiance * (1.0f + 0.3f * gauss(rng));
+      for (int c = 0; c < 3; ++c) {
+        clean.at(x, y, c) = radiance;
+        s.hv.at(x, y, c) = noisy;
+        s.lv.at(x, y, c) = 0.0f;
+        s.range.at(x, y, c) = 0.5f;
+        s.surface.at(x, y, c) = n[c];
+      }
+      s.surface.at(x, y, 3) = 0.5f;
+      s.var.at(x, y, 0) = 0.09f * radiance * radiance;
+      s.depth.at(x, y, 0) = 3.0f;
+    }
+  auto high_pass = [](const Image& im) {
+    std::vector<double> hp(im.pixel_count());
+    for (int y = 0; y < im.height; ++y)
+      for (int x = 0; x < im.width; ++x) {
+        double sum = 0;
+        int count = 0;
+        for (int qy = std::max(0, y - 2); qy <= std::min(im.height - 1, y + 2); ++qy)
+          for (int qx = std::max(0, x - 2); qx <= std::min(im.width - 1, x + 2); ++qx, ++count) sum += im.at(qx, qy, 1);
+        hp[static_cast<size_t>(y) * im.width + x] = im.at(x, y, 1) - sum / count;
+      }
+    return hp;
+  };
+  const std::vector<double> expected = high_pass(clean);
+  double expected_energy = 0;
+  for (double v : expected) expected_energy += v * v;
+  // The share of the noise-free detail's energy the filtered image gets wrong.
+  auto detail_error = [&](const Image& filtered) {
+    const std::vector<double> hp = high_pass(filtered);
+    double e = 0;
+    for (size_t i = 0; i < hp.size(); ++i) e += (hp[i] - expected[i]) * (hp[i] - expected[i]);
+    return e / expected_energy;
+  };
+  // The noise-free radiance as L_u (with the noisy one's variance, so the filter does filter it):
+  // what is left of its detail is the filter's blur alone.
+  Scenario noiseless = s;
+  noiseless.hv = clean;
+  GpuFixture gpu(s), gpu_noiseless(noiseless);
+  const double noisy_error = detail_error(s.hv);
+  for (FilterKind kind : {FilterKind::Atrous, FilterKind::BilateralDepth, FilterKind::Separable, FilterKind::Subsampled}) {
+    SCOPED_TRACE(filter_kind_name(kind));
+    FilterParams p;
+    p.kind = kind;
+    p.sigma_s = 16.0f;
+    p.skip_case2 = false;
+    FilterPass filter(W, H);
+    auto run = [&](const GpuFixture& in) {
+      filter.run(in.inputs, in.guide, p, test::kTestThreshold, &in.surface);
+      return filter.filtered_image();
+    };
+    const Image kept = run(gpu_noiseless), kept_noisy = run(gpu);
+    expect_close(kept_noisy, cpu_filter(s.hv, s.var, s.lv, s.range, s.depth, p, test::kTestThreshold, &s.surface).filtered,
+                 1e-4f, 1e-7f, "L_f");
+    p.sigma_n = 0.0f;  // the normal term off
+    const Image blurred = run(gpu_noiseless);
+    const double kept_error = detail_error(kept), blurred_error = detail_error(blurred);
+    const double noisy_kept_error = detail_error(kept_noisy);
+    std::printf("%s: detail error of the noise-free plane with the normal term %.3f, without %.3f; of the noisy one "
+                "%.3f unfiltered, %.3f filtered\n",
+                filter_kind_name(kind), kept_error, blurred_error, noisy_error, noisy_kept_error);
+    EXPECT_GT(blurred_error, 0.8);  // without the normal term the bumps are averaged away
+    EXPECT_LT(kept_error, 0.1);     // with it they stay
+    EXPECT_LT(noisy_kept_error, 0.6 * noisy_error);  // and the noise on them still drops
   }
 }
 

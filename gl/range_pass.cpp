@@ -14,6 +14,7 @@ struct Vertex {
   glm::vec3 position, normal;
   glm::vec2 uv0, uv1;
   glm::vec4 color;
+  glm::vec4 tangent;
 };
 
 GLint gl_wrap(Wrap w) {
@@ -37,6 +38,7 @@ struct RangePass::GpuMesh {
   VertexArray vao;
   int index_count = 0;
   int material = 0;
+  bool has_tangents = false;
 };
 
 RangePass::RangePass(int width, int height)
@@ -45,16 +47,19 @@ RangePass::RangePass(int width, int height)
       accumulate_(Program::from_embedded("fullscreen.vert", "range_accumulate.frag")),
       background_(Program::from_embedded("fullscreen.vert", "range_background.frag")),
       frame_color_(width, height, TextureFormat::RGBA32F), frame_distance_(width, height, TextureFormat::R32F),
-      frame_depth_(width, height, TextureFormat::Depth32F),
+      frame_surface_(width, height, TextureFormat::RGBA32F), frame_depth_(width, height, TextureFormat::Depth32F),
       guide_{Texture2D(width, height, TextureFormat::RGBA32F), Texture2D(width, height, TextureFormat::RGBA32F)},
+      surface_{Texture2D(width, height, TextureFormat::RGBA32F), Texture2D(width, height, TextureFormat::RGBA32F)},
       change_(width, height, TextureFormat::R32F), white_(1, 1, TextureFormat::RGBA32F) {
   frame_fbo_.attach(0, frame_color_);
   frame_fbo_.attach(1, frame_distance_);
+  frame_fbo_.attach(2, frame_surface_);
   frame_fbo_.attach_depth(frame_depth_);
   frame_fbo_.check("range pass");
   for (int i = 0; i < 2; ++i) {
     accum_fbo_[i].attach(0, guide_[i]);
     accum_fbo_[i].attach(1, change_);
+    accum_fbo_[i].attach(2, surface_[i]);
     accum_fbo_[i].check("range accumulation");
   }
   const float white[4] = {1, 1, 1, 1};
@@ -62,6 +67,8 @@ RangePass::RangePass(int width, int height)
   // An empty guide until the first frame: range color 0, background distance.
   const float clear[4] = {0, 0, 0, kBackgroundDepth};
   for (auto& g : guide_) glClearTexImage(g.id(), 0, GL_RGBA, GL_FLOAT, clear);
+  const float no_surface[4] = {0, 0, 0, 0};  // normal unknown
+  for (auto& s : surface_) glClearTexImage(s.id(), 0, GL_RGBA, GL_FLOAT, no_surface);
 }
 
 RangePass::~RangePass() = default;
@@ -71,14 +78,15 @@ void RangePass::set_scene(const Scene& scene) {
   textures_.clear();
   materials_ = scene.materials;
   has_specular_material_ = false;
-  // The range color reads base color textures only; 8-bit ones stay 8-bit (GL decodes sRGB).
-  std::vector<bool> base_color(scene.textures.size(), false);
+  // The range color reads base color textures, the surface normal maps and metallic-roughness
+  // textures; 8-bit ones stay 8-bit (GL decodes sRGB).
+  std::vector<bool> used(scene.textures.size(), false);
   for (const Material& m : scene.materials)
-    if (m.base_color_texture.valid() && m.base_color_texture.texture < static_cast<int>(base_color.size()))
-      base_color[m.base_color_texture.texture] = true;
+    for (const TextureRef* ref : {&m.base_color_texture, &m.normal_texture, &m.metallic_roughness_texture})
+      if (ref->valid() && ref->texture < static_cast<int>(used.size())) used[ref->texture] = true;
   for (size_t i = 0; i < scene.textures.size(); ++i) {
     const Texture& t = scene.textures[i];
-    if (!base_color[i] || !t.valid()) {
+    if (!used[i] || !t.valid()) {
       textures_.emplace_back();  // unused or invalid: the white texture is bound instead
       continue;
     }
@@ -101,6 +109,7 @@ void RangePass::set_scene(const Scene& scene) {
       v.uv0 = i < m.uv0.size() ? m.uv0[i] : glm::vec2(0);
       v.uv1 = i < m.uv1.size() ? m.uv1[i] : glm::vec2(0);
       v.color = i < m.colors.size() ? m.colors[i] : glm::vec4(1);
+      v.tangent = i < m.tangents.size() ? m.tangents[i] : glm::vec4(0, 0, 0, 1);
     }
     GpuMesh g;
     g.vertices = Buffer(vertices.size() * sizeof(Vertex), vertices.data());
@@ -110,6 +119,8 @@ void RangePass::set_scene(const Scene& scene) {
     g.vao.attribute(2, g.vertices, 2, sizeof(Vertex), offsetof(Vertex, uv0));
     g.vao.attribute(3, g.vertices, 2, sizeof(Vertex), offsetof(Vertex, uv1));
     g.vao.attribute(4, g.vertices, 4, sizeof(Vertex), offsetof(Vertex, color));
+    g.vao.attribute(5, g.vertices, 4, sizeof(Vertex), offsetof(Vertex, tangent));
+    g.has_tangents = !m.tangents.empty();
     g.vao.element_buffer(g.indices);
     g.index_count = static_cast<int>(m.triangles.size() * 3);
     g.material = (m.material >= 0 && m.material < static_cast<int>(materials_.size())) ? m.material : -1;
@@ -164,9 +175,11 @@ void RangePass::draw_scene(glm::vec2 jitter) {
   raster_.set("orthographic", camera_.orthographic ? 1 : 0);
   const float clear_color[4] = {0, 0, 0, 0};
   const float clear_distance[4] = {kBackgroundDepth, 0, 0, 0};
+  const float clear_surface[4] = {0, 0, 0, 0};
   const float clear_depth = 1.0f;
   glClearNamedFramebufferfv(frame_fbo_.id(), GL_COLOR, 0, clear_color);
   glClearNamedFramebufferfv(frame_fbo_.id(), GL_COLOR, 1, clear_distance);
+  glClearNamedFramebufferfv(frame_fbo_.id(), GL_COLOR, 2, clear_surface);
   glClearNamedFramebufferfv(frame_fbo_.id(), GL_DEPTH, 0, &clear_depth);
   if (environment_.valid()) draw_environment(view_projection);
   raster_.use();
@@ -178,12 +191,27 @@ void RangePass::draw_scene(glm::vec2 jitter) {
   static const Material kDefault;
   for (const GpuMesh& g : meshes_) {
     const Material& m = g.material >= 0 ? materials_[g.material] : kDefault;
+    auto uploaded = [&](const TextureRef& r) {
+      return r.valid() && r.texture < static_cast<int>(textures_.size()) && textures_[r.texture].valid();
+    };
     const TextureRef& ref = m.base_color_texture;
-    bool textured = ref.valid() && ref.texture < static_cast<int>(textures_.size()) && textures_[ref.texture].valid();
-    raster_.bind(0, textured ? textures_[ref.texture] : white_);
+    raster_.bind(0, uploaded(ref) ? textures_[ref.texture] : white_);
     raster_.set("base_color", m.base_color);
     raster_.set("texcoord", ref.texcoord);
     raster_.set("uv_transform", ref.transform);
+    // The path tracer maps normals only where the mesh has tangents (the loader adds them).
+    const TextureRef& nref = m.normal_texture;
+    const bool normal_map = uploaded(nref) && g.has_tangents;
+    raster_.bind(1, normal_map ? textures_[nref.texture] : white_);
+    raster_.set("normal_map", normal_map ? 1 : 0);
+    raster_.set("normal_scale", m.normal_scale);
+    raster_.set("normal_texcoord", nref.texcoord);
+    raster_.set("normal_uv_transform", nref.transform);
+    const TextureRef& rref = m.metallic_roughness_texture;
+    raster_.bind(2, uploaded(rref) ? textures_[rref.texture] : white_);
+    raster_.set("roughness", m.roughness);
+    raster_.set("roughness_texcoord", rref.texcoord);
+    raster_.set("roughness_uv_transform", rref.transform);
     // The guide is deterministic: it sees a BLEND surface where its opacity is at least one half
     // (where the path tracer's stochastic transparency keeps most hits).
     raster_.set("alpha_mask", m.alpha_mode != AlphaMode::Opaque ? 1 : 0);
@@ -227,18 +255,23 @@ std::vector<uint32_t> RangePass::specular_pixels() {
 void RangePass::apply_specular_chains(const std::vector<uint32_t>& pixels, const std::vector<SpecularChainHit>& hits) {
   if (pixels.empty()) return;
   if (hits.size() != pixels.size()) throw Error("range pass: specular chain results do not match the pixels");
-  std::vector<float> data(pixels.size() * 6);
+  constexpr int kFloats = 10;  // pixel, color + distance, normal + roughness
+  std::vector<float> data(pixels.size() * kFloats);
   for (size_t i = 0; i < pixels.size(); ++i) {
-    float* d = &data[6 * i];
+    float* d = &data[kFloats * i];
     d[0] = static_cast<float>(pixels[i] % width_);
     d[1] = static_cast<float>(pixels[i] / width_);
     const SpecularChainHit& h = hits[i];
     d[2] = h.range_color.x, d[3] = h.range_color.y, d[4] = h.range_color.z;
     d[5] = h.hit ? h.distance : kBackgroundDepth;
+    const glm::vec3 n = h.hit ? h.normal : glm::vec3(0.0f);
+    d[6] = n.x, d[7] = n.y, d[8] = n.z;
+    d[9] = h.hit ? h.roughness : 0.0f;
   }
   point_buffer_.upload(data.data(), data.size() * sizeof(float));
-  point_vao_.attribute(0, point_buffer_, 2, 6 * sizeof(float), 0);
-  point_vao_.attribute(1, point_buffer_, 4, 6 * sizeof(float), 2 * sizeof(float));
+  point_vao_.attribute(0, point_buffer_, 2, kFloats * sizeof(float), 0);
+  point_vao_.attribute(1, point_buffer_, 4, kFloats * sizeof(float), 2 * sizeof(float));
+  point_vao_.attribute(2, point_buffer_, 4, kFloats * sizeof(float), 6 * sizeof(float));
   points_.set("size", glm::vec2(width_, height_));
   points_.use();
   frame_fbo_.bind(width_, height_);
@@ -256,6 +289,8 @@ void RangePass::end_frame() {
   accumulate_.bind(0, frame_color_);
   accumulate_.bind(1, frame_distance_);
   accumulate_.bind(2, guide_[current_]);
+  accumulate_.bind(3, frame_surface_);
+  accumulate_.bind(4, surface_[current_]);
   quad_.draw(accumulate_, accum_fbo_[next], width_, height_);
   current_ = next;
   ++frames_;
@@ -272,6 +307,10 @@ void RangePass::end_frame() {
 const Texture2D& RangePass::guide() const { return guide_[current_]; }
 
 Image RangePass::range_color_image() const { return guide().download({"R", "G", "B"}); }
+
+const Texture2D& RangePass::surface() const { return surface_[current_]; }
+
+Image RangePass::surface_image() const { return surface().download({"X", "Y", "Z", "R"}); }
 
 Image RangePass::depth_image() const {
   Image rgba = guide().download({"R", "G", "B", "A"});

@@ -1,5 +1,5 @@
 // G-buffer/range pass (docs/method.md section 1.2): rasterizes the scene with the path tracer's exact camera into a
-// noise-free guide (range color + distance), antialiased by accumulating jittered frames
+// noise-free guide (range color + distance) and surface buffer (shading normal + roughness), antialiased by accumulating jittered frames
 // (raster_jitter(k)) until the mean per-pixel change drops below a tolerance or a frame cap.
 // Re-rendered only when the camera or the scene changes.
 // Usage (with a path tracer for the perfectly specular pixels):
@@ -56,12 +56,18 @@ class RangePass {
   glm::vec2 jitter() const;              // of the frame begun last
   // Pixels (y * width + x) of the current frame whose visible surface is perfectly specular.
   std::vector<uint32_t> specular_pixels();
-  // Overrides color and distance of those pixels in the current frame (hit = false: color 0,
-  // distance kBackgroundDepth).
+  // Overrides color, distance and surface of those pixels in the current frame (hit = false: color
+  // 0, distance kBackgroundDepth, normal 0: unknown).
   void apply_specular_chains(const std::vector<uint32_t>& pixels, const std::vector<SpecularChainHit>& hits);
   void end_frame();                      // accumulates, updates converged()
 
   const Texture2D& guide() const;        // rgb range color, a distance (antialiased)
+  // xyz the shading normal (normal map applied, flipped toward the viewer for double-sided
+  // materials; 0 where unknown: the environment, an escaped specular chain), w the roughness;
+  // averaged over the antialiasing frames like the guide. Perfectly specular pixels hold their
+  // chain's end.
+  const Texture2D& surface() const;
+  Image surface_image() const;           // "X,Y,Z,R": normal, roughness
   // The newest frame's raster output: rgb its range color, a 1 where its surface is perfectly
   // specular (the guide's distance there is a specular chain's, not the distance to a surface).
   const Texture2D& frame_color() const { return frame_color_; }
@@ -77,7 +83,7 @@ class RangePass {
   void draw_environment(const glm::mat4& view_projection);  // where camera rays escape
   int width_, height_;
   Program raster_, points_, accumulate_, background_;
-  Texture2D frame_color_, frame_distance_, frame_depth_, guide_[2], change_;
+  Texture2D frame_color_, frame_distance_, frame_surface_, frame_depth_, guide_[2], surface_[2], change_;
   Framebuffer frame_fbo_, accum_fbo_[2];
   FullscreenPass quad_;
   GpuReduction reduction_;

@@ -861,8 +861,11 @@ SpecularChainHit PathTracer::trace_specular_chain(const Ray& camera_ray) const {
     glm::vec3 wo = -ray.direction;
     if (!material_is_perfect_specular(material) || bounce == kMaxSpecularChainBounces) {
       glm::vec3 n = sp.vertex_normal;
-      if (material.double_sided && glm::dot(n, wo) < 0.0f) n = -n;
+      const bool flip = material.double_sided && glm::dot(n, wo) < 0.0f;
+      if (flip) n = -n;
       result.range_color = range_shading(p.base_color * tint, n, wo);
+      result.normal = flip ? -sp.shading_normal : sp.shading_normal;
+      result.roughness = p.roughness;
       result.hit = true;
       return result;
     }

@@ -341,11 +341,11 @@ void Preview::begin_filter_run() {
     if (!demod_) demod_ = std::make_unique<Demodulation>(width_, height_);
     PreviewInputs& in = pass_inputs();
     in.upload_albedo(&renderer_->accumulation().albedo_mean[0].x);
-    demod_->demodulate(in, range_.guide(), params, threshold_now());
-    filter_.begin(demod_->filter_inputs(), range_.guide(), params, threshold_now());
+    demod_->demodulate(in, range_.guide(), params, threshold_now(), &range_.surface());
+    filter_.begin(demod_->filter_inputs(), range_.guide(), params, threshold_now(), &range_.surface());
     open_run_.filter_ms = elapsed_ms(demod_start);
   } else {
-    filter_.begin(inputs(), range_.guide(), params, threshold_now());
+    filter_.begin(inputs(), range_.guide(), params, threshold_now(), &range_.surface());
   }
   open_run_.range_ms = last_.range - range_before;
   last_sigma_s_ = params.sigma_s;
@@ -440,7 +440,8 @@ void Preview::blend_and_tonemap() {
   // acts in cases 1 and 3 only, would change nothing: its passes are left out (the same image).
   const bool guard = settings_.bias_guard && !schedule_.all_pixels_case2;
   blend_.run(inputs(), have_filtered_ ? &filtered_output() : nullptr, &range_.guide(), threshold_now(),
-             BlendParams{range_weights(settings_.filter), guard, static_cast<float>(samples())}, have_filtered_ ? filter_.centre_weight() : nullptr);
+             BlendParams{range_weights(settings_.filter), guard, static_cast<float>(samples())}, have_filtered_ ? filter_.centre_weight() : nullptr,
+             &range_.surface());
   last_.blend += blend_.last_ms();
   tonemap_.run(blend_.output(), settings_.tonemap);
   last_.tonemap += tonemap_.last_ms();

@@ -108,6 +108,13 @@ std::vector<SettingDescriptor> make_table() {
   t.push_back(number("sigma_d", "--sigma-d", "range depth sigma, scene units", 1e-6, 1e6,
                      [](PreviewSettings& s) -> float& { return s.filter.sigma_d; }, E::Refilter,
                      {"sigma d", 1e-3, 1e3, true, "%.3g"}));
+  t.push_back(number("sigma_n", "--sigma-n",
+                     "range normal sigma, radians between shading normals (normal maps applied); 0: off",
+                     0.0, 4.0, [](PreviewSettings& s) -> float& { return s.filter.sigma_n; }, E::Refilter,
+                     {"sigma n (rad)", 0.0, 3.2, false, "%.3g"}));
+  t.push_back(number("sigma_r", "--sigma-r", "range roughness sigma (glTF roughness, 0..1); 0: off", 0.0, 1e3,
+                     [](PreviewSettings& s) -> float& { return s.filter.sigma_r; }, E::Refilter,
+                     {"sigma r", 0.0, 1.0, false, "%.3g"}));
   t.push_back(choice<&filter_kind>("filter", "--filter", "filter variant (grid: the bilateral grid on the range luminance)",
                                   filter_option_names(), E::Refilter, "filter"));
   t.push_back(on_off("demodulate", "--demodulate",

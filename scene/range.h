@@ -19,6 +19,11 @@ struct SpecularChainHit {
   glm::vec3 range_color{0.0f};
   float distance = 0.0f;  // total distance along the chain, scene units (hit only)
   bool hit = false;       // false: the chain escaped (the range pass uses the background distance)
+  // The surface buffer's texel at the chain's end (hit only): the shading normal there, flipped
+  // toward the chain's last ray for double-sided materials, and the roughness; an escaped chain
+  // leaves the normal 0 (unknown), as the environment's pixels have.
+  glm::vec3 normal{0.0f};
+  float roughness = 0.0f;
 };
 
 }  // namespace pxf

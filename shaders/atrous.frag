@@ -12,11 +12,14 @@
 layout(binding = kUnitHv) uniform sampler2D hv_tex;     // rgb L_u, a Var[L_u] (kVarUnknown: n < 2; 0: all samples equal)
 layout(binding = kUnitLv) uniform sampler2D lv_tex;     // rgb L_lv (only for skipping)
 layout(binding = kUnitGuide) uniform sampler2D guide_tex;  // rgb range color, a distance
+layout(binding = kUnitSurface) uniform sampler2D surface_tex;  // xyz shading normal (0: unknown), w roughness
 layout(binding = kUnitSignal) uniform sampler2D signal_tex; // what is filtered: hv_tex, or the previous pass
 uniform int step_px;
 uniform int final_pass;  // skipping and counting happen in the final pass only: later passes read every pixel
 uniform float k_c;  // 1 / (2 sigma_c^2)
 uniform float k_d;  // 1 / (2 sigma_d^2)
+uniform float k_n;  // 1 / sigma_n^2, 0: no normal term (range_weights)
+uniform float k_r;  // 1 / (2 sigma_r^2), 0: no roughness term
 uniform int skip_case2;
 uniform float t;
 uniform float variance_correction;  // atrous_variance_correction(pass)
@@ -27,12 +30,13 @@ layout(location = 0) out vec4 out_filtered;  // rgb L_f, a Var[L_f] (kVarUnknown
 void main() {
   ivec2 p = ivec2(gl_FragCoord.xy);
   ivec2 size = textureSize(hv_tex, 0);
-  if (final_pass != 0 && skip_case2 != 0 && skip_as_case2(hv_tex, lv_tex, guide_tex, p, k_c, k_d, t)) {
+  if (final_pass != 0 && skip_case2 != 0 && skip_as_case2(hv_tex, lv_tex, guide_tex, surface_tex, p, k_c, k_d, k_n, k_r, t)) {
     out_filtered = vec4(clean(texelFetch(hv_tex, p, 0).rgb), kVarSkipped);
     return;
   }
   if (final_pass != 0) atomicAdd(filtered_pixels, 1u);
   vec4 g_p = texelFetch(guide_tex, p, 0);
+  vec4 s_p = texelFetch(surface_tex, p, 0);
   KernelSums sums = kernel_sums_zero();
   float h_sum = 0.0;  // sum h over the taps inside the image
   for (int j = 0; j < 5; ++j) {
@@ -43,7 +47,7 @@ void main() {
       if (qx < 0 || qx >= size.x) continue;
       ivec2 q = ivec2(qx, qy);
       h_sum += kB3[i] * kB3[j];
-      float w = kB3[i] * kB3[j] * range_weight(g_p, texelFetch(guide_tex, q, 0), k_c, k_d);
+      float w = kB3[i] * kB3[j] * range_weight(g_p, texelFetch(guide_tex, q, 0), s_p, texelFetch(surface_tex, q, 0), k_c, k_d, k_n, k_r);
       vec4 s_q = texelFetch(signal_tex, q, 0);
       kernel_sums_add(sums, w, clean(s_q.rgb), clean_var(s_q.a));
     }

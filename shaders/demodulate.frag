@@ -9,9 +9,12 @@
 layout(binding = kUnitHv) uniform sampler2D hv_tex;    // rgb L_u, a Var[L_u]
 layout(binding = kUnitLv) uniform sampler2D lv_tex;    // rgb L_lv
 layout(binding = kUnitGuide) uniform sampler2D guide_tex;  // rgb range color, a distance
+layout(binding = kUnitSurface) uniform sampler2D surface_tex;  // xyz shading normal (0: unknown), w roughness
 layout(binding = kUnitAlbedo) uniform sampler2D albedo_tex;  // rgb mean albedo
 uniform float k_c;
 uniform float k_d;
+uniform float k_n;  // 1 / sigma_n^2, 0: no normal term (range_weights)
+uniform float k_r;  // 1 / (2 sigma_r^2), 0: no roughness term
 uniform float t;
 uniform int skip_case2;
 
@@ -25,6 +28,6 @@ void main() {
   float k = luminance(a);
   float v = clean_var(hv.a);
   out_hv = vec4(clean(hv.rgb) / a, demodulated_var(v, k));
-  bool skip = skip_case2 != 0 && skip_as_case2(hv_tex, lv_tex, guide_tex, p, k_c, k_d, t);
+  bool skip = skip_case2 != 0 && skip_as_case2(hv_tex, lv_tex, guide_tex, surface_tex, p, k_c, k_d, k_n, k_r, t);
   out_lv = vec4(vec3(skip ? kMaxInput : -kMaxInput), 1.0);
 }

@@ -12,6 +12,7 @@
 layout(binding = kUnitHv) uniform sampler2D hv_tex;     // rgb L_u, a Var[L_u]
 layout(binding = kUnitLv) uniform sampler2D lv_tex;     // rgb L_lv (only for skipping)
 layout(binding = kUnitGuide) uniform sampler2D guide_tex;  // rgb range color, a distance
+layout(binding = kUnitSurface) uniform sampler2D surface_tex;  // xyz shading normal (0: unknown), w roughness
 layout(std430, binding = kBufferGrid) readonly buffer Grid { vec4 cells[]; };
 layout(std430, binding = kBufferCounts) buffer Counter { uint filtered_pixels; };
 uniform ivec2 grid_xy;
@@ -19,6 +20,8 @@ uniform float inv_cell_s;
 uniform float min_cell_z;  // grid_min_cell_z(sigma_c)
 uniform float k_c;  // 1 / (2 sigma_c^2), for skipping
 uniform float k_d;  // 1 / (2 sigma_d^2), for skipping
+uniform float k_n;  // 1 / sigma_n^2, 0: no normal term (range_weights)
+uniform float k_r;  // 1 / (2 sigma_r^2), 0: no roughness term
 uniform int skip_case2;
 uniform float t;
 
@@ -27,7 +30,7 @@ layout(location = 1) out float out_centre_weight;  // the pixel's own share of L
 
 void main() {
   ivec2 p = ivec2(gl_FragCoord.xy);
-  if (skip_case2 != 0 && skip_as_case2(hv_tex, lv_tex, guide_tex, p, k_c, k_d, t)) {
+  if (skip_case2 != 0 && skip_as_case2(hv_tex, lv_tex, guide_tex, surface_tex, p, k_c, k_d, k_n, k_r, t)) {
     out_filtered = vec4(clean(texelFetch(hv_tex, p, 0).rgb), kVarSkipped);
     out_centre_weight = 1.0;
     return;

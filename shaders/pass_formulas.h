@@ -63,6 +63,7 @@ PXF_CONST int kUnitAlbedo = 6;        // rgb mean first non-specular albedo
 PXF_CONST int kUnitGuardSums = 7;     // the bias guard's finding (b2, var_u), or the row sums over x in [-r, r]
 PXF_CONST int kUnitGuardRowsLowX = 8;   // the bias guard's row sums over x in [-r, 0]
 PXF_CONST int kUnitGuardRowsHighX = 9;  // and over x in [0, r]
+PXF_CONST int kUnitSurface = 10;      // the range buffer's surface: xyz shading normal (0: unknown), w roughness
 
 // Shader storage buffer bindings of the pass shaders.
 PXF_CONST int kBufferCounts = 0;      // the filters' filtered-pixel counter, the blend's case counts
@@ -84,15 +85,37 @@ PXF_INLINE float clean_var(float v) { return (isnan(v) || isinf(v) || v < 0.0f) 
 
 // ---- Range weights ----
 
-// The exponent of the cross bilateral filter's range weight between guide texels (rgb range
-// color, a distance): |R(p) - R(q)|^2 k_c + (d(p) - d(q))^2 k_d.
-PXF_INLINE wide_float range_exponent(vec4 g_p, vec4 g_q, float k_c, float k_d) {
+// The surface term of the range weight (docs/method.md section 2.1) between surface texels (xyz the
+// shading normal, w the roughness; the range pass's antialiasing averages them, so the normal is
+// not unit length at edges): (1 - cos(n_p, n_q)) k_n + (r_p - r_q)^2 k_r. 1 - cos is about
+// angle^2 / 2 for small angles, so with k_n = 1 / sigma_n^2 the normal term is a Gaussian of the
+// angle with deviation sigma_n (radians); unlike SVGF's max(0, cos)^sigma_n it stays above 0 for
+// opposite normals, so it is one more addend of the one exponent. Where either normal is unknown
+// (the environment, a specular chain without an end, no surface buffer: a normal shorter than
+// kMinSurfaceNormal) the term is 0: the colour and distance terms alone decide there.
+PXF_CONST float kMinSurfaceNormal = 0.25f;
+PXF_INLINE wide_float surface_exponent(vec4 s_p, vec4 s_q, float k_n, float k_r) {
+  if (!(k_n > 0.0f) && !(k_r > 0.0f)) return 0.0f;
+  vec3 a = clean(vec3(s_p)), b = clean(vec3(s_q));
+  float la = dot(a, a), lb = dot(b, b);
+  if (!(la >= kMinSurfaceNormal * kMinSurfaceNormal) || !(lb >= kMinSurfaceNormal * kMinSurfaceNormal)) return 0.0f;
+  wide_float c = wide_float(dot(a, b)) / sqrt(wide_float(la) * wide_float(lb));
+  wide_float dr = wide_float(clean(s_p.a)) - wide_float(clean(s_q.a));
+  return max(1.0f - c, wide_float(0.0f)) * k_n + dr * dr * k_r;
+}
+
+// The exponent of the cross bilateral filter's range weight between guide texels g (rgb range
+// color, a distance) and surface texels s: |R(p) - R(q)|^2 k_c + (d(p) - d(q))^2 k_d + the surface
+// term (surface_exponent; k_n = k_r = 0 leaves it out).
+PXF_INLINE wide_float range_exponent(vec4 g_p, vec4 g_q, vec4 s_p, vec4 s_q, float k_c, float k_d, float k_n,
+                                     float k_r) {
   wide_vec3 dr = wide_vec3(clean(vec3(g_p)) - clean(vec3(g_q)));
   wide_float dd = wide_float(clean(g_p.a)) - wide_float(clean(g_q.a));
-  return dot(dr, dr) * k_c + dd * dd * k_d;
+  return dot(dr, dr) * k_c + dd * dd * k_d + surface_exponent(s_p, s_q, k_n, k_r);
 }
-PXF_INLINE wide_float range_weight(vec4 g_p, vec4 g_q, float k_c, float k_d) {
-  return exp(-range_exponent(g_p, g_q, k_c, k_d));
+PXF_INLINE wide_float range_weight(vec4 g_p, vec4 g_q, vec4 s_p, vec4 s_q, float k_c, float k_d, float k_n,
+                                   float k_r) {
+  return exp(-range_exponent(g_p, g_q, s_p, s_q, k_c, k_d, k_n, k_r));
 }
 
 // ---- Kernel sums ----
@@ -213,11 +236,13 @@ PXF_CONST float kMinPooledWeight = 1.17549435e-38f;
 // Both fall as 1/n, so the bias still vanishes. Returns kVarUnknown where n < 2, and 0 where all
 // the pixel's samples were equal and no neighbour variance is known. A neighbour whose range weight
 // is below kMinPooledWeight counts as unknown.
-PXF_SAMPLER_FN float pooled_var_u(sampler2D hv, sampler2D guide, ivec2 p, float k_c, float k_d) {
+PXF_SAMPLER_FN float pooled_var_u(sampler2D hv, sampler2D guide, sampler2D surface, ivec2 p, float k_c, float k_d,
+                                   float k_n, float k_r) {
   float own = clean_var(texelFetch(hv, p, 0).a);
   if (own < 0.0f) return kVarUnknown;
   ivec2 size = textureSize(hv, 0);
   vec4 g_p = texelFetch(guide, p, 0);
+  vec4 s_p = texelFetch(surface, p, 0);
   wide_float sw = 0.0f, swv = 0.0f;
   for (int dy = -1; dy <= 1; ++dy)
     for (int dx = -1; dx <= 1; ++dx) {
@@ -225,7 +250,7 @@ PXF_SAMPLER_FN float pooled_var_u(sampler2D hv, sampler2D guide, ivec2 p, float 
       if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) continue;
       float v = clean_var(texelFetch(hv, q, 0).a);
       if (!(v > 0.0f)) continue;  // unknown, or all samples equal: no evidence
-      wide_float w = range_weight(g_p, texelFetch(guide, q, 0), k_c, k_d);
+      wide_float w = range_weight(g_p, texelFetch(guide, q, 0), s_p, texelFetch(surface, q, 0), k_c, k_d, k_n, k_r);
       if (!(w >= kMinPooledWeight)) continue;  // across a range edge: as the GPU flushes it
       sw += w;
       swv += w * v;
@@ -245,15 +270,15 @@ PXF_INLINE float pixel_threshold(float t, vec4 lv_texel) { return t * lv_texel.a
 // pixel whose own variance already exceeds t is not skipped without looking at its neighbours: the
 // same answer for a fraction of the cost (at low spp nearly every pixel leaves here, and the 3x3
 // pooling cost more than a grid slice).
-PXF_SAMPLER_FN bool skip_as_case2(sampler2D hv, sampler2D lv, sampler2D guide, ivec2 p, float k_c, float k_d,
-                                  float t) {
+PXF_SAMPLER_FN bool skip_as_case2(sampler2D hv, sampler2D lv, sampler2D guide, sampler2D surface, ivec2 p, float k_c,
+                                  float k_d, float k_n, float k_r, float t) {
   vec4 hv_p = texelFetch(hv, p, 0);
   vec4 lv_p = texelFetch(lv, p, 0);
   float lb = max(luminance(clean(vec3(hv_p))) + luminance(clean(vec3(lv_p))), 0.0f);
   float t_p = max(pixel_threshold(t, lv_p), 0.0f);
   float own = clean_var(hv_p.a);
   if (own > 0.0f && relative_variance(own, lb) > t_p) return false;
-  float v = pooled_var_u(hv, guide, p, k_c, k_d);
+  float v = pooled_var_u(hv, guide, surface, p, k_c, k_d, k_n, k_r);
   return v > 0.0f && relative_variance(v, lb) <= t_p;
 }
 

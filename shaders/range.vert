@@ -6,6 +6,7 @@ layout(location = 1) in vec3 in_normal;
 layout(location = 2) in vec2 in_uv0;
 layout(location = 3) in vec2 in_uv1;
 layout(location = 4) in vec4 in_color;
+layout(location = 5) in vec4 in_tangent;  // xyz + handedness w; (0, 0, 0, 1) without a normal map
 uniform mat4 view_projection;
 
 out vec3 world_position;
@@ -13,6 +14,7 @@ out vec3 world_normal;
 out vec2 uv0;
 out vec2 uv1;
 out vec4 vertex_color;
+out vec4 world_tangent;
 
 void main() {
   world_position = in_position;
@@ -20,5 +22,6 @@ void main() {
   uv0 = in_uv0;
   uv1 = in_uv1;
   vertex_color = in_color;
+  world_tangent = in_tangent;
   gl_Position = view_projection * vec4(in_position, 1.0);
 }

@@ -12,6 +12,7 @@ uniform float background_distance;
 
 layout(location = 0) out vec4 out_color;  // rgb range color, a specular flag (0)
 layout(location = 1) out float out_distance;
+layout(location = 2) out vec4 out_surface;  // no surface: normal 0 (unknown), roughness 0
 
 const float kPi = 3.14159265358979;
 
@@ -30,4 +31,5 @@ void main() {
   vec3 radiance = texture(environment_tex, equirect_uv(direction)).rgb * strength;
   out_color = vec4(range_environment_color(radiance), 0.0);
   out_distance = background_distance;
+  out_surface = vec4(0.0);
 }

@@ -11,10 +11,13 @@
 layout(binding = kUnitHv) uniform sampler2D hv_tex;     // rgb L_u, a Var[L_u] (kVarUnknown: n < 2; 0: all samples equal)
 layout(binding = kUnitLv) uniform sampler2D lv_tex;     // rgb L_lv (only for skipping)
 layout(binding = kUnitGuide) uniform sampler2D guide_tex;  // rgb range color, a distance
+layout(binding = kUnitSurface) uniform sampler2D surface_tex;  // xyz shading normal (0: unknown), w roughness
 uniform int taps_per_rotation;
 uniform int rotations;
 uniform float k_c;  // 1 / (2 sigma_c^2)
 uniform float k_d;  // 1 / (2 sigma_d^2)
+uniform float k_n;  // 1 / sigma_n^2, 0: no normal term (range_weights)
+uniform float k_r;  // 1 / (2 sigma_r^2), 0: no roughness term
 uniform int skip_case2;
 uniform float t;
 
@@ -26,12 +29,13 @@ layout(location = 0) out vec4 out_filtered;  // rgb L_f, a Var[L_f] (kVarUnknown
 void main() {
   ivec2 p = ivec2(gl_FragCoord.xy);
   ivec2 size = textureSize(hv_tex, 0);
-  if (skip_case2 != 0 && skip_as_case2(hv_tex, lv_tex, guide_tex, p, k_c, k_d, t)) {
+  if (skip_case2 != 0 && skip_as_case2(hv_tex, lv_tex, guide_tex, surface_tex, p, k_c, k_d, k_n, k_r, t)) {
     out_filtered = vec4(clean(texelFetch(hv_tex, p, 0).rgb), kVarSkipped);
     return;
   }
   atomicAdd(filtered_pixels, 1u);
   vec4 g_p = texelFetch(guide_tex, p, 0);
+  vec4 s_p = texelFetch(surface_tex, p, 0);
   KernelSums sums = kernel_sums_zero();
   int first = subsampled_rotation(p, rotations) * taps_per_rotation;
   for (int i = 0; i < taps_per_rotation; ++i) {
@@ -39,7 +43,7 @@ void main() {
     if (tap.z == 0) break;
     ivec2 q = p + tap.xy;
     if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) continue;
-    float w = float(tap.z) * range_weight(g_p, texelFetch(guide_tex, q, 0), k_c, k_d);
+    float w = float(tap.z) * range_weight(g_p, texelFetch(guide_tex, q, 0), s_p, texelFetch(surface_tex, q, 0), k_c, k_d, k_n, k_r);
     vec4 hv_q = texelFetch(hv_tex, q, 0);
     kernel_sums_add(sums, w, clean(hv_q.rgb), clean_var(hv_q.a));
   }

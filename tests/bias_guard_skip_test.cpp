@@ -40,7 +40,8 @@ TEST(BiasGuardSkip, LeftOutOnceEveryPixelIsCase2WithTheSameImage) {
   // The same blend with the guard's passes gives the same image.
   BlendPass guarded(w, h);
   guarded.run(quiet.inputs(), &quiet.filtered_output(), &quiet.range().guide(), quiet.threshold_now(),
-              BlendParams{range_weights(settings.filter), true}, quiet.filter().centre_weight());
+              BlendParams{range_weights(settings.filter), true}, quiet.filter().centre_weight(),
+              &quiet.range().surface());
   EXPECT_EQ(guarded.guard_runs(), 1);
   EXPECT_EQ(guarded.final_image().pixels, quiet.final_image().pixels);
   EXPECT_EQ(guarded.case_counts()[kCaseUnfiltered], uint32_t(w * h));
