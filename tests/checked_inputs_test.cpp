@@ -46,24 +46,13 @@ std::string folder(const std::string& name) {
   return dir;
 }
 
-// One triangle facing +Z (a data-URI buffer), no lights, no camera.
-std::string write_triangle(const std::string& dir) {
-  const std::string path = dir + "/triangle.gltf";
-  std::ofstream(path) << R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],)"
-                         R"("meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],)"
-                         R"("accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}],)"
-                         R"("bufferViews":[{"buffer":0,"byteLength":36}],)"
-                         R"("buffers":[{"byteLength":36,"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA"}]})";
-  return path;
-}
-
 }  // namespace
 
 // --until-clean where the filter has nothing to do (a black scene; one triangle under the sky, whose
 // HV is below the filter's 1 % share): clean at the first check, not 2^24 frames later.
 TEST(CheckedInputs, UntilCleanEndsAtOnceWhereNothingNeedsTheFilter) {
   const std::string dir = folder("until_clean");
-  const std::string scene = write_triangle(dir);
+  const std::string scene = test_support::write_bare_triangle(dir, "triangle.gltf");
   for (const std::string light : {"none", "sky"}) {
     const Result r = run_in(dir, "render --scene triangle.gltf --default-light " + light +
                                      " --size 16x16 --until-clean --quiet --out " + light);
@@ -119,7 +108,7 @@ TEST(CheckedInputs, BenchRefusesAReferenceWithNaNSamplesLikeDiff) {
   write_exr(dir + "/nan.exr", nan);
   write_exr(dir + "/test.exr", Image::rgb(16, 16, 0.5f));
   const Result diff = run_in(dir, "diff test.exr nan.exr");
-  write_triangle(dir);
+  test_support::write_bare_triangle(dir, "triangle.gltf");
   const Result bench = run_in(dir, "bench demodulation-ab --scene triangle.gltf --size 16x16 --budgets 1 --rounds 1 --reference nan.exr --out b");
   const std::string line = "nan.exr: 1 non-finite samples (NaN or Inf); it cannot serve as a reference";
   for (const Result* r : {&diff, &bench}) {

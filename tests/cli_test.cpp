@@ -154,21 +154,9 @@ TEST(Cli, BadSceneIsOneLineNamingTheFileAndWritesNothing) {
   EXPECT_NE(missing.err.find("/nonexistent/scene.gltf"), std::string::npos) << missing.err;
 }
 
-// One triangle facing +Z (a data-URI buffer), no lights, no camera.
-std::string write_bare_triangle(const std::string& dir) {
-  fs::create_directories(dir);
-  const std::string path = dir + "/bare.gltf";
-  std::ofstream(path) << R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],)"
-                         R"("meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],)"
-                         R"("accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}],)"
-                         R"("bufferViews":[{"buffer":0,"byteLength":36}],)"
-                         R"("buffers":[{"byteLength":36,"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA"}]})";
-  return path;
-}
-
 TEST(Cli, TriangleCapIsAFlagOfRenderAndBench) {
   const std::string dir = temp_dir("triangle_cap");
-  const std::string scene = write_bare_triangle(dir);
+  const std::string scene = test_support::write_bare_triangle(dir);
   const std::string out = dir + "/out";
   for (const char* command : {"render", "bench"}) {
     const Result r = run(std::string(command) + " --scene " + scene + " --max-triangles 1 --max-triangles 0 --out " + out);
@@ -194,7 +182,7 @@ TEST(Cli, TriangleCapIsAFlagOfRenderAndBench) {
 
 TEST(Cli, SceneWithoutLightsIsLitByDefaultAndNoneWarnsOfBlack) {
   const std::string dir = temp_dir("bare");
-  const std::string scene = write_bare_triangle(dir);
+  const std::string scene = test_support::write_bare_triangle(dir);
   const Result lit = run("render --scene " + scene + " --size 16x16 --spp 2 --filter none --quiet --out " + dir + "/lit");
   ASSERT_EQ(lit.code, 0) << lit.err;
   EXPECT_NE(lit.err.find("lit by the built-in sky"), std::string::npos) << lit.err;
@@ -790,20 +778,24 @@ const char* const kOutputs[] = {"final.png", "final.exr", "buffers.exr", "stats.
 
 }  // namespace
 
+// `pxf ARGS` under a file size limit of 4 KiB (8 blocks of 512 bytes), which stands in for a nearly
+// full disk: writes past it fail with EFBIG. Its stderr is kept in temp_dir(`name`).
+Result run_on_a_full_disk(const std::string& args, const std::string& name) {
+  const std::string base = temp_dir(name);
+  fs::create_directories(base);
+  const std::string limited = "sh -c \"ulimit -f 8; trap '' XFSZ; exec " + std::string(PXF_EXECUTABLE) + " " + args + "\"";
+  const int status = std::system((limited + " 2>" + base + "/err").c_str());
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, "", slurp(base + "/err")};
+}
+
 TEST(Cli, FullDiskKeepsThePreviousOutputSetAndNamesTheFile) {
   const std::string out = temp_dir("full_disk");
   ASSERT_EQ(run("render --size 64x64 --spp 3 --quiet --out " + out).code, 0);
   std::map<std::string, std::string> before;
-  // A file size limit of 4 KiB (8 blocks of 512 bytes) stands in for a nearly full disk: writes
-  // past it fail with EFBIG.
   for (const char* name : kOutputs) before[name] = file_bytes(out + "/" + name);
-  const std::string limited = "sh -c \"ulimit -f 8; trap '' XFSZ; exec " + std::string(PXF_EXECUTABLE) +
-                              " render --size 64x64 --spp 3 --seed 7 --quiet --out " + out + "\"";
-  const std::string base = temp_dir("io_full");
-  fs::create_directories(base);
-  const int status = std::system((limited + " 2>" + base + "/err").c_str());
-  const std::string err = slurp(base + "/err");
-  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 1) << err;
+  const Result full = run_on_a_full_disk("render --size 64x64 --spp 3 --seed 7 --quiet --out " + out, "io_full");
+  const std::string& err = full.err;
+  EXPECT_EQ(full.code, 1) << err;
   EXPECT_EQ(lines(err), 1u) << err;
   EXPECT_NE(err.find("cannot write"), std::string::npos) << err;
   for (const char* name : kOutputs) EXPECT_EQ(file_bytes(out + "/" + name), before[name]) << name << " changed";
@@ -814,13 +806,10 @@ TEST(Cli, FullDiskKeepsThePreviousOutputSetAndNamesTheFile) {
 // each names its file on a line of its own.
 TEST(Cli, FullDiskReportsBothTheStateAndTheOutputs) {
   const std::string out = temp_dir("full_disk_state");
-  const std::string limited = "sh -c \"ulimit -f 8; trap '' XFSZ; exec " + std::string(PXF_EXECUTABLE) +
-                              " render --size 64x64 --spp 3 --checkpoint 1000 --quiet --out " + out + "\"";
-  const std::string base = temp_dir("io_full_state");
-  fs::create_directories(base);
-  const int status = std::system((limited + " 2>" + base + "/err").c_str());
-  const std::string err = slurp(base + "/err");
-  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 1) << err;
+  const Result full =
+      run_on_a_full_disk("render --size 64x64 --spp 3 --checkpoint 1000 --quiet --out " + out, "io_full_state");
+  const std::string& err = full.err;
+  EXPECT_EQ(full.code, 1) << err;
   EXPECT_EQ(lines(err), 2u) << err;
   EXPECT_NE(err.find("state.pxfs"), std::string::npos) << err;
   EXPECT_NE(err.find("cannot write"), std::string::npos) << err;

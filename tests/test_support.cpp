@@ -71,4 +71,15 @@ void expect_merge_close(const Image& merged, const Image& single, const std::str
   EXPECT_EQ(bad, 0u) << what << ": " << bad << " values outside 2e-5 relative + 1e-6";
 }
 
+std::string write_bare_triangle(const std::string& dir, const std::string& name) {
+  std::filesystem::create_directories(dir);
+  const std::string path = dir + "/" + name;
+  std::ofstream(path) << R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],)"
+                         R"("meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],)"
+                         R"("accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}],)"
+                         R"("bufferViews":[{"buffer":0,"byteLength":36}],)"
+                         R"("buffers":[{"byteLength":36,"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA"}]})";
+  return path;
+}
+
 }  // namespace pxf::test_support

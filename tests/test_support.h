@@ -37,6 +37,9 @@ PxfResult run_pxf(const std::string& args, const std::string& suite);
 // (2e-5 relative + 1e-6; docs/state-format.md).
 void expect_merge_close(const Image& merged, const Image& single, const std::string& what);
 
+// DIR/NAME: a glTF of one triangle facing +Z (a data-URI buffer), no lights, no camera; creates DIR.
+std::string write_bare_triangle(const std::string& dir, const std::string& name = "bare.gltf");
+
 // Folder for files a failing test leaves behind for a person to look at.
 std::string failure_dir(const std::string& test_name);
 
