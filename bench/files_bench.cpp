@@ -62,15 +62,28 @@ const char* kCsvHeader =
     "filtered_hdr_nrmse_percent,hdr_ratio,unfiltered_display_nrmse_percent,filtered_display_nrmse_percent,"
     "display_ratio,unfiltered_flip,filtered_flip,flip_ratio\n";
 
-std::string csv_row(const BenchFileEntry& e, const FileRow& row) {
-  const double uh = median_metric(row.plain, &RowError::hdr_nrmse), fh = median_metric(row.filtered, &RowError::hdr_nrmse);
-  const double ud = median_metric(row.plain, &RowError::display_nrmse),
-               fd = median_metric(row.filtered, &RowError::display_nrmse);
-  const double uf = median_metric(row.plain, &RowError::flip), ff = median_metric(row.filtered, &RowError::flip);
+// A row's medians over its rounds, unfiltered (u) and filtered (f).
+struct RowMedians {
+  double u_spp, f_spp, u_hdr, f_hdr, u_display, f_display, u_flip, f_flip;
+};
+
+RowMedians medians(const FileRow& row) {
+  return {median_spp(row.plain),
+          median_spp(row.filtered),
+          median_metric(row.plain, &RowError::hdr_nrmse),
+          median_metric(row.filtered, &RowError::hdr_nrmse),
+          median_metric(row.plain, &RowError::display_nrmse),
+          median_metric(row.filtered, &RowError::display_nrmse),
+          median_metric(row.plain, &RowError::flip),
+          median_metric(row.filtered, &RowError::flip)};
+}
+
+std::string csv_row(const BenchFileEntry& e, const FileRow& row, const RowMedians& m) {
   std::ostringstream s;
-  s << e.name << "," << e.scene << "," << e.env << "," << row.seconds << "," << row.plain.size() << ","
-    << median_spp(row.plain) << "," << median_spp(row.filtered) << "," << uh << "," << fh << "," << fh / uh << ","
-    << ud << "," << fd << "," << fd / ud << "," << uf << "," << ff << "," << ff / uf << "\n";
+  s << e.name << "," << e.scene << "," << e.env << "," << row.seconds << "," << row.plain.size() << "," << m.u_spp
+    << "," << m.f_spp << "," << m.u_hdr << "," << m.f_hdr << "," << m.f_hdr / m.u_hdr << "," << m.u_display << ","
+    << m.f_display << "," << m.f_display / m.u_display << "," << m.u_flip << "," << m.f_flip << ","
+    << m.f_flip / m.u_flip << "\n";
   return s.str();
 }
 
@@ -181,14 +194,11 @@ int files_bench_mode(const std::vector<std::string>& args, const std::string& su
           (plain ? row.plain : row.filtered).push_back(std::move(run));
         }
       }
-      const std::string line = csv_row(e, row);
-      csv << line;
-      const double ud = median_metric(row.plain, &RowError::display_nrmse), fd = median_metric(row.filtered, &RowError::display_nrmse);
-      const double uh = median_metric(row.plain, &RowError::hdr_nrmse), fh = median_metric(row.filtered, &RowError::hdr_nrmse);
-      const double uf = median_metric(row.plain, &RowError::flip), ff = median_metric(row.filtered, &RowError::flip);
+      const RowMedians m = medians(row);
+      csv << csv_row(e, row, m);
       std::printf("%-16s %6g | %9.0f %9.0f | %7.2f%% %7.2f%% %5.2fx | %7.2f%% %7.2f%% %5.2fx | %7.4f %7.4f %5.2fx\n",
-                  e.name.c_str(), times[k], median_spp(row.plain), median_spp(row.filtered), ud, fd, fd / ud, uh, fh,
-                  fh / uh, uf, ff, ff / uf);
+                  e.name.c_str(), times[k], m.u_spp, m.f_spp, m.u_display, m.f_display, m.f_display / m.u_display,
+                  m.u_hdr, m.f_hdr, m.f_hdr / m.u_hdr, m.u_flip, m.f_flip, m.f_flip / m.u_flip);
       std::fflush(stdout);
       sheet->put(static_cast<int>(i), 2 * static_cast<int>(k), tonemap_like_reference(row.plain.back().image, reference).test);
       sheet->put(static_cast<int>(i), 2 * static_cast<int>(k) + 1,

@@ -405,7 +405,7 @@ bool Preview::filter_needed() const { return hv_energy_share(renderer_->accumula
 bool Preview::clean() const { return case2_share() == 1.0 || (!have_filtered_ && !filter_needed()); }
 
 bool Preview::filter_worthwhile() {
-  if (hv_energy_share(renderer_->accumulation()) >= kMinHvShare) return true;
+  if (filter_needed()) return true;
   ++low_hv_skips_;
   return false;
 }
