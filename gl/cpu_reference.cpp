@@ -249,11 +249,6 @@ BlendOutput cpu_blend(const Image& lv, const Image& hv, const Image& var_u, cons
   return out;
 }
 
-std::array<float, 3> demodulation_factor(float r, float g, float b) {
-  const glm::vec3 a = shared::demodulation_factor(glm::vec3(r, g, b));
-  return {a.r, a.g, a.b};
-}
-
 DemodulatedInputs cpu_demodulate(const Image& hv, const Image& var_u, const Image& lv, const Image& albedo,
                                  const Image& range_color, const Image& depth, const FilterParams& p, float t,
                                  const Image* surface) {
@@ -261,12 +256,9 @@ DemodulatedInputs cpu_demodulate(const Image& hv, const Image& var_u, const Imag
   DemodulatedInputs out{Image::rgb(w, h), Image::gray(w, h), Image::rgb(w, h)};
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
-      const auto a = demodulation_factor(albedo.at(x, y, 0), albedo.at(x, y, 1), albedo.at(x, y, 2));
-      const float k = luminance(a[0], a[1], a[2]);
-      const Px lu = rgb_at(hv, x, y);
-      for (int c = 0; c < 3; ++c) out.hv.at(x, y, c) = lu.c[c] / a[c];
-      const float v = clean_var(var_u.at(x, y, 0));
-      out.var_u.at(x, y, 0) = shared::demodulated_var(v, k);
+      const glm::vec4 d = shared::demodulated_texel(TexelView{&hv, &var_u}, TexelView{&albedo}, glm::ivec2(x, y));
+      for (int c = 0; c < 3; ++c) out.hv.at(x, y, c) = d[c];
+      out.var_u.at(x, y, 0) = d.a;
       const bool skip = p.skip_case2 && case2_skip_decision(hv, var_u, lv, range_color, depth, p, t, x, y, surface);
       for (int c = 0; c < 3; ++c) out.lv.at(x, y, c) = skip ? kMaxInput : -kMaxInput;
     }
@@ -277,12 +269,10 @@ FilterOutput cpu_remodulate(const FilterOutput& filtered, const Image& albedo) {
   FilterOutput out = filtered;
   for (int y = 0; y < albedo.height; ++y)
     for (int x = 0; x < albedo.width; ++x) {
-      const auto a = demodulation_factor(albedo.at(x, y, 0), albedo.at(x, y, 1), albedo.at(x, y, 2));
-      const float k = luminance(a[0], a[1], a[2]);
-      const Px lf = rgb_at(filtered.filtered, x, y);
-      for (int c = 0; c < 3; ++c) out.filtered.at(x, y, c) = clean(a[c] * lf.c[c]);
-      const float v = filtered.variance.at(x, y, 0);
-      out.variance.at(x, y, 0) = shared::remodulated_var(v, k);
+      const glm::vec4 f = texelFetch(TexelView{&filtered.filtered, &filtered.variance}, glm::ivec2(x, y), 0);
+      const glm::vec4 r = shared::remodulated_texel(f, glm::vec3(albedo.at(x, y, 0), albedo.at(x, y, 1), albedo.at(x, y, 2)));
+      for (int c = 0; c < 3; ++c) out.filtered.at(x, y, c) = r[c];
+      out.variance.at(x, y, 0) = r.a;
     }
   return out;
 }

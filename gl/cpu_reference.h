@@ -67,19 +67,17 @@ bool case2_skip_decision(const Image& hv, const Image& var_u, const Image& lv, c
                          const Image& depth, const FilterParams& p, float t, int x, int y,
                          const Image* surface = nullptr);
 
-// Albedo demodulation (gl/demodulation.h). The factor (shared::demodulation_factor): grey Y(albedo)
-// where that is at least kAlbedoEpsilon, else (1, 1, 1) (that pixel is not demodulated).
-std::array<float, 3> demodulation_factor(float r, float g, float b);
+// Albedo demodulation (gl/demodulation.h): shared::demodulated_texel and shared::remodulated_texel.
 struct DemodulatedInputs {
-  Image hv;     // "R,G,B": L_u / a
-  Image var_u;  // "Y": Var[L_u] / Y(a)^2 (sentinels kept)
+  Image hv;     // "R,G,B" and
+  Image var_u;  // "Y": shared::demodulated_texel
   Image lv;     // "R,G,B": the skip decision on the original buffers: +kMaxInput skip, -kMaxInput filter
 };
 // The filter's inputs under demodulation; albedo "R,G,B" (the mean first non-specular albedo).
 DemodulatedInputs cpu_demodulate(const Image& hv, const Image& var_u, const Image& lv, const Image& albedo,
                                  const Image& range_color, const Image& depth, const FilterParams& params, float t,
                                  const Image* surface = nullptr);
-// L_f = a L_f', Var[L_f] = Y(a)^2 Var[L_f'] (sentinels kept).
+// shared::remodulated_texel of every pixel.
 FilterOutput cpu_remodulate(const FilterOutput& filtered, const Image& albedo);
 
 struct BlendOutput {

@@ -115,6 +115,10 @@ class Bsdf {
            (p_glass_ > 0.0f && !glass_delta_);
   }
   bool is_black() const { return black_; }
+  // The directional albedo at wo of the non-delta lobes, RGB: the share of light from all
+  // directions that they reflect or transmit toward wo. Illumination demodulation divides the
+  // light these lobes carry by it (PathSample::albedo), so it counts the specular lobes too.
+  glm::vec3 nondelta_albedo() const { return nondelta_albedo_; }
   glm::vec3 shading_normal() const { return frame_.n; }
   // The lobes sample() picks from, each with its probability and whether it is a delta lobe (the
   // explorer's inspector shows them: ProgressiveRenderer::surface_material).
@@ -170,6 +174,7 @@ class Bsdf {
   float p_diffuse_ = 0.0f, p_glossy_ = 0.0f, p_sheen_ = 0.0f, p_coat_ = 0.0f, p_glass_ = 0.0f;
   bool has_nondelta_ = false;
   bool black_ = true;
+  glm::vec3 nondelta_albedo_{0.0f};
 };
 
 // GGX helpers (local frame, n = +z), exposed for tests.

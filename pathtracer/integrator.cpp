@@ -27,7 +27,7 @@ struct PathState {
   bool prev_delta = true;  // the last interaction was a delta lobe (or the camera)
   float prev_pdf = 0.0f;   // solid-angle pdf of the last non-delta BSDF sample
   glm::vec3 prev_position{0.0f};  // the surface point the ray left (un-offset: the light pdf's origin)
-  bool albedo_set = false;        // PathSample::albedo holds the first non-delta vertex's base color
+  bool albedo_set = false;        // PathSample::albedo holds the first non-delta vertex's albedo
   // Specular sampling: the MIS weight of light found after the last non-delta sample through a
   // chain of perfectly specular surfaces (D S+ L), against the specular strategy; 1 without it.
   float chain_mis = 1.0f;
@@ -672,7 +672,7 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
   const BsdfParams& bsdf_params = lobes.params;
   Bsdf bsdf(lobes, sp.shading_normal, sp.geometric_normal, wo, sp.front_face, sp.clearcoat_normal);
   if (!s.albedo_set && (bsdf.has_nondelta() || bsdf.is_black())) {
-    out.albedo = bsdf_params.base_color;
+    out.albedo = bsdf.nondelta_albedo();
     s.albedo_set = true;
   }
   if (last_vertex || bsdf.is_black()) return false;

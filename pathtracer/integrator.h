@@ -23,10 +23,12 @@ class GuidingField;
 struct PathSample {
   glm::vec3 lv{0.0f};
   glm::vec3 hv{0.0f};
-  // Base color of the first vertex with a non-delta lobe (through perfectly specular chains, not
-  // tinted by them); (1, 1, 1) when the path escapes or ends before such a vertex, so that light
-  // seen directly or through glass is not demodulated (albedo demodulation, gl/demodulation.h).
-  glm::vec3 albedo{1.0f};
+  // The directional albedo of the non-delta lobes of the path's first vertex that has one (through
+  // perfectly specular chains, not tinted by them): Bsdf::nondelta_albedo. 0 when the path escapes
+  // or ends before such a vertex. A pixel's mean albedo is then its coverage times its surfaces'
+  // albedo, and HV, which only paths through such a vertex carry, divided by it is the light
+  // arriving there, even where a thin surface covers part of the pixel (gl/demodulation.h).
+  glm::vec3 albedo{0.0f};
   uint32_t rays = 0;
   bool finite() const;
 };

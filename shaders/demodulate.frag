@@ -1,6 +1,6 @@
 #version 450 core
-// Albedo demodulation before the filter (gl/demodulation.h): the filter's inputs are HV divided by
-// the demodulation factor a and Var[L_u] divided by Y(a)^2. The filter reads its LV input only for
+// Albedo demodulation before the filter (gl/demodulation.h): the filter's inputs are
+// demodulated_texel. The filter reads its LV input only for
 // its case-2 skip; that input here carries the skip decision taken on the original buffers, so that
 // every variant skips exactly the pixels it skips without demodulation: +kMaxInput makes u vanish
 // (skip), -kMaxInput makes L_b = 0 and u infinite (filter).
@@ -18,16 +18,12 @@ uniform float k_r;  // 1 / (2 sigma_r^2), 0: no roughness term
 uniform float t;
 uniform int skip_case2;
 
-layout(location = 0) out vec4 out_hv;  // rgb L_u / a, a Var[L_u] / Y(a)^2 (sentinels kept)
+layout(location = 0) out vec4 out_hv;  // demodulated_texel
 layout(location = 1) out vec4 out_lv;  // the skip decision (see above)
 
 void main() {
   ivec2 p = ivec2(gl_FragCoord.xy);
-  vec4 hv = texelFetch(hv_tex, p, 0);
-  vec3 a = demodulation_factor(texelFetch(albedo_tex, p, 0).rgb);
-  float k = luminance(a);
-  float v = clean_var(hv.a);
-  out_hv = vec4(clean(hv.rgb) / a, demodulated_var(v, k));
+  out_hv = demodulated_texel(hv_tex, albedo_tex, p);
   bool skip = skip_case2 != 0 && skip_as_case2(hv_tex, lv_tex, guide_tex, surface_tex, p, k_c, k_d, k_n, k_r, t);
   out_lv = vec4(vec3(skip ? kMaxInput : -kMaxInput), 1.0);
 }

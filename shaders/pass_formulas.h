@@ -49,7 +49,9 @@ PXF_CONST float kBackgroundDistanceMin = 0.5f * kBackgroundDepth;
 
 // Albedo demodulation (gl/demodulation.h): a pixel whose mean albedo's luminance is below this is
 // not demodulated (factor 1), so that dividing never amplifies by more than 1 / kAlbedoEpsilon.
-PXF_CONST float kAlbedoEpsilon = 0.05f;
+// The mean albedo is coverage times albedo (PathSample::albedo), and HV shrinks with it, so the
+// division is exact down to a pixel that a dark surface barely touches.
+PXF_CONST float kAlbedoEpsilon = 1e-3f;
 
 // Texture units of the pass shaders (filters, demodulation, blend), one per role: the GL passes
 // bind their textures to these names.
@@ -621,18 +623,60 @@ PXF_INLINE BlendPixel blend_pixel(BlendTexels px, BlendSwitches on, BlendVarianc
 
 // ---- Albedo demodulation ----
 
-// The factor HV is divided by before the filter and L_f multiplied by after it (gl/demodulation.h):
-// grey, the luminance Y(a) of the pixel's mean albedo where it is at least kAlbedoEpsilon, else 1
-// (a nearly black albedo is not demodulated). Grey, not per channel: a channel near 0 (a saturated
-// texture) would amplify that channel of light the albedo does not shape (specular highlights,
-// neighbours' light) many times over.
-PXF_INLINE vec3 demodulation_factor(vec3 albedo) {
-  float k = luminance(clean(albedo));
-  return k >= kAlbedoEpsilon ? vec3(k) : vec3(1.0f);
+// The albedo divides HV channel by channel: it is the directional albedo of all the non-delta
+// lobes (PathSample::albedo), specular included, so no channel of the light those lobes carry is
+// much larger than that channel of the albedo, and a saturated texture amplifies nothing. A channel
+// below kChannelFloor of the albedo's luminance (a pure-red metal's blue) is floored there.
+PXF_CONST float kChannelFloor = 0.05f;
+PXF_INLINE vec3 modulation_factor(vec3 albedo) {
+  vec3 a = max(clean(albedo), vec3(0.0f));
+  return max(a, vec3(kChannelFloor * luminance(a)));
 }
-// Var[L_u] / k^2 and Var[L_f'] k^2 with k = Y(a); the sentinels (negative) are kept.
-PXF_INLINE float demodulated_var(float v, float k) { return v >= 0.0f ? (v / k) / k : v; }
-PXF_INLINE float remodulated_var(float v, float k) { return v >= 0.0f ? (v * k) * k : v; }
+// The luminance variance of l * m given that of l: the relative noise is taken as the same in every
+// channel, so Var scales with (Y(l m) / Y(l))^2; by Y(m)^2 where l is black (exact for a grey m).
+PXF_INLINE float modulated_var(float v, vec3 l, vec3 m) {
+  if (!(v >= 0.0f)) return v;  // the sentinels are kept
+  float y = luminance(l);
+  float r = y > 0.0f ? luminance(l * m) / y : luminance(m);
+  return min((v * r) * r, kMaxInput);
+}
+
+// The filter's input at p under demodulation: rgb L_u / m, a its luminance variance (modulated_var),
+// m = modulation_factor(mean albedo). A pixel whose mean albedo's luminance is below kAlbedoEpsilon
+// holds no light to demodulate (its L_u shrinks with its coverage and is about 0), and as a neighbour
+// it would pull the light filtered around it toward 0: it takes the mean of its 3x3 neighbours that
+// are demodulated, with an unknown variance (they speak for it, it adds no evidence of its own).
+// None of them: its own L_u and Var[L_u], as without demodulation.
+PXF_SAMPLER_FN vec4 demodulated_texel(sampler2D hv, sampler2D albedo, ivec2 p) {
+  vec4 own = texelFetch(hv, p, 0);
+  vec3 m = modulation_factor(vec3(texelFetch(albedo, p, 0)));
+  vec3 l = clean(vec3(own));
+  if (luminance(m) >= kAlbedoEpsilon) return vec4(l / m, modulated_var(clean_var(own.a), l, vec3(1.0f) / m));
+  ivec2 size = textureSize(hv, 0);
+  vec3 sum = vec3(0.0f);
+  float count = 0.0f;
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx) {
+      ivec2 q = p + ivec2(dx, dy);
+      if (q.x < 0 || q.y < 0 || q.x >= size.x || q.y >= size.y) continue;
+      vec3 mq = modulation_factor(vec3(texelFetch(albedo, q, 0)));
+      if (!(luminance(mq) >= kAlbedoEpsilon)) continue;
+      sum += clean(vec3(texelFetch(hv, q, 0))) / mq;
+      count += 1.0f;
+    }
+  if (count > 0.0f) return vec4(sum / count, kVarUnknown);
+  return vec4(l, clean_var(own.a));
+}
+
+// The filter's output at p remodulated: rgb m L_f', a its luminance variance (modulated_var), at
+// every pixel, down to m = 0. The mean albedo is coverage times albedo, so a pixel that surfaces
+// barely cover takes that share of the light filtered around it, and a gap between thin strands,
+// which no surface covers, none of it.
+PXF_INLINE vec4 remodulated_texel(vec4 filtered, vec3 albedo) {
+  vec3 m = modulation_factor(albedo);
+  vec3 l = clean(vec3(filtered));
+  return vec4(clean(m * l), modulated_var(filtered.a, l, m));
+}
 
 // ---- Filter variants ----
 
