@@ -1,4 +1,4 @@
-// Compressed and extended glTF (issue 35 item 1): each decoder's file loads to exactly the
+// Compressed and extended glTF: each decoder's file loads to exactly the
 // triangles or texels of its uncompressed twin; malformed data and unsupported requirements are
 // one-line errors; EXT_mesh_gpu_instancing counts against the limits like nodes do. The files are
 // written by the libraries' encoders (testing/gltf_compressed_fixtures.h).

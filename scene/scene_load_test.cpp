@@ -997,7 +997,7 @@ TEST(SceneLoadBadInput, NodeCycleAndBadMaterialIndex) {
 }
 
 // ----------------------------------------------------------------------------------------------
-// Hostile input (issue 12)
+// Hostile input
 
 TEST(SceneLoadBadInput, DeepNodeHierarchyLoadsWithoutOverflowingTheStack) {
   // Far deeper than the ~8,400 levels a recursive traversal survived in Release.
@@ -1458,7 +1458,7 @@ TEST(SceneLoadLimits, InstancedTrianglesOverTheCapAreAClearError) {
 
 
 // ----------------------------------------------------------------------------------------------
-// Issue 38: camera-derived ray origins, JSON depth, texture transforms, the whole memory estimate
+// Hostile input at the limits: camera-derived ray origins, JSON depth, texture transforms, the whole memory estimate
 
 // A quad seen by a camera node with `camera_node`'s transform (a perspective camera unless `camera` says).
 std::string write_camera_scene(const std::string& path, const json& camera_node, const json& camera = nullptr) {

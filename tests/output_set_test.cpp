@@ -1,4 +1,4 @@
-// Issue 38 items 1-4, end to end: pxf keeps the user's files, and a stop signal, a kill or a second
+// The output set end to end: pxf keeps the user's files, and a stop signal, a kill or a second
 // render at any moment of the output write leaves the old set or the new one, whole, never neither
 // and never a mix; a reader that closes the pipe does not kill the render.
 // PXF_STRESS_TRIALS (default 70) and PXF_STRESS_PAIRS (default 35) set the trial counts; the
