@@ -296,8 +296,7 @@ int check_path_set(const std::string& out, std::string* problem) {
 
 // Ctrl-C (or SIGTERM) at random moments of a long camera path, after its first frame: the render
 // finishes the frame under way, commits every finished frame with path.json, and exits 128 + the
-// signal. No frame that the render reported finished is lost. PXF_STRESS_TRIALS sets the count
-// (docs/robustness.md quotes 100).
+// signal. No frame that the render reported finished is lost. PXF_STRESS_TRIALS sets the count.
 TEST(OutputSet, StopSignalsDuringACameraPathLoseNoFinishedFrame) {
   const std::string out = test_support::temp_dir("output_set", "path_signals");
   const std::string err_file = test_support::temp_dir("output_set", "path_signals_err") + ".txt";
