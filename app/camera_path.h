@@ -1,4 +1,4 @@
-// Camera paths (issue 37): keyframes of position, target and vertical field of view, each with the
+// Camera paths: keyframes of position, target and vertical field of view, each with the
 // frames to the next keyframe, interpolated linearly or by a Catmull-Rom spline. Read from JSON:
 //   {"interpolation": "spline",                       // or "linear" (the default)
 //    "keyframes": [{"position": [0, 1, 4], "target": [0, 1, 0], "fov": 40, "frames": 30},

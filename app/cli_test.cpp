@@ -94,7 +94,7 @@ TEST(CommandLine, PositionalListTakesEveryRemainingArgument) {
   EXPECT_THROW(empty.parse({}), UsageError);
 }
 
-// Issue 12 item 10: a limit given as a float is compared as a float (0.1 is inside [0.1f, ...]), and
+// A limit given as a float is compared as a float (0.1 is inside [0.1f, ...]), and
 // limits print as a person reads them.
 TEST(CommandLine, FloatLimitsCompareInTheirTypeAndPrintReadably) {
   float sigma = 0;

@@ -1,4 +1,4 @@
-// Integer counts of the command line (issue 38 item 9): --frames is capped like --spp, and an
+// Integer counts of the command line: --frames is capped like --spp, and an
 // integer option's bound is exact at the top of a 64-bit type (2^64 - 1 is 2^64 in double).
 #include <gtest/gtest.h>
 

@@ -38,7 +38,7 @@ void check_first_frame_fits(const Scene& scene, const PreviewSettings& settings,
   const auto start = std::chrono::steady_clock::now();
   // What the render's first frame does under a budget: trace, the passes due, display, finish.
   // Timed on the probe's second first frame: the first compiles the passes' shaders (llvmpipe
-  // compiles on first use), a fixed cost that scaled to the pixels would overstate the frame 1.5-3x.
+  // compiles on first use), a fixed cost that scaled to the pixels would overstate the frame severalfold.
   Preview probe(scene, settings, probe_width, probe_height);
   auto first_frame = [&probe] {
     probe.add_frame(/*last_frame=*/false, /*display=*/true);

@@ -1,6 +1,6 @@
 // `pxf render --time`: the first frame traces whatever the budget (it is what measures the costs
-// the budget then stops on), so a budget too small for one frame was overrun silently (--time 3 at
-// 4000x4000 ran 47.5 s). Large images therefore get a probe first: one frame, with its passes and
+// the budget then stops on), so a budget too small for one frame would be overrun silently, by
+// many times on a large image. Large images therefore get a probe first: one frame, with its passes and
 // the finish, of the same scene and settings at kProbePixels pixels, timed and scaled to the image's
 // pixels. When even that one frame would not fit the budget, the render is refused up front.
 #pragma once

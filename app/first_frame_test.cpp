@@ -26,7 +26,7 @@ TEST(FirstFrame, CostScalesWithThePixels) {
 }
 
 TEST(FirstFrame, RefusedWithOneLineWhenItCannotFit) {
-  // The case: --time 3 at 4000x4000, where the first frame took 47.5 s.
+  // A budget far below one frame: --time 3 at 4000x4000.
   const std::string refusal = first_frame_refusal(30518.0, 600.0, 3000.0, 4000, 4000);
   ASSERT_FALSE(refusal.empty());
   EXPECT_EQ(refusal.find('\n'), std::string::npos);

@@ -31,9 +31,9 @@ LoadLimits load_limits(const SceneOptions& options);
 // The filter of an all-HV render (--all-hv, or a glTF whose extras ask for it) unless --filter is
 // given. There HV holds the direct light too, so textured detail is filtered, and the grid's range
 // axis (luminance only) averages texture stripes that differ in luminance by less than sigma_c;
-// a-trous weighs the RGB range color. Measured on envmap in all-HV mode (384x216, 32 PT frames,
-// median of 3, display NRMSE filtered / unfiltered): grid 1.48x, a-trous 0.97x. The LV/HV split,
-// envmap's default, does better still (docs/measurements.md, "Environment-lit scenes").
+// a-trous weighs the RGB range color, so it keeps the texture where the grid blurs it and made
+// the filtered all-HV image worse than the unfiltered one. The LV/HV split, envmap's default, does
+// better still (docs/measurements.md, "Environment-lit scenes").
 constexpr FilterKind kAllHvFilter = FilterKind::Atrous;
 
 void add_scene_options(CommandLine& cli, SceneOptions& options, bool headless);

@@ -1,4 +1,4 @@
-// OutputSetWriter and the clean-up of pxf's temporaries (issue 38 items 1 and 2): a set is
+// OutputSetWriter and the clean-up of pxf's temporaries: a set is
 // replaced as one unit, and nothing that pxf did not name itself is removed.
 #include "app/output_set.h"
 

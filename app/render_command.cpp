@@ -1,4 +1,4 @@
-// pxf render: headless progressive capture with pixel filtering (issue 4 item 6).
+// pxf render: headless progressive capture with pixel filtering.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>

@@ -1,4 +1,4 @@
-// pxf bench adaptive (issue 33): adaptive against uniform sampling, both filtered, on one scene.
+// pxf bench adaptive: adaptive against uniform sampling, both filtered, on one scene.
 // Not a test: prints tables and writes CSV, SVG plots and the images behind the numbers into --out.
 //   1. throughput: paths/s of uniform frames and of frames that trace 100 %, 50 % and 10 % of the
 //      pixels (scattered at random), back to back, median of --rounds;

@@ -1,4 +1,4 @@
-// pxf bench guiding-ab (issue 34, docs/guiding.md): path guiding against none, unfiltered, on one
+// pxf bench guiding-ab (docs/guiding.md): path guiding against none, unfiltered, on one
 // scene. Not a test: prints tables and writes guiding.csv into --out.
 //   1. cost: ms per path-tracing frame at equal spp (the first --frames frames, training included:
 //      apply_records after each frame and the iterations' ends), guided / unguided per round, median

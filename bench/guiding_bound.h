@@ -1,4 +1,4 @@
-// How far path guiding at a path's first non-delta vertex can go (issue 34, docs/guiding.md "How
+// How far path guiding at a path's first non-delta vertex can go (docs/guiding.md, "How
 // far first-vertex guiding can go"): the variance of the cosine-weighted indirect light at sampled
 // first vertices under cosine sampling, under the renderer's trained field, and under guides that
 // know the light exactly. `pxf bench guiding-bound` prints it.

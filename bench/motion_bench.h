@@ -1,4 +1,4 @@
-// pxf bench motion (issue 37): a camera orbit or a camera path, one path per pixel per frame, with the reprojected
+// pxf bench motion: a camera orbit or a camera path, one path per pixel per frame, with the reprojected
 // history and the filter every frame, against today's explorer behaviour during motion (restart
 // plus unfiltered) at equal frame time. Not a test: prints a table and writes motion.csv and frames
 // into --out.

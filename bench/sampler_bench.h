@@ -1,4 +1,4 @@
-// pxf bench modes of the sampler (issue 11): Sobol against independent sampling. Not tests: they
+// pxf bench modes of the sampler: Sobol against independent sampling. Not tests: they
 // print tables and write CSV into the output folder.
 //   sampler-error     unfiltered HDR NRMSE (total, LV and HV alone; RMS over seeds) at several spp
 //                     against a high-spp reference from another seed, and paths/s of both samplers measured

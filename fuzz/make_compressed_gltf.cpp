@@ -1,7 +1,7 @@
 // Writes compressed glTF files with the libraries' own encoders (testing/gltf_compressed_fixtures.h),
 // which fuzz/make_seeds.py (standard library only) cannot:
 //   make_compressed_gltf seeds DIR
-//       the gltf_scene fuzz seeds of issue 35: Draco, meshopt (every mode and filter, instancing),
+//       the gltf_scene fuzz seeds of compressed glTF: Draco, meshopt (every mode and filter, instancing),
 //       WebP and KTX2 textures, each valid and malformed (fuzz/corpus/gltf_scene/compressed_*);
 //   make_compressed_gltf draco-pair SIDE DIR
 //       DIR/grid_plain.glb, DIR/grid_draco.glb and DIR/grid_draco_quantized.glb, a grid of 2 SIDE^2

@@ -314,7 +314,7 @@ def gltf_seeds():
     ortho["cameras"] = [{"type": "orthographic", "orthographic": {"xmag": 2, "ymag": 2, "znear": 0.1, "zfar": 10}}]
     ortho["nodes"][0]["scale"] = [1e-10, 1e-10, 1e-10]
     put("gltf_scene", "ortho_tiny.gltf", gltf(ortho, [quad_buffer()]))
-    # Issue 38: a camera node scaled by 2e19 (its frame's length overflowed float: NaN rays, an Embree
+    # Hostile scales and depths: a camera node scaled by 2e19 (its frame's length overflowed float: NaN rays, an Embree
     # abort), an orthographic camera of xmag/ymag 1e19 (ray origins past Embree's bound), "extras"
     # nested 20,000 deep at the top level and in a node (a stack overflow in the JSON conversion),
     # and a texture transform of 3e38 (an infinite range buffer).

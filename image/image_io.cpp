@@ -87,8 +87,8 @@ void check_sample_count(const std::string& path, int64_t width, int64_t height, 
     throw Error(path + ": " + std::to_string(width) + "x" + std::to_string(height) + " pixels with " +
                 std::to_string(channels) + " channels exceed the readable " + std::to_string(max_samples) +
                 " samples (a corrupt header, or an image too large to load)");
-  // The pixels are allocated from the header before any data is read: a 23 KB EXR declaring
-  // 40000x40000 took 6.3 GB. Stated and checked first, like the scene loader's estimate.
+  // The pixels are allocated from the header before any data is read, so a tiny file can declare
+  // gigabytes. Stated and checked first, like the scene loader's estimate.
   // (A negative size from a corrupt header is the decoder's to refuse.)
   if (!(samples > 0)) return;
   const uint64_t bytes = static_cast<uint64_t>(samples) * sizeof(float), available = available_memory_bytes();

@@ -1,6 +1,6 @@
 // The readers allocate an image's pixels from its header, before any data: a header declaring more
-// than the memory this process may take is refused first (issue 38: a 23 KB EXR declaring
-// 40000x40000 took 6.3 GB). And available_memory_bytes() sees a limit set with `ulimit -v`.
+// than the memory this process may take is refused first (a 23 KB EXR can declare
+// 40000x40000 pixels, gigabytes once decoded). And available_memory_bytes() sees a limit set with `ulimit -v`.
 #include <gtest/gtest.h>
 #include <sys/resource.h>
 #include <sys/wait.h>

@@ -29,8 +29,8 @@ DisplayMetrics compare_display(const Image& test, const Image& reference, const 
                                const DisplayMetricOptions& options = {});
 
 // A reference renders noise of its own, and that noise adds to every error measured against it:
-// at 2048 spp on cornell (384x216) two references of different seeds differ by 3.3 % display NRMSE,
-// as much as a filtered 2 s job's whole error. With a second reference R2 rendered like the first
+// two references of different seeds at a few thousand spp can differ by as much as a filtered
+// short job's whole error. With a second reference R2 rendered like the first
 // R1 (same sample count and settings, another seed), the test's error against the truth follows:
 //   E[NRMSE(test, R1)^2] = NRMSE(test, truth)^2 + noise(R1)^2   (independent noise adds in MSE)
 //   E[NRMSE(R2, R1)^2]   = 2 noise(R1)^2                        (R2's noise is R1's in law)

@@ -198,7 +198,7 @@ TEST(Accumulation, EmitterCoverageIsTheFractionOfCameraRaysSeeingAnEmitter) {
 
 }  // namespace
 
-// Issue 12: luminance near the float limit has a variance beyond float range; it saturates.
+// Luminance near the float limit has a variance beyond float range; it saturates.
 TEST(Accumulation, VarianceOfMeanSaturatesInsteadOfOverflowing) {
   Accumulation acc;
   resize_accumulation(acc, 1, 1);

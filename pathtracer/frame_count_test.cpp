@@ -1,4 +1,4 @@
-// Frame counts of states (issue 38 item 9): a state's frames are summed in 64 bits and refused
+// Frame counts of states: a state's frames are summed in 64 bits and refused
 // beyond kMaxStateFrames on reading and before a merge, so no count wraps into the int sample
 // count of the preview (a crafted state of 2^31 frames merged to "spp": -2147483648).
 #include <gtest/gtest.h>

@@ -114,11 +114,10 @@ Blocks blocks_of(const Accumulation& acc, int block) {
 // The guiding learns what it is for. In the cornell box the heaviest-tailed light is the ceiling
 // light's reflection in the mirror sphere, reaching the walls as a caustic (D S L) that BSDF
 // sampling finds about once in a thousand directions, each find a firefly. After training, guided
-// paths must find it at least 5x as often, with smaller weights (measured with the parallax-aware
-// lobes: 12.1x at 128x128 after 31 frames, the second moment of those samples 0.56x; with the
-// quadtree 2.1x and 0.66x). Without the photons (camera paths do not find the caustic often enough
-// to learn it), or with Russian roulette on the guided throughput (it killed the guided paths and
-// gave the survivors their weight back), they found it about as often as unguided ones (0.9-1.1x).
+// paths must find it at least 5x as often, with smaller weights: the parallax-aware lobes clear
+// that with a wide margin. Without the photons (camera paths do not find the caustic often enough
+// to learn it), or with Russian roulette on the guided throughput (it kills the guided paths and
+// gives the survivors their weight back), guided paths find it about as often as unguided ones.
 TEST(Guiding, TrainedFieldFindsTheMirrorCaustic) {
   const Scene scene = make_cornell_box(true);
   const int size = 128, train = 31, measure = 16;

@@ -82,7 +82,8 @@ class LightSampler {
   static constexpr size_t kMaxNearFieldClusters = 16;
   // A rectangular emitter (a quad of two triangles with perpendicular edges) is sampled uniformly
   // in the solid angle it subtends where its diagonal is at least its distance (this factor on
-  // the squares), else uniformly in area (docs/sampling.md: measured choice).
+  // the squares), else uniformly in area, where the two pdfs are alike and area sampling is
+  // cheaper (docs/sampling.md).
   static constexpr float kSolidAngleNearness = 1.0f;
   // The environment's importance map: at most about this many cells wide where the coarser map
   // multiplies the variance of sampling the map's own luminance by at most the factor below,
@@ -142,8 +143,7 @@ class LightSampler {
   const Parallelogram& parallelogram(size_t index) const { return parallelograms_[index]; }
 
   // Directional lights sampled at every vertex, outside the category choice: with up to this many
-  // the scene is lit by a sun or two (the case measured), and a sun costs one shadow ray and no
-  // random number. More keep their place in the punctual category.
+  // the scene is lit by a sun or two, and a sun costs one shadow ray and no random number. More keep their place in the punctual category.
   static constexpr size_t kMaxSuns = 4;
   size_t sun_count() const { return suns_.size(); }
   // Sun `index`'s sample: its direction, radiance (E), pdf 1 (always taken), delta.

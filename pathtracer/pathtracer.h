@@ -75,7 +75,7 @@ inline int accumulated_replicates(SamplerType sampler, int replicates) {
 }
 
 // The material under a pixel as the path tracer shades the camera ray's first surface (the
-// explorer's inspector, issue 35): its evaluated parameters there (textures and vertex colour
+// explorer's inspector): its evaluated parameters there (textures and vertex colour
 // applied) and the lobes its BSDF samples from, each with the probability sample() picks it.
 struct SurfaceLobe {
   std::string name;  // diffuse, glossy, sheen, clearcoat, glass

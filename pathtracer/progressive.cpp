@@ -20,14 +20,13 @@ namespace {
 constexpr int kTileSize = 16;
 constexpr int kChunk = kTileSize * kTileSize;  // jobs per batch that one thread traces
 
-// Path guiding's training (docs/guiding.md, measured there): after each frame, a sixteenth of a
+// Path guiding's training (docs/guiding.md): after each frame, a sixteenth of a
 // photon per pixel, but at least kGuidingMinPhotonsPerFrame (the field's resolution depends on the
 // scene, not on the image), and no iteration (2^k frames) traces more than
 // kGuidingPhotonsPerIteration, so the training's cost per frame falls once the field has that
-// many: a leaf's lobes are fitted to a reservoir of 128 records. Half the minimum (4096) cut cornell
-// 256²'s cost by a tenth of an unguided frame at the same error, but left the open envmap scene,
-// whose photons mostly miss or land where direct light is not recorded, with too few records: HDR
-// NRMSE 22.9 against 21.1 % at 32 spp. The field's spatial leaves split at
+// many: a leaf's lobes are fitted to a reservoir of 128 records. A lower minimum saves a little
+// time in closed scenes but leaves an open scene, whose photons mostly miss or land where direct
+// light is not recorded, with too few records, and its error rises. The field's spatial leaves split at
 // c = 100 records (x sqrt(2^k)), not the paper's 12000, which left a Cornell box wall in one leaf
 // at these photon counts.
 constexpr double kGuidingPhotonsPerPixel = 0.0625;
@@ -37,8 +36,8 @@ constexpr float kGuidingSpatialThreshold = 100.0f;
 // The directional model: at most 8 parallax-aware lobes per leaf (docs/guiding.md), not the quadtree.
 constexpr int kGuidingLobes = 8;
 // Of those, the lobes fitted to the light that came through delta bounces (GuidingSettings::delta_lobes):
-// half. Measured on cornell 128^2 (the field of 31 frames, docs/guiding.md): the mirror caustic's
-// second moment 0.55x of one reservoir's, all HV 0.87x.
+// half: in one reservoir the caustic's few records are outweighed by the leaf's other light and
+// get no lobe; with their own, the caustic's second moment and HV's fall (docs/guiding.md).
 constexpr int kGuidingDeltaLobes = 4;
 
 int guiding_photons_per_frame(int width, int height, int iteration) {

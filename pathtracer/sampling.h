@@ -138,8 +138,8 @@ inline bool is_finite(glm::vec3 v) { return std::isfinite(v.x) && std::isfinite(
 // std::upper_bound gives), without branches on the comparisons: where a random u falls is a coin
 // flip per sample, and a branch on it is mispredicted half the time. Up to `count_up_to` entries
 // (a light's two triangles) are counted; more are halved with conditional moves (an environment
-// map's rows and columns: once the map fitted in the cache, its sampling was still 9 % of atrium's
-// time, most of it in std::upper_bound's loop).
+// map's rows and columns: once the map fits in the cache, std::upper_bound's mispredicted loop is
+// most of what its sampling costs).
 inline size_t sorted_upper_bound(const float* sorted, size_t n, float u, size_t count_up_to) {
   if (n <= count_up_to) {
     size_t count = 0;

@@ -1,4 +1,4 @@
-// Compressed and extended glTF (issue 35 item 1): each decoder's file loads to exactly the
+// Compressed and extended glTF: each decoder's file loads to exactly the
 // triangles or texels of its uncompressed twin; malformed data and unsupported requirements are
 // one-line errors; EXT_mesh_gpu_instancing counts against the limits like nodes do. The files are
 // written by the libraries' encoders (testing/gltf_compressed_fixtures.h).
@@ -142,7 +142,7 @@ TEST(GltfMeshopt, MalformedDataIsAOneLineError) {
 }
 
 // Many views may name the same compressed bytes: the decoded bytes of all used views are bounded by
-// the distinct compressed bytes, each counted once (a 1 MB file used to decode to 1.4 GB).
+// the distinct compressed bytes, each counted once (else a small file can decode to gigabytes).
 TEST(GltfMeshopt, ViewsSharingCompressedBytesAreBoundedTogether) {
   MeshoptPair files = meshopt_grid_glbs(make_grid(10));
   json& doc = files.compressed.doc;

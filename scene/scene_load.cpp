@@ -1449,14 +1449,14 @@ void check_scene_file(const std::string& path) {
 // 72 B) and the raster pass's vertex, in its staging copy and its GL buffer (2 x 64 B). Per
 // instanced triangle: the indices as read and as triangles, the raster pass's index buffer
 // (3 x 12 B) and the BVH (Embree's build, about 100 B). Per instanced primitive, whatever its size:
-// a Mesh with its vectors, an Embree geometry and the raster pass's draw (measured: 1e4 and 1e5
-// instances of a quad peaked 6.5-7 KB per instance above the vertices' and triangles' share).
+// a Mesh with its vectors, an Embree geometry and the raster pass's draw (measured on many
+// instances of a quad above the vertices' and triangles' share, with a margin).
 // Per instanced punctual light: the PunctualLight in a growing vector (up to 3 copies while it
-// doubles) and the light sampler's pointer (measured: about 110 B at 1e5 lights). Textures: their
+// doubles) and the light sampler's pointer (measured on many lights). Textures: their
 // storage, the raster pass's copy (at most as large), and the largest image's decoding buffers.
 // Per environment texel: while loading, the decoded image (up to 4 float channels) and the linear
 // RGBA texture (16 + 16 B); after, the texture, the raster pass's RGBA32F copy and the importance
-// map (16 + 16 + 8 B; measured: 31 B per texel at 8192x4096).
+// map (16 + 16 + 8 B; a measured peak agrees).
 uint64_t LoadEstimate::bytes() const {
   constexpr uint64_t kBytesPerVertex = 72 + 2 * 64, kBytesPerTriangle = 3 * 12 + 100, kBytesPerMesh = 8192,
                      kBytesPerLight = 320, kBytesPerEnvironmentTexel = 40;

@@ -997,7 +997,7 @@ TEST(SceneLoadBadInput, NodeCycleAndBadMaterialIndex) {
 }
 
 // ----------------------------------------------------------------------------------------------
-// Hostile input (issue 12)
+// Hostile input
 
 TEST(SceneLoadBadInput, DeepNodeHierarchyLoadsWithoutOverflowingTheStack) {
   // Far deeper than the ~8,400 levels a recursive traversal survived in Release.
@@ -1458,7 +1458,7 @@ TEST(SceneLoadLimits, InstancedTrianglesOverTheCapAreAClearError) {
 
 
 // ----------------------------------------------------------------------------------------------
-// Issue 38: camera-derived ray origins, JSON depth, texture transforms, the whole memory estimate
+// Hostile input at the limits: camera-derived ray origins, JSON depth, texture transforms, the whole memory estimate
 
 // A quad seen by a camera node with `camera_node`'s transform (a perspective camera unless `camera` says).
 std::string write_camera_scene(const std::string& path, const json& camera_node, const json& camera = nullptr) {
@@ -1587,7 +1587,7 @@ TEST(SceneLoadLimits, InstancedLightsAndPrimitivesAreInTheEstimate) {
   const std::string lights_path = lights.write_gltf(dir + "/lights.gltf");
   std::string msg = error_of([&] { load_scene(lights_path, "", 1.0f, DefaultLight::None, limits); });
   EXPECT_NE(msg.find("loading needs an estimated 305 MiB (2 triangles, 1000000 lights, 0 MiB of textures)"), std::string::npos) << msg;
-  // 10^4 instances of a quad: 8 KB each for its Mesh, BVH geometry and draw (measured 6.5-7 KB),
+  // 10^4 instances of a quad: 8 KB each for its Mesh, BVH geometry and draw (a little more than they take),
   // where the estimate had only the vertices and triangles (10 MiB).
   GltfBuilder quads;
   quads.scene({instancing_tree(quads, {{"mesh", quads.mesh(quads.quad_primitive())}}, 4)});

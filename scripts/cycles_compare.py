@@ -1,4 +1,4 @@
-"""pxf against Blender Cycles on the same glTF (issue 35): rough glass and multiscatter rough metal.
+"""pxf against Blender Cycles on the same glTF: rough glass and multiscatter rough metal.
 
 Two modes, driven by scripts/cycles_compare.sh:
   python3 scripts/cycles_compare.py scene CASE DIR

@@ -1,5 +1,5 @@
 #!/bin/sh
-# pxf against Blender Cycles 3.4 on the same glTF (issue 35; scripts/cycles_compare.py says what is
+# pxf against Blender Cycles 3.4 on the same glTF (scripts/cycles_compare.py says what is
 # compared). Needs a build (scripts/setup.sh) and Debian's blender and python3-numpy:
 #   apt-get install blender python3-numpy
 # The glass cases are also rendered by a second build, build-cycles-glass (CMake option

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Equal wall time, Sobol against independent sampling (issue 11): for each scene, ROUNDS rounds of
+# Equal wall time, Sobol against independent sampling: for each scene, ROUNDS rounds of
 # four whole jobs back to back (`pxf render --time SECONDS`: sobol/independent x unfiltered/default
 # grid filter, seed 101, 102, ... per round; which sampler goes first alternates by round), each
 # judged against the scene's reference with

@@ -73,8 +73,8 @@ if [ "$mode" = unit ]; then
   # The libraries' coverage instrumentation (-fsanitize=fuzzer-no-link) costs these tests about a
   # third more time, less than a second sanitizer build of the libraries would. Leaks are not
   # findings here: the tests' process-lifetime objects (the GL context, TBB's arenas) are not freed.
-  # Left out here, not in the normal build: three image statistics over thousands of paths (100 of
-  # the 280 s these tests took under the sanitizers), whose code paths the furnace and
+  # Left out here, not in the normal build: three image statistics over thousands of paths (a large
+  # share of these tests' time under the sanitizers), whose code paths the furnace and
   # restored-field tests run here too.
   cmake --build "$BUILD" -j "${PXF_JOBS:-$(nproc)}" --target core_tests image_tests scene_tests pathtracer_tests
   ASAN_OPTIONS=detect_leaks=0 ctest --test-dir "$BUILD" --output-on-failure -j "$(nproc)" --timeout 900 \

@@ -1,4 +1,4 @@
-// Checkpoint, resume and shard merging end to end through the pxf executable (issue 13): a render
+// Checkpoint, resume and shard merging end to end through the pxf executable: a render
 // killed with SIGKILL at random moments and resumed gives the uninterrupted render's images bit for
 // bit; merges of uneven shards equal one render within the stated tolerance; states of another
 // render, overlapping shards and corrupt files are refused with one line and overwrite nothing.
@@ -144,7 +144,7 @@ TEST(Checkpoint, ResumeAfterSigkillAtRandomMomentsIsBitIdentical) {
   expect_resume_after_kills_is_bit_identical(kScene, "uniform", 20);
 }
 
-// Issue 33: an adaptive render's state holds each pixel's traced count and the allocation's credits
+// Adaptive sampling: an adaptive render's state holds each pixel's traced count and the allocation's credits
 // and next mask (format 6), and the allocation's guide is the converged range buffer whatever the
 // timing, so a resumed adaptive render traces exactly what the uninterrupted one did. 16 warm-up
 // frames, then 8 allocated ones.

@@ -1,4 +1,4 @@
-// The pxf command line end to end (issue 2 item 6, issue 4 item 6): exit codes, one-line errors,
+// The pxf command line end to end: exit codes, one-line errors,
 // no partial output, Ctrl-C, and `pxf diff` on EXRs written by another writer.
 #include <gtest/gtest.h>
 
@@ -221,7 +221,7 @@ TEST(Cli, AllHvRendersDefaultToAtrousUnlessFilterIsGiven) {
   EXPECT_EQ(stats["settings"]["all_hv"], false);
 }
 
-// --adaptive on (issue 33): off by default, recorded in stats.json with the paths per pixel; after
+// --adaptive on: off by default, recorded in stats.json with the paths per pixel; after
 // the 16 uniform warm-up frames the pixels' counts part, the same with one thread and two. (Its
 // states: tests/checkpoint_test.cpp.)
 TEST(Cli, AdaptiveRenderRecordsItsPixelCounts) {
@@ -470,7 +470,7 @@ TEST(Cli, DiffReadsForeignHalfFloatExrsAndGetsTheNumbersRight) {
   EXPECT_NE(missing.err.find("nope.exr"), std::string::npos);
 }
 
-// Issue 12 item 9: a reference without finite values is an error, never NRMSE 0 and exit 0.
+// A reference without finite values is an error, never NRMSE 0 and exit 0.
 TEST(Cli, DiffRejectsANonFiniteReference) {
   const std::string dir = temp_dir("diff_nan");
   fs::create_directories(dir);
@@ -629,7 +629,7 @@ TEST(Cli, DiffSecondReferenceTakesOutTheReferencesNoise) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Issue 12: very bright but finite input still gives a finished render with finite layers.
+// Very bright but finite input still gives a finished render with finite layers.
 
 namespace {
 
@@ -751,7 +751,7 @@ TEST(Cli, ExtremeRadianceGivesFiniteOutputsAndAnExactDroppedSampleCount) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Issue 12: the output set is replaced whole or not at all.
+// The output set is replaced whole or not at all.
 
 namespace {
 
@@ -909,7 +909,7 @@ TEST(Cli, KillsAtRandomMomentsNeverLeavePartialOrMixedOutputs) {
   EXPECT_TRUE(leftovers(out).empty());
 }
 
-// --until-clean (issue 33 item 2): a diffuse-only box at a loose threshold gets clean and stops
+// --until-clean: a diffuse-only box at a loose threshold gets clean and stops
 // there, unbounded by --spp; cornell with its mirror and glass at a strict one stops at its cap.
 TEST(Cli, UntilCleanStopsWhenEveryPixelIsCase2OrAtItsCap) {
   const std::string dir = temp_dir("until_clean");

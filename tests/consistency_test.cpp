@@ -1,4 +1,4 @@
-// Consistency of pixel filtering (issue 4): as spp grows, the fraction of pixels with s = 1 rises
+// Consistency of pixel filtering: as spp grows, the fraction of pixels with s = 1 rises
 // to 1 and the error of the filtered image to a high-spp reference falls (the bias vanishes).
 #include <gtest/gtest.h>
 
@@ -109,7 +109,7 @@ double largest_z(const std::vector<std::vector<double>>& runs, const std::vector
 
 }  // namespace
 
-// Issue 33, no bias from stopping: adaptive sampling decides from the samples which pixels to trace,
+// Adaptive sampling, no bias from stopping: adaptive sampling decides from the samples which pixels to trace,
 // and a rule that retired pixels on a lucky dark run would bias their means. Over 32 seeds the mean
 // of the adaptive unfiltered image (t = 0.01, 64 frames, so 48 of them allocated) agrees with an
 // 8192-spp reference of other seeds in every 16x16 block: |z| < 4.5 (9 blocks; at 4.5 a correct

@@ -1,4 +1,4 @@
-// Counts and limits end to end through the pxf executable (issue 38 items 9 and 10, near-misses):
+// Counts and limits end to end through the pxf executable (near-misses included):
 // frame counts are checked at the command line and in states with one line; a size whose grid
 // filter needs more work groups than one dispatch row holds still renders; --time refuses up front
 // when not even one frame fits; a failed periodic state write warns once and the render goes on.

@@ -1,4 +1,4 @@
-// Golden images (issue 4): small, fixed seed and spp, headless on OSMesa. Each case names the
+// Golden images: small, fixed seed and spp, headless on OSMesa. Each case names the
 // buffers it checks and a per-pixel tolerance plus a maximum fraction of failing pixels. A failing
 // case writes the image, the golden and a difference image under build/test-failures/<case>/.
 // Regenerate every golden (after an intended change, and look at them):

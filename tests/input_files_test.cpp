@@ -1,5 +1,5 @@
 // Every input path pxf reads is checked to be a regular file of bounded size before it is opened
-// (image/input_file.h; issue 38 items 7, 8 and 13): a FIFO, /dev/zero or a directory named as any
+// (image/input_file.h): a FIFO, /dev/zero or a directory named as any
 // input ends the command with exit code 1 and one line naming the path, at once. pxf runs under
 // `timeout 20`, so that a regression (a read that blocks or never ends) fails instead of hanging.
 #include <gtest/gtest.h>

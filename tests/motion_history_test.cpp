@@ -1,4 +1,4 @@
-// The reprojected history of a moving camera (issue 37, docs/method.md 4.1) in the preview core:
+// The reprojected history of a moving camera (docs/method.md 4.1) in the preview core:
 // once the camera rests, the history's weight falls to 0 and the render converges to the one that
 // never moved; while it moves, the history stands beside the fresh samples.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Issue 38 items 1-4, end to end: pxf keeps the user's files, and a stop signal, a kill or a second
+// The output set end to end: pxf keeps the user's files, and a stop signal, a kill or a second
 // render at any moment of the output write leaves the old set or the new one, whole, never neither
 // and never a mix; a reader that closes the pipe does not kill the render.
 // PXF_STRESS_TRIALS (default 70) and PXF_STRESS_PAIRS (default 35) set the trial counts; the
@@ -296,8 +296,7 @@ int check_path_set(const std::string& out, std::string* problem) {
 
 // Ctrl-C (or SIGTERM) at random moments of a long camera path, after its first frame: the render
 // finishes the frame under way, commits every finished frame with path.json, and exits 128 + the
-// signal. No frame that the render reported finished is lost. PXF_STRESS_TRIALS sets the count
-// (docs/robustness.md quotes 100).
+// signal. No frame that the render reported finished is lost. PXF_STRESS_TRIALS sets the count.
 TEST(OutputSet, StopSignalsDuringACameraPathLoseNoFinishedFrame) {
   const std::string out = test_support::temp_dir("output_set", "path_signals");
   const std::string err_file = test_support::temp_dir("output_set", "path_signals_err") + ".txt";

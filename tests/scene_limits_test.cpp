@@ -1,5 +1,5 @@
-// Scene inputs at the loader's limits, end to end through `pxf render` (issue 38 items 5, 6, 11,
-// 12): a camera scaled or widened past the coordinate bound, JSON nested 20,000 deep, a texture
+// Scene inputs at the loader's limits, end to end through `pxf render`:
+// a camera scaled or widened past the coordinate bound, JSON nested 20,000 deep, a texture
 // transform of 3e38 and an environment map over --max-texture-size each end as a render or a
 // one-line error, never as a signal or a lost render.
 #include <gtest/gtest.h>

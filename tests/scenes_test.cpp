@@ -1,4 +1,4 @@
-// No NaN or Inf in any output buffer for any built-in scene (issue 4), through the same core
+// No NaN or Inf in any output buffer for any built-in scene, through the same core
 // as `pxf render`, with every filter variant the command line offers.
 #include <gtest/gtest.h>
 

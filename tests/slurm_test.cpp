@@ -1,4 +1,4 @@
-// The Slurm scripts end to end (issue 13): brings up a real single-node Slurm on this machine
+// The Slurm scripts end to end: brings up a real single-node Slurm on this machine
 // (munged, slurmctld and slurmd with their own key, configuration, ports and files in a temporary
 // folder), submits a 4-shard render and its dependent merge through scripts/slurm/submit.sh, and
 // compares the merged images with one `pxf render` of the same settings. Where Slurm cannot be

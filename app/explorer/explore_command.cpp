@@ -1,4 +1,4 @@
-// pxf explore: command line of the Dear ImGui explorer (issue 6); the window is app/explorer/explorer.cpp.
+// pxf explore: command line of the Dear ImGui explorer; the window is app/explorer/explorer.cpp.
 #include <cstdio>
 
 #include "app/commands.h"

@@ -38,7 +38,7 @@ using Clock = std::chrono::steady_clock;
 constexpr float kPanelWidth = 430.0f;
 constexpr double kTraceBudgetMs = 30.0;  // path tracing per displayed frame when it is fast
 // A GL step's predicted cost is its last one; the same step varies by about a third from frame to
-// frame (a filter run or a camera change at 512^2: 28-41 ms), so the budget counts it this much larger.
+// frame, so the budget counts it this much larger.
 constexpr double kPredictionMargin = 1.3;
 constexpr size_t kPlotLength = 600;
 constexpr float kDividerGrabPixels = 6.0f;
@@ -838,8 +838,8 @@ class Explorer {
   double camera_change_ms_ = 0;        // the last camera change's GL work (apply_changes)
   bool frame_gl_work_ = false;         // this display frame waited for a traced frame or ran a pass
   // The views' and the window's drawing, after the GL steps, as the budget predicts it: the longest
-  // of the last 8 display frames (it varied from 4 to 15 ms a frame at 512x512 on llvmpipe, and
-  // the last one alone let display frames reach 103 ms).
+  // of the last 8 display frames: the drawing varies severalfold from frame to frame on a
+  // software rasterizer, and predicting from the last one alone let display frames run long.
   std::array<double, 8> recent_ui_draw_ms_{};
   double ui_draw_ms_ = 0;
   std::string out_dir_, scene_path_, scene_error_, status_message_;

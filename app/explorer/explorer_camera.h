@@ -1,4 +1,4 @@
-// The explorer's camera controls (issue 6): orbit around a target, pan, zoom (dolly) and fly.
+// The explorer's camera controls: orbit around a target, pan, zoom (dolly) and fly.
 // Pure math on pxf::Camera, no GL and no GUI, so it is unit-tested.
 // Usage:
 //   CameraController control(scene.camera, scene_bounds(scene));

@@ -1,4 +1,4 @@
-// Tests of `pxf explore` (issue 6): the camera controls and view names as units, and the whole
+// Tests of `pxf explore`: the camera controls and view names as units, and the whole
 // explorer in a window under Xvfb against a headless `pxf render` of the same settings.
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -105,7 +105,7 @@ TEST(ExplorerViews, NamesDigitsAndScalarViews) {
   EXPECT_EQ(buffer_view_of_digit(10), -1);
   EXPECT_TRUE(is_scalar_view(BufferView::VarU));
   EXPECT_FALSE(is_scalar_view(BufferView::Final));
-  // Issue 33's views: reachable by name (--view, --split, the UI's list), no number key.
+  // The adaptive-sampling views: reachable by name (--view, --split, the UI's list), no number key.
   EXPECT_EQ(parse_buffer_view("samples"), BufferView::Samples);
   EXPECT_EQ(parse_buffer_view("active"), BufferView::Active);
   for (int digit = 0; digit <= 9; ++digit) {
@@ -116,7 +116,7 @@ TEST(ExplorerViews, NamesDigitsAndScalarViews) {
   EXPECT_FALSE(is_scalar_view(BufferView::Active));  // two colors with the shares
 }
 
-// --- issue 33: the samples and active views and the status line, headless ----------------------
+// --- the samples and active views and the status line, headless --------------------------------
 
 // The status line from known counts: every figure and its format, and the empty mask (adaptive off
 // or warm-up) counted as every pixel active.
@@ -236,7 +236,7 @@ TEST_F(ExplorerSamplingViews, StatusLineOfAnAdaptivePreview) {
   EXPECT_EQ(sampling_status_line(preview_->case2_share(), views_->sampling()), want);
 }
 
-// --- issue 36: the inspector shows the blend's own decision, headless ----------------------------
+// --- the inspector shows the blend's own decision, headless -------------------------------------
 
 // Cornell at 32x24, 6 frames with the default settings (variance pooling, the centre weight, the
 // bias guard): at every pixel the inspector's case is the blend pass's and its s the pass's to the
@@ -392,7 +392,7 @@ TEST_F(ExplorerWindow, CapturedBuffersEqualPxfRender) {
   EXPECT_TRUE(std::filesystem::exists(dir_ / "explore" / "view-final.png"));
 }
 
-// The history view (issue 37): a kept pixel is green, brighter with more weight; disoccluded red,
+// The history view: a kept pixel is green, brighter with more weight; disoccluded red,
 // outside blue, no history grey.
 TEST(ExplorerViews, HistoryViewColorsShowOutcomeAndWeight) {
   Image outcome = Image::gray(5, 1), weight = Image::gray(5, 1);

@@ -1,4 +1,4 @@
-// The explorer's buffer views (issue 6): every buffer of the preview rendered into a display
+// The explorer's buffer views: every buffer of the preview rendered into a display
 // texture (tone-mapped, false color, case colors), split views and legends. GL only, no ImGui,
 // so the views can be tested headless.
 // Usage:
@@ -19,8 +19,8 @@
 namespace pxf {
 
 // In the order of the number keys 1..9, 0; Unfiltered (L_lv + L_u), Samples (paths traced into
-// each pixel), Active (the next frame's adaptive mask, issue 33) and History (the reprojected
-// history after a camera move: kept with its weight, disoccluded, outside; issue 37) have no key.
+// each pixel), Active (the next frame's adaptive mask) and History (the reprojected
+// history after a camera move: kept with its weight, disoccluded, outside) have no key.
 enum class BufferView { Final, Lv, Hv, HvFiltered, RangeColor, Depth, VarU, VarF, Blend, Case, Unfiltered, Samples, Active,
                         History };
 constexpr int kBufferViewCount = 14;
@@ -55,7 +55,7 @@ const std::array<CaseStyle, 4>& history_styles();
 // The history view's colors ("R,G,B") from HistoryPass::outcome_image and weight_image.
 Image history_view_colors(const Image& outcome, const Image& weight);
 
-// Adaptive sampling per pixel (issue 33), copied from the preview while it is not tracing: the
+// Adaptive sampling per pixel, copied from the preview while it is not tracing: the
 // explorer's worker writes the per-pixel counts during a frame, so the samples and active views
 // and the status line read this copy (taken after each traced frame) instead of the live vectors.
 struct SamplingSnapshot {

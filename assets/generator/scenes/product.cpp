@@ -1,7 +1,7 @@
 // A product shot: a sci-fi helmet floating in a daylight environment, its only light
 // (environment.exr: a cloudy sky with the sun as a small, very bright disc, so direct light is
 // noisy through every glossy lobe). It stands for the most common public glTF file, a textured,
-// normal-mapped PBR asset under an HDR sky, shown as viewers show it (issue 57): nearly all of its
+// normal-mapped PBR asset under an HDR sky, shown as viewers show it: nearly all of its
 // light is direct light at the first surface, so with no ground under it, it has almost no
 // indirect light. Several materials, each with fine texture and normal detail: a clear-coated
 // painted shell with panel seams, rivets, stencils, grime and chipped paint (metallic where

@@ -1,8 +1,8 @@
 // A furnished living room, 5 m x 5 m x 3 m, closed on every side but for one 1.6 m x 1.4 m window,
 // and lit only by a daylight environment (environment.exr: a clear sky with the sun as a small,
 // very bright disc) through that window: no lights inside. Sunlight lands on a patch of floor and
-// rug, and that patch lights the rest of the room. It stands for the most common interior (issues
-// 57 and 58): next-event estimation towards the sky is blocked by the walls almost everywhere, and
+// rug, and that patch lights the rest of the room. It stands for the most common interior:
+// next-event estimation towards the sky is blocked by the walls almost everywhere, and
 // BSDF sampling rarely leaves through the window. Textured diffuse surfaces (oak floor, plaster,
 // rug, upholstery) and some glossy ones (lacquered table, ceramics, metal lamp, picture glaze).
 #include <glm/gtc/constants.hpp>
