@@ -369,6 +369,27 @@ TEST(Bsdf, CompensatedWhiteLobesKeepAllTheEnergy) {
       }
 }
 
+// nondelta_albedo is the directional albedo the lobes sample to: the mean sample weight f cos / pdf,
+// for colored bases, metals, a rough coat and a sheen, at several view angles (luminance).
+TEST(Bsdf, NondeltaAlbedoIsTheSampledDirectionalAlbedo) {
+  const BsdfParams materials[] = {plastic(glm::vec3(0.2f, 0.4f, 0.6f), 0.5f), plastic(glm::vec3(0.05f), 0.3f),
+                                  conductor(glm::vec3(1.0f, 0.78f, 0.34f), 0.4f),
+                                  coated(plastic(glm::vec3(0.7f, 0.1f, 0.1f), 0.8f), 0.8f, 0.3f),
+                                  sheened(plastic(glm::vec3(0.3f), 0.9f), glm::vec3(0.6f, 0.5f, 0.9f), 0.5f)};
+  int index = 0;
+  for (const BsdfParams& params : materials) {
+    for (float mu : {1.0f, 0.6f, 0.2f}) {
+      const glm::vec3 n(0, 0, 1), wo(std::sqrt(1.0f - mu * mu), 0.0f, mu);
+      const Bsdf bsdf(params, n, n, wo, true);
+      EXPECT_NEAR(luminance(bsdf.nondelta_albedo()), stratified_albedo(bsdf, 96), 0.01) << "material " << index << " mu " << mu;
+    }
+    ++index;
+  }
+  // A mirror has no non-delta lobe: nothing to demodulate by.
+  const glm::vec3 n(0, 0, 1);
+  EXPECT_EQ(Bsdf(conductor(glm::vec3(0.9f), 0.0f), n, n, n, true).nondelta_albedo(), glm::vec3(0.0f));
+}
+
 // The clearcoat over white bases keeps all the light: the coat reflects clearcoat E_coat(cos_o)
 // (compensated), the base gets the rest. At several coat and base roughnesses, smooth coat included.
 TEST(Bsdf, ClearcoatOverWhiteKeepsAllTheEnergy) {

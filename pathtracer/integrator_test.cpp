@@ -672,9 +672,10 @@ TEST(Integrator, EscapedSpecularChainTakesTheCompressedEnvironment) {
   EXPECT_EQ(dark.trace_specular_chains({8 * size + 8}, glm::vec2(0.5f))[0].range_color, glm::vec3(0.0f));
 }
 
-// The albedo channel: the base color of the first surface with a non-delta lobe, not tinted by
-// the perfectly specular chain before it; 1 where the path escapes before any such surface.
-TEST(Integrator, AlbedoIsTheFirstNonSpecularBaseColor) {
+// The albedo channel: the non-delta albedo of the first surface with a non-delta lobe (a Lambert
+// surface's: its base color), not tinted by the perfectly specular chain before it; 0 where the
+// path escapes before any such surface.
+TEST(Integrator, AlbedoIsTheFirstNonSpecularAlbedo) {
   // Camera at the origin looking -Z. Lower left: a diffuse quad (0.2, 0.4, 0.6) at z = -2. Lower
   // right: a tinted mirror in the plane z = -2 - x (normal (1, 0, 1) / sqrt 2), which sends the rays
   // to +x onto a diffuse wall (0.7, 0.3, 0.1) at x = 3. Upper rows: nothing (the environment).
@@ -697,7 +698,7 @@ TEST(Integrator, AlbedoIsTheFirstNonSpecularBaseColor) {
   };
   expect_albedo(6, 26, glm::vec3(0.2f, 0.4f, 0.6f));  // the diffuse quad
   expect_albedo(26, 26, glm::vec3(0.7f, 0.3f, 0.1f));  // through the mirror, untinted
-  expect_albedo(16, 2, glm::vec3(1.0f));               // the environment
+  expect_albedo(16, 2, glm::vec3(0.0f));               // the environment
 }
 
 // Where the BSDF comes from per vertex: precomputed for an untextured material, evaluated where a
