@@ -154,7 +154,11 @@ FilterOutput atrous_pass(const Image& signal, const Image& signal_var, const Ima
         for (int i = 0; i < 5; ++i) {
           const int qx = x + (i - 2) * step, qy = y + (j - 2) * step;
           if (qx < 0 || qx >= w || qy < 0 || qy >= h) continue;
-          const double range_weight = std::exp(-range_exponent(range_color, depth, surface, x, y, qx, qy, range));
+          const Px l_p = rgb_at(signal, x, y), l_q = rgb_at(signal, qx, qy);
+          const double edge = shared::luminance_edge_exponent(glm::vec3(l_p.c[0], l_p.c[1], l_p.c[2]),
+                                                              glm::vec3(l_q.c[0], l_q.c[1], l_q.c[2]),
+                                                              clean_var(signal_var.at(x, y, 0)), atrous_k_l(p));
+          const double range_weight = std::exp(-range_exponent(range_color, depth, surface, x, y, qx, qy, range) - edge);
           h_sum += double(shared::kB3[i]) * shared::kB3[j];
           sums.add(double(shared::kB3[i]) * shared::kB3[j] * range_weight, signal, signal_var, qx, qy);
         }

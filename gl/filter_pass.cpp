@@ -116,6 +116,7 @@ void FilterPass::run_atrous(const PreviewInputs& inputs, const Texture2D& guide,
   if (!atrous_program_.id()) atrous_program_ = Program::from_embedded("fullscreen.vert", "atrous.frag");
   set_range_and_skip(atrous_program_, p, t, staged_.surface);
   use_with_inputs(atrous_program_, inputs, guide, staged_.surface);
+  atrous_program_.set("k_l", atrous_k_l(p));
   const int passes = atrous_iterations(p.sigma_s);
   atrous_program_.bind(shared::kUnitSignal, inputs.hv());
   for (int i = 0; i < passes; ++i) {

@@ -61,6 +61,9 @@ struct FilterParams {
   // wide enough that a smooth curved surface still averages over several pixels.
   float sigma_n = 0.15f;
   float sigma_r = 0.1f;
+  // The à-trous variant's luminance edge stop (shaders/pass_formulas.h luminance_edge_exponent), in
+  // standard deviations of the signal; 0 turns it off. SVGF's value.
+  float sigma_l = 4.0f;
   // Skip pixels in case 2 (u <= t, t the blend threshold every filter run is given): they need no
   // filtered value. u is computed with the *unfiltered* background L_b = Y(L_u) + Y(L_lv), so the
   // decision needs no history; a skipped pixel gets L_f = L_u and Var[L_f] = kVarSkipped, and the
@@ -108,6 +111,9 @@ constexpr RangeWeights range_weights(const FilterParams& p) {
   return {inv_two_sigma2(p.sigma_c), p.kind != FilterKind::Bilateral ? inv_two_sigma2(p.sigma_d) : 0.0f,
           inv_sigma2_or_off(p.sigma_n, 1.0f), inv_sigma2_or_off(p.sigma_r, 0.5f)};
 }
+
+// k_l = 1 / sigma_l of the à-trous luminance edge stop, 0 where it is off.
+constexpr float atrous_k_l(const FilterParams& p) { return p.sigma_l > 0.0f ? 1.0f / p.sigma_l : 0.0f; }
 
 // Passes of the à-trous variant for sigma_s (rule in gl/pass_params.cpp), at least 1, and few
 // enough that its footprint radius 2 (2^k - 1) stays within kMaxFilterRadius.

@@ -115,6 +115,10 @@ std::vector<SettingDescriptor> make_table() {
   t.push_back(number("sigma_r", "--sigma-r", "range roughness sigma (glTF roughness, 0..1); 0: off", 0.0, 1e3,
                      [](PreviewSettings& s) -> float& { return s.filter.sigma_r; }, E::Refilter,
                      {"sigma r", 0.0, 1.0, false, "%.3g"}));
+  t.push_back(number("sigma_l", "--sigma-l",
+                     "atrous: luminance edge stop, in standard deviations of the filtered light (SVGF); 0: off",
+                     0.0, 1e3, [](PreviewSettings& s) -> float& { return s.filter.sigma_l; }, E::Refilter,
+                     {"sigma l", 0.0, 64.0, false, "%.3g"}));
   t.push_back(choice<&filter_kind>("filter", "--filter", "filter variant (grid: the bilateral grid on the range luminance)",
                                   filter_option_names(), E::Refilter, "filter"));
   t.push_back(on_off("demodulate", "--demodulate",

@@ -1,8 +1,8 @@
 #version 450 core
 // One pass of the edge-avoiding à-trous wavelet filter (Dammertz et al. 2010; FilterKind::Atrous):
 // the 5x5 B3-spline kernel h at hole spacing `step_px` (1, 2, 4, ... over the passes), each tap
-// weighted by h x the range weights of the cross bilateral filter (color, depth; no spatial
-// Gaussian beyond h): L_f = sum w L / sum w, Var[L_f] = c sum w^2 Var / (sum w)^2 with the
+// weighted by h x the range weights of the cross bilateral filter (color, depth, surface; no spatial
+// Gaussian beyond h) x the luminance edge stop on the signal itself (luminance_edge_exponent): L_f = sum w L / sum w, Var[L_f] = c sum w^2 Var / (sum w)^2 with the
 // correction c for the correlation between the previous pass's pixels: atrous_variance_correction
 // scaled by the share of the kernel the range weights keep (atrous_local_correction).
 // Taps outside the image are left out.
@@ -20,6 +20,7 @@ uniform float k_c;  // 1 / (2 sigma_c^2)
 uniform float k_d;  // 1 / (2 sigma_d^2)
 uniform float k_n;  // 1 / sigma_n^2, 0: no normal term (range_weights)
 uniform float k_r;  // 1 / (2 sigma_r^2), 0: no roughness term
+uniform float k_l;  // 1 / sigma_l, 0: no luminance edge stop (luminance_edge_exponent)
 uniform int skip_case2;
 uniform float t;
 uniform float variance_correction;  // atrous_variance_correction(pass)
@@ -37,6 +38,9 @@ void main() {
   if (final_pass != 0) atomicAdd(filtered_pixels, 1u);
   vec4 g_p = texelFetch(guide_tex, p, 0);
   vec4 s_p = texelFetch(surface_tex, p, 0);
+  vec4 signal_p = texelFetch(signal_tex, p, 0);
+  vec3 l_p = clean(signal_p.rgb);
+  float var_p = clean_var(signal_p.a);
   KernelSums sums = kernel_sums_zero();
   float h_sum = 0.0;  // sum h over the taps inside the image
   for (int j = 0; j < 5; ++j) {
@@ -47,8 +51,10 @@ void main() {
       if (qx < 0 || qx >= size.x) continue;
       ivec2 q = ivec2(qx, qy);
       h_sum += kB3[i] * kB3[j];
-      float w = kB3[i] * kB3[j] * range_weight(g_p, texelFetch(guide_tex, q, 0), s_p, texelFetch(surface_tex, q, 0), k_c, k_d, k_n, k_r);
       vec4 s_q = texelFetch(signal_tex, q, 0);
+      float w = kB3[i] * kB3[j] *
+                exp(-range_exponent(g_p, texelFetch(guide_tex, q, 0), s_p, texelFetch(surface_tex, q, 0), k_c, k_d, k_n, k_r) -
+                    luminance_edge_exponent(l_p, clean(s_q.rgb), var_p, k_l));
       kernel_sums_add(sums, w, clean(s_q.rgb), clean_var(s_q.a));
     }
   }

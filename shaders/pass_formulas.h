@@ -96,6 +96,18 @@ PXF_INLINE float clean_var(float v) { return (isnan(v) || isinf(v) || v < 0.0f) 
 // (the environment, a specular chain without an end, no surface buffer: a normal shorter than
 // kMinSurfaceNormal) the term is 0: the colour and distance terms alone decide there.
 PXF_CONST float kMinSurfaceNormal = 0.25f;
+// The normal term narrows with the sharper of the two surfaces' glossy lobes: the light a lobe of
+// GGX alpha = roughness^2 reflects changes over normals about alpha / 2 apart, so a highlight on a
+// curved glossy surface is not spread over its neighbours. sigma_n applies from alpha
+// kLobeAlphaWide up (rough, nearly diffuse surfaces); below it sigma_n alpha / kLobeAlphaWide, at
+// least kLobeNarrowest sigma_n (a mirror-like lobe).
+PXF_CONST float kLobeAlphaWide = 0.6f;
+PXF_CONST float kLobeNarrowest = 0.02f;
+PXF_INLINE wide_float lobe_normal_scale(float roughness_p, float roughness_q) {
+  float r = clamp(min(roughness_p, roughness_q), 0.0f, 1.0f);
+  wide_float s = wide_float(clamp(r * r / kLobeAlphaWide, kLobeNarrowest, 1.0f));
+  return 1.0f / (s * s);
+}
 PXF_INLINE wide_float surface_exponent(vec4 s_p, vec4 s_q, float k_n, float k_r) {
   if (!(k_n > 0.0f) && !(k_r > 0.0f)) return 0.0f;
   vec3 a = clean(vec3(s_p)), b = clean(vec3(s_q));
@@ -103,7 +115,8 @@ PXF_INLINE wide_float surface_exponent(vec4 s_p, vec4 s_q, float k_n, float k_r)
   if (!(la >= kMinSurfaceNormal * kMinSurfaceNormal) || !(lb >= kMinSurfaceNormal * kMinSurfaceNormal)) return 0.0f;
   wide_float c = wide_float(dot(a, b)) / sqrt(wide_float(la) * wide_float(lb));
   wide_float dr = wide_float(clean(s_p.a)) - wide_float(clean(s_q.a));
-  return max(1.0f - c, wide_float(0.0f)) * k_n + dr * dr * k_r;
+  wide_float lobe = lobe_normal_scale(clean(s_p.a), clean(s_q.a));
+  return max(1.0f - c, wide_float(0.0f)) * k_n * lobe + dr * dr * k_r;
 }
 
 // The exponent of the cross bilateral filter's range weight between guide texels g (rgb range
@@ -118,6 +131,20 @@ PXF_INLINE wide_float range_exponent(vec4 g_p, vec4 g_q, vec4 s_p, vec4 s_q, flo
 PXF_INLINE wide_float range_weight(vec4 g_p, vec4 g_q, vec4 s_p, vec4 s_q, float k_c, float k_d, float k_n,
                                    float k_r) {
   return exp(-range_exponent(g_p, g_q, s_p, s_q, k_c, k_d, k_n, k_r));
+}
+
+// The à-trous variant's luminance edge stop (SVGF, Schied et al. 2017): the exponent
+// |Y(l_p) - Y(l_q)| / (sigma_l sqrt(Var_p)) with k_l = 1 / sigma_l, Var_p the variance of the
+// signal at p in this pass. It stops the kernel at edges of the light itself that the guide does
+// not show (a shadow's edge, a highlight) once they stand out of the noise, and lets the noise
+// through. 0 where Var_p is unknown or k_l is 0 (off); a noise-free pixel (Var_p = 0) keeps to
+// neighbours equal to it.
+PXF_INLINE wide_float luminance_edge_exponent(vec3 l_p, vec3 l_q, float var_p, float k_l) {
+  if (!(k_l > 0.0f) || var_p < 0.0f) return 0.0f;
+  wide_float d = abs(wide_float(luminance(l_p)) - wide_float(luminance(l_q)));
+  if (!(d > 0.0f)) return 0.0f;
+  wide_float sd = sqrt(wide_float(var_p));
+  return sd > 0.0f ? min(d * wide_float(k_l) / sd, wide_float(1e4f)) : wide_float(1e4f);
 }
 
 // ---- Kernel sums ----
