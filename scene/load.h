@@ -22,7 +22,7 @@ struct LoadLimits {
 };
 
 // The loader's memory estimate for a scene, in bytes: what the loaded scene, the BVH, the raster
-// pass's copies and the decoding need at the peak (docs/scenes.md, "Resource limits").
+// pass's copies and draws and the decoding need at the peak (docs/scenes.md, "Resource limits").
 struct LoadEstimate {
   uint64_t vertices = 0, triangles = 0;  // instanced
   uint64_t meshes = 0;                   // instanced primitives: each a Mesh, a BVH geometry, a draw

@@ -1451,6 +1451,10 @@ void check_scene_file(const std::string& path) {
 // (3 x 12 B) and the BVH (Embree's build, about 100 B). Per instanced primitive, whatever its size:
 // a Mesh with its vectors, an Embree geometry and the raster pass's draw (measured on many
 // instances of a quad above the vertices' and triangles' share, with a margin).
+// The raster pass's draws through llvmpipe, the software GL that renders headless: it bins every
+// triangle it draws (about 700 B each with the range pass's varyings) into scenes of bounded size
+// that queue for its rasterizer threads, so this grows with the triangles up to a ceiling and
+// then stays (docs/robustness.md, "Memory", has the measurements).
 // Per instanced punctual light: the PunctualLight in a growing vector (up to 3 copies while it
 // doubles) and the light sampler's pointer (measured on many lights). Textures: their
 // storage, the raster pass's copy (at most as large), and the largest image's decoding buffers.
@@ -1460,9 +1464,11 @@ void check_scene_file(const std::string& path) {
 uint64_t LoadEstimate::bytes() const {
   constexpr uint64_t kBytesPerVertex = 72 + 2 * 64, kBytesPerTriangle = 3 * 12 + 100, kBytesPerMesh = 8192,
                      kBytesPerLight = 320, kBytesPerEnvironmentTexel = 40;
+  constexpr uint64_t kRasterBinBytesPerTriangle = 768, kRasterBinBytesMax = uint64_t{160} << 20;
   auto add = [](uint64_t a, uint64_t b) { return a > UINT64_MAX - b ? UINT64_MAX : a + b; };
   auto mul = [](uint64_t a, uint64_t b) { return b != 0 && a > UINT64_MAX / b ? UINT64_MAX : a * b; };
-  const uint64_t geometry = add(add(mul(vertices, kBytesPerVertex), mul(triangles, kBytesPerTriangle)),
+  const uint64_t raster_bins = std::min(mul(triangles, kRasterBinBytesPerTriangle), kRasterBinBytesMax);
+  const uint64_t geometry = add(add(add(mul(vertices, kBytesPerVertex), mul(triangles, kBytesPerTriangle)), raster_bins),
                                 add(mul(meshes, kBytesPerMesh), mul(lights, kBytesPerLight)));
   const uint64_t images = add(add(mul(texture_bytes, 2), largest_decode_bytes),
                               mul(environment_texels, kBytesPerEnvironmentTexel));
