@@ -98,14 +98,16 @@ PXF_INLINE float clean_var(float v) { return (isnan(v) || isinf(v) || v < 0.0f) 
 PXF_CONST float kMinSurfaceNormal = 0.25f;
 // The normal term narrows with the sharper of the two surfaces' glossy lobes: the light a lobe of
 // GGX alpha = roughness^2 reflects changes over normals about alpha / 2 apart, so a highlight on a
-// curved glossy surface is not spread over its neighbours. sigma_n applies from alpha
-// kLobeAlphaWide up (rough, nearly diffuse surfaces); below it sigma_n alpha / kLobeAlphaWide, at
-// least kLobeNarrowest sigma_n (a mirror-like lobe).
-PXF_CONST float kLobeAlphaWide = 0.6f;
-PXF_CONST float kLobeNarrowest = 0.02f;
+// curved glossy surface must not be spread over its neighbours. sigma_n applies from roughness
+// kLobeRoughnessWide up (nearly diffuse surfaces); below it sigma_n roughness / kLobeRoughnessWide,
+// at least kLobeNarrowest sigma_n. Linear in the roughness rather than in alpha: the sharpest lobes
+// keep a few pixels' averaging on a smooth surface, and the weight does not hang on the roughness's
+// last bits.
+PXF_CONST float kLobeRoughnessWide = 0.8f;
+PXF_CONST float kLobeNarrowest = 0.1f;
 PXF_INLINE wide_float lobe_normal_scale(float roughness_p, float roughness_q) {
   float r = clamp(min(roughness_p, roughness_q), 0.0f, 1.0f);
-  wide_float s = wide_float(clamp(r * r / kLobeAlphaWide, kLobeNarrowest, 1.0f));
+  wide_float s = wide_float(clamp(r * (1.0f / kLobeRoughnessWide), kLobeNarrowest, 1.0f));
   return 1.0f / (s * s);
 }
 PXF_INLINE wide_float surface_exponent(vec4 s_p, vec4 s_q, float k_n, float k_r) {
@@ -113,10 +115,13 @@ PXF_INLINE wide_float surface_exponent(vec4 s_p, vec4 s_q, float k_n, float k_r)
   vec3 a = clean(vec3(s_p)), b = clean(vec3(s_q));
   float la = dot(a, a), lb = dot(b, b);
   if (!(la >= kMinSurfaceNormal * kMinSurfaceNormal) || !(lb >= kMinSurfaceNormal * kMinSurfaceNormal)) return 0.0f;
-  wide_float c = wide_float(dot(a, b)) / sqrt(wide_float(la) * wide_float(lb));
+  // 1 - cos = |a/|a| - b/|b||^2 / 2, which keeps its precision for nearly equal normals, where the
+  // narrow lobes' scale (up to 2500) would magnify the rounding of 1 - cos.
+  wide_vec3 d = wide_vec3(a) / sqrt(wide_float(la)) - wide_vec3(b) / sqrt(wide_float(lb));
+  wide_float one_minus_cos = 0.5f * dot(d, d);
   wide_float dr = wide_float(clean(s_p.a)) - wide_float(clean(s_q.a));
   wide_float lobe = lobe_normal_scale(clean(s_p.a), clean(s_q.a));
-  return max(1.0f - c, wide_float(0.0f)) * k_n * lobe + dr * dr * k_r;
+  return one_minus_cos * k_n * lobe + dr * dr * k_r;
 }
 
 // The exponent of the cross bilateral filter's range weight between guide texels g (rgb range
@@ -672,7 +677,7 @@ PXF_INLINE float modulated_var(float v, vec3 l, vec3 m) {
 // m = modulation_factor(mean albedo). A pixel whose mean albedo's luminance is below kAlbedoEpsilon
 // holds no light to demodulate (its L_u shrinks with its coverage and is about 0), and as a neighbour
 // it would pull the light filtered around it toward 0: it takes the mean of its 3x3 neighbours that
-// are demodulated, with an unknown variance (they speak for it, it adds no evidence of its own).
+// are demodulated, and the mean of their variances (they speak for it).
 // None of them: its own L_u and Var[L_u], as without demodulation.
 PXF_SAMPLER_FN vec4 demodulated_texel(sampler2D hv, sampler2D albedo, ivec2 p) {
   vec4 own = texelFetch(hv, p, 0);
@@ -681,17 +686,24 @@ PXF_SAMPLER_FN vec4 demodulated_texel(sampler2D hv, sampler2D albedo, ivec2 p) {
   if (luminance(m) >= kAlbedoEpsilon) return vec4(l / m, modulated_var(clean_var(own.a), l, vec3(1.0f) / m));
   ivec2 size = textureSize(hv, 0);
   vec3 sum = vec3(0.0f);
-  float count = 0.0f;
+  float count = 0.0f, var_sum = 0.0f, var_count = 0.0f;
   for (int dy = -1; dy <= 1; ++dy)
     for (int dx = -1; dx <= 1; ++dx) {
       ivec2 q = p + ivec2(dx, dy);
       if (q.x < 0 || q.y < 0 || q.x >= size.x || q.y >= size.y) continue;
       vec3 mq = modulation_factor(vec3(texelFetch(albedo, q, 0)));
       if (!(luminance(mq) >= kAlbedoEpsilon)) continue;
-      sum += clean(vec3(texelFetch(hv, q, 0))) / mq;
+      vec4 texel = texelFetch(hv, q, 0);
+      vec3 lq = clean(vec3(texel));
+      sum += lq / mq;
       count += 1.0f;
+      float vq = modulated_var(clean_var(texel.a), lq, vec3(1.0f) / mq);
+      if (vq >= 0.0f) {
+        var_sum += vq;
+        var_count += 1.0f;
+      }
     }
-  if (count > 0.0f) return vec4(sum / count, kVarUnknown);
+  if (count > 0.0f) return vec4(sum / count, var_count > 0.0f ? var_sum / var_count : kVarUnknown);
   return vec4(l, clean_var(own.a));
 }
 
