@@ -464,7 +464,7 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
   const PathSampler::LightNumbers u_light = numbers ? numbers->light : sampler.light_numbers(vertex, bsdf.has_nondelta());
   if (bsdf.has_nondelta()) sample_direct_light<kClassify>(path, v, u_light, shadows, cls);
   // Light through a specular chain, which NEE cannot reach (HV: D S+ L).
-  const bool room = !chains_.empty() && bsdf.has_nondelta() && vertex + 2 <= params.max_vertices;
+  const bool room = chains_.traces_any(params) && bsdf.has_nondelta() && vertex + 2 <= params.max_vertices;
   const SpecularChainSampler::Plan plan = room ? chains_.plan(sp.position, params, s.nonspecular == 0)
                                                : SpecularChainSampler::Plan{};
   if (plan.traces()) add_chain_light<kClassify>(path, v, plan, params, cls);

@@ -105,7 +105,7 @@ SpecularChainSampler::Plan SpecularChainSampler::plan(glm::vec3 p, const TracePa
     for (const Target& t : targets_) plan.candidates += t.near(p);
     if (plan.candidates > 0) return plan;
   }
-  if (solved_chain_share_ > 0.0f && mirror_caster_targets_ > 0) {
+  if (far_chains()) {
     plan.targets = Plan::Targets::Casters;
     plan.candidates = mirror_caster_targets_;
     plan.probability = kFarCasterChainProbability;

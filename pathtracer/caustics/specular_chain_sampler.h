@@ -70,6 +70,13 @@ class SpecularChainSampler {
   bool has_perfect_specular() const { return has_perfect_specular_; }
   // No target: no vertex traces a chain, and plan() need not be asked.
   bool empty() const { return targets_.empty(); }
+  // Whether plan() can give any vertex a chain under these params: with the chains of
+  // TraceParams::specular_chains only, a scene needs a target that fills its bounding sphere (near
+  // chains) or a mirror sphere whose light is solved for (far chains). False: plan() need not be
+  // asked, its answer would be no chain everywhere.
+  bool traces_any(const TraceParams& params) const {
+    return params.specular_sampling ? !targets_.empty() : params.specular_chains && (has_near_targets_ || far_chains());
+  }
   const std::vector<Target>& targets() const { return targets_; }
 
   // The chains a non-delta vertex at p traces (the first one of its path: `first_vertex`).
@@ -94,6 +101,8 @@ class SpecularChainSampler {
   // (SphereCausticSampler::sample's), which need not be solved for again.
   float pdf(glm::vec3 p, glm::vec3 wi, const Plan& plan, const Target* drawn_from, float drawn_pdf) const;
   void set_up_solved_chains();
+  // The far chains toward the mirror spheres (Plan::Targets::Casters).
+  bool far_chains() const { return solved_chain_share_ > 0.0f && mirror_caster_targets_ > 0; }
 
   // The chains toward a sphere target are drawn toward the emissive triangles by solving for the
   // path through the sphere (pathtracer/caustics/sphere_caustics.h, docs/sampling.md): all of

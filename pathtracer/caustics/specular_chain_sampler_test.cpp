@@ -64,6 +64,41 @@ TEST(SpecularChainSampler, NoPerfectlySpecularMeshNoChains) {
     EXPECT_FALSE(c.sampler.plan(glm::vec3(0.0f), with(all, true), true).traces());
 }
 
+// Glass that fills little of its bounding sphere (six small balls in one mesh, as jars on a shelf)
+// and is no sphere: a target for --specular-sampling, but the default chains have nothing to aim
+// at, so no vertex asks for a plan. The Cornell box's spheres get both kinds of chain.
+TEST(SpecularChainSampler, TracesAnyOnlyWhereAPlanCanHaveCandidates) {
+  Scene scene = make_cornell_box(false);
+  const int glass = static_cast<int>(scene.materials.size());
+  scene.materials.push_back(make_glass());
+  Mesh spread;
+  spread.material = glass;
+  for (int axis = 0; axis < 3; ++axis)
+    for (float sign : {-1.0f, 1.0f}) {
+      glm::vec3 c(0.0f, -0.5f, 0.0f);
+      c[axis] += sign * 0.4f;
+      const Mesh small = make_sphere(c, 0.05f, glass, 8, 4);
+      const uint32_t base = static_cast<uint32_t>(spread.positions.size());
+      spread.positions.insert(spread.positions.end(), small.positions.begin(), small.positions.end());
+      spread.normals.insert(spread.normals.end(), small.normals.begin(), small.normals.end());
+      spread.uv0.insert(spread.uv0.end(), small.uv0.begin(), small.uv0.end());
+      for (const glm::uvec3& t : small.triangles) spread.triangles.push_back(t + glm::uvec3(base));
+    }
+  scene.meshes.push_back(spread);
+  const Chains jars(scene);
+  ASSERT_FALSE(jars.sampler.empty());
+  EXPECT_TRUE(jars.sampler.traces_any(with(true, false)));
+  EXPECT_FALSE(jars.sampler.traces_any(with(false, true)));
+  EXPECT_FALSE(jars.sampler.traces_any(with(false, false)));
+  for (const glm::vec3& p : points_in_the_box())
+    for (bool first : {true, false}) EXPECT_FALSE(jars.sampler.plan(p, with(false, true), first).traces());
+
+  const Chains spheres(cornell(false));
+  EXPECT_TRUE(spheres.sampler.traces_any(with(false, true)));
+  EXPECT_TRUE(spheres.sampler.traces_any(with(true, false)));
+  EXPECT_FALSE(spheres.sampler.traces_any(with(false, false)));
+}
+
 // A plan's candidates are the targets it includes; every target with --specular-sampling, none
 // with the chains off, else the near ones at the first vertex or the mirror spheres 1 time in 20.
 TEST(SpecularChainSampler, PlanCountsTheTargetsItIncludes) {
