@@ -76,7 +76,7 @@ void apply_sample_settings(const SampleSettings& s, SceneOptions& scene, Preview
   preview.trace.guiding = s.guiding != 0;
   const auto mode = static_cast<SpecularSamplingMode>(s.specular_sampling);
   preview.trace.specular_sampling = mode == SpecularSamplingMode::All;
-  preview.trace.near_specular_sampling = mode == SpecularSamplingMode::Near;
+  preview.trace.specular_chains = mode == SpecularSamplingMode::Chains;
 }
 
 Checkpointer::Checkpointer(const CheckpointOptions& options, const std::string& out_dir,

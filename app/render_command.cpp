@@ -47,6 +47,75 @@ class ProgressBar {
   double last_print_ = -1e9;
 };
 
+// render --camera-path: the frame sequence (app/camera_path_render.h).
+int render_camera_path(const std::string& camera_path, PathRenderOptions path_options, const std::string& out,
+                       bool quiet, SceneOptions& scene_options, PreviewSettings& preview_settings,
+                       const CommandLine& cli) {
+  path_options.out = out;
+  path_options.quiet = quiet;
+  Scene scene = load_scene_for(scene_options, preview_settings, cli);
+  check_output_folder(out);  // before the path's cameras are made and traced
+  const CameraPath path = camera_path_for(camera_path, scene);
+  set_gl_timing(scene_options.stage_timing);
+  auto context = create_gl_context(parse_gl_backend(scene_options.gl));
+  return run_camera_path_render(scene, scene_options.scene, preview_settings, scene_options.width,
+                                scene_options.height, path, path_options);
+}
+
+// The frames of a render, from the first one the preview lacks (> 0 after --resume) until `total`,
+// the budget, a clean image (report->until_clean) or a stop signal; the clean checks go to *report.
+void trace_render_frames(Preview& preview, Checkpointer& checkpointer, ProgressBar& progress, int total,
+                         double budget_ms, BenchClock::time_point start, bool quiet, RenderReport* report) {
+  const int first = preview.samples();
+  GrowingSchedule checks = clean_checks(first);
+  for (int i = first; i < total && !stop_signal(); ++i) {
+    // The first frame always traces; the next ones only while they and the finish fit the budget.
+    if (i > first && !next_frame_fits(preview.predict_next_frame(budget_ms, elapsed_ms(start)))) break;
+    // With a budget the first frame is displayed: that measures the finish's blend and tone map.
+    // Clean is the blend's finding on a fresh filter run: a check frame is run like a last frame
+    // (filter and blend; app/adaptive.h, clean_checks).
+    const bool check_clean = report->until_clean && checks.due(preview.samples() + 1);
+    preview.add_frame(/*last_frame=*/check_clean, /*display=*/check_clean || (i == first && budget_ms > 0));
+    if (check_clean) {
+      report->case2_share_over_time.push_back({elapsed_ms(start), double(preview.samples()), preview.case2_share()});
+      checks.done(preview.samples());
+    }
+    checkpointer.maybe_write(preview);
+    if (!quiet) progress.update(i + 1, i + 1 == total);
+    if (check_clean && preview.clean()) {
+      report->clean_ms = elapsed_ms(start);
+      if (preview.case2_share() < 1.0)
+        std::printf("until-clean: clean at %d spp with no filter run: HV carries %.3g %% of the energy, below the "
+                    "%g %% the filter runs from, so every pixel is unfiltered and unbiased\n",
+                    preview.samples(), 100.0 * hv_energy_share(preview.renderer().accumulation()), 100.0 * kMinHvShare);
+      break;
+    }
+  }
+}
+
+// What a finished render prints: its times, the budget, the error against a reference and the files.
+void print_render_summary(const SceneOptions& scene_options, const Preview& preview, const RenderReport& report,
+                          const std::string& out, const Checkpointer& checkpointer) {
+  const StageTimes& t = preview.total_times();
+  std::printf("%s: %dx%d, %d spp%s, %.2f s (path tracing %.0f ms, upload %.0f, range %.0f, filter %.0f in %d runs, "
+              "blend %.0f, tone map %.0f)\n",
+              scene_options.scene.c_str(), preview.width(), preview.height(), preview.samples(),
+              report.interrupted ? " (interrupted)" : "", report.wall_ms / 1000.0, t.path_tracing, t.upload, t.range,
+              t.filter, preview.filter_runs(), t.blend, t.tonemap);
+  std::printf("outside path tracing: %.1f %% of the job (filter + range %.1f %% of the tracing)\n",
+              100.0 * share_outside_tracing(t, report.used_ms), 100.0 * pass_share_of_tracing(t));
+  if (report.budget_ms > 0)
+    std::printf("time budget %.2f s: used %.2f s until the finish\n", report.budget_ms / 1000.0,
+                report.used_ms / 1000.0);
+  if (report.final_vs_reference)
+    std::printf("NRMSE vs reference: final %.3f %%, unfiltered %.3f %%\n", report.final_vs_reference->nrmse_percent,
+                report.unfiltered_vs_reference->nrmse_percent);
+  std::printf("wrote %s/final.png, %s/final.exr, %s/buffers.exr, %s/stats.json\n", out.c_str(), out.c_str(),
+              out.c_str(), out.c_str());
+  if (checkpointer.written())
+    std::printf("wrote %s (state writes %.0f ms in all)\n", state_path(out).c_str(), checkpointer.write_ms());
+}
+
 }  // namespace
 
 int run_render(const Args& args) {
@@ -99,15 +168,7 @@ int run_render(const Args& args) {
     if (cli.given("--spp-per-frame") && cli.given("--time-per-frame"))
       throw UsageError("--spp-per-frame and --time-per-frame exclude each other");
     if (uses_state(checkpoint_options)) throw UsageError("checkpoints do not go with --camera-path");
-    path_options.out = out;
-    path_options.quiet = quiet;
-    Scene scene = load_scene_for(scene_options, preview_settings, cli);
-    check_output_folder(out);  // before the path's cameras are made and traced
-    const CameraPath path = camera_path_for(camera_path, scene);
-    set_gl_timing(scene_options.stage_timing);
-    auto context = create_gl_context(parse_gl_backend(scene_options.gl));
-    return run_camera_path_render(scene, scene_options.scene, preview_settings, scene_options.width,
-                                  scene_options.height, path, path_options);
+    return render_camera_path(camera_path, path_options, out, quiet, scene_options, preview_settings, cli);
   }
   const double budget_ms = time_s * 1000.0;
   if ((budget_ms > 0 || until_clean) && !cli.given("--spp")) {
@@ -142,33 +203,9 @@ int run_render(const Args& args) {
   const StopSignalHandlers stop_handlers;  // kept through the writes: a stop then still gives 128 + signal
   const int total = static_cast<int>(frames.count());
   ProgressBar progress(total);
-  const int first = preview.samples();  // > 0 after --resume
   RenderReport report;
   report.until_clean = until_clean;
-  GrowingSchedule checks = clean_checks(first);
-  for (int i = first; i < total && !stop_signal(); ++i) {
-    // The first frame always traces; the next ones only while they and the finish fit the budget.
-    if (i > first && !next_frame_fits(preview.predict_next_frame(budget_ms, elapsed_ms(start)))) break;
-    // With a budget the first frame is displayed: that measures the finish's blend and tone map.
-    // Clean is the blend's finding on a fresh filter run: a check frame is run like a last frame
-    // (filter and blend; app/adaptive.h, clean_checks).
-    const bool check_clean = until_clean && checks.due(preview.samples() + 1);
-    preview.add_frame(/*last_frame=*/check_clean, /*display=*/check_clean || (i == first && budget_ms > 0));
-    if (check_clean) {
-      report.case2_share_over_time.push_back({elapsed_ms(start), double(preview.samples()), preview.case2_share()});
-      checks.done(preview.samples());
-    }
-    checkpointer.maybe_write(preview);
-    if (!quiet) progress.update(i + 1, i + 1 == total);
-    if (check_clean && preview.clean()) {
-      report.clean_ms = elapsed_ms(start);
-      if (preview.case2_share() < 1.0)
-        std::printf("until-clean: clean at %d spp with no filter run: HV carries %.3g %% of the energy, below the "
-                    "%g %% the filter runs from, so every pixel is unfiltered and unbiased\n",
-                    preview.samples(), 100.0 * hv_energy_share(preview.renderer().accumulation()), 100.0 * kMinHvShare);
-      break;
-    }
-  }
+  trace_render_frames(preview, checkpointer, progress, total, budget_ms, start, quiet, &report);
   preview.finish();
   const double used_ms = elapsed_ms(start);
   const std::string state_error = checkpointer.write_final(preview);  // reported after the outputs
@@ -191,22 +228,7 @@ int run_render(const Args& args) {
     throw;
   }
 
-  const StageTimes& t = preview.total_times();
-  std::printf("%s: %dx%d, %d spp%s, %.2f s (path tracing %.0f ms, upload %.0f, range %.0f, filter %.0f in %d runs, "
-              "blend %.0f, tone map %.0f)\n",
-              scene_options.scene.c_str(), preview.width(), preview.height(), preview.samples(),
-              report.interrupted ? " (interrupted)" : "", report.wall_ms / 1000.0, t.path_tracing, t.upload, t.range,
-              t.filter, preview.filter_runs(), t.blend, t.tonemap);
-  std::printf("outside path tracing: %.1f %% of the job (filter + range %.1f %% of the tracing)\n",
-              100.0 * share_outside_tracing(t, used_ms), 100.0 * pass_share_of_tracing(t));
-  if (budget_ms > 0) std::printf("time budget %.2f s: used %.2f s until the finish\n", budget_ms / 1000.0, used_ms / 1000.0);
-  if (report.final_vs_reference)
-    std::printf("NRMSE vs reference: final %.3f %%, unfiltered %.3f %%\n", report.final_vs_reference->nrmse_percent,
-                report.unfiltered_vs_reference->nrmse_percent);
-  std::printf("wrote %s/final.png, %s/final.exr, %s/buffers.exr, %s/stats.json\n", out.c_str(), out.c_str(),
-              out.c_str(), out.c_str());
-  if (checkpointer.written())
-    std::printf("wrote %s (state writes %.0f ms in all)\n", state_path(out).c_str(), checkpointer.write_ms());
+  print_render_summary(scene_options, preview, report, out, checkpointer);
   if (!state_error.empty()) {
     std::fprintf(stderr, "pxf render: %s\n", state_error.c_str());
     return 1;

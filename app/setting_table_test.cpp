@@ -158,7 +158,7 @@ TEST(SettingTable, AChangeInvalidatesWhatItsDescriptorSays) {
   // Under full specular sampling the near-only switch changes nothing.
   PreviewSettings a, b;
   a.trace.specular_sampling = b.trace.specular_sampling = true;
-  b.trace.near_specular_sampling = !a.trace.near_specular_sampling;
+  b.trace.specular_chains = !a.trace.specular_chains;
   EXPECT_FALSE(changes(a, b, SettingEffect::Retrace));
   // A threshold and a seed together: the seed's retrace is what the preview must do.
   b = PreviewSettings{};

@@ -194,7 +194,7 @@ void run_guiding_bound_bench(const GuidingBoundBenchSetup& b, const GuidingBound
   }
   if (bound.chains_left_out)
     std::printf("note: the renderer's first vertices here also trace specular chains, which the cells leave out: these "
-                "figures do not bound the renderer (--near-specular off, or a scene without perfectly specular meshes)\n");
+                "figures do not bound the renderer (--specular-chains off, or a scene without perfectly specular meshes)\n");
   write_bench_text(b.out + "/guiding_bound.csv", csv.str());
   std::printf("wrote %s/guiding_bound.csv\n", b.out.c_str());
 }

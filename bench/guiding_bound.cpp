@@ -236,7 +236,7 @@ GuidingBound measure_guiding_bound(const Scene& scene, const TraceParams& params
   tbb::task_arena arena(params.threads > 0 ? params.threads : tbb::task_arena::automatic);
   Rng rng(s.seed, 0, 0);
   GuidingBound bound;
-  bound.chains_left_out = tracer.has_perfect_specular() && (params.specular_sampling || params.near_specular_sampling);
+  bound.chains_left_out = tracer.has_perfect_specular() && (params.specular_sampling || params.specular_chains);
   std::vector<GuidingBoundPoint>& out = bound.points;
   for (int attempt = 0; attempt < 100 * s.points && static_cast<int>(out.size()) < s.points; ++attempt) {
     const int x = std::min(width - 1, int(rng.next_float() * width));

@@ -72,7 +72,7 @@ struct GuidingBoundSettings {
 struct GuidingBound {
   std::vector<GuidingBoundPoint> points;
   // The renderer's first vertices also trace specular chains toward the scene's perfectly specular
-  // meshes (TraceParams::near_specular_sampling), a strategy the cells leave out: cosine sampling
+  // meshes (TraceParams::specular_chains), a strategy the cells leave out: cosine sampling
   // here is then noisier than the unguided renderer, and the figures do not bound it.
   bool chains_left_out = false;
 };

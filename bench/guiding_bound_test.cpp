@@ -182,7 +182,7 @@ TEST(GuidingBound, SaysWhenItLeavesTheChainsOut) {
   tiny.floor_directions = 1;
   tiny.floor_paths = 2;
   EXPECT_TRUE(measure_guiding_bound(scene, params, 8, 8, tiny).chains_left_out);
-  params.near_specular_sampling = false;
+  params.specular_chains = false;
   EXPECT_FALSE(measure_guiding_bound(scene, params, 8, 8, tiny).chains_left_out);
 }
 

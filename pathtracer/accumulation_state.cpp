@@ -105,7 +105,7 @@ SampleSettings get_settings(ByteReader& r) {
   s.specular_sampling = r.get<uint32_t>("header");
   s.adaptive = r.get<uint32_t>("header");
   s.guiding = r.get<uint32_t>("header");
-  if (s.all_hv > 1 || s.specular_sampling > static_cast<uint32_t>(SpecularSamplingMode::Near) || s.sampler > 1 ||
+  if (s.all_hv > 1 || s.specular_sampling > static_cast<uint32_t>(SpecularSamplingMode::Chains) || s.sampler > 1 ||
       s.adaptive > 2 || s.guiding > 1)
     throw Error("state file has an invalid setting flag (all-hv, sampler, specular sampling, adaptive or guiding)");
   if (s.replicates < 1 || s.replicates > kMaxReplicates)

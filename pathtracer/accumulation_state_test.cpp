@@ -184,10 +184,10 @@ TEST(AccumulationState, SamplerSettingsRoundTripAndAreChecked) {
   a = plain;
   a.replicates = 4;
   EXPECT_EQ(a.difference(plain), "replicates 4 vs 1");
-  // The default is near specular sampling (2); without it 0; --specular-sampling wins over it (1).
+  // The default is the specular chains (2); without them 0; --specular-sampling wins over them (1).
   EXPECT_EQ(plain.specular_sampling, 2u);
   TraceParams none;
-  none.near_specular_sampling = false;
+  none.specular_chains = false;
   EXPECT_EQ(sample_settings(0x1234, kW, kH, none).specular_sampling, 0u);
   a = plain;
   a.specular_sampling = 1;

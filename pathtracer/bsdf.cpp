@@ -29,9 +29,16 @@ bool constant(const TextureRef& ref) { return !ref.valid(); }
 
 // A lobe's normal n turned to wo's side of the face (ng faces wo); the face itself where wo is below
 // n's horizon (interpolated or mapped normals can put it there).
+// a or b, chosen per component: a select of values that the compiler keeps in registers, where
+// `c ? a : b` of two vectors became a load through a pointer to one of them, which stalled on the
+// stores that had just written them (about a quarter of the Bsdf constructor's time).
+inline glm::vec3 select(bool c, glm::vec3 a, glm::vec3 b) {
+  return glm::vec3(c ? a.x : b.x, c ? a.y : b.y, c ? a.z : b.z);
+}
+
 glm::vec3 normal_facing(glm::vec3 n, glm::vec3 ng, glm::vec3 wo) {
-  const glm::vec3 facing = glm::dot(n, ng) >= 0.0f ? n : -n;
-  return glm::dot(wo, facing) > 1e-4f ? facing : ng;
+  const glm::vec3 facing = select(glm::dot(n, ng) >= 0.0f, n, -n);
+  return select(glm::dot(wo, facing) > 1e-4f, facing, ng);
 }
 
 // wo in a lobe's frame, kept just above its horizon.
@@ -167,7 +174,7 @@ Bsdf::Bsdf(const BsdfMaterial& k, glm::vec3 shading_normal, glm::vec3 geometric_
   g1_o_ = 1.0f / (1.0f + lambda_o_);
   // The coat reflects clearcoat * E_coat of the light, the sheen below it sheen_color * E_sheen of
   // the rest (scaling what is below by 1 - max(sheen_color) E_sheen), and the base gets the rest.
-  const float coat_albedo = set_up_coat(k, glm::dot(coat_normal, coat_normal) > 0.0f ? coat_normal : ns, wo);
+  const float coat_albedo = set_up_coat(k, coat_normal, ns, wo);
   const float coat_share = 1.0f - clearcoat_ * coat_albedo;
   const float sheen_albedo_o = set_up_sheen(k, coat_share);
   const float base_share = coat_share * std::max(0.0f, 1.0f - max_component(k.sheen_color) * sheen_albedo_o);
@@ -232,10 +239,13 @@ void Bsdf::choose_lobes(float w_diffuse, float w_glossy, float w_sheen, float w_
                   (p_coat_ > 0.0f && !coat_delta_) || (p_glass_ > 0.0f && !glass_delta_);
 }
 
-// The coat's frame at wo and its compensated albedo (F0 0.04, ior 1.5); 0 without a coat.
-float Bsdf::set_up_coat(const BsdfMaterial& k, glm::vec3 coat_normal, glm::vec3 wo) {
+// The coat's frame at wo and its compensated albedo (F0 0.04, ior 1.5); 0 without a coat. The
+// coat's normal is coat_normal, or the base's shading normal ns where it is zero (no coat normal
+// map); chosen after the coat test, so that a material without a coat does not wait on ns.
+float Bsdf::set_up_coat(const BsdfMaterial& k, glm::vec3 coat_normal, glm::vec3 ns, glm::vec3 wo) {
   clearcoat_ = k.clearcoat;
   if (!(clearcoat_ > 0.0f)) return 0.0f;
+  if (!(glm::dot(coat_normal, coat_normal) > 0.0f)) coat_normal = ns;
   coat_alpha_ = k.coat_alpha;
   coat_delta_ = k.coat_delta;
   coat_frame_ = Frame::from_normal(normal_facing(coat_normal, ng_, wo));

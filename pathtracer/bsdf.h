@@ -128,7 +128,7 @@ class Bsdf {
   glm::vec3 eval_local(glm::vec3 wi, float* pdf) const;
   glm::vec3 eval_glass_transmission(glm::vec3 wi, float* pdf) const;
   glm::vec3 eval_coat(glm::vec3 wi_coat, float* pdf) const;  // adds the coat's pdf to *pdf
-  float set_up_coat(const BsdfMaterial& material, glm::vec3 coat_normal, glm::vec3 wo);
+  float set_up_coat(const BsdfMaterial& material, glm::vec3 coat_normal, glm::vec3 ns, glm::vec3 wo);
   glm::vec3 eval_sheen(glm::vec3 wi) const;  // f cos of the sheen lobe (local, wi.z > 0)
   float set_up_sheen(const BsdfMaterial& material, float coat_share);
   glm::vec3 set_up_base(const BsdfMaterial& material, float base_share);

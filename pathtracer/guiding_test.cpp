@@ -17,14 +17,6 @@
 namespace pxf {
 namespace {
 
-Environment uniform_environment(float radiance) {
-  Environment env;
-  env.image.width = 8;
-  env.image.height = 4;
-  env.image.texels.assign(32, glm::vec4(radiance, radiance, radiance, 1.0f));
-  return env;
-}
-
 TraceParams guided_params() {
   TraceParams params;
   params.guiding = true;
@@ -134,7 +126,7 @@ TEST(Guiding, TrainedFieldFindsTheMirrorCaustic) {
     p.guiding = guided;
     p.seed = 5;
     // Guiding alone: the specular chains solve for the mirror's caustic themselves (docs/sampling.md).
-    p.near_specular_sampling = false;
+    p.specular_chains = false;
     const PixelRect rect{0, 0, size, size};
     std::vector<PathSample> out(static_cast<size_t>(rect.count()));
     std::vector<HvSampleClass> classes(out.size());

@@ -7,6 +7,7 @@
 
 #include "pathtracer/bsdf.h"
 #include "pathtracer/guiding_field.h"
+#include "pathtracer/guiding_mixture.h"
 #include "pathtracer/sampler.h"
 
 #include <tbb/parallel_for.h>
@@ -42,11 +43,6 @@ struct PathState {
 // PathState::roulette_scale; bounded so that the scale stays finite (any factor keeps roulette unbiased).
 float unguided_weight_ratio(float mixture_pdf, float bsdf_pdf) {
   return bsdf_pdf > 0.0f ? std::min(mixture_pdf / bsdf_pdf, 1e6f) : 1e6f;
-}
-
-// Emission leaves a surface toward the ray only on its front face, unless it is double-sided.
-bool emission_visible(const Material& material, const SurfacePoint& sp) {
-  return material.is_emissive() && (sp.front_face || material.double_sided);
 }
 
 // The path so far is E S* (emission here is E S* L), or E S* D with the D just before (E S* D L).
@@ -114,18 +110,6 @@ struct PathTracer::ClassState {
   }
 };
 
-// The BSDF-side strategy of a vertex: BSDF sampling alone (not guided), or with path guiding the
-// one-sample mixture that picks the guided direction with probability alpha.
-struct PathTracer::GuidingMixture {
-  bool guided = false;
-  GuidingField::Distribution guide;  // the field's at the vertex, when guided
-  float alpha = 0.0f;
-  // The solid-angle pdf of direction wi under the strategy, given the BSDF's own pdf of it.
-  float pdf(float bsdf_pdf, glm::vec3 wi) const {
-    return guided ? alpha * guide.pdf(wi) + (1.0f - alpha) * bsdf_pdf : bsdf_pdf;
-  }
-};
-
 // One path of a batch: its random stream, the ray it traces next, and what it has gathered.
 struct PathTracer::Path {
   PathSampler sampler;
@@ -172,222 +156,20 @@ struct PathTracer::ShadowQueue {
   }
 };
 
+// A surface vertex of a path as shade_vertex's parts see it: the point, its material's parameters,
+// its BSDF, the BSDF-side strategy (guiding_mixture) and the vertex's index.
+struct PathTracer::Vertex {
+  const SurfacePoint& sp;
+  const BsdfParams& params;
+  const Bsdf& bsdf;
+  GuidingMixture mixture;
+  int index;
+};
+
 bool PathSample::finite() const { return is_finite(lv) && is_finite(hv); }
 
-PathTracer::PathTracer(const Scene& scene) : geometry_(scene), lights_(scene) {
-  for (const Material& material : scene.materials) {
-    PrecomputedBsdfMaterial precomputed;
-    precomputed.constant = eval_material_is_constant(material);
-    if (precomputed.constant)
-      precomputed.material =
-          bsdf_material(eval_material(scene, material, glm::vec2(0.0f), glm::vec2(0.0f), glm::vec4(1.0f)));
-    precomputed_materials_.push_back(precomputed);
-  }
-  for (unsigned mesh_index = 0; mesh_index < scene.meshes.size(); ++mesh_index) {
-    const Mesh& mesh = scene.meshes[mesh_index];
-    if (!mesh.triangles.empty() && material_is_perfect_specular(scene.materials[mesh.material])) {
-      has_perfect_specular_ = true;
-      glm::vec3 lo(INFINITY), hi(-INFINITY);
-      for (const glm::vec3& p : mesh.positions) {
-        lo = glm::min(lo, p);
-        hi = glm::max(hi, p);
-      }
-      SpecularTarget target;
-      target.center = 0.5f * (lo + hi);
-      for (const glm::vec3& p : mesh.positions) target.radius = std::max(target.radius, glm::length(p - target.center));
-      target.radius *= 1.0001f;
-      // Near chains only toward a mesh that fills its bounding sphere's cone: by Cauchy's formula a
-      // convex surface's mean projected area is a quarter of its area, so area / (4 pi r^2) is the
-      // mean share of the cone it covers (a sphere 1, a cube 0.64; three jars merged into one mesh,
-      // as on the kitchen's shelf, 0.2: chains toward them mostly miss the glass).
-      double area = 0.0;
-      for (unsigned prim = 0; prim < mesh.triangles.size(); ++prim) area += geometry_.triangle_area(mesh_index, prim);
-      const double sphere_area = 4.0 * kPi * double(target.radius) * double(target.radius);
-      if (area >= kNearSpecularMinFill * sphere_area)
-        target.near_distance2 = target.radius * target.radius * kNearSpecularDistance2PerRadius2;
-      SphereCaster caster;
-      if (fit_sphere_caster(mesh.positions, mesh.normals, &caster)) {
-        const Material& m = scene.materials[mesh.material];
-        caster.mirror = material_is_perfect_mirror(m);
-        caster.ior = m.ior;
-        target.caster = static_cast<int>(casters_.size());
-        target.mirror_caster = caster.mirror;
-        casters_.push_back(caster);
-      }
-      if (std::isfinite(target.radius) && target.radius > 0.0f) {
-        mirror_caster_targets_ += target.mirror_caster;
-        specular_targets_.push_back(target);
-        has_near_targets_ |= target.near_distance2 > 0.0f;
-      }
-    }
-  }
-  if (!casters_.empty()) set_up_solved_chains();
-}
-
-void PathTracer::set_up_solved_chains() {
-  const size_t count = lights_.emissive_triangle_count();
-  if (count == 0 || count > kMaxSolvedChainEmitters) return;
-  std::vector<SphereCausticSampler::Emitter> emitters;
-  std::vector<float> powers;
-  for (size_t i = 0; i < count; ++i) {
-    const LightSampler::EmissiveTriangle& t = lights_.triangle(i);
-    emitters.push_back({glm::dvec3(t.p0), glm::dvec3(t.e1), glm::dvec3(t.e2), double(t.area)});
-    powers.push_back(lights_.triangle_power_pmf(i));
-  }
-  caustics_ = SphereCausticSampler(std::move(emitters), powers);
-  if (!caustics_.empty()) solved_chain_share_ = lights_.has_environment() ? kSolvedChainShareWithEnvironment : 1.0f;
-}
-
-const BsdfMaterial& PathTracer::bsdf_material_at(const SurfacePoint& sp, BsdfMaterial* scratch) const {
-  const Scene& scene = geometry_.scene();
-  const size_t index = static_cast<size_t>(sp.material - scene.materials.data());
-  const PrecomputedBsdfMaterial& precomputed = precomputed_materials_[index];
-  if (precomputed.constant && sp.color == glm::vec4(1.0f)) return precomputed.material;
-  *scratch = bsdf_material(eval_material(scene, *sp.material, sp.uv0, sp.uv1, sp.color));
-  return *scratch;
-}
-
-namespace {
-// The cone from p that holds the sphere: its axis and the cosine of its half angle. False when p
-// is inside the sphere or the cone is too narrow to sample in float.
-bool target_cone(glm::vec3 center, float radius, glm::vec3 p, glm::vec3* axis, float* cos_max) {
-  const glm::vec3 d = center - p;
-  const float dist2 = glm::dot(d, d);
-  if (!(dist2 > radius * radius)) return false;
-  *axis = d / std::sqrt(dist2);
-  *cos_max = std::sqrt(std::max(0.0f, 1.0f - radius * radius / dist2));
-  return 1.0f - *cos_max > 1e-6f;
-}
-}  // namespace
-
-bool PathTracer::SpecularTarget::near(glm::vec3 p) const {
-  const glm::vec3 d = center - p;
-  const float d2 = glm::dot(d, d);
-  return d2 <= near_distance2 && d2 > radius * radius;
-}
-
-bool PathTracer::ChainPlan::includes(const SpecularTarget& t, glm::vec3 p) const {
-  return targets == Targets::All || (targets == Targets::Near ? t.near(p) : t.mirror_caster);
-}
-
-PathTracer::ChainPlan PathTracer::chain_plan(glm::vec3 p, const TraceParams& params, bool first_vertex) const {
-  ChainPlan plan;
-  if (specular_targets_.empty()) return plan;
-  if (params.specular_sampling) {
-    plan.candidates = static_cast<int>(specular_targets_.size());
-    return plan;
-  }
-  if (!params.near_specular_sampling) return plan;
-  if (has_near_targets_ && first_vertex) {
-    plan.targets = ChainPlan::Targets::Near;
-    for (const SpecularTarget& t : specular_targets_) plan.candidates += t.near(p);
-    if (plan.candidates > 0) return plan;
-  }
-  if (solved_chain_share_ > 0.0f && mirror_caster_targets_ > 0) {
-    plan.targets = ChainPlan::Targets::Casters;
-    plan.candidates = mirror_caster_targets_;
-    plan.probability = kFarCasterChainProbability;
-  }
-  return plan;
-}
-
-float PathTracer::specular_pdf(glm::vec3 p, glm::vec3 wi, const ChainPlan& plan, const SpecularTarget* drawn_from,
-                               float drawn_pdf) const {
-  float sum = 0.0f;
-  int candidates = 0;
-  for (const SpecularTarget& t : specular_targets_) {
-    if (!plan.includes(t, p)) continue;
-    ++candidates;
-    glm::vec3 axis;
-    float cos_max;
-    if (!target_cone(t.center, t.radius, p, &axis, &cos_max) || glm::dot(wi, axis) < cos_max) continue;
-    const float cone = 1.0f / (2.0f * kPi * (1.0f - cos_max));
-    if (t.caster < 0 || solved_chain_share_ == 0.0f) {
-      sum += cone;
-    } else {  // every solved direction meets the analytic sphere, inside the bounding one: in the cone
-      const float solved = &t == drawn_from ? drawn_pdf : caustics_.pdf(casters_[t.caster], p, wi);
-      sum += (1.0f - solved_chain_share_) * cone + solved_chain_share_ * solved;
-    }
-  }
-  return candidates > 0 ? plan.probability * sum / static_cast<float>(candidates) : 0.0f;
-}
-
-glm::vec3 PathTracer::specular_chain_light(const SurfacePoint& sp, const Bsdf& bsdf, const GuidingMixture& mixture,
-                                           glm::vec3 throughput, int vertex, const ChainPlan& plan,
-                                           PathSampler& sampler, const TraceParams& params, uint32_t* rays,
-                                           bool* through_glass) const {
-  const Scene& scene = geometry_.scene();
-  const PathSampler::SpecularNumbers numbers = sampler.specular_numbers(vertex);
-  float u_select = numbers.select;
-  const glm::vec2 u = numbers.direction;
-  if (u_select >= plan.probability) return glm::vec3(0.0f);  // not traced this time
-  u_select /= plan.probability;
-  // The target: candidate number k of the plan's, chosen uniformly.
-  const int n = plan.candidates;
-  const int chosen = std::min(n - 1, static_cast<int>(u_select * static_cast<float>(n)));
-  // u_select rescaled within the choice: it picks the strategy, then the emitter and the path.
-  float u_rest = std::min(std::max(u_select * static_cast<float>(n) - static_cast<float>(chosen), 0.0f), 0x1.fffffep-1f);
-  int k = chosen;
-  const SpecularTarget* target = nullptr;
-  for (const SpecularTarget& t : specular_targets_)
-    if (plan.includes(t, sp.position) && k-- == 0) {
-      target = &t;
-      break;
-    }
-  glm::vec3 axis;
-  float cos_max;
-  if (!target_cone(target->center, target->radius, sp.position, &axis, &cos_max)) return glm::vec3(0.0f);
-  glm::vec3 wi;
-  const SpecularTarget* drawn_from = nullptr;
-  float drawn_pdf = 0.0f;
-  if (target->caster >= 0 && u_rest < solved_chain_share_) {
-    if (!caustics_.sample(casters_[target->caster], sp.position, u_rest / solved_chain_share_, u, &wi, &drawn_pdf))
-      return glm::vec3(0.0f);
-    drawn_from = target;
-  } else {
-    const float cos_t = 1.0f - u.x * (1.0f - cos_max), sin_t = std::sqrt(std::max(0.0f, 1.0f - cos_t * cos_t));
-    const float phi = 2.0f * kPi * u.y;
-    wi = glm::normalize(Frame::from_normal(axis).to_world(glm::vec3(std::cos(phi) * sin_t, std::sin(phi) * sin_t, cos_t)));
-  }
-  float bsdf_pdf;
-  const glm::vec3 f = bsdf.eval(wi, &bsdf_pdf);
-  const float pdf = specular_pdf(sp.position, wi, plan, drawn_from, drawn_pdf);
-  if (!(max_component(f) > 0.0f) || !(pdf > 0.0f)) return glm::vec3(0.0f);
-  glm::vec3 t = throughput * f / pdf;
-  const float w = power_heuristic(pdf, mixture.pdf(bsdf_pdf, wi));
-  glm::vec3 light(0.0f);
-  Ray ray{offset_ray_origin(sp.position, sp.geometric_normal, wi), wi};
-  // The chain's vertices get the indices the path's own would: the same length limit as BSDF sampling.
-  for (int v = vertex + 1; v <= params.max_vertices; ++v) {
-    const Hit hit = geometry_.intersect(ray);
-    ++*rays;
-    if (!hit.valid()) {
-      if (v > vertex + 1 && lights_.has_environment()) light += t * lights_.environment_radiance(ray.direction) * w;
-      break;
-    }
-    const SurfacePoint q = geometry_.surface_point(hit, ray);
-    const Material& material = *q.material;
-    if (!q.front_face && material.has_volume()) t *= volume_transmittance(material, hit.t);
-    // Emission at the first hit is D L (NEE and BSDF sampling); after a specular bounce it is D S+ L.
-    if (v > vertex + 1 && emission_visible(material, q)) light += t * eval_emission(scene, material, q.uv0, q.uv1) * w;
-    if (!material_is_perfect_specular(material) || v == params.max_vertices) break;
-    BsdfMaterial scratch;
-    const BsdfMaterial& lobes = bsdf_material_at(q, &scratch);
-    const BsdfParams& p = lobes.params;
-    const Bsdf chain_bsdf(lobes, q.shading_normal, q.geometric_normal, -ray.direction, q.front_face, q.clearcoat_normal);
-    if (chain_bsdf.is_black()) break;
-    float u_lobe;
-    glm::vec2 u_dir;
-    sampler.get_chain(vertex, v - vertex, &u_lobe, &u_dir);
-    BsdfSample bs;
-    if (!chain_bsdf.sample(u_lobe, u_dir, &bs) || !bs.delta) break;
-    if (p.transmission > 0.0f && p.metallic < 1.0f) *through_glass = true;
-    t *= bs.weight;
-    ray.origin = offset_ray_origin(q.position, q.geometric_normal, bs.wi);
-    ray.direction = bs.wi;
-  }
-  return light;
-}
+PathTracer::PathTracer(const Scene& scene)
+    : geometry_(scene), lights_(scene), materials_(scene), chains_(geometry_, lights_, materials_) {}
 
 PathSample PathTracer::trace_pixel(const Camera& camera, int width, int height, int x, int y, uint32_t frame,
                                    const TraceParams& params) const {
@@ -551,7 +333,7 @@ void PathTracer::trace_guiding_photon(uint32_t frame, uint32_t index, const Trac
   const uint64_t key = (static_cast<uint64_t>(frame) << 36) | (static_cast<uint64_t>(index) << 4);  // + surface < 16
   const int max_surfaces = std::min(params.max_vertices - 1, kMaxPhotonSurfaces);
   const auto bsdf_at = [&](const SurfacePoint& sp, const glm::vec3& wo, BsdfMaterial* scratch) {
-    return Bsdf(bsdf_material_at(sp, scratch), sp.shading_normal, sp.geometric_normal, wo, sp.front_face, sp.clearcoat_normal);
+    return Bsdf(materials_.at(sp, scratch), sp.shading_normal, sp.geometric_normal, wo, sp.front_face, sp.clearcoat_normal);
   };
   Ray chain_start = ray;  // the segment that left the chain's source
   bool chain_from_infinity = photon.from_infinity, chain_has_delta = false;
@@ -621,12 +403,12 @@ void PathTracer::trace_guiding_photon(uint32_t frame, uint32_t index, const Trac
 }
 
 // Vertex `vertex` of a path at `hit`: the emission found there, next event estimation (queued on
-// `shadows`) and the BSDF sample that continues the path into path.ray. False: the path ends here.
+// `shadows`), the light of a specular chain, and the BSDF sample that continues the path into
+// path.ray. False: the path ends here.
 // kClassify: the firefly attribution's instrumentation (trace_pixels_classified, tests only). It
 // stays inline, in `if constexpr` blocks, because the attribution must see exactly the decisions a
-// render makes, and a second shading function would drift from this one; it costs the renders
-// nothing: with the blocks deleted, the machine code of shade_vertex<false> is byte-identical
-// (objdump, g++ 12 -O3, checked when issue 36 asked).
+// render makes, and a second shading function would drift from this one; the blocks compile away
+// in the renders' instantiation (kClassify false).
 template <bool kClassify>
 bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const TraceParams& params, ShadowQueue& shadows,
                               const PathSampler::VertexNumbers* numbers, [[maybe_unused]] ClassState* cls) const {
@@ -668,7 +450,7 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
 
   glm::vec3 wo = -path.ray.direction;
   BsdfMaterial scratch;
-  const BsdfMaterial& lobes = bsdf_material_at(sp, &scratch);
+  const BsdfMaterial& lobes = materials_.at(sp, &scratch);
   const BsdfParams& bsdf_params = lobes.params;
   Bsdf bsdf(lobes, sp.shading_normal, sp.geometric_normal, wo, sp.front_face, sp.clearcoat_normal);
   if (!s.albedo_set && (bsdf.has_nondelta() || bsdf.is_black())) {
@@ -677,103 +459,141 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
   }
   if (last_vertex || bsdf.is_black()) return false;
 
-  // Path guiding: once the field is trained, the BSDF-side strategy of the path's first non-delta
-  // vertex is the mixture that takes the guided direction with probability alpha (times the
-  // BSDF's diffuse share: the field knows the incident light, not the BSDF, so it serves a diffuse
-  // lobe; glossy and delta lobes keep their samples). Deeper vertices sample the BSDF alone: most
-  // of the heavy-tailed light arrives at the first, and a guided vertex pays field lookups for its
-  // sample and every MIS weight. A leaf that learned no light (a uniform distribution), or only
-  // light behind the surface or too wide to guide, is not guided, and alpha is scaled by the
-  // learned light's share the point's distribution holds. Measured in docs/guiding.md.
+  const Vertex v{sp, bsdf_params, bsdf, guiding_mixture(sp, bsdf, wo, s.nonspecular == 0, params), vertex};
+  // Next event estimation (the light vertex is vertex + 1 <= max_vertices).
+  const PathSampler::LightNumbers u_light = numbers ? numbers->light : sampler.light_numbers(vertex, bsdf.has_nondelta());
+  if (bsdf.has_nondelta()) sample_direct_light<kClassify>(path, v, u_light, shadows, cls);
+  // Light through a specular chain, which NEE cannot reach (HV: D S+ L).
+  const bool room = chains_.traces_any(params) && bsdf.has_nondelta() && vertex + 2 <= params.max_vertices;
+  const SpecularChainSampler::Plan plan = room ? chains_.plan(sp.position, params, s.nonspecular == 0)
+                                               : SpecularChainSampler::Plan{};
+  if (plan.traces()) add_chain_light<kClassify>(path, v, plan, params, cls);
+  return continue_path<kClassify>(path, v, plan, params, numbers, cls);
+}
+
+// Path guiding: once the field is trained, the BSDF-side strategy of the path's first non-delta
+// vertex is the mixture that takes the guided direction with probability alpha (times the
+// BSDF's diffuse share: the field knows the incident light, not the BSDF, so it serves a diffuse
+// lobe; glossy and delta lobes keep their samples). Deeper vertices sample the BSDF alone: most
+// of the heavy-tailed light arrives at the first, and a guided vertex pays field lookups for its
+// sample and every MIS weight. A leaf that learned no light (a uniform distribution), or only
+// light behind the surface or too wide to guide, is not guided, and alpha is scaled by the
+// learned light's share the point's distribution holds. Measured in docs/guiding.md.
+GuidingMixture PathTracer::guiding_mixture(const SurfacePoint& sp, const Bsdf& bsdf, glm::vec3 wo, bool first_vertex,
+                                           const TraceParams& params) const {
   GuidingMixture mixture;
-  if (guiding_ && params.guiding && s.nonspecular == 0 && bsdf.has_nondelta() && guiding_->trained()) {
-    const glm::vec3 n = sp.geometric_normal, wo = -path.ray.direction;
+  if (guiding_ && params.guiding && first_vertex && bsdf.has_nondelta() && guiding_->trained()) {
+    const glm::vec3 n = sp.geometric_normal;
     mixture.guide = guiding_->distribution(sp.position, glm::dot(n, wo) >= 0.0f ? n : -n);
     mixture.guided = mixture.guide.learned();
     mixture.alpha = mixture.guide.alpha() * bsdf.diffuse_probability() * mixture.guide.share();
   }
+  return mixture;
+}
 
-  // Next event estimation (the light vertex is vertex + 1 <= max_vertices).
-  const PathSampler::LightNumbers u_light = numbers ? numbers->light : sampler.light_numbers(vertex, bsdf.has_nondelta());
-  if (bsdf.has_nondelta()) {
-    // The light sample: the chosen light, then every sun (LightSampler::kMaxSuns).
-    const auto queue_light = [&](const LightSample& ls) {
-      float bsdf_pdf;
-      glm::vec3 f = bsdf.eval(ls.wi, &bsdf_pdf);
-      if (!(max_component(f) > 0.0f && max_component(ls.radiance) > 0.0f)) return;
-      ShadowRay ray = std::isinf(ls.distance)
-                          ? ShadowRay{offset_ray_origin(sp.position, sp.geometric_normal, ls.wi), ls.wi, ls.distance}
-                          : shadow_ray_between(sp.position, sp.geometric_normal, ls.point, ls.normal);
-      ++out.rays;
-      float w = ls.delta ? 1.0f : power_heuristic(ls.pdf, mixture.pdf(bsdf_pdf, ls.wi));
-      if constexpr (kClassify) {
-        shadows.class_out[shadows.count] = cls->out;
-        shadows.classes[shadows.count] = cls->classify(s.nonspecular, false);
-      }
-      shadows.push(ray, {&out, s.throughput * f * ls.radiance * (w / ls.pdf), s.nonspecular == 0});
-    };
-    LightSample ls;
-    if (u_light.shared ? lights_.sample(sp.position, u_light.point, &ls)
-                       : lights_.sample(sp.position, u_light.select, u_light.point, &ls))
-      queue_light(ls);
-    for (size_t sun = 0; sun < lights_.sun_count(); ++sun) queue_light(lights_.sun_sample(sun));
-  }
+// Next event estimation at a non-delta vertex: the light sample of the chosen light, then every
+// sun's (LightSampler::kMaxSuns), each queued on `shadows` with its MIS weight.
+template <bool kClassify>
+void PathTracer::sample_direct_light(Path& path, const Vertex& v, const PathSampler::LightNumbers& u_light,
+                                     ShadowQueue& shadows, [[maybe_unused]] ClassState* cls) const {
+  const PathState& s = path.state;
+  PathSample& out = *path.out;
+  const SurfacePoint& sp = v.sp;
+  const auto queue_light = [&](const LightSample& ls) {
+    float bsdf_pdf;
+    glm::vec3 f = v.bsdf.eval(ls.wi, &bsdf_pdf);
+    if (!(max_component(f) > 0.0f && max_component(ls.radiance) > 0.0f)) return;
+    ShadowRay ray = std::isinf(ls.distance)
+                        ? ShadowRay{offset_ray_origin(sp.position, sp.geometric_normal, ls.wi), ls.wi, ls.distance}
+                        : shadow_ray_between(sp.position, sp.geometric_normal, ls.point, ls.normal);
+    ++out.rays;
+    float w = ls.delta ? 1.0f : power_heuristic(ls.pdf, v.mixture.pdf(bsdf_pdf, ls.wi));
+    if constexpr (kClassify) {
+      shadows.class_out[shadows.count] = cls->out;
+      shadows.classes[shadows.count] = cls->classify(s.nonspecular, false);
+    }
+    shadows.push(ray, {&out, s.throughput * f * ls.radiance * (w / ls.pdf), s.nonspecular == 0});
+  };
+  LightSample ls;
+  if (u_light.shared ? lights_.sample(sp.position, u_light.point, &ls)
+                     : lights_.sample(sp.position, u_light.select, u_light.point, &ls))
+    queue_light(ls);
+  for (size_t sun = 0; sun < lights_.sun_count(); ++sun) queue_light(lights_.sun_sample(sun));
+}
 
-  // Specular sampling: light through a specular chain, which NEE cannot reach (HV: D S+ L). At every
-  // diffuse vertex toward every specular object (params.specular_sampling), else at the first one
-  // toward the specular objects that fill much of its view (params.near_specular_sampling).
-  const bool room = !specular_targets_.empty() && bsdf.has_nondelta() && vertex + 2 <= params.max_vertices;
-  const ChainPlan plan = room ? chain_plan(sp.position, params, s.nonspecular == 0) : ChainPlan{};
-  const bool specular_sampling = plan.candidates > 0;
-  if (specular_sampling) {
-    bool through_glass = false;
-    const glm::vec3 light = specular_chain_light(sp, bsdf, mixture, s.throughput, vertex, plan,
-                                                 sampler, params, &out.rays, &through_glass);
-    if (max_component(light) > 0.0f) {
-      out.hv += light;
-      if constexpr (kClassify) {
-        const HvClass c = cls->emitter_back_face ? HvClass::EmitterBackFace
-                                                 : (through_glass ? HvClass::CausticGlass : HvClass::CausticMirror);
-        record_hv(*cls->out, light, c);
-      }
+// The specular chain a vertex's plan traces (SpecularChainSampler): at every diffuse vertex toward
+// every specular object (TraceParams::specular_sampling), else toward the specular objects near the
+// first one and the mirror spheres from any (TraceParams::specular_chains). Its light is HV.
+template <bool kClassify>
+void PathTracer::add_chain_light(Path& path, const Vertex& v, const SpecularChainSampler::Plan& plan,
+                                 const TraceParams& params, [[maybe_unused]] ClassState* cls) const {
+  PathSample& out = *path.out;
+  bool through_glass = false;
+  const glm::vec3 light = chains_.light(v.sp, v.bsdf, v.mixture, path.state.throughput, v.index, plan, path.sampler,
+                                        params.max_vertices, &out.rays, &through_glass);
+  if (max_component(light) > 0.0f) {
+    out.hv += light;
+    if constexpr (kClassify) {
+      const HvClass c = cls->emitter_back_face ? HvClass::EmitterBackFace
+                                               : (through_glass ? HvClass::CausticGlass : HvClass::CausticMirror);
+      record_hv(*cls->out, light, c);
     }
   }
+}
 
-  // Continue the path by sampling the BSDF.
-  const bool roulette = vertex >= params.rr_start_vertex;
-  const PathSampler::BsdfNumbers u = numbers ? numbers->bsdf : sampler.bsdf_numbers(vertex, bsdf.has_lobe_choice(), roulette);
-  BsdfSample bs;
-  if (!mixture.guided) {
-    if (!bsdf.sample(u.lobe, u.direction, &bs)) return false;
+// The vertex's BSDF-side sample: the BSDF's own, or with guiding the one-sample mixture's, weighted
+// by f cos / the mixture's pdf whichever strategy drew it. False: no direction.
+// *roulette_scale: PathState::roulette_scale, updated for the strategy that drew the sample.
+bool PathTracer::sample_bsdf_side(const Vertex& v, const PathSampler::BsdfNumbers& u, PathSampler& sampler,
+                                  BsdfSample* bs, float* roulette_scale) const {
+  const Bsdf& bsdf = v.bsdf;
+  const GuidingMixture& mixture = v.mixture;
+  if (!mixture.guided) return bsdf.sample(u.lobe, u.direction, bs);
+  // One-sample MIS: either strategy's direction is weighted by f cos / the mixture's pdf.
+  const PathSampler::GuidingNumbers g = sampler.guiding_numbers(v.index);
+  const float alpha = mixture.alpha;
+  if (g.choice < alpha) {
+    float guide_pdf, bsdf_pdf;
+    bs->wi = mixture.guide.sample(g.direction, &guide_pdf);
+    const glm::vec3 f = bsdf.eval(bs->wi, &bsdf_pdf);
+    if (!(max_component(f) > 0.0f)) return false;
+    bs->pdf = alpha * guide_pdf + (1.0f - alpha) * bsdf_pdf;
+    bs->weight = f / bs->pdf;
+    *roulette_scale *= unguided_weight_ratio(bs->pdf, bsdf_pdf);
+    bs->delta = bs->transmitted = false;
+    return true;
+  }
+  if (!bsdf.sample(u.lobe, u.direction, bs)) return false;
+  if (bs->delta) {
+    bs->weight /= 1.0f - alpha;  // a delta lobe's share of the mixture
+    *roulette_scale *= 1.0f - alpha;
   } else {
-    // One-sample MIS: either strategy's direction is weighted by f cos / the mixture's pdf.
-    const PathSampler::GuidingNumbers g = sampler.guiding_numbers(vertex);
-    const float alpha = mixture.alpha;
-    if (g.choice < alpha) {
-      float guide_pdf, bsdf_pdf;
-      bs.wi = mixture.guide.sample(g.direction, &guide_pdf);
-      const glm::vec3 f = bsdf.eval(bs.wi, &bsdf_pdf);
-      if (!(max_component(f) > 0.0f)) return false;
-      bs.pdf = alpha * guide_pdf + (1.0f - alpha) * bsdf_pdf;
-      bs.weight = f / bs.pdf;
-      s.roulette_scale *= unguided_weight_ratio(bs.pdf, bsdf_pdf);
-      bs.delta = bs.transmitted = false;
-    } else {
-      if (!bsdf.sample(u.lobe, u.direction, &bs)) return false;
-      if (bs.delta) {
-        bs.weight /= 1.0f - alpha;  // a delta lobe's share of the mixture
-        s.roulette_scale *= 1.0f - alpha;
-      } else {
-        const float pdf = mixture.pdf(bs.pdf, bs.wi);
-        bs.weight *= bs.pdf / pdf;
-        s.roulette_scale *= unguided_weight_ratio(pdf, bs.pdf);
-        bs.pdf = pdf;
-      }
-    }
+    const float pdf = mixture.pdf(bs->pdf, bs->wi);
+    bs->weight *= bs->pdf / pdf;
+    *roulette_scale *= unguided_weight_ratio(pdf, bs->pdf);
+    bs->pdf = pdf;
   }
+  return true;
+}
+
+// Continues the path by sampling the vertex's BSDF side into path.ray, with Russian roulette.
+// False: the path ends here.
+template <bool kClassify>
+bool PathTracer::continue_path(Path& path, const Vertex& v, const SpecularChainSampler::Plan& plan,
+                               const TraceParams& params, const PathSampler::VertexNumbers* numbers,
+                               [[maybe_unused]] ClassState* cls) const {
+  PathState& s = path.state;
+  PathSampler& sampler = path.sampler;
+  const SurfacePoint& sp = v.sp;
+  const Bsdf& bsdf = v.bsdf;
+  const bool roulette = v.index >= params.rr_start_vertex;
+  const PathSampler::BsdfNumbers u =
+      numbers ? numbers->bsdf : sampler.bsdf_numbers(v.index, bsdf.has_lobe_choice(), roulette);
+  BsdfSample bs;
+  if (!sample_bsdf_side(v, u, sampler, &bs, &s.roulette_scale)) return false;
   if constexpr (kClassify) {
     if (bs.delta) {
-      const bool glass = bsdf_params.transmission > 0.0f && bsdf_params.metallic < 1.0f;
+      const bool glass = v.params.transmission > 0.0f && v.params.metallic < 1.0f;
       (glass ? cls->glass_since_d : cls->mirror_since_d) = true;
       if (glass && !sp.front_face && !bs.transmitted) cls->glass_internal = true;
       if (s.nonspecular == 0) cls->specular_before_d = true;
@@ -788,8 +608,8 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
   // of the paths entering glass and give the survivors eta^2 times their weight.
   if (bs.transmitted) s.roulette_scale *= bsdf.eta() * bsdf.eta();
   if (!bs.delta)
-    s.chain_mis = specular_sampling ? power_heuristic(bs.pdf, specular_pdf(sp.position, bs.wi, plan)) : 1.0f;
-  else if (!material_is_perfect_specular(material))
+    s.chain_mis = plan.traces() ? power_heuristic(bs.pdf, chains_.pdf(sp.position, bs.wi, plan)) : 1.0f;
+  else if (!material_is_perfect_specular(*sp.material))
     s.chain_mis = 1.0f;  // a delta lobe of a surface the specular chains stop at
   if (!bs.delta) ++s.nonspecular;
   // Low-discrepancy numbers up to the first non-delta bounce only: deeper vertices gain nothing
@@ -830,7 +650,7 @@ SurfaceMaterial PathTracer::surface_material(const Ray& camera_ray) const {
   out.sheen_roughness = p.sheen_roughness;
   if (emission_visible(material, sp)) out.emission = eval_emission(scene, material, sp.uv0, sp.uv1);
   BsdfMaterial scratch;
-  const Bsdf bsdf(bsdf_material_at(sp, &scratch), sp.shading_normal, sp.geometric_normal, -camera_ray.direction,
+  const Bsdf bsdf(materials_.at(sp, &scratch), sp.shading_normal, sp.geometric_normal, -camera_ray.direction,
                   sp.front_face, sp.clearcoat_normal);
   if (!bsdf.is_black()) out.lobes = bsdf.lobes();
   return out;

@@ -5,16 +5,17 @@
 #include <vector>
 #include <glm/glm.hpp>
 #include "pathtracer/bsdf.h"
+#include "pathtracer/caustics/specular_chain_sampler.h"
 #include "pathtracer/embree_scene.h"
 #include "pathtracer/lights.h"
+#include "pathtracer/guiding_mixture.h"
 #include "pathtracer/pathtracer.h"
 #include "pathtracer/sampler.h"
-#include "pathtracer/sphere_caustics.h"
+#include "pathtracer/shading.h"
 #include "scene/camera.h"
 
 namespace pxf {
 
-class Bsdf;
 class GuidingField;
 
 // One path's contributions. LV = E S* L and E S* D L (both MIS strategies at that D vertex);
@@ -113,7 +114,7 @@ class PathTracer {
   void trace_guiding_photons(uint32_t frame, int count, const TraceParams& params) const;
 
   bool dark() const { return lights_.empty(); }
-  bool has_perfect_specular() const { return has_perfect_specular_; }
+  bool has_perfect_specular() const { return chains_.has_perfect_specular(); }
   const EmbreeScene& geometry() const { return geometry_; }
   const LightSampler& lights() const { return lights_; }
 
@@ -121,81 +122,34 @@ class PathTracer {
   struct Path;
   struct ShadowQueue;
   struct ClassState;
-  struct GuidingMixture;
+  struct Vertex;
   template <bool kClassify>
   void trace_batch(const Camera& camera, int width, int height, const PixelSampleJob* jobs, int count,
                    const TraceParams& params, PathSample* out, HvSampleClass* classes) const;
   void trace_guiding_photon(uint32_t frame, uint32_t index, const TraceParams& params) const;
+  // One path vertex (shade_vertex) and its parts: the guided mixture it samples from, next event
+  // estimation, the specular chain's light, and the BSDF sample that continues the path.
   template <bool kClassify>
   bool shade_vertex(Path& path, const Hit& hit, int vertex, const TraceParams& params, ShadowQueue& shadows,
                     const PathSampler::VertexNumbers* numbers, ClassState* cls) const;
-
-  // Specular sampling (TraceParams::specular_sampling, near_specular_sampling): the bounding spheres
-  // of the perfectly specular meshes; the candidates a chain from p aims at (every target, or with
-  // near_only those whose sphere subtends at least kNearSpecularSolidAngle from p), one chosen
-  // uniformly; the solid-angle pdf of a direction from p under that choice; and the light one
-  // sampled direction reaches through a specular chain (already MIS-weighted).
-  struct SpecularTarget {
-    glm::vec3 center{0.0f};
-    float radius = 0.0f;
-    float near_distance2 = 0.0f;  // squared distance from the center within which p is near
-    int caster = -1;               // index into casters_ when the mesh is a sphere: its light is solved for
-    bool mirror_caster = false;    // a mirror sphere: its chains go from every first vertex (ChainPlan)
-    bool near(glm::vec3 p) const;  // outside the sphere, and it subtends >= kNearSpecularSolidAngle
-  };
-  // Which targets a vertex's chain aims at (one of them, chosen uniformly) and the probability
-  // that it is traced at all: every target with params.specular_sampling; else the near ones at
-  // the first non-delta vertex, and elsewhere (deeper vertices too) the mirror spheres with
-  // kFarCasterChainProbability: their solved chains find a mirror's caustic anywhere, also where
-  // the camera sees it after a diffuse bounce (the ceiling under cornell's mirror ball).
-  struct ChainPlan {
-    enum class Targets { All, Near, Casters } targets = Targets::All;
-    int candidates = 0;  // 0: no chain
-    float probability = 1.0f;
-    bool includes(const SpecularTarget& t, glm::vec3 p) const;
-  };
-  ChainPlan chain_plan(glm::vec3 p, const TraceParams& params, bool first_vertex) const;
-  // `drawn_from`, `drawn_pdf`: the target a solved chain drew wi for and that draw's density
-  // (SphereCausticSampler::sample's), which need not be solved for again.
-  float specular_pdf(glm::vec3 p, glm::vec3 wi, const ChainPlan& plan, const SpecularTarget* drawn_from = nullptr,
-                     float drawn_pdf = 0.0f) const;
-  // `plan`: chain_plan(sp.position, ...), with candidates.
-  // `mixture`: the pdf of the vertex's BSDF-side strategy (the guided mixture where guiding samples).
-  glm::vec3 specular_chain_light(const SurfacePoint& sp, const Bsdf& bsdf, const GuidingMixture& mixture,
-                                 glm::vec3 throughput, int vertex, const ChainPlan& plan,
-                                 PathSampler& sampler, const TraceParams& params, uint32_t* rays,
-                                 bool* through_glass) const;
-
-  // The BsdfMaterial at sp: the one precomputed for its material when eval_material() reads no
-  // texture of it and the vertex color is white (base color x 1 is exact, so the values are the
-  // same), else evaluated into *scratch.
-  const BsdfMaterial& bsdf_material_at(const SurfacePoint& sp, BsdfMaterial* scratch) const;
+  GuidingMixture guiding_mixture(const SurfacePoint& sp, const Bsdf& bsdf, glm::vec3 wo, bool first_vertex,
+                                 const TraceParams& params) const;
+  template <bool kClassify>
+  void sample_direct_light(Path& path, const Vertex& v, const PathSampler::LightNumbers& u_light, ShadowQueue& shadows,
+                           ClassState* cls) const;
+  template <bool kClassify>
+  void add_chain_light(Path& path, const Vertex& v, const SpecularChainSampler::Plan& plan, const TraceParams& params,
+                       ClassState* cls) const;
+  template <bool kClassify>
+  bool continue_path(Path& path, const Vertex& v, const SpecularChainSampler::Plan& plan, const TraceParams& params,
+                     const PathSampler::VertexNumbers* numbers, ClassState* cls) const;
+  bool sample_bsdf_side(const Vertex& v, const PathSampler::BsdfNumbers& u, PathSampler& sampler, BsdfSample* bs,
+                        float* roulette_scale) const;
 
   EmbreeScene geometry_;
   LightSampler lights_;
-  struct PrecomputedBsdfMaterial {
-    bool constant = false;  // eval_material_is_constant: `material` holds its BsdfMaterial
-    BsdfMaterial material;
-  };
-  std::vector<PrecomputedBsdfMaterial> precomputed_materials_;  // per scene material
-  std::vector<SpecularTarget> specular_targets_;
-  // The chains toward a sphere target are drawn toward the emissive triangles by solving for the
-  // path through the sphere (pathtracer/sphere_caustics.h, docs/sampling.md): all of them, or
-  // kSolvedChainShareWithEnvironment where an environment needs the cone's chains too.
-  static constexpr size_t kMaxSolvedChainEmitters = 64;  // the pdf visits every emitter
-  static constexpr float kSolvedChainShareWithEnvironment = 0.5f;
-  // A mirror's image of the light seen from afar is small and its solved density large, so few
-  // chains serve it. Cornell 256^2, 64 spp: HDR NRMSE 12.47, 12.36, 12.35 % with 0.02, 0.05, 0.1,
-  // for 1.06, 1.12, 1.26x the time without far chains (docs/sampling.md): 0.02 and 0.05 are even
-  // at equal time, and 0.05 keeps more margin for a mirror that looks larger.
-  static constexpr float kFarCasterChainProbability = 0.05f;
-  int mirror_caster_targets_ = 0;
-  void set_up_solved_chains();
-  std::vector<SphereCaster> casters_;
-  SphereCausticSampler caustics_;
-  float solved_chain_share_ = 0.0f;
-  bool has_perfect_specular_ = false;
-  bool has_near_targets_ = false;  // a target that fills its bounding sphere enough for near chains
+  BsdfMaterials materials_;
+  SpecularChainSampler chains_;  // light through specular chains (caustics)
   GuidingField* guiding_ = nullptr;
 };
 

@@ -21,14 +21,6 @@
 namespace pxf {
 namespace {
 
-Environment uniform_environment(float radiance) {
-  Environment env;
-  env.image.width = 8;
-  env.image.height = 4;
-  env.image.texels.assign(32, glm::vec4(radiance, radiance, radiance, 1.0f));
-  return env;
-}
-
 double image_mean(const std::vector<glm::vec3>& lv, const std::vector<glm::vec3>& hv) {
   double sum = 0;
   for (size_t i = 0; i < lv.size(); ++i) sum += luminance(lv[i] + hv[i]);
@@ -891,7 +883,7 @@ TEST(FireflyFigures, DISABLED_Cornell) {
 }  // namespace
 }  // namespace pxf
 
-// Specular sampling (TraceParams::specular_sampling, near_specular_sampling) must not change the
+// Specular sampling (TraceParams::specular_sampling, specular_chains) must not change the
 // expected image.
 namespace pxf {
 namespace {
@@ -899,7 +891,7 @@ namespace {
 enum class ChainMode { Off, Near, All };
 TraceParams with_chains(TraceParams params, ChainMode mode) {
   params.specular_sampling = mode == ChainMode::All;
-  params.near_specular_sampling = mode == ChainMode::Near;
+  params.specular_chains = mode == ChainMode::Near;
   return params;
 }
 
@@ -996,7 +988,7 @@ void expect_block_means_agree(const ChainPixelStats& off, const ChainPixelStats&
 // The Cornell box with the mirror and glass spheres, independent samples: the mean of every 4x4
 // block with and without specular sampling (near, or at every vertex) agree; the sum of the 16
 // blocks' squared z-scores is chi-square with 16 degrees of freedom, below 39.25 with probability
-// 0.999. Specular sampling traces more rays (its chains), near specular sampling fewer than it.
+// 0.999. Specular sampling traces more rays (its chains), the default chains fewer than it.
 TEST(SpecularSampling, CornellMeansAgreeWithoutIt) {
   const Scene scene = make_cornell_box(true);
   TraceParams params;

@@ -33,13 +33,16 @@ struct TraceParams {
   // caustics that NEE cannot see), combined with BSDF sampling by the power heuristic
   // (docs/sampling.md#fireflies). Off by default.
   bool specular_sampling = false;
-  // Near specular sampling, the default: the same chains at the first diffuse vertex only, toward the
-  // specular objects whose bounding sphere subtends at least kNearSpecularSolidAngle from it. That
-  // is where a glass object focuses the light onto the floor it stands on, a caustic that BSDF
-  // sampling finds in a few % of its samples; there a chain costs little (few first vertices are
-  // that near) and about halves the variance there (docs/sampling.md#near-specular-sampling). Ignored with
-  // specular_sampling, which does this and more.
-  bool near_specular_sampling = true;
+  // Specular chains, the default: the chains of specular_sampling only where they pay. From the
+  // first diffuse vertex toward the specular objects whose bounding sphere subtends at least
+  // kNearSpecularSolidAngle from it: that is where a glass object focuses the light onto the floor
+  // it stands on, a caustic that BSDF sampling finds in a few % of its samples, and there a chain
+  // costs little (few first vertices are that near) and about halves the variance. From every
+  // other diffuse vertex (and the first where nothing is near), toward the mirror spheres in 1 of
+  // 20: their solved chains find a mirror's caustic on every wall. See
+  // pathtracer/caustics/specular_chain_sampler.h and docs/sampling.md#specular-chains.
+  // Ignored with specular_sampling, which does this and more.
+  bool specular_chains = true;
   // Path guiding (docs/guiding.md): the renderer learns an SD-tree of the indirect light from
   // photons it traces from the lights after each frame, and once trained each path's first
   // non-delta vertex samples its direction from it with the probability its region learned (times
@@ -49,23 +52,14 @@ struct TraceParams {
   bool guiding = false;
 };
 
-// A sphere subtends solid angle 2 pi (1 - cos a) from a point at distance d from its center, with
-// sin a = r / d. Near: at least pi sr (a >= 60 degrees), i.e. d^2 <= r^2 / sin^2 a = r^2 / (1 - cos^2 a).
-constexpr float kNearSpecularSolidAngle = 3.14159265358979323846f;
-constexpr float kNearSpecularCosHalfAngle = 1.0f - kNearSpecularSolidAngle / (2.0f * 3.14159265358979323846f);
-constexpr float kNearSpecularDistance2PerRadius2 = 1.0f / (1.0f - kNearSpecularCosHalfAngle * kNearSpecularCosHalfAngle);
-// ... and only toward a mesh whose area is at least this share of its bounding sphere's (on average
-// it then covers at least this share of the cone the chain samples).
-constexpr double kNearSpecularMinFill = 0.5;
-
-// The specular sampling a TraceParams asks for, as the state files number it: near sampling means
-// nothing while full specular sampling is on, so two params that differ only there trace the same
-// samples.
-enum class SpecularSamplingMode : uint32_t { None = 0, All = 1, Near = 2 };
+// The specular sampling a TraceParams asks for, as the state files number it: specular_chains
+// means nothing while full specular sampling is on, so two params that differ only there trace the
+// same samples.
+enum class SpecularSamplingMode : uint32_t { None = 0, All = 1, Chains = 2 };
 inline SpecularSamplingMode specular_sampling_mode(const TraceParams& p) {
-  return p.specular_sampling         ? SpecularSamplingMode::All
-         : p.near_specular_sampling ? SpecularSamplingMode::Near
-                                    : SpecularSamplingMode::None;
+  return p.specular_sampling ? SpecularSamplingMode::All
+         : p.specular_chains ? SpecularSamplingMode::Chains
+                             : SpecularSamplingMode::None;
 }
 
 // The replicates an accumulation keeps sums for: only the Sobol sampler has any (independent

@@ -17,7 +17,7 @@
 //                       rescaled, is the point's first coordinate; dimension 2 is unused)
 //   vertex v, bsdf    : 0,1 BSDF direction (2D) | 2 BSDF lobe | 3 Russian roulette
 //   vertex v, specular: 0,1 direction in the chosen object's cone (2D) | 2 object selection
-//   (with TraceParams::specular_sampling, or near_specular_sampling at the first diffuse vertex;
+//   (with TraceParams::specular_sampling, or where TraceParams::specular_chains plans a chain;
 //   the chain's delta choices: one group per bounce b)
 //   vertex v, guiding : 0,1 guided direction (2D) | 2 guided-vs-BSDF choice (TraceParams::guiding,
 //                       only at non-delta vertices once the field is trained: docs/guiding.md)

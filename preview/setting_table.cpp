@@ -176,16 +176,17 @@ std::vector<SettingDescriptor> make_table() {
                      "rays (docs/sampling.md#fireflies)",
                      [](PreviewSettings& s) -> bool& { return s.trace.specular_sampling; }, E::Retrace,
                      "specular sampling", /*bare_flag=*/true));
-  SettingDescriptor near = on_off(
-      "near_specular_sampling", "--near-specular",
-      "the same at the first diffuse vertex only, toward mirror and glass objects that fill at least pi sr\n"
-      "of its view (the focus a glass object throws on the floor it stands on), else toward a mirror sphere\n"
-      "in 1 of 20 paths (its caustic on every wall; docs/sampling.md#near-specular-sampling)",
-      [](PreviewSettings& s) -> bool& { return s.trace.near_specular_sampling; }, E::Retrace, "near specular sampling");
-  near.same = [](const PreviewSettings& a, const PreviewSettings& b) {
+  SettingDescriptor chains = on_off(
+      "specular_chains", "--specular-chains",
+      "the same only where it pays: from the first diffuse vertex toward mirror and glass objects that\n"
+      "fill at least pi sr of its view (the focus a glass object throws on the floor it stands on), and from\n"
+      "the other diffuse vertices toward a mirror sphere in 1 of 20 (its caustic on every wall;\n"
+      "docs/sampling.md#specular-chains)",
+      [](PreviewSettings& s) -> bool& { return s.trace.specular_chains; }, E::Retrace, "specular chains");
+  chains.same = [](const PreviewSettings& a, const PreviewSettings& b) {
     return specular_sampling_mode(a.trace) == specular_sampling_mode(b.trace);
   };
-  t.push_back(near);
+  t.push_back(chains);
   t.push_back(on_off("guiding", "--guiding",
                      "path guiding: learn from photons where indirect light comes from (parallax-aware lobes in\n"
                      "an SD-tree's regions) and send a learned share of the first diffuse bounce there,\n"

@@ -60,7 +60,7 @@ struct SettingDescriptor {
   size_t (*choice_index)(const PreviewSettings&) = nullptr;
   void (*set_choice_index)(PreviewSettings&, size_t) = nullptr;
   // Optional: whether two settings objects count as equal for this setting where their values
-  // differ (near specular sampling does nothing under full specular sampling).
+  // differ (the specular chains do nothing under full specular sampling).
   bool (*same)(const PreviewSettings&, const PreviewSettings&) = nullptr;
 
   // The value as a number (a Switch 0 or 1, a Choice its index).

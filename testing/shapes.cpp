@@ -144,4 +144,12 @@ Scene make_cornell_box(bool with_specular_spheres) {
   return scene;
 }
 
+Environment uniform_environment(float radiance) {
+  Environment env;
+  env.image.width = 8;
+  env.image.height = 4;
+  env.image.texels.assign(32, glm::vec4(radiance, radiance, radiance, 1.0f));
+  return env;
+}
+
 }  // namespace pxf

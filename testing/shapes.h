@@ -15,6 +15,9 @@ Mesh make_box(glm::vec3 min_corner, glm::vec3 max_corner, int material);
 
 Camera look_at_camera(glm::vec3 eye, glm::vec3 target, glm::vec3 up, float yfov);
 
+// A sky of the same radiance in every direction.
+Environment uniform_environment(float radiance);
+
 Material make_diffuse(glm::vec3 albedo);  // Lambertian (metallic 0, KHR specular 0)
 Material make_mirror(glm::vec3 tint = glm::vec3(1.0f));
 Material make_glass(float ior = 1.5f, glm::vec3 tint = glm::vec3(1.0f));

@@ -304,15 +304,17 @@ TEST(Cli, RenderWritesEveryOutput) {
   EXPECT_EQ(shrunk["settings"]["sigma_shrink"], true);
   EXPECT_FLOAT_EQ(shrunk["filter_last_sigma_s"].get<float>(), 4.0f);
   EXPECT_EQ(run("render --size 32x24 --spp 2 --sigma-shrink maybe --quiet --out " + out).code, 2);
-  // Specular sampling is off unless asked for, near specular sampling on unless turned off, and
+  // Specular sampling is off unless asked for, the specular chains on unless turned off, and
   // stats.json says which.
   EXPECT_EQ(stats2["settings"]["specular_sampling"], false);
-  EXPECT_EQ(stats2["settings"]["near_specular_sampling"], true);
-  ASSERT_EQ(run("render --size 32x24 --spp 2 --specular-sampling --near-specular off --quiet --out " + out).code, 0);
+  EXPECT_EQ(stats2["settings"]["specular_chains"], true);
+  ASSERT_EQ(run("render --size 32x24 --spp 2 --specular-sampling --specular-chains off --quiet --out " + out).code, 0);
   const auto stats3 = nlohmann::json::parse(slurp(out + "/stats.json"));
   EXPECT_EQ(stats3["settings"]["specular_sampling"], true);
-  EXPECT_EQ(stats3["settings"]["near_specular_sampling"], false);
-  EXPECT_EQ(run("render --size 32x24 --spp 2 --near-specular maybe --quiet --out " + out).code, 2);
+  EXPECT_EQ(stats3["settings"]["specular_chains"], false);
+  EXPECT_EQ(run("render --size 32x24 --spp 2 --specular-chains maybe --quiet --out " + out).code, 2);
+  // The option's earlier name is not taken.
+  EXPECT_EQ(run("render --size 32x24 --spp 2 --near-specular on --quiet --out " + out).code, 2);
   EXPECT_GT(stats2["unfiltered_vs_reference"]["nrmse_percent"].get<double>(), 0.0);
 }
 

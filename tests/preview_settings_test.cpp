@@ -34,10 +34,10 @@ TEST(PreviewSettings, TraceChangesRestartAndPassChangesKeepTheSamples) {
   EXPECT_EQ(samples_after_change(scene, [](PreviewSettings& s) { s.trace.replicates = 4; }), 0);
   EXPECT_EQ(samples_after_change(scene, [](PreviewSettings& s) { s.trace.specular_sampling = true; }), 0);
   EXPECT_EQ(samples_after_change(scene, [](PreviewSettings& s) { s.trace.max_vertices = 4; }), 0);
-  EXPECT_EQ(samples_after_change(scene, [](PreviewSettings& s) { s.trace.near_specular_sampling = false; }), 0);
+  EXPECT_EQ(samples_after_change(scene, [](PreviewSettings& s) { s.trace.specular_chains = false; }), 0);
   // Under full specular sampling near sampling changes no sample: the accumulation stays.
   const auto full = [](PreviewSettings& s) { s.trace.specular_sampling = true; };
-  EXPECT_EQ(samples_after_change(scene, [](PreviewSettings& s) { s.trace.near_specular_sampling = false; }, full), 2);
+  EXPECT_EQ(samples_after_change(scene, [](PreviewSettings& s) { s.trace.specular_chains = false; }, full), 2);
   EXPECT_EQ(samples_after_change(scene, [](PreviewSettings& s) { s.threshold = 0.01f; }), 2);
   EXPECT_EQ(samples_after_change(scene, [](PreviewSettings& s) { s.filter.sigma_s = 4.0f; }), 2);
 }

@@ -46,6 +46,56 @@ std::vector<unsigned char> noise_image(int size, uint32_t seed, float base, floa
   return rgb;
 }
 
+struct SphereMesh {
+  std::vector<float> positions, normals, uvs;
+  std::vector<uint32_t> indices;
+};
+
+SphereMesh helmet_sphere() {
+  // A sphere of 256 x 138 quads: 70,656 triangles, 35,717 vertices (seam and poles duplicated).
+  const int segments = 256, rings = 138;
+  SphereMesh m;
+  for (int r = 0; r <= rings; ++r)
+    for (int s = 0; s <= segments; ++s) {
+      float theta = 3.14159265f * r / rings, phi = 2.0f * 3.14159265f * s / segments;
+      float nx = std::sin(theta) * std::cos(phi), ny = std::cos(theta), nz = std::sin(theta) * std::sin(phi);
+      m.positions.insert(m.positions.end(), {nx, ny, nz});
+      m.normals.insert(m.normals.end(), {nx, ny, nz});
+      m.uvs.insert(m.uvs.end(), {static_cast<float>(s) / segments, static_cast<float>(r) / rings});
+    }
+  for (int r = 0; r < rings; ++r)
+    for (int s = 0; s < segments; ++s) {
+      uint32_t a = r * (segments + 1) + s, b = a + segments + 1;
+      m.indices.insert(m.indices.end(), {a, b, a + 1, a + 1, b, b + 1});
+    }
+  return m;
+}
+
+// The material (textures 0-4), the mesh of `primitive`, its node and the scene.
+void add_helmet(tinygltf::Model& model, const tinygltf::Primitive& primitive) {
+  tinygltf::Material material;
+  material.name = "helmet";
+  material.pbrMetallicRoughness.baseColorTexture.index = 0;
+  material.pbrMetallicRoughness.metallicRoughnessTexture.index = 1;
+  material.normalTexture.index = 2;
+  material.emissiveTexture.index = 3;
+  material.emissiveFactor = {1, 1, 1};
+  material.occlusionTexture.index = 4;
+  model.materials.push_back(material);
+
+  tinygltf::Mesh mesh;
+  mesh.name = "helmet";
+  mesh.primitives.push_back(primitive);
+  model.meshes.push_back(mesh);
+  tinygltf::Node node;
+  node.mesh = 0;
+  model.nodes.push_back(node);
+  tinygltf::Scene scene;
+  scene.nodes = {0};
+  model.scenes.push_back(scene);
+  model.defaultScene = 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -59,23 +109,9 @@ int main(int argc, char** argv) {
     return 2;
   }
 
-  // A sphere of 256 x 138 quads: 70,656 triangles, 35,717 vertices (seam and poles duplicated).
-  const int segments = 256, rings = 138;
-  std::vector<float> positions, normals, uvs;
-  std::vector<uint32_t> indices;
-  for (int r = 0; r <= rings; ++r)
-    for (int s = 0; s <= segments; ++s) {
-      float theta = 3.14159265f * r / rings, phi = 2.0f * 3.14159265f * s / segments;
-      float nx = std::sin(theta) * std::cos(phi), ny = std::cos(theta), nz = std::sin(theta) * std::sin(phi);
-      positions.insert(positions.end(), {nx, ny, nz});
-      normals.insert(normals.end(), {nx, ny, nz});
-      uvs.insert(uvs.end(), {static_cast<float>(s) / segments, static_cast<float>(r) / rings});
-    }
-  for (int r = 0; r < rings; ++r)
-    for (int s = 0; s < segments; ++s) {
-      uint32_t a = r * (segments + 1) + s, b = a + segments + 1;
-      indices.insert(indices.end(), {a, b, a + 1, a + 1, b, b + 1});
-    }
+  const SphereMesh sphere = helmet_sphere();
+  const std::vector<float>&positions = sphere.positions, &normals = sphere.normals, &uvs = sphere.uvs;
+  const std::vector<uint32_t>& indices = sphere.indices;
 
   tinygltf::Model model;
   model.asset.version = "2.0";
@@ -153,27 +189,7 @@ int main(int argc, char** argv) {
   sampler.minFilter = TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_LINEAR;
   model.samplers.push_back(sampler);
 
-  tinygltf::Material material;
-  material.name = "helmet";
-  material.pbrMetallicRoughness.baseColorTexture.index = 0;
-  material.pbrMetallicRoughness.metallicRoughnessTexture.index = 1;
-  material.normalTexture.index = 2;
-  material.emissiveTexture.index = 3;
-  material.emissiveFactor = {1, 1, 1};
-  material.occlusionTexture.index = 4;
-  model.materials.push_back(material);
-
-  tinygltf::Mesh mesh;
-  mesh.name = "helmet";
-  mesh.primitives.push_back(primitive);
-  model.meshes.push_back(mesh);
-  tinygltf::Node node;
-  node.mesh = 0;
-  model.nodes.push_back(node);
-  tinygltf::Scene scene;
-  scene.nodes = {0};
-  model.scenes.push_back(scene);
-  model.defaultScene = 0;
+  add_helmet(model, primitive);
 
   tinygltf::Buffer buffer;
   buffer.data = std::move(bin);

@@ -1,4 +1,4 @@
-#include "pathtracer/sphere_caustics.h"
+#include "pathtracer/caustics/sphere_caustics.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,6 +1,6 @@
-// The solved sphere caustics (pathtracer/sphere_caustics.h): the fit, the solver's paths, and the
-// sampling against its pdf (chi-square).
-#include "pathtracer/sphere_caustics.h"
+// The solved sphere caustics (pathtracer/caustics/sphere_caustics.h): the fit, the solver's
+// paths, and the sampling against its pdf (chi-square).
+#include "pathtracer/caustics/sphere_caustics.h"
 
 #include <gtest/gtest.h>
 
