@@ -9,14 +9,14 @@ TEST(PreviewOptions, CommandLineSetsThePreviewSettingsThemselves) {
   CommandLine cli{"render", "[options]", "test"};
   add_preview_options(cli, s);
   ASSERT_TRUE(cli.parse({"--threshold", "0.02", "--filter", "none", "--schedule", "pow2", "--sampler", "independent",
-                         "--demodulate", "on", "--bias-guard", "off", "--sigma-shrink", "on", "--seed", "7",
+                         "--demodulate", "off", "--bias-guard", "off", "--sigma-shrink", "on", "--seed", "7",
                          "--all-hv"}));
   EXPECT_EQ(s.threshold, 0.02f);
   EXPECT_EQ(s.filter.kind, FilterKind::None);
   EXPECT_FALSE(s.filtering());
   EXPECT_EQ(s.schedule, FilterSchedule::PowersOfTwo);
   EXPECT_EQ(s.trace.sampler, SamplerType::Independent);
-  EXPECT_TRUE(s.demodulate);
+  EXPECT_FALSE(s.demodulate);
   EXPECT_FALSE(s.bias_guard);
   EXPECT_TRUE(s.shrink_sigma);
   EXPECT_EQ(s.trace.seed, 7u);
@@ -34,7 +34,7 @@ TEST(PreviewOptions, DefaultsAreThoseOfPreviewSettings) {
   EXPECT_TRUE(s.filtering());
   EXPECT_EQ(s.schedule, FilterSchedule::Budget);
   EXPECT_EQ(s.trace.sampler, SamplerType::Sobol);
-  EXPECT_FALSE(s.demodulate);
+  EXPECT_TRUE(s.demodulate);
   EXPECT_TRUE(s.bias_guard);
   EXPECT_FALSE(s.shrink_sigma);
 }

@@ -37,11 +37,10 @@ struct PreviewSettings {
   // blend both get it, scaled for the sample count by threshold_now() on every run.
   float threshold = 0.001f;
   FilterParams filter;  // variant (FilterKind::None = plain path tracing) and sigmas
-  // Albedo demodulation: filter HV divided by the first non-specular albedo and multiply L_f back
-  // (gl/demodulation.h), so the filter does not blur textures. Off by default: at equal time it did
-  // not beat filtering radiance with the default grid filter (docs/measurements.md, "Albedo
-  // demodulation").
-  bool demodulate = false;
+  // Albedo demodulation: filter HV divided by the first non-delta vertex's directional albedo and
+  // multiply L_f back (gl/demodulation.h), so the filter smooths illumination, not texture, and thin
+  // strands keep their gaps.
+  bool demodulate = true;
   // The blend's bias guard (BlendParams::bias_guard, docs/method.md section 3.7): s raised where
   // L_f measurably differs from L_u. On: at equal time it lowered the filtered image's error on all
   // four built-in scenes (docs/measurements.md, "Bias guard"); off is the method's blend as published.

@@ -122,8 +122,8 @@ std::vector<SettingDescriptor> make_table() {
   t.push_back(choice<&filter_kind>("filter", "--filter", "filter variant (grid: the bilateral grid on the range luminance)",
                                   filter_option_names(), E::Refilter, "filter"));
   t.push_back(on_off("demodulate", "--demodulate",
-                     "albedo demodulation: filter HV divided by the first non-specular albedo, so textures stay\n"
-                     "sharp (off: docs/measurements.md, \"Albedo demodulation\")",
+                     "albedo demodulation: filter HV divided by the directional albedo of the first non-delta\n"
+                     "surface (its coverage of the pixel included), so textures and thin strands stay sharp",
                      [](PreviewSettings& s) -> bool& { return s.demodulate; }, E::Refilter, "albedo demodulation"));
   t.push_back(on_off("bias_guard", "--bias-guard",
                      "the blend's bias guard: where the filtered light measurably differs from the unfiltered\n"

@@ -267,7 +267,7 @@ TEST(Cli, RenderWritesEveryOutput) {
   const auto stats = nlohmann::json::parse(slurp(out + "/stats.json"));
   EXPECT_EQ(stats["settings"]["spp"], 4);
   EXPECT_EQ(stats["filter_runs"], 3);  // 1, 2, 4
-  EXPECT_EQ(stats["settings"]["demodulate"], false);
+  EXPECT_EQ(stats["settings"]["demodulate"], true);
   EXPECT_EQ(stats["settings"]["bias_guard"], true);
   EXPECT_EQ(stats["settings"]["sampler"], "sobol");
   EXPECT_TRUE(stats["blend_case_pixels"].contains("bias_guard"));
@@ -285,9 +285,9 @@ TEST(Cli, RenderWritesEveryOutput) {
   ASSERT_EQ(with_ref.code, 0) << with_ref.err;
   const auto stats2 = nlohmann::json::parse(slurp(out + "/stats.json"));
   EXPECT_GT(stats2["final_vs_reference"]["nrmse_percent"].get<double>(), 0.0);
-  // --demodulate on is recorded; a bad value is a usage error.
-  ASSERT_EQ(run("render --size 32x24 --spp 2 --demodulate on --quiet --out " + out).code, 0);
-  EXPECT_EQ(nlohmann::json::parse(slurp(out + "/stats.json"))["settings"]["demodulate"], true);
+  // --demodulate off is recorded; a bad value is a usage error.
+  ASSERT_EQ(run("render --size 32x24 --spp 2 --demodulate off --quiet --out " + out).code, 0);
+  EXPECT_EQ(nlohmann::json::parse(slurp(out + "/stats.json"))["settings"]["demodulate"], false);
   EXPECT_EQ(run("render --size 32x24 --spp 2 --demodulate maybe --quiet --out " + out).code, 2);
   // So is --bias-guard off.
   ASSERT_EQ(run("render --size 32x24 --spp 2 --bias-guard off --quiet --out " + out).code, 0);
