@@ -137,7 +137,7 @@ TEST(Shader, CompileErrorInIncludeNamesIncludedFile) {
 
 // Every fragment and compute shader in shaders/ (most include the shared shaders/pass_formulas.h),
 // each fragment shader with its vertex shader: the one of the same name, else the full-screen one.
-// A uniform the program does not have is an error naming both, not a silent no-op (issue 36: a
+// A uniform the program does not have is an error naming both, not a silent no-op (a
 // misspelt name used to leave the pass running with the uniform's default).
 TEST(Shader, SettingAnUndeclaredUniformFails) {
   test::osmesa_context();

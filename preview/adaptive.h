@@ -1,4 +1,4 @@
-// Adaptive sampling (issue 33): how many paths each pixel traces in the next frame, from the
+// Adaptive sampling: how many paths each pixel traces in the next frame, from the
 // method's own quantities. Pure functions on images and per-pixel counts, so that they are tested
 // under a fake variance image (preview/adaptive_test.cpp); the preview (preview/preview.cpp) feeds them the
 // accumulation.

@@ -51,7 +51,7 @@ struct PreviewSettings {
   // kernel of 4 px or less the blend's mixed pixels keep about twice the perceived noise t it
   // promises (docs/measurements.md, "Shrinking sigma_s"), and that promise is the method's.
   bool shrink_sigma = false;
-  // Adaptive sampling (preview/adaptive.h, issue 33): after adaptive_params.warmup_frames uniform
+  // Adaptive sampling (preview/adaptive.h): after adaptive_params.warmup_frames uniform
   // frames, each frame traces only the pixels the allocation picks, each at its own sample index.
   // Off by default until pxf bench shows it wins.
   bool adaptive = false;

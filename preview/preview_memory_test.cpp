@@ -1,4 +1,4 @@
-// The render's memory check (#12 item 8: `--size 16384x16384` used to be accepted, then failed
+// The render's memory check (`--size 16384x16384` must not be accepted and then fail
 // with bad_alloc or "framebuffer incomplete" after allocating most of the machine).
 #include <gtest/gtest.h>
 

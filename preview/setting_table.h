@@ -1,4 +1,4 @@
-// One descriptor per preview setting (issue 36, item 3; yocto-gl's trace_params and name tables
+// One descriptor per preview setting (yocto-gl's trace_params and name tables
 // are the model): the field of PreviewSettings, its command-line flag and help, default (the
 // struct's), range, stats.json key, explorer widget and what a change of it invalidates. The
 // command line (add_preview_options), the explorer's parameter panel, stats.json, pxf diff's
