@@ -150,6 +150,8 @@ FilterOutput atrous_pass(const Image& signal, const Image& signal_var, const Ima
       if (final_pass && p.skip_case2 && skip_as_case2(hv, var_u, lv, range_color, depth, p, t, x, y, out, surface)) continue;
       KernelSums sums;
       double h_sum = 0;
+      const float var_p = atrous_k_l(p) > 0.0f ? shared::edge_stop_variance(TexelView{&signal, &signal_var}, glm::ivec2(x, y))
+                                                : kVarUnknown;
       for (int j = 0; j < 5; ++j)
         for (int i = 0; i < 5; ++i) {
           const int qx = x + (i - 2) * step, qy = y + (j - 2) * step;
@@ -157,7 +159,7 @@ FilterOutput atrous_pass(const Image& signal, const Image& signal_var, const Ima
           const Px l_p = rgb_at(signal, x, y), l_q = rgb_at(signal, qx, qy);
           const double edge = shared::luminance_edge_exponent(glm::vec3(l_p.c[0], l_p.c[1], l_p.c[2]),
                                                               glm::vec3(l_q.c[0], l_q.c[1], l_q.c[2]),
-                                                              clean_var(signal_var.at(x, y, 0)), atrous_k_l(p));
+                                                              var_p, atrous_k_l(p));
           const double range_weight = std::exp(-range_exponent(range_color, depth, surface, x, y, qx, qy, range) - edge);
           h_sum += double(shared::kB3[i]) * shared::kB3[j];
           sums.add(double(shared::kB3[i]) * shared::kB3[j] * range_weight, signal, signal_var, qx, qy);

@@ -40,7 +40,7 @@ void main() {
   vec4 s_p = texelFetch(surface_tex, p, 0);
   vec4 signal_p = texelFetch(signal_tex, p, 0);
   vec3 l_p = clean(signal_p.rgb);
-  float var_p = clean_var(signal_p.a);
+  float var_p = k_l > 0.0f ? edge_stop_variance(signal_tex, p) : kVarUnknown;
   KernelSums sums = kernel_sums_zero();
   float h_sum = 0.0;  // sum h over the taps inside the image
   for (int j = 0; j < 5; ++j) {

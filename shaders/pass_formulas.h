@@ -138,18 +138,43 @@ PXF_INLINE wide_float range_weight(vec4 g_p, vec4 g_q, vec4 s_p, vec4 s_q, float
   return exp(-range_exponent(g_p, g_q, s_p, s_q, k_c, k_d, k_n, k_r));
 }
 
-// The à-trous variant's luminance edge stop (SVGF, Schied et al. 2017): the exponent
-// |Y(l_p) - Y(l_q)| / (sigma_l sqrt(Var_p)) with k_l = 1 / sigma_l, Var_p the variance of the
-// signal at p in this pass. It stops the kernel at edges of the light itself that the guide does
-// not show (a shadow's edge, a highlight) once they stand out of the noise, and lets the noise
-// through. 0 where Var_p is unknown or k_l is 0 (off); a noise-free pixel (Var_p = 0) keeps to
-// neighbours equal to it.
+// The à-trous variant's luminance edge stop (after SVGF, Schied et al. 2017), an addend of the
+// range exponent between p and q: with x = |Y(l_p) - Y(l_q)| / (sigma_l sqrt(Var_p)), k_l = 1 /
+// sigma_l and Var_p the variance of the signal at p in this pass, 4 max(0, x - 1)^2. It stops the
+// kernel at edges of the light itself that the guide does not show (a shadow's edge, a highlight)
+// once they stand out of the noise by more than sigma_l standard deviations, and is 0 below that:
+// a difference the noise can make (nearly always under 4 of its deviations) leaves the weight
+// alone, so the kernel stays independent of the noise and Var[L_f] stays what the sums claim. 0
+// where Var_p is unknown or k_l is 0 (off); a noise-free pixel (Var_p = 0) keeps to neighbours
+// equal to it.
 PXF_INLINE wide_float luminance_edge_exponent(vec3 l_p, vec3 l_q, float var_p, float k_l) {
   if (!(k_l > 0.0f) || var_p < 0.0f) return 0.0f;
   wide_float d = abs(wide_float(luminance(l_p)) - wide_float(luminance(l_q)));
   if (!(d > 0.0f)) return 0.0f;
   wide_float sd = sqrt(wide_float(var_p));
-  return sd > 0.0f ? min(d * wide_float(k_l) / sd, wide_float(1e4f)) : wide_float(1e4f);
+  if (!(sd > 0.0f)) return wide_float(1e4f);
+  wide_float x = max(min(d * wide_float(k_l) / sd, wide_float(100.0f)) - 1.0f, wide_float(0.0f));
+  return 4.0f * x * x;
+}
+
+// The variance the luminance edge stop reads at p: the mean of the known variances of the signal
+// over p's 3x3 neighbourhood (SVGF prefilters it too): a pixel's own estimate from few samples is
+// itself noisy, and one that came out low would shut its neighbours out and keep its noise.
+// kVarUnknown where none is known.
+PXF_SAMPLER_FN float edge_stop_variance(sampler2D signal, ivec2 p) {
+  ivec2 size = textureSize(signal, 0);
+  float sum = 0.0f, count = 0.0f;
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx) {
+      ivec2 q = p + ivec2(dx, dy);
+      if (q.x < 0 || q.y < 0 || q.x >= size.x || q.y >= size.y) continue;
+      float v = clean_var(texelFetch(signal, q, 0).a);
+      if (v >= 0.0f) {
+        sum += v;
+        count += 1.0f;
+      }
+    }
+  return count > 0.0f ? sum / count : kVarUnknown;
 }
 
 // ---- Kernel sums ----
