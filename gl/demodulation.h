@@ -6,12 +6,13 @@
 // a = demodulation_factor(mean albedo) (shaders/pass_formulas.h): grey, the albedo's luminance where
 // that is at least kAlbedoEpsilon (0.05), else 1 (that pixel is not demodulated). Grey because a
 // per-channel division amplifies, in the channels a saturated texture nearly lacks, light that the
-// albedo does not shape (specular highlights): on envmap that gave pink speckles and a red halo and
-// doubled the error. So luminance texture is kept, chroma texture within the filter's range
-// tolerance is still smoothed. With a grey factor the variance scaling is exact. On an unfiltered
-// pixel the two steps give back L_u and Var[L_u]; the blend sees L_f and Var[L_f] in radiance units, so its
-// perceived-variance logic is unchanged. The filter's case-2 skip is decided on the original
-// buffers (shaders/demodulate.frag). CPU reference: cpu_demodulate / cpu_remodulate.
+// albedo does not shape (specular highlights): that gave pink speckles and a red halo and a larger
+// error than no demodulation (docs/notebook/measurements.md, "Albedo demodulation"). So luminance
+// texture is kept, chroma texture within the filter's range tolerance is still smoothed. With a
+// grey factor the variance scaling is exact. On an unfiltered pixel the two steps give back L_u and
+// Var[L_u]; the blend sees L_f and Var[L_f] in radiance units, so its perceived-variance logic is
+// unchanged. The filter's case-2 skip is decided on the original buffers (shaders/demodulate.frag).
+// CPU reference: cpu_demodulate / cpu_remodulate.
 // Usage:
 //   inputs.upload_albedo(&acc.albedo_mean[0].x);
 //   demod.demodulate(inputs, guide, filter_params, t);

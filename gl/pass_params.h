@@ -136,8 +136,8 @@ float effective_threshold(float t, uint64_t samples);
 // kSigmaShrinkMin (a sigma_s already below it is kept). Why 1 / sqrt(n): the filter has to bring a
 // pixel's perceived variance u down to about t, i.e. average about u / t pixels; u falls as 1 / n,
 // so the kernel's area may fall as 1 / n, and a narrower kernel averages light over less of the
-// scene: less bias. Measured on the four built-in scenes at 384x216: sigma 8 is best at 4 spp, 4 or 2
-// from 16 spp on (docs/measurements.md, "Shrinking sigma_s").
+// scene: less bias. The wide kernel is best at the first few samples, narrower ones once samples
+// accumulate (docs/measurements.md, "Shrinking sigma_s").
 constexpr uint64_t kSigmaShrinkFromSpp = 4;
 constexpr float kSigmaShrinkMin = 2.0f;
 float shrunk_sigma_s(float sigma_s, uint64_t samples);

@@ -210,12 +210,12 @@ class FullscreenPass {
 //     pxf bench and the timing tests.
 //   Submit: no glFinish: the time to issue the stage plus the GL work the driver does before
 //     returning. On llvmpipe that is nearly all of it: a pass runs when it is issued (its memory
-//     barriers and read-backs wait for it), and the time left to a following glFinish was 0.1 to 4
-//     ms of passes of 28 to 5000 ms at 512x512. On a GPU it would be the submission only. For
-//     production frames (pxf render, merge, explore): their per-stage figures (stats.json, the
-//     filter schedule's budget) stay those of llvmpipe's work without a stall per stage.
+//     barriers and read-backs wait for it), so little is left to a following glFinish. On a GPU it
+//     would be the submission only. For production frames (pxf render, merge, explore): their
+//     per-stage figures (stats.json, the filter schedule's budget) stay those of llvmpipe's work
+//     without a stall per stage.
 // GL timer queries (GL_TIME_ELAPSED, GL_TIMESTAMP) are not used: llvmpipe answers them, but with
-// a fraction of the work (bilateral-depth at 512x512: 120-210 ms against 4850 ms of wall time).
+// a fraction of the work (docs/timebudget.md, "Stage times").
 enum class GlTiming { Finish, Submit };
 const std::vector<std::string>& gl_timing_names();  // "finish", "submit" (index = value)
 void set_gl_timing(GlTiming timing);

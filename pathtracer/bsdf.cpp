@@ -31,7 +31,7 @@ bool constant(const TextureRef& ref) { return !ref.valid(); }
 // n's horizon (interpolated or mapped normals can put it there).
 // a or b, chosen per component: a select of values that the compiler keeps in registers, where
 // `c ? a : b` of two vectors became a load through a pointer to one of them, which stalled on the
-// stores that had just written them (about a quarter of the Bsdf constructor's time).
+// stores that had just written them (a large share of the Bsdf constructor's time).
 inline glm::vec3 select(bool c, glm::vec3 a, glm::vec3 b) {
   return glm::vec3(c ? a.x : b.x, c ? a.y : b.y, c ? a.z : b.z);
 }

@@ -12,8 +12,8 @@
 //     radius dilation_radius around it (Cycles dilates its active mask with a box), never by its
 //     own. A pixel's rate decided by its own samples biases its mean: the pixel that drew a bright
 //     path is traced more and the path diluted, the one that drew a dark run is retired and stays
-//     dark (measured: cornell 48x48, 64 frames, 32 seeds, block means 1.5-3.5 % low, |z| up to 6.5
-//     against an 8192-spp reference; tests/consistency_test.cpp). Decided by its neighbours, whose
+//     dark, so that block means of the image come out low (tests/consistency_test.cpp;
+//     docs/notebook/sampling.md has the figures). Decided by its neighbours, whose
 //     samples are independent of its own, its count says nothing about its values. A caustic covers
 //     more than one pixel, so its pixels keep each other sampled, and its quiet neighbours that
 //     have not yet met its paths are sampled with it.
@@ -31,17 +31,14 @@
 //     max_rate), until the frame's paths are spent; the rest sit at the floor. Taking the shortest
 //     jobs first is what makes the most pixels clean by any given time; the typical count first, so
 //     that a pixel beside one hard neighbour is not funded to that neighbour's count before the
-//     others are funded to theirs. Measured against the rule before it, which water-filled the
-//     lacks to N_p (so that every pixel reached its count at once): cornell 128^2, t = 0.01, seed 5,
-//     clean share 0.68 against 0.43 after 112 frames, 99 % after about 7200 frames against 6200;
-//     kitchen clean after the same number of frames at the median of five seeds (3156);
-//     docs/sampling.md has the rest.
+//     others are funded to theirs. Against the rule before it, which water-filled the lacks to N_p
+//     (so that every pixel reached its count at once), it makes far more pixels clean early on and
+//     the whole image clean in about as many frames (docs/notebook/sampling.md has the figures).
 //     Not a rate from r_p alone: a rate in proportion to the
 //     deviation (the rule of goal Error) went on sampling the neighbours of a pixel that one rare
-//     path had made noisy, at 32 paths a frame, long after they were clean, and left that pixel at
-//     the floor (cornell 128^2, t = 0.01, 300 s: 99.26 % clean against uniform sampling's 99.96 %);
-//     a rate in proportion to the estimated variance chased the pixels one rare path had just
-//     inflated and starved the rest (60 % against 97 % after 203 s).
+//     path had made noisy, at max_rate, long after they were clean, and left that pixel at the
+//     floor, so that it fell behind uniform sampling; a rate in proportion to the estimated
+//     variance chased the pixels one rare path had just inflated and starved the rest.
 //   minimum: a pixel with fewer than min_samples paths counts as at least at the threshold (r >= 1),
 //     so that a pixel that only looks quiet (its rare bright paths not yet found) is not retired.
 //   rate, goal Error: a_p = clamp(lambda w_p, floor_rate, max_rate) paths per frame, lambda such that the rates
@@ -85,9 +82,9 @@ struct AdaptiveParams {
   // Radius of the box whose other pixels decide a pixel's rate (2: the 5x5 window of the bias guard).
   int dilation_radius = 2;
   // Goal Clean: a pixel's predicted count is this times the largest count its neighbours need. Above
-  // 1 because a pixel's own need is a draw like its neighbours' (measured on cornell 128^2 at 39620
-  // spp, t = 0.01: 2.9 % of the pixels need more than the largest of their 24 neighbours, and at
-  // the median 1.08 times, at the 90th percentile 1.41 times as much).
+  // 1 because a pixel's own need is a draw like its neighbours': some pixels need more than the
+  // largest of their neighbours, and the margin covers nearly all of them (docs/notebook/sampling.md
+  // has the figures).
   float clean_margin = 1.5f;
   // The rates are recomputed after the warm-up and then whenever the frames grew by 1/16 (at least
   // one frame): a pixel's variance estimate moves by a few per cent in 1/16 more samples, and the

@@ -205,7 +205,7 @@ void Preview::reproject_history() {
 // A pixel that traced extra paths in the view's first frame passes its mean with its variance
 // unknown, as a one-path pixel does. Its own variance from 4 paths, pooled over a neighbourhood that
 // the range weights cut (a crease: its taps straddle two normals, so it took no history), was often
-// too low: the blend showed it partly unfiltered, coloured specks along cornell's creases while the
+// too low: the blend showed it partly unfiltered, coloured specks along a room's creases while the
 // camera moved (docs/measurements.md, "A moving camera"). Unknown, it shows the filtered value, and
 // the filter gets its 4-path mean.
 void Preview::hide_first_frame_variances() {
@@ -219,7 +219,7 @@ void Preview::hide_first_frame_variances() {
 // extra paths are at most kFirstFrameExtraShare of a uniform frame's: where a move uncovers much of
 // the image (a fast turn), each uncovered pixel's extra paths are scaled down, to none when more
 // than that share of the image is new, so that the new view comes no later than about 1.5 frames'
-// tracing (the explorer's turntable at 512x512 traced 2.5x a frame's paths without the bound).
+// tracing (without the bound, a fast turn in the explorer traced far more than that in one frame).
 void Preview::plan_first_frame_after_move() {
   const Image history = history_->history_lv_image();  // alpha: the samples it holds
   std::vector<uint8_t> paths(static_cast<size_t>(width_) * height_, 1);

@@ -47,9 +47,10 @@ struct PreviewSettings {
   bool bias_guard = true;
   // Shrink the filter's sigma_s as samples accumulate (shrunk_sigma_s in gl/pass_params.h,
   // docs/method.md 2.5): filter.sigma_s up to 4 spp, then sigma_s sqrt(4 / n), at least 2 px. Off
-  // by default: it lowers the filtered error (3-8 % at equal time from about 30 spp on), but with a
-  // kernel of 4 px or less the blend's mixed pixels keep about twice the perceived noise t it
-  // promises (docs/measurements.md, "Shrinking sigma_s"), and that promise is the method's.
+  // by default: it lowers the filtered error a little at equal time once jobs have a few tens of
+  // samples, but with a kernel of 4 px or less the blend's mixed pixels keep well above the
+  // perceived noise t it promises (docs/measurements.md, "Shrinking sigma_s"), and that promise is
+  // the method's.
   bool shrink_sigma = false;
   // Adaptive sampling (preview/adaptive.h): after adaptive_params.warmup_frames uniform
   // frames, each frame traces only the pixels the allocation picks, each at its own sample index.
@@ -95,11 +96,10 @@ constexpr double kMinHvShare = 0.01;
 constexpr double kFirstFrameExtraShare = 0.5;
 
 // Memory a Preview of width x height needs, checked before it allocates anything: the peak memory
-// of `pxf render` grows by about this much per pixel (cornell at 256x256 and 1024x1024, 2 spp: 130
-// and 615 MiB, before the bias guard's two sums textures added 32 B: 647 MiB at 1024x1024, and its
-// half windows' two more row textures another 37 B: 683 MiB): the accumulation (means, variances in
-// double, albedo, replicates), the GL textures of every pass, and the read-backs written to
-// buffers.exr.
+// of `pxf render` grows by about this much per pixel (the slope between two image sizes, plus what
+// each pass's textures added since; docs/notebook/measurements.md has the figures): the
+// accumulation (means, variances in double, albedo, replicates), the GL textures of every pass, and
+// the read-backs written to buffers.exr.
 constexpr uint64_t kPreviewBytesPerPixel = 590;
 uint64_t preview_bytes(int width, int height);
 // Throws pxf::Error, one line naming the size and both figures, when preview_bytes exceeds

@@ -11,11 +11,8 @@ PXF_SHARED_BEGIN
 
 // The history counts as at most this many samples (an exponential moving average of about this
 // length while the camera keeps moving), so that the lag and the blur of repeated resampling stay
-// short. pxf bench motion, median display NRMSE and flicker against the references' own, for
-// 4 / 8 / 16 (with one path everywhere, before kHistoryFirstFrameSamples): the helmet-like GLB
-// under the envmap (384x216, 60 frames over 90 degrees, 1024-spp references) 8.43 / 8.11 / 8.10 %
-// and 1.58 / 1.52 / 1.50x; cornell 128x128 (30 frames over 45 degrees) 14.74 / 14.77 / 14.73 % and
-// 1.01x for all three. Longer keeps a wrongly kept history longer.
+// short. Beyond a few samples a longer history barely lowers the error or the flicker of a moving
+// camera (pxf bench motion), while it keeps a wrongly kept history longer.
 PXF_CONST float kHistoryMaxCount = 8.0f;
 // The history's weight falls linearly to 0 over this many fresh samples: from then on the pixel is
 // the unbiased mean of its fresh samples, exactly as if the camera had never moved.
@@ -34,7 +31,7 @@ PXF_CONST float kHistoryNormalAgreement = 0.8f;
 // A pixel with a neighbour more than this share of its distance nearer or farther is on a
 // silhouette: no normal, and it neither gives nor takes history. Its samples mix the surfaces on
 // both sides (the path tracer's pixel footprint); reprojected as the surface of its center they
-// smeared a mirror sphere's reflections along the wall beside it in a cornell orbit.
+// smear a mirror sphere's reflections along the wall beside it while the camera orbits.
 PXF_CONST float kHistoryEdgeDepthJump = 0.2f;
 
 // Texture units of the history passes (beyond the pass shaders' kUnit* of pass_formulas.h).
@@ -238,7 +235,8 @@ PXF_SAMPLER_FN HistorySample reproject_history(sampler2D previous_lv, sampler2D 
   h.hv = vec3(shv / sw);
   h.var = sw_known > 0.0f ? float((sw2v_known + swv_known / sw_known * sw2_unknown) / (sw * sw)) : kVarUnknown;
   // Not renormalized: a pixel that only a corner of the taps supports gets that share of their
-  // samples (a history renormalized from a tap of weight 0.05 smeared streaks along the motion).
+  // samples (renormalized, one tap of small weight would stand for a whole history and smear
+  // streaks along the motion).
   h.count = float(swm);
   h.outcome = kHistoryKept;
   return h;
@@ -250,11 +248,12 @@ PXF_SAMPLER_FN HistorySample reproject_history(sampler2D previous_lv, sampler2D 
 // paths together: one whose history holds less (disoccluded, outside the previous view, a partial
 // footprint) traces the difference, so that the pixels without history are not the noisiest of the
 // frame (in that frame their variance stays unknown: Preview::hide_first_frame_variances).
-// pxf bench motion on the helmet-like GLB (as above), 1 / 2 / 4 / 8: median display NRMSE 8.11 /
-// 6.29 / 4.57 / 3.58 %, flicker 1.52 / 1.43 / 1.26 / 1.07x the references', rejected pixels'
-// display RMSE 0.226 / 0.165 / 0.108 / 0.070; the cost is 3 paths in each uncovered pixel (the
-// frame time of 1 and 4 alike within the machine's noise there; cornell 128x128, whose specular
-// spheres never take history, 1.3x the frame time).
+// With one path, a silhouette's pixels are 1-spp antialiasing and dominate a moving camera's error
+// and flicker; more paths lower both, at the cost of the extra paths in the uncovered pixels, which
+// is small where few pixels are uncovered and grows where many never take history (perfectly
+// specular objects). 4 meets the error and flicker a moving camera aims at; more costs more where
+// much is uncovered, for a gain not needed (docs/notebook/measurements.md, "A moving camera", has
+// the figures).
 PXF_CONST float kHistoryFirstFrameSamples = 4.0f;
 
 // The paths pixel p traces in the first frame after a move, given the samples its reprojected

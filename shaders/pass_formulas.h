@@ -234,8 +234,8 @@ PXF_INLINE float kernel_sums_variance(KernelSums s, float factor) {
 // The à-trous pass correction c (atrous_variance_correction, exact for a plain convolution) at a
 // pixel whose range weights keep the share rho = sum h r / sum h of the pass's kernel: c where
 // rho = 1, 1 where only the centre tap counts (its variance is the previous pass's own); in between
-// linear, an interpolation measured rather than derived: on cornell 64^2 at 16 spp the claim is
-// 1.12x the variance of L_f over 32 seeds (median over pixels; 3.38x with c everywhere).
+// linear, an interpolation fitted rather than derived: it claims a little more than the variance of
+// L_f over seeds, where c everywhere would claim several times too much (docs/method.md section 2.3).
 PXF_INLINE float atrous_local_correction(float c, float rho) { return 1.0f + (c - 1.0f) * clamp(rho, 0.0f, 1.0f); }
 
 // ---- Perceived variance ----
@@ -256,10 +256,9 @@ PXF_INLINE float relative_variance(float var, float lb) {
 // rarer than 1 in k (all of it in paths of probability 1/k, by Cauchy-Schwarz). Without that, a
 // pixel whose light truly is 0 beside lit neighbours (cornell: points of the mirror sphere that
 // reflect the open front) kept u = (Y(L_f) / L_b)^2 whatever its samples, stayed filtered forever
-// and so kept the filter's bias: measured, 3 of the 7 pixels cornell 128^2 at t = 0.01 still
-// filtered after 39620 spp, all HV samples 0. 1024: the rarest light the built-in scenes are known
-// to need, the mirror sphere's caustic on a wall, comes in about 1 BSDF sample in 1000
-// (docs/guiding.md). n: the pixel's own sample count (pixel_samples); 0 or unknown: no decay.
+// and so kept the filter's bias, however many samples it took. 1024: the rarest light the built-in
+// scenes are known to need, the mirror sphere's caustic on a wall, comes in about 1 BSDF sample in
+// 1000 (docs/guiding.md). n: the pixel's own sample count (pixel_samples); 0 or unknown: no decay.
 PXF_CONST float kZeroVarianceSamples = 1024.0f;
 PXF_INLINE float zero_variance_u(float y_f, float lb, float n) {
   if (!(y_f > 0.0f)) return 0.0f;
@@ -283,8 +282,8 @@ PXF_INLINE float pixel_samples(float run_samples, float factor) {
 // GPU flushes a smaller weight to 0 (exp(-e) for e > 87), so the shader leaves such a neighbour
 // out; the C++ compilation, whose weights are doubles, left it in, and where every known
 // neighbour was that far across a range edge it normalized their tiny weights back to a full
-// mean: the CPU reference and the explorer's inspector pooled a variance the blend pass did not
-// (cornell 32x24 at 6 spp, 1 pixel in 768, s 0.067 against the pass's 0.056).
+// mean: the CPU reference and the explorer's inspector pooled a variance the blend pass did not,
+// and so gave such a pixel another s than the pass.
 PXF_CONST float kMinPooledWeight = 1.17549435e-38f;
 
 // Var[L_u] for the decisions of the blend and the filter's skipping (docs/method.md section 3.3). A
@@ -416,18 +415,18 @@ PXF_INLINE float blend_factor_covariance(float u, float f, float t, float w, PXF
 // (kBiasGuardRadius) has variance about sum (Var[L_u] + Var[L_f]) / 25^2 (the covariance of L_u
 // and L_f left out: the test reads high, so it errs towards finding no bias). All 25 count alike,
 // whatever their range colour: a bias is a property of the filter around the pixel, and weighting
-// by the range buffer left fewer pixels to the test, which then missed bias it finds otherwise
-// (3x3, atrium 32 spp: display NRMSE 9.15 % with the range weights against 8.68 % without). 5x5
-// rather than 3x3: a steadier decision. With 3x3 a pixel was raised in some seeds and not in
-// others, which added variance to the pixels the blend holds at t (cornell 128², 16 spp,
-// t = 0.001: case-3 median 1.056 t against 0.924 t with 5x5; docs/measurements.md, "Bias guard").
+// by the range buffer left fewer pixels to the test, which then missed bias it finds otherwise,
+// and the error rose. 5x5 rather than 3x3: a steadier decision. With 3x3 a pixel was raised in
+// some seeds and not in others, which added variance to the pixels the blend holds at t, pushing
+// them above t (docs/notebook/measurements.md, "Bias guard", has the figures).
 // The test: the squared mean of d counts as the bias where it exceeds kBiasGuardZ^2 times that
 // variance, else no bias (window_bias_squared).
 //
 // The 5x5 mean misses a bias on one side of a sharp change the filter blurs: next to a focused
 // caustic, the contact shadow under the glass sphere takes the caustic's light in L_f (d > 0) while
-// the caustic loses it (d < 0), and the two cancel in the mean (cornell, 2 s: those 0.1 % of the
-// pixels held 40 % of the filtered image's squared display error, 30-70x too bright, seed after seed).
+// the caustic loses it (d < 0), and the two cancel in the mean: those few pixels stay many times too
+// bright, seed after seed, and hold much of the filtered image's error (docs/notebook/measurements.md,
+// "Half windows").
 // So the guard also judges the four half windows that contain the pixel (5 wide and 3 tall below
 // and above it, 3 wide and 5 tall left and right of it) at kBiasGuardHalfZ, stricter against the
 // more tests, each with its own mean Var[L_u] (the shadow side's variance, not the caustic's), and
@@ -508,7 +507,7 @@ PXF_INLINE float window_bias_squared(BiasGuardSums sums, float z) {
 // larger than the pixel's own (the blend's u). The guard adds noise where it raises s, so it must
 // not take that noise for less than it is; a variance estimated from few heavy-tailed samples is
 // low far more often than high, the more so the fewer pixels it pools (with the blend's u alone the
-// guard cost atrium 13-23 % of its display error at 4-32 spp; docs/method.md section 3.7).
+// guard made textured scenes worse; docs/method.md section 3.7).
 PXF_INLINE float broad_var_u(BiasGuardSums sums) {
   return sums.known > 0 ? float(min(sums.var_u / wide_float(sums.known), wide_float(kMaxInput))) : 0.0f;
 }
@@ -801,8 +800,8 @@ PXF_INLINE float grid_interpolation_correction(float a) {
 // cell (a surface of one range colour), so the two interpolated cells hold the same pixels through
 // the blur with taps g0 = g(k0 - own), g1 = g(k0 + 1 - own): the exact variance is
 // ((1 - a) g0 + a g1)^2 against ((1 - a)^2 g0^2 + a^2 g1^2) propagated (the cells hold g^2 Var).
-// 1 at a = 0 and 1; 1.8 at a = 1/2, where leaving it out made Var[L_f] 0.56x the truth: averaged
-// over a, Var[L_f] read 0.72x the variance measured over seeds (cornell, 128^2, 16 spp).
+// 1 at a = 0 and 1; 1.8 at a = 1/2. Without it Var[L_f] falls well short of the variance over
+// seeds, most halfway between cells (docs/filter-grid.md, "Var[L_f]").
 PXF_INLINE float grid_range_correction(float a, int k0, int own) {
   float w0 = (1.0f - a) * grid_blur_tap(k0 - own), w1 = a * grid_blur_tap(k0 + 1 - own);
   return (w0 + w1) * (w0 + w1) / (w0 * w0 + w1 * w1);  // > 0: own is k0 or k0 + 1, with weight >= 1/2
