@@ -8,7 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/cli.h"
-#include "app/explorer/explorer_camera.h"
+#include "scene/camera_controls.h"
 #include "core/error.h"
 #include "core/json_depth.h"
 #include "image/input_file.h"

@@ -7,7 +7,7 @@
 #include <fstream>
 
 #include "app/camera_path.h"
-#include "app/explorer/explorer_camera.h"
+#include "scene/camera_controls.h"
 #include "core/timing.h"
 #include "image/metrics.h"
 

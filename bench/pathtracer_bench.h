@@ -16,7 +16,7 @@ struct BenchResult {
   double rays_per_path = 0;
   double median_frame_ms = 0;
   double embree_rays_per_s = 0;         // rtcIntersect1 on incoherent rays of the scene, same threads
-  double fraction_of_embree = 0;        // rays_per_s / embree_rays_per_s (the target figure)
+  double fraction_of_embree = 0;        // rays_per_s / embree_rays_per_s (how close the tracer comes to raw Embree)
   double embree_stream_rays_per_s = 0;  // the same rays as rtcIntersect1M streams of 256
   double fraction_of_embree_stream = 0; // rays_per_s / embree_stream_rays_per_s
   double primary_ray_ms = 0;            // median time of a frame cut to camera rays and first hits

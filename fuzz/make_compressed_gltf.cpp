@@ -78,7 +78,7 @@ void write_meshopt_bombs(const std::string& dir) {
     write(dir + "/" + name, bytes);
     std::printf("wrote %s/%s (%zu bytes)\n", dir.c_str(), name.c_str(), bytes.size());
   };
-  // The attack: 4,000 views of one 16 KB block (64,000 zero vertices) each.
+  // A decompression bomb: 4,000 views of one 16 KB block (64,000 zero vertices) each.
   report("shared_unused.glb", meshopt_shared_views(87000, 4000, false));
   report("shared_used.glb", meshopt_shared_views(87000, 4000, true));
   // One view, expanded about 64-fold: 1 MB to 64 MB of vertices, drawn.

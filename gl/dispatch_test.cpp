@@ -74,7 +74,7 @@ TEST(GlLimits, QueriedFromTheContext) {
   EXPECT_GE(limits.max_texture_size, 16384);     // GL 4.5
 }
 
-// The case: 16384x100 at sigma_s 0.1 makes a grid of 4097 x 26 x 40 cells, whose blur
+// A hostile case: 16384x100 at sigma_s 0.1 makes a grid of 4097 x 26 x 40 cells, whose blur
 // needs 66,578 groups of 64: more than one row of 65,535 (GL_INVALID_VALUE before the 2D layout).
 // The guide's luminance ramps along x over [0, 1], so that the cells past the first row (the top
 // range cells: the layout is z-major) hold pixels, and the pass must match the CPU reference there.

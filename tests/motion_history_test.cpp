@@ -6,7 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "app/explorer/explorer_camera.h"
+#include "scene/camera_controls.h"
 #include "app/render_output.h"
 #include "gl/grid_filter.h"
 #include "image/metrics.h"

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "app/camera_path.h"
-#include "app/explorer/explorer_camera.h"
+#include "scene/camera_controls.h"
 #include "app/explorer/explorer_views.h"
 #include "app/render_output.h"
 #include "gl/context.h"

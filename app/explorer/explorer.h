@@ -1,6 +1,6 @@
 // `pxf explore`: the Dear ImGui desktop explorer. A GLFW window that path-traces
 // progressively through the shared Preview core, shows every buffer (explorer_views.h), edits the
-// parameters live, moves the camera (explorer_camera.h), inspects pixels and captures the same
+// parameters live, moves the camera (scene/camera_controls.h), inspects pixels and captures the same
 // files as `pxf render`. The only part of pxf that includes ImGui.
 #pragma once
 #include <string>

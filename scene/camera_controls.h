@@ -1,5 +1,5 @@
-// The explorer's camera controls: orbit around a target, pan, zoom (dolly) and fly.
-// Pure math on pxf::Camera, no GL and no GUI, so it is unit-tested.
+// Camera controls: orbit around a target, pan, zoom (dolly) and fly, for the explorer, camera paths
+// and the motion bench. Pure math on pxf::Camera, no GL and no GUI, so it is unit-tested.
 // Usage:
 //   CameraController control(scene.camera, scene_bounds(scene));
 //   control.orbit(dx, dy); control.pan(dx, dy, image_height); control.zoom(wheel);

@@ -1,4 +1,4 @@
-#include "app/explorer/explorer_camera.h"
+#include "scene/camera_controls.h"
 
 #include <algorithm>
 #include <cmath>
