@@ -152,11 +152,12 @@ FilterOutput atrous_pass(const Image& signal, const Image& signal_var, const Ima
       double h_sum = 0;
       const float var_p = atrous_k_l(p) > 0.0f ? shared::edge_stop_variance(TexelView{&signal, &signal_var}, glm::ivec2(x, y))
                                                 : kVarUnknown;
+      const Px l_p = rgb_at(signal, x, y);
       for (int j = 0; j < 5; ++j)
         for (int i = 0; i < 5; ++i) {
           const int qx = x + (i - 2) * step, qy = y + (j - 2) * step;
           if (qx < 0 || qx >= w || qy < 0 || qy >= h) continue;
-          const Px l_p = rgb_at(signal, x, y), l_q = rgb_at(signal, qx, qy);
+          const Px l_q = rgb_at(signal, qx, qy);
           const double edge = shared::luminance_edge_exponent(glm::vec3(l_p.c[0], l_p.c[1], l_p.c[2]),
                                                               glm::vec3(l_q.c[0], l_q.c[1], l_q.c[2]),
                                                               var_p, atrous_k_l(p));

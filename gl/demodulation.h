@@ -1,15 +1,10 @@
 // Albedo demodulation around the filter, for every filter variant: the filter smooths HV divided by
-// the albedo of the first non-specular vertex (irradiance-like, free of texture detail) and its
-// output is multiplied back by each pixel's own albedo before the blend, so textures stay sharp.
-//   demodulate: L_u' = L_u / a, Var[L_u'] = Var[L_u] / Y(a)^2
-//   remodulate: L_f  = a L_f', Var[L_f]  = Y(a)^2 Var[L_f']   (a grey: Y(a) = a)
-// a = demodulation_factor(mean albedo) (shaders/pass_formulas.h): grey, the albedo's luminance where
-// that is at least kAlbedoEpsilon (0.05), else 1 (that pixel is not demodulated). Grey because a
-// per-channel division amplifies, in the channels a saturated texture nearly lacks, light that the
-// albedo does not shape (specular highlights): that gave pink speckles and a red halo and a larger
-// error than no demodulation (docs/notebook/measurements.md, "Albedo demodulation"). So luminance
-// texture is kept, chroma texture within the filter's range tolerance is still smoothed. With a
-// grey factor the variance scaling is exact. On an unfiltered pixel the two steps give back L_u and
+// the directional albedo of the first non-delta vertex (PathSample::albedo; its pixel mean is
+// coverage x albedo), so it sees illumination, free of texture detail, and its output is multiplied
+// back by each pixel's own albedo before the blend, so textures and thin strands stay sharp.
+// The formulas are shared with the CPU reference (shaders/pass_formulas.h): demodulated_texel
+// (per channel, with modulation_factor; a pixel below kAlbedoEpsilon takes its neighbours' light)
+// and remodulated_texel. On an unfiltered, demodulated pixel the two steps give back L_u and
 // Var[L_u]; the blend sees L_f and Var[L_f] in radiance units, so its perceived-variance logic is
 // unchanged. The filter's case-2 skip is decided on the original buffers (shaders/demodulate.frag).
 // CPU reference: cpu_demodulate / cpu_remodulate.

@@ -33,7 +33,7 @@ class PreviewInputs {
   void upload(const float* lv_rgb, const float* hv_rgb, const float* var_of_mean);
   // The same from images: lv "R,G,B" (or "R,G,B,A", A the threshold factor), hv "R,G,B"; var one channel.
   void upload(const Image& lv, const Image& hv, const Image& var);
-  // The per-pixel mean albedo of the first non-specular vertex (Accumulation::albedo_mean, 3 floats
+  // The per-pixel mean albedo of the first non-delta vertex (Accumulation::albedo_mean, 3 floats
   // per pixel), for albedo demodulation (gl/demodulation.h). Uploaded only when demodulating.
   void upload_albedo(const float* albedo_rgb);
   void upload_albedo(const Image& albedo);  // "R,G,B"

@@ -1151,6 +1151,64 @@ TEST(Demodulation, TexturedConstantIrradiancePlaneKeepsItsTexture) {
   }
 }
 
+// The à-trous luminance edge stop: on a flat guide, a step in the light itself (a shadow's edge the
+// guide does not show, 1 against 0.2 with standard deviations of 0.01) stays sharp with it and is
+// blurred without it; differences within sigma_l standard deviations (a ripple of 0.02 at the
+// same 0.01) leave every weight as it is, so the filter is the same as without the stop there.
+TEST(AtrousEdgeStop, KeepsAnEdgeOfTheLightAndLeavesTheNoiseAlone) {
+  auto plane = [](auto light) {
+    Scenario s;
+    for (int y = 0; y < H; ++y)
+      for (int x = 0; x < W; ++x) {
+        for (int c = 0; c < 3; ++c) {
+          s.hv.at(x, y, c) = light(x, y);
+          s.lv.at(x, y, c) = 0.0f;
+          s.range.at(x, y, c) = 0.5f;
+        }
+        s.var.at(x, y, 0) = 1e-4f;
+        s.depth.at(x, y, 0) = 3.0f;
+      }
+    return s;
+  };
+  FilterParams p;
+  p.kind = FilterKind::Atrous;
+  p.skip_case2 = false;
+  FilterParams no_stop = p;
+  no_stop.sigma_l = 0.0f;
+  auto filtered = [](const Scenario& s, const FilterParams& params) {
+    return cpu_filter(s.hv, s.var, s.lv, s.range, s.depth, params, test::kTestThreshold).filtered;
+  };
+  const Scenario step = plane([](int x, int) { return x < W / 2 ? 1.0f : 0.2f; });
+  double kept = 0, blurred = 0;
+  const Image with_stop = filtered(step, p), without = filtered(step, no_stop);
+  for (int y = 0; y < H; ++y)
+    for (int x = W / 2 - 2; x < W / 2 + 2; ++x) {
+      kept = std::max(kept, double(std::abs(with_stop.at(x, y, 0) - step.hv.at(x, y, 0))));
+      blurred = std::max(blurred, double(std::abs(without.at(x, y, 0) - step.hv.at(x, y, 0))));
+    }
+  EXPECT_LT(kept, 1e-3);
+  EXPECT_GT(blurred, 0.1);
+  const Scenario ripple = plane([](int x, int y) { return 1.0f + 0.02f * float((x + y) % 2); });
+  expect_close(filtered(ripple, p), filtered(ripple, no_stop), 1e-6f, 1e-9f, "ripple");
+}
+
+// The normal term narrows with the sharper glossy lobe of the two surfaces: 1 / s^2 times the
+// diffuse exponent, s = roughness / 0.8 between 0.1 and 1.
+TEST(SurfaceTerms, NormalTermNarrowsWithTheGlossyLobe) {
+  const glm::vec4 a(0.0f, 0.0f, 1.0f, 1.0f), b(std::sin(0.1f), 0.0f, std::cos(0.1f), 1.0f);
+  auto exponent = [&](float roughness_a, float roughness_b) {
+    glm::vec4 p = a, q = b;
+    p.w = roughness_a;
+    q.w = roughness_b;
+    return double(shared::surface_exponent(p, q, 1.0f / (0.15f * 0.15f), 0.0f));
+  };
+  const double rough = exponent(1.0f, 1.0f);
+  EXPECT_NEAR(rough, (1.0 - std::cos(0.1)) / (0.15 * 0.15), 1e-6);
+  EXPECT_NEAR(exponent(0.9f, 0.8f), rough, 1e-9);
+  EXPECT_NEAR(exponent(1.0f, 0.2f) / rough, 16.0, 1e-4);  // s = 0.25: the sharper lobe decides
+  EXPECT_NEAR(exponent(0.0f, 0.5f) / rough, 100.0, 1e-3);  // s at its floor, 0.1
+}
+
 // A normal-mapped plane under a directional light: its radiance varies with the shading normal
 // alone (flat range color, one depth), as the path tracer sees a normal-mapped wall. With the
 // normal term the filter keeps the bumps at a kernel far wider than they are; without it, it

@@ -14,7 +14,7 @@ struct Accumulation {
   int width = 0, height = 0;
   std::vector<glm::vec3> lv_mean;      // mean RGB radiance of LV paths
   std::vector<glm::vec3> hv_mean;      // mean RGB radiance of HV paths
-  std::vector<glm::vec3> albedo_mean;  // mean PathSample::albedo (first non-specular base color)
+  std::vector<glm::vec3> albedo_mean;  // mean PathSample::albedo (coverage x first non-delta albedo)
   std::vector<double> hv_lum_mean;     // Welford state of HV luminance
   std::vector<double> hv_lum_m2;
   // Welford state of LV luminance: LV is never filtered, so its noise is part of what the viewer

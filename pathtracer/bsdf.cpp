@@ -184,7 +184,9 @@ Bsdf::Bsdf(const BsdfMaterial& k, glm::vec3 shading_normal, glm::vec3 geometric_
   const float w_sheen = luminance(sheen_factor_) * std::max(sheen_albedo_o, 1e-3f);
   choose_lobes(luminance(diffuse_factor_) * kPi, luminance(glossy_albedo), w_sheen, clearcoat_ * coat_albedo, c_glass_);
   if (black_) return;
-  nondelta_albedo_ = diffuse_factor_ * kPi + sheen_factor_ * sheen_albedo_o;
+  // The sheen lobe reflects sheen_color coat_share min(E_sheen, 1) (set_up_sheen scales it down
+  // where E_sheen exceeds 1).
+  nondelta_albedo_ = diffuse_factor_ * kPi + k.sheen_color * (coat_share * sheen_albedo_o);
   if (!glossy_delta_) nondelta_albedo_ += glossy_albedo;
   if (!coat_delta_) nondelta_albedo_ += glm::vec3(clearcoat_ * coat_albedo);
   // Rough glass reflects and transmits nearly all it receives, the transmission tinted by the base.

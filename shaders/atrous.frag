@@ -1,8 +1,9 @@
 #version 450 core
 // One pass of the edge-avoiding à-trous wavelet filter (Dammertz et al. 2010; FilterKind::Atrous):
 // the 5x5 B3-spline kernel h at hole spacing `step_px` (1, 2, 4, ... over the passes), each tap
-// weighted by h x the range weights of the cross bilateral filter (color, depth, surface; no spatial
-// Gaussian beyond h) x the luminance edge stop on the signal itself (luminance_edge_exponent): L_f = sum w L / sum w, Var[L_f] = c sum w^2 Var / (sum w)^2 with the
+// weighted by h x the range weights of the cross bilateral filter (color, depth, surface; no
+// spatial Gaussian beyond h) x the luminance edge stop on the signal itself
+// (luminance_edge_exponent): L_f = sum w L / sum w, Var[L_f] = c sum w^2 Var / (sum w)^2 with the
 // correction c for the correlation between the previous pass's pixels: atrous_variance_correction
 // scaled by the share of the kernel the range weights keep (atrous_local_correction).
 // Taps outside the image are left out.

@@ -1,9 +1,9 @@
 #version 450 core
 // Albedo demodulation before the filter (gl/demodulation.h): the filter's inputs are
-// demodulated_texel. The filter reads its LV input only for
-// its case-2 skip; that input here carries the skip decision taken on the original buffers, so that
-// every variant skips exactly the pixels it skips without demodulation: +kMaxInput makes u vanish
-// (skip), -kMaxInput makes L_b = 0 and u infinite (filter).
+// demodulated_texel. The filter reads its LV input only for its case-2 skip; that input here
+// carries the skip decision taken on the original buffers, so that every variant skips exactly the
+// pixels it skips without demodulation: +kMaxInput makes u vanish (skip), -kMaxInput makes L_b = 0
+// and u infinite (filter).
 #include "pass_formulas.h"
 
 layout(binding = kUnitHv) uniform sampler2D hv_tex;    // rgb L_u, a Var[L_u]
