@@ -100,12 +100,16 @@ Scene load_scene_for(SceneOptions& options, PreviewSettings& settings, const Com
   }
   if (scene.automatic_camera) scene.camera = frame_scene(scene, static_cast<float>(options.width) / options.height);
   if (!cli.given("--all-hv") && scene.defaults.all_hv) settings.trace.all_hv = true;
-  if (settings.trace.all_hv && !cli.given("--filter")) {
+  if (takes_all_hv_filter(scene, settings) && !cli.given("--filter")) {
     settings.filter.kind = kAllHvFilter;
-    std::fprintf(stderr, "pxf: all-HV (environment-lit) scene: filter %s (--filter to choose another)\n",
-                 filter_kind_name(kAllHvFilter));
+    std::fprintf(stderr, "pxf: %s: filter %s (--filter to choose another)\n",
+                 settings.trace.all_hv ? "all-HV scene" : "lit mostly by its environment", filter_kind_name(kAllHvFilter));
   }
   return scene;
+}
+
+bool takes_all_hv_filter(const Scene& scene, const PreviewSettings& settings) {
+  return settings.trace.all_hv || environment_light_share(scene) >= 0.5f;
 }
 
 }  // namespace pxf

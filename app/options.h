@@ -28,13 +28,16 @@ struct SceneOptions {
 // The loader's limits from the scene options (memory: what the system reports).
 LoadLimits load_limits(const SceneOptions& options);
 
-// The filter of an all-HV render (--all-hv, or a glTF whose extras ask for it) unless --filter is
-// given. There HV holds the direct light too, so textured detail is filtered, and the grid's range
-// axis (luminance only) averages texture stripes that differ in luminance by less than sigma_c;
-// a-trous weighs the RGB range color, so it keeps the texture where the grid blurs it and made
-// the filtered all-HV image worse than the unfiltered one. The LV/HV split, envmap's default, does
-// better still (docs/measurements.md, "Environment-lit scenes").
+// The filter of an all-HV render (--all-hv, or a glTF whose extras ask for it) and of a scene lit
+// mostly by its environment (at least half of the light sampler's power estimate), unless --filter
+// is given. There HV holds the
+// direct light too, so textured and glossy detail is filtered, and the grid's range axis (luminance
+// only) averages detail that differs in luminance by less than sigma_c and shows its cells as
+// blocks; a-trous weighs the RGB range color and the surface, and kept the detail where the grid
+// blurred it (docs/measurements.md, "Environment-lit scenes").
 constexpr FilterKind kAllHvFilter = FilterKind::Atrous;
+// Whether a scene's render takes kAllHvFilter when --filter is not given.
+bool takes_all_hv_filter(const Scene& scene, const PreviewSettings& settings);
 
 void add_scene_options(CommandLine& cli, SceneOptions& options, bool headless);
 // Binds the command line to the one PreviewSettings (enums through their name tables).
@@ -43,7 +46,7 @@ void add_preview_options(CommandLine& cli, PreviewSettings& settings);
 // Prints the built-in scenes when options.scene == "list" (returns true: nothing else to do).
 bool print_scene_list_if_asked(const SceneOptions& options);
 // Loads the scene, applies its render defaults (size, all_hv unless given on the command line, and
-// then kAllHvFilter unless --filter is given).
+// then kAllHvFilter where takes_all_hv_filter, unless --filter is given).
 Scene load_scene_for(SceneOptions& options, PreviewSettings& settings, const CommandLine& cli);
 // Prints the scene's notes and warnings to stderr, one "pxf: ..." line each.
 void print_scene_messages(const Scene& scene);

@@ -33,6 +33,8 @@ void BlendPass::run_bias_guard(const PreviewInputs& inputs, const Texture2D& fil
   guard_columns_program_.bind(shared::kUnitGuardSums, guard_rows_);
   guard_columns_program_.bind(shared::kUnitGuardRowsLowX, guard_rows_low_x_);
   guard_columns_program_.bind(shared::kUnitGuardRowsHighX, guard_rows_high_x_);
+  guard_columns_program_.bind(shared::kUnitHv, inputs.hv());
+  guard_columns_program_.bind(shared::kUnitFiltered, filtered);
   quad_.draw(guard_columns_program_, guard_fbo_, width_, height_);
 }
 

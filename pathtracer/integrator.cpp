@@ -48,11 +48,15 @@ float unguided_weight_ratio(float mixture_pdf, float bsdf_pdf) {
 // The path so far is E S* (emission here is E S* L), or E S* D with the D just before (E S* D L).
 bool emission_is_lv(const PathState& s) { return s.nonspecular == 0 || (s.nonspecular == 1 && !s.prev_delta); }
 
-// Where emission reached along the path goes. all_hv moves to HV what light sampling made noisy;
-// light the camera sees directly or through perfectly specular chains (E S* L: nothing sampled but
-// the pixel position) stays in LV, so that an environment seen as the backdrop is not filtered into,
-// or blurred with, the objects before it.
-bool emission_goes_to_lv(const PathState& s, bool all_hv) { return emission_is_lv(s) && (!all_hv || s.nonspecular == 0); }
+// Where emission reached along the path goes. Light the camera sees directly or through perfectly
+// specular chains (E S* L: nothing sampled but the pixel position) stays in LV, so that an
+// environment seen as the backdrop is not filtered into, or blurred with, the objects before it.
+// The environment's light at the first surface goes to HV: a large light of high dynamic range, often
+// partly hidden, seen through glossy lobes, it is where an object under a sky keeps its noise
+// (docs/method.md 1.1). all_hv moves the emitters' there too.
+bool emission_goes_to_lv(const PathState& s, bool environment, bool all_hv) {
+  return emission_is_lv(s) && ((!all_hv && !environment) || s.nonspecular == 0);
+}
 
 void add_contribution(PathSample& out, glm::vec3 value, bool lv) {
   if (lv)
@@ -127,8 +131,8 @@ struct PathTracer::ShadowQueue {
     glm::vec3 contribution;  // added when the shadow ray reaches the light
     bool lv;
   };
-  // Per path and vertex: the chosen light's shadow ray and one per sun.
-  static constexpr size_t kCapacity = kBatchPaths * (1 + LightSampler::kMaxSuns);
+  // Per path and vertex: the chosen light's shadow ray and one per fixed light.
+  static constexpr size_t kCapacity = kBatchPaths * (1 + LightSampler::kMaxFixedLights);
   ShadowRay rays[kCapacity];
   Pending pending[kCapacity];
   bool occluded[kCapacity];
@@ -143,11 +147,11 @@ struct PathTracer::ShadowQueue {
     ++count;
   }
   template <bool kClassify>
-  void resolve(const EmbreeScene& geometry, bool all_hv) {
+  void resolve(const EmbreeScene& geometry) {
     geometry.occluded(rays, static_cast<size_t>(count), occluded);
     for (int i = 0; i < count; ++i)
       if (!occluded[i]) {
-        const bool lv = pending[i].lv && !all_hv;
+        const bool lv = pending[i].lv;
         add_contribution(*pending[i].out, pending[i].contribution, lv);
         if constexpr (kClassify)
           if (!lv) record_hv(*class_out[i], pending[i].contribution, classes[i]);
@@ -273,7 +277,7 @@ void PathTracer::trace_batch(const Camera& camera, int width, int height, const 
                                   kClassify ? &class_states[live[k]] : nullptr))
         live[still_live++] = live[k];
     live_count = still_live;
-    shadows.resolve<kClassify>(geometry_, params.all_hv);
+    shadows.resolve<kClassify>(geometry_);
   }
 }
 
@@ -421,7 +425,7 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
     if (lights_.has_environment()) {
       float w = s.prev_delta ? s.chain_mis : power_heuristic(s.prev_pdf, lights_.pdf_environment(path.ray.direction));
       const glm::vec3 value = s.throughput * lights_.environment_radiance(path.ray.direction) * w;
-      const bool lv = emission_goes_to_lv(s, params.all_hv);
+      const bool lv = emission_goes_to_lv(s, true, params.all_hv);
       add_contribution(out, value, lv);
       if constexpr (kClassify)
         if (!lv) record_hv(*cls->out, value, cls->classify(s.nonspecular, true));
@@ -438,7 +442,7 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
       w = power_heuristic(s.prev_pdf,
                           lights_.pdf_triangle(hit.mesh, hit.prim, s.prev_position, sp.position, sp.geometric_normal));
     const glm::vec3 value = s.throughput * eval_emission(scene, material, sp.uv0, sp.uv1) * w;
-    const bool lv = emission_goes_to_lv(s, params.all_hv);
+    const bool lv = emission_goes_to_lv(s, false, params.all_hv);
     add_contribution(out, value, lv);
     if constexpr (kClassify)
       if (!lv) record_hv(*cls->out, value, cls->classify(s.nonspecular, true));
@@ -462,7 +466,7 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
   const Vertex v{sp, bsdf_params, bsdf, guiding_mixture(sp, bsdf, wo, s.nonspecular == 0, params), vertex};
   // Next event estimation (the light vertex is vertex + 1 <= max_vertices).
   const PathSampler::LightNumbers u_light = numbers ? numbers->light : sampler.light_numbers(vertex, bsdf.has_nondelta());
-  if (bsdf.has_nondelta()) sample_direct_light<kClassify>(path, v, u_light, shadows, cls);
+  if (bsdf.has_nondelta()) sample_direct_light<kClassify>(path, v, u_light, params.all_hv, shadows, cls);
   // Light through a specular chain, which NEE cannot reach (HV: D S+ L).
   const bool room = chains_.traces_any(params) && bsdf.has_nondelta() && vertex + 2 <= params.max_vertices;
   const SpecularChainSampler::Plan plan = room ? chains_.plan(sp.position, params, s.nonspecular == 0)
@@ -492,14 +496,17 @@ GuidingMixture PathTracer::guiding_mixture(const SurfacePoint& sp, const Bsdf& b
 }
 
 // Next event estimation at a non-delta vertex: the light sample of the chosen light, then every
-// sun's (LightSampler::kMaxSuns), each queued on `shadows` with its MIS weight.
+// fixed light's (LightSampler::kMaxFixedLights), each queued on `shadows` with its MIS weight. At the
+// first non-delta vertex a fixed light's contribution is exact (nothing random decides it), so it
+// goes to LV; the chosen light's goes there too unless it is the environment's or all_hv is on
+// (emission_goes_to_lv: sampling made it noisy).
 template <bool kClassify>
-void PathTracer::sample_direct_light(Path& path, const Vertex& v, const PathSampler::LightNumbers& u_light,
+void PathTracer::sample_direct_light(Path& path, const Vertex& v, const PathSampler::LightNumbers& u_light, bool all_hv,
                                      ShadowQueue& shadows, [[maybe_unused]] ClassState* cls) const {
   const PathState& s = path.state;
   PathSample& out = *path.out;
   const SurfacePoint& sp = v.sp;
-  const auto queue_light = [&](const LightSample& ls) {
+  const auto queue_light = [&](const LightSample& ls, bool exact) {
     float bsdf_pdf;
     glm::vec3 f = v.bsdf.eval(ls.wi, &bsdf_pdf);
     if (!(max_component(f) > 0.0f && max_component(ls.radiance) > 0.0f)) return;
@@ -508,17 +515,20 @@ void PathTracer::sample_direct_light(Path& path, const Vertex& v, const PathSamp
                         : shadow_ray_between(sp.position, sp.geometric_normal, ls.point, ls.normal);
     ++out.rays;
     float w = ls.delta ? 1.0f : power_heuristic(ls.pdf, v.mixture.pdf(bsdf_pdf, ls.wi));
+    const bool environment = std::isinf(ls.distance) && !ls.delta;
+    const bool lv = s.nonspecular == 0 && (exact || (!all_hv && !environment));
     if constexpr (kClassify) {
       shadows.class_out[shadows.count] = cls->out;
       shadows.classes[shadows.count] = cls->classify(s.nonspecular, false);
     }
-    shadows.push(ray, {&out, s.throughput * f * ls.radiance * (w / ls.pdf), s.nonspecular == 0});
+    shadows.push(ray, {&out, s.throughput * f * ls.radiance * (w / ls.pdf), lv});
   };
   LightSample ls;
   if (u_light.shared ? lights_.sample(sp.position, u_light.point, &ls)
                      : lights_.sample(sp.position, u_light.select, u_light.point, &ls))
-    queue_light(ls);
-  for (size_t sun = 0; sun < lights_.sun_count(); ++sun) queue_light(lights_.sun_sample(sun));
+    queue_light(ls, false);
+  for (size_t k = 0; k < lights_.fixed_light_count(); ++k)
+    if (lights_.fixed_light_sample(k, sp.position, &ls)) queue_light(ls, true);
 }
 
 // The specular chain a vertex's plan traces (SpecularChainSampler): at every diffuse vertex toward

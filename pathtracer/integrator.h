@@ -18,9 +18,10 @@ namespace pxf {
 
 class GuidingField;
 
-// One path's contributions. LV = E S* L and E S* D L (both MIS strategies at that D vertex);
-// HV = everything else. With all_hv, LV holds E S* L only (what the camera sees directly or through
-// perfectly specular chains), everything else goes to HV.
+// One path's contributions. LV = E S* L and E S* D L (both MIS strategies at that D vertex) but the
+// environment's E S* D L; HV = everything else. With all_hv, LV holds only what no random choice
+// made noisy: E S* L (what the camera sees directly or through perfectly specular chains) and the
+// fixed lights' E S* D L (LightSampler::kMaxFixedLights); everything else goes to HV.
 struct PathSample {
   glm::vec3 lv{0.0f};
   glm::vec3 hv{0.0f};
@@ -135,8 +136,8 @@ class PathTracer {
   GuidingMixture guiding_mixture(const SurfacePoint& sp, const Bsdf& bsdf, glm::vec3 wo, bool first_vertex,
                                  const TraceParams& params) const;
   template <bool kClassify>
-  void sample_direct_light(Path& path, const Vertex& v, const PathSampler::LightNumbers& u_light, ShadowQueue& shadows,
-                           ClassState* cls) const;
+  void sample_direct_light(Path& path, const Vertex& v, const PathSampler::LightNumbers& u_light, bool all_hv,
+                           ShadowQueue& shadows, ClassState* cls) const;
   template <bool kClassify>
   void add_chain_light(Path& path, const Vertex& v, const SpecularChainSampler::Plan& plan, const TraceParams& params,
                        ClassState* cls) const;

@@ -320,7 +320,7 @@ TEST(Integrator, PowerBasedLightSelectionKeepsTheExpectation) {
   // A diffuse plane under a uniform sky (L = 1) and suns straight down (E = 2 in all): the radiance
   // is albedo / pi x (pi L + E) however the light is sampled. One sun or two: each sampled at every
   // vertex beside the chosen light (a sun counted twice would add 0.6 x 2 / pi); five, above
-  // kMaxSuns: chosen among the lights by power (sky 4 pi : suns 2). Z-test on the image mean; the
+  // kMaxFixedLights: chosen among the lights by power (sky 4 pi : suns 2). Z-test on the image mean; the
   // per-frame variance overestimates the Sobol mean's, so |z| < 4 is safe.
   for (int suns : {1, 2, 5}) {
     Scene scene;
@@ -334,11 +334,11 @@ TEST(Integrator, PowerBasedLightSelectionKeepsTheExpectation) {
     for (int k = 0; k < suns; ++k) scene.lights.push_back(sun);
     scene.camera = look_at_camera(glm::vec3(0, 2, 0.01f), glm::vec3(0, 0, 0), glm::vec3(0, 0, -1), 0.8f);
     PathTracer tracer(scene);
-    if (suns <= static_cast<int>(LightSampler::kMaxSuns)) {
-      ASSERT_EQ(tracer.lights().sun_count(), static_cast<size_t>(suns));
+    if (suns <= static_cast<int>(LightSampler::kMaxFixedLights)) {
+      ASSERT_EQ(tracer.lights().fixed_light_count(), static_cast<size_t>(suns));
       ASSERT_EQ(tracer.lights().environment_probability(), 1.0f);
     } else {
-      ASSERT_EQ(tracer.lights().sun_count(), 0u);
+      ASSERT_EQ(tracer.lights().fixed_light_count(), 0u);
       // 1e-2: the 8 x 4 sky's power is a midpoint sum over 4 rows.
       ASSERT_NEAR(tracer.lights().environment_probability(), 4 * kPi / (4 * kPi + 2), 1e-2);
     }
@@ -397,11 +397,10 @@ TEST(Integrator, LvPlusHvEqualsUnsplitEstimator) {
   EXPECT_NEAR(total_a / total_b, 1.0, 0.02);
 }
 
-TEST(Integrator, AllHvKeepsWhatTheCameraSeesDirectlyInLv) {
-  // A diffuse plane under a uniform sky, the camera looking at the horizon: with all_hv, pixels
-  // whose camera ray escapes hold exactly the sky's radiance in LV and nothing in HV; pixels on the
-  // plane hold everything in HV (their direct light is sampled, hence noisy). Without all_hv the
-  // plane's direct light is LV.
+TEST(Integrator, TheEnvironmentsLightAtTheFirstSurfaceGoesToHv) {
+  // A diffuse plane under a uniform sky, the camera looking at the horizon: pixels whose camera ray
+  // escapes hold exactly the sky's radiance in LV and nothing in HV; pixels on the plane hold
+  // everything in HV, with or without all_hv (the sky's light there is sampled, hence noisy).
   Scene scene;
   scene.materials = {make_diffuse(glm::vec3(0.6f))};
   scene.meshes.push_back(make_quad(glm::vec3(-50, 0, 50), glm::vec3(100, 0, 0), glm::vec3(0, 0, -100), 0));
@@ -421,14 +420,50 @@ TEST(Integrator, AllHvKeepsWhatTheCameraSeesDirectlyInLv) {
         continue;
       }
       ++plane;
-      if (all_hv) {
-        EXPECT_EQ(s.lv, glm::vec3(0.0f)) << "plane light in LV with all_hv";
-      }
+      EXPECT_EQ(s.lv, glm::vec3(0.0f)) << "the sky's light on the plane in LV, all_hv " << all_hv;
     }
     EXPECT_GT(plane, kSize * kSize / 4) << all_hv;
-    if (all_hv) {
-      EXPECT_GT(sky, kSize * kSize / 4) << "escaping camera rays: LV = sky radiance, HV = 0";
-    }
+    EXPECT_GT(sky, kSize * kSize / 4) << "escaping camera rays: LV = sky radiance, HV = 0";
+  }
+}
+
+TEST(Integrator, ExactLightStaysInLvAndSampledLightGoesToHvWithAllHv) {
+  // A diffuse plane lit by a point light and a sun (fixed lights: each taken at every vertex, its
+  // light exact) and by an emissive quad overhead, chosen by sampling. Seen straight down, the plane's
+  // LV is the fixed lights' light alone with all_hv, the same in every sample of a pixel; without
+  // all_hv the quad's first-surface light joins it (the thesis' rule), and LV varies.
+  Scene scene;
+  scene.materials = {make_diffuse(glm::vec3(0.5f)), make_emitter(glm::vec3(2.0f))};
+  scene.meshes.push_back(make_quad(glm::vec3(-5, 0, 5), glm::vec3(10, 0, 0), glm::vec3(0, 0, -10), 0));
+  scene.meshes.push_back(make_quad(glm::vec3(3, 4, -1), glm::vec3(2, 0, 0), glm::vec3(0, 0, 2), 1));  // faces -y
+  PunctualLight point;
+  point.type = PunctualLight::Type::Point;
+  point.position = glm::vec3(0, 100, 0);  // far: the same irradiance over the pixels' footprints
+  point.intensity = 5e4f;
+  PunctualLight sun;
+  sun.type = PunctualLight::Type::Directional;
+  sun.direction = glm::vec3(0.3f, -1, 0);
+  sun.intensity = 1.0f;
+  scene.lights = {point, sun};
+  scene.camera = look_at_camera(glm::vec3(0, 2, 0.01f), glm::vec3(0, 0, 0), glm::vec3(0, 0, -1), 0.3f);
+  PathTracer tracer(scene);
+  ASSERT_EQ(tracer.lights().fixed_light_count(), 2u);
+  constexpr int kSize = 4, kSamples = 32;
+  for (bool all_hv : {true, false}) {
+    TraceParams params;
+    params.all_hv = all_hv;
+    bool lv_varies = false;
+    for (int y = 0; y < kSize; ++y)
+      for (int x = 0; x < kSize; ++x) {
+        glm::vec3 first{-1.0f};
+        for (uint32_t frame = 0; frame < kSamples; ++frame) {
+          const PathSample s = tracer.trace_pixel(scene.camera, kSize, kSize, x, y, frame, params);
+          ASSERT_GT(s.lv.x, 0.0f);
+          if (frame == 0) first = s.lv;
+          if (glm::length(s.lv - first) > 1e-3f * glm::length(first)) lv_varies = true;
+        }
+      }
+    EXPECT_EQ(lv_varies, !all_hv) << "all_hv " << all_hv;
   }
 }
 

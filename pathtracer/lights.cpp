@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "pathtracer/bsdf.h"
+#include "pathtracer/pathtracer.h"
 #include "scene/texture.h"
 
 namespace pxf {
@@ -184,11 +185,8 @@ LightSampler::LightSampler(const Scene& scene) : scene_(scene) {
   }
   for (const PunctualLight& light : scene.lights)
     if (light.intensity > 0.0f && std::isfinite(light.intensity) && max_component(light.color) > 0.0f)
-      (light.type == PunctualLight::Type::Directional ? suns_ : punctual_).push_back(&light);
-  if (suns_.size() > kMaxSuns) {  // many directional lights: chosen among the punctual ones, as any other
-    punctual_.insert(punctual_.end(), suns_.begin(), suns_.end());
-    suns_.clear();
-  }
+      punctual_.push_back(&light);
+  if (punctual_.size() <= kMaxFixedLights) fixed_.swap(punctual_);  // more: chosen among themselves, by the category
 
   bool has_tri = triangle_dist_.valid(), has_env = env_ != nullptr, has_punctual = !punctual_.empty();
   category_count_ = int(has_tri) + int(has_env) + int(has_punctual);
@@ -196,7 +194,7 @@ LightSampler::LightSampler(const Scene& scene) : scene_(scene) {
   const float scene_radius = scene_radius_;
   std::vector<float> emission_powers{has_tri ? static_cast<float>(triangle_power(triangle_dist_.total())) : 0.0f,
                                      has_env ? static_cast<float>(environment_power(*env_, scene_radius)) : 0.0f};
-  for (const auto* lights : {&punctual_, &suns_})
+  for (const auto* lights : {&punctual_, &fixed_})
     for (const PunctualLight* light : *lights) emission_powers.push_back(static_cast<float>(punctual_power(*light, scene_radius)));
   for (float& power : emission_powers)
     if (!std::isfinite(power)) power = 0.0f;
@@ -206,6 +204,8 @@ LightSampler::LightSampler(const Scene& scene) : scene_(scene) {
   power_environment_ = has_env ? environment_power(*env_, scene_radius) : 0.0;
   power_punctual_ = 0.0;
   for (const PunctualLight* light : punctual_) power_punctual_ += punctual_power(*light, scene_radius);
+  power_fixed_ = 0.0;
+  for (const PunctualLight* light : fixed_) power_fixed_ += punctual_power(*light, scene_radius);
   const double total = power_triangles_ + power_environment_ + power_punctual_;
   if (!(total > 0.0) || !std::isfinite(total)) {  // no usable estimate: equal shares
     float share = 1.0f / category_count_;
@@ -565,12 +565,17 @@ LightSample directional_sample(const PunctualLight& light, float pdf) {
 }
 }  // namespace
 
-LightSample LightSampler::sun_sample(size_t index) const { return directional_sample(*suns_[index], 1.0f); }
+bool LightSampler::fixed_light_sample(size_t index, glm::vec3 position, LightSample* out) const {
+  return punctual_sample(*fixed_[index], position, 1.0f, out);
+}
 
 bool LightSampler::sample_punctual(glm::vec3 position, float u_select, LightSample* out) const {
   size_t index = std::min(static_cast<size_t>(u_select * punctual_.size()), punctual_.size() - 1);
-  const PunctualLight& light = *punctual_[index];
-  const float pdf = p_punctual_ / static_cast<float>(punctual_.size());
+  return punctual_sample(*punctual_[index], position, p_punctual_ / static_cast<float>(punctual_.size()), out);
+}
+
+// A punctual light's sample at `position`, taken with probability `pdf`.
+bool LightSampler::punctual_sample(const PunctualLight& light, glm::vec3 position, float pdf, LightSample* out) {
   if (light.type == PunctualLight::Type::Directional) {
     *out = directional_sample(light, pdf);
     return true;
@@ -606,8 +611,8 @@ bool LightSampler::sample_emission(glm::vec2 u_select, glm::vec2 u_position, glm
     *out = emit_from_infinity(toward_light, environment_radiance(toward_light), pdf, u_position);
   } else {
     const size_t index = choice - 2;
-    const bool sun = index >= punctual_.size();
-    const PunctualLight& light = sun ? *suns_[index - punctual_.size()] : *punctual_[index];
+    const bool fixed = index >= punctual_.size();
+    const PunctualLight& light = fixed ? *fixed_[index - punctual_.size()] : *punctual_[index];
     const glm::vec3 power = light.color * light.intensity;
     if (light.type == PunctualLight::Type::Directional) {
       *out = emit_from_infinity(-glm::normalize(light.direction), power, 1.0f, u_position);
@@ -661,6 +666,14 @@ EmittedPhoton LightSampler::emit_from_infinity(glm::vec3 toward_light, glm::vec3
   photon.flux = radiance * (kPi * scene_radius_ * scene_radius_ / pdf);
   photon.from_infinity = true;
   return photon;
+}
+
+// The fixed lights count too: they are outside the choice, not outside the light.
+float environment_light_share(const Scene& scene) {
+  if (!scene.environment) return 0.0f;
+  const LightSampler lights(scene);
+  double total = lights.estimated_power(), environment = lights.estimated_environment_power();
+  return total > 0.0 && std::isfinite(total) ? static_cast<float>(environment / total) : 0.0f;
 }
 
 }  // namespace pxf

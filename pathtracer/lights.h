@@ -3,8 +3,9 @@
 // (luminance x sin(theta) importance sampling on the equirect image) and KHR punctual lights
 // (delta lights, NEE only). One light sample per call: a category
 // (triangles / environment / punctual) is picked first, in proportion to its estimated power.
-// Directional lights (suns; at most kMaxSuns) are not in that choice: every vertex samples each of
-// them besides (sun_sample), one shadow ray each and no random number (docs/sampling.md).
+// Punctual lights, when there are at most kMaxFixedLights, are not in that choice: every vertex
+// samples each of them besides (fixed_light_sample), one shadow ray each and no random number
+// (docs/sampling.md).
 #pragma once
 #include <limits>
 #include <vector>
@@ -34,7 +35,7 @@ class LightSampler {
  public:
   explicit LightSampler(const Scene& scene);
 
-  bool empty() const { return category_count_ == 0 && suns_.empty(); }  // nothing emits: the image is black
+  bool empty() const { return category_count_ == 0 && fixed_.empty(); }  // nothing emits: the image is black
   bool has_environment() const { return env_ != nullptr; }
 
   bool sample(glm::vec3 position, float u_select, glm::vec2 u, LightSample* out) const;
@@ -142,18 +143,24 @@ class LightSampler {
   }
   const Parallelogram& parallelogram(size_t index) const { return parallelograms_[index]; }
 
-  // Directional lights sampled at every vertex, outside the category choice: with up to this many
-  // the scene is lit by a sun or two, and a sun costs one shadow ray and no random number. More keep their place in the punctual category.
-  static constexpr size_t kMaxSuns = 4;
-  size_t sun_count() const { return suns_.size(); }
-  // Sun `index`'s sample: its direction, radiance (E), pdf 1 (always taken), delta.
-  LightSample sun_sample(size_t index) const;
+  // Punctual lights (suns, points, spots) sampled at every vertex, outside the category choice: with
+  // up to this many a light costs one shadow ray and no random number, and its light at a vertex is
+  // exact, free of noise (so the path tracer keeps the first vertex's in LV: docs/method.md 1.1).
+  // With more, they all keep their place in the punctual category.
+  static constexpr size_t kMaxFixedLights = 4;
+  size_t fixed_light_count() const { return fixed_.size(); }
+  // Fixed light `index`'s sample at `position`: direction, radiance, pdf 1 (always taken), delta.
+  // False where it cannot light the point (a point light at it, a spot's cone, its range).
+  bool fixed_light_sample(size_t index, glm::vec3 position, LightSample* out) const;
 
   // Category selection probabilities and the power estimates they come from.
   float triangles_probability() const { return p_triangles_; }
   float environment_probability() const { return p_environment_; }
   float punctual_probability() const { return p_punctual_; }
   static double triangle_power(double weighted_area_sum);  // sum of L x area x sides
+  // The estimates summed over every light, the fixed ones included, and the environment's alone.
+  double estimated_power() const { return power_triangles_ + power_environment_ + power_punctual_ + power_fixed_; }
+  double estimated_environment_power() const { return power_environment_; }
   static double environment_power(const Environment& env, float scene_radius);
   static double punctual_power(const PunctualLight& light, float scene_radius);
 
@@ -174,6 +181,7 @@ class LightSampler {
                        LightSample* out) const;
   bool sample_environment(glm::vec3 position, glm::vec2 u, LightSample* out) const;
   bool sample_punctual(glm::vec3 position, float u_select, LightSample* out) const;
+  static bool punctual_sample(const PunctualLight& light, glm::vec3 position, float pdf, LightSample* out);
 
   // Whether points of rectangle q seen from `from` are drawn uniformly in solid angle (a rectangle
   // that is large against its distance and not seen edge-on) rather than uniformly in area; sr is
@@ -210,14 +218,14 @@ class LightSampler {
   const Environment* env_ = nullptr;
   Distribution2D env_dist_;
   std::vector<const PunctualLight*> punctual_;
-  std::vector<const PunctualLight*> suns_;  // sampled at every vertex (kMaxSuns)
+  std::vector<const PunctualLight*> fixed_;  // sampled at every vertex (kMaxFixedLights)
   // Category selection: [0, p_tri) triangles, [p_tri, p_tri + p_env) environment, rest punctual.
   float p_triangles_ = 0.0f, p_environment_ = 0.0f, p_punctual_ = 0.0f;
-  // sample_emission's choice by power: [triangles, environment, each of punctual_, each of suns_].
+  // sample_emission's choice by power: [triangles, environment, each of punctual_, each of fixed_].
   Distribution1D emission_dist_;
   glm::vec3 scene_center_{0.0f};
   float scene_radius_ = 1.0f;
-  double power_triangles_ = 0.0, power_environment_ = 0.0, power_punctual_ = 0.0;
+  double power_triangles_ = 0.0, power_environment_ = 0.0, power_punctual_ = 0.0, power_fixed_ = 0.0;
   int category_count_ = 0;
 };
 

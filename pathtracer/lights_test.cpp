@@ -437,9 +437,10 @@ TEST(Lights, EnvironmentImportanceMapIsCoarseOnlyWhereThatCostsLittleVariance) {
 
 TEST(Lights, LightTypesAreSelectedByPower) {
   // A one-sided emitter quad (L = 2, area 0.5), a uniform sky (L = 0.25), a point light (I = 3), a
-  // spot (I = 5, mean cone angle 0.3) and a sun (E = 1.5), white. The geometry spans a 4 x 2 x 4
-  // box: r = sqrt(36) / 2 = 3. Expected powers: quad pi x 2 x 0.5; sky pi r^2 x 4 pi x 0.25;
-  // punctual 4 pi x 3 + 2 pi (1 - cos 0.3) x 5. The sun is not chosen: every vertex samples it.
+  // spot (I = 5, mean cone angle 0.3), a sun (E = 1.5) and two dim points (I = 1), white: more
+  // punctual lights than kMaxFixedLights, so all of them are chosen by sampling. The geometry spans
+  // a 4 x 2 x 4 box: r = sqrt(36) / 2 = 3. Expected powers: quad pi x 2 x 0.5; sky pi r^2 x 4 pi x
+  // 0.25; punctual 4 pi x 3 + 2 pi (1 - cos 0.3) x 5 + pi r^2 x 1.5 + 2 x 4 pi.
   Scene scene;
   scene.materials = {make_diffuse(glm::vec3(0.5f)), make_emitter(glm::vec3(2.0f))};
   scene.meshes.push_back(make_quad(glm::vec3(-2, 0, -2), glm::vec3(4, 0, 0), glm::vec3(0, 0, 4), 0));
@@ -459,35 +460,29 @@ TEST(Lights, LightTypesAreSelectedByPower) {
   spot.outer_cone = 0.4f;
   sun.type = PunctualLight::Type::Directional;
   sun.intensity = 1.5f;
-  sun.color = glm::vec3(1.0f, 0.8f, 0.5f);
   sun.direction = glm::vec3(0.0f, -0.6f, -0.8f);
-  scene.lights = {point, spot, sun};
+  PunctualLight dim = point;
+  dim.intensity = 1.0f;
+  scene.lights = {point, spot, sun, dim, dim};
   LightSampler lights(scene);
+  ASSERT_EQ(lights.fixed_light_count(), 0u);
   const double r2 = 9.0;
   const double tri = kPi * 2.0 * 0.5, sky = kPi * r2 * 4 * kPi * 0.25;
-  const double punctual = 4 * kPi * 3.0 + 2 * kPi * (1 - std::cos(0.3)) * 5.0;
+  const double punctual = 4 * kPi * 3.0 + 2 * kPi * (1 - std::cos(0.3)) * 5.0 + kPi * r2 * 1.5 + 2 * 4 * kPi;
   const double total = tri + sky + punctual;
   EXPECT_NEAR(lights.triangles_probability(), tri / total, 1e-3 * tri / total);
   EXPECT_NEAR(lights.environment_probability(), sky / total, 1e-3 * sky / total);
   EXPECT_NEAR(lights.punctual_probability(), punctual / total, 1e-3 * punctual / total);
-  // The sun: always taken (pdf 1), towards where its light comes from, E x colour.
-  ASSERT_EQ(lights.sun_count(), 1u);
-  const LightSample sun_sample = lights.sun_sample(0);
-  EXPECT_TRUE(sun_sample.delta);
-  EXPECT_EQ(sun_sample.pdf, 1.0f);
-  EXPECT_TRUE(std::isinf(sun_sample.distance));
-  EXPECT_NEAR(glm::length(sun_sample.wi - glm::vec3(0.0f, 0.6f, 0.8f)), 0.0f, 1e-6f);
-  EXPECT_NEAR(glm::length(sun_sample.radiance - glm::vec3(1.5f, 1.2f, 0.75f)), 0.0f, 1e-6f);
-  // The pdfs of the samples carry the selection: the point and the spot share their category evenly.
+  // The pdfs of the samples carry the selection: the punctual lights share their category evenly.
   LightSample ls;
   ASSERT_TRUE(lights.sample(glm::vec3(0.5f, 1.0f, 0.25f), 0.9999f, glm::vec2(0.5f), &ls));
   EXPECT_TRUE(ls.delta);
-  EXPECT_NEAR(ls.pdf, lights.punctual_probability() / 2.0f, 1e-6f);
+  EXPECT_NEAR(ls.pdf, lights.punctual_probability() / 5.0f, 1e-6f);
   float env_pdf;
   lights.sample_environment_direction(glm::vec2(0.3f, 0.6f), &env_pdf);
   EXPECT_NEAR(lights.pdf_environment(glm::vec3(0, 0, -1)), lights.environment_probability() / (4 * kPi), 1e-3f);
   // Frequencies of the selected category over many draws, from a point every light reaches: chi-square against the probabilities.
-  // With a separate selection number and with the selection taken from u.x. The sun is never drawn.
+  // With a separate selection number and with the selection taken from u.x.
   for (bool shared : {false, true}) {
     const int n = 100000;
     std::vector<double> observed(3, 0.0);
@@ -497,7 +492,6 @@ TEST(Lights, LightTypesAreSelectedByPower) {
       const float u_select = rng.next_float();
       const glm::vec2 u = rng.next_2d();
       if (!(shared ? lights.sample(at, u, &ls) : lights.sample(at, u_select, u, &ls))) continue;
-      EXPECT_FALSE(ls.delta && std::isinf(ls.distance)) << "a sun was drawn";
       observed[ls.delta ? 2 : std::isinf(ls.distance) ? 1 : 0] += 1.0;
     }
     const std::vector<double> expected = {n * tri / total, n * sky / total, n * punctual / total};
@@ -506,8 +500,50 @@ TEST(Lights, LightTypesAreSelectedByPower) {
   }
 }
 
-TEST(Lights, SunsBeyondTheLimitAreChosenLikeOtherPunctualLights) {
-  // kMaxSuns suns are each sampled at every vertex; one more and they all join the punctual
+TEST(Lights, FewPunctualLightsAreTakenAtEveryVertex) {
+  // A point light (I = 3), a spot (I = 5, cone 0.2 to 0.4 around straight down) and a sun (E = 1.5):
+  // no more than kMaxFixedLights, so each is taken at every vertex (pdf 1), outside the category
+  // choice, and its sample is exact: the same from the same point.
+  Scene scene;
+  scene.materials = {make_diffuse(glm::vec3(0.5f))};
+  scene.meshes.push_back(make_quad(glm::vec3(-2, 0, -2), glm::vec3(4, 0, 0), glm::vec3(0, 0, 4), 0));
+  PunctualLight point, spot, sun;
+  point.intensity = 3.0f;
+  point.position = spot.position = glm::vec3(0, 3, 0);
+  spot.direction = glm::vec3(0, -1, 0);
+  spot.type = PunctualLight::Type::Spot;
+  spot.intensity = 5.0f;
+  spot.inner_cone = 0.2f;
+  spot.outer_cone = 0.4f;
+  sun.type = PunctualLight::Type::Directional;
+  sun.intensity = 1.5f;
+  sun.color = glm::vec3(1.0f, 0.8f, 0.5f);
+  sun.direction = glm::vec3(0.0f, -0.6f, -0.8f);
+  scene.lights = {point, spot, sun};
+  const LightSampler lights(scene);
+  ASSERT_EQ(lights.fixed_light_count(), 3u);
+  EXPECT_EQ(lights.punctual_probability(), 0.0f);
+  EXPECT_EQ(lights.triangles_probability(), 0.0f);
+  EXPECT_FALSE(lights.empty());
+  const glm::vec3 below(0.0f, 1.0f, 0.0f), aside(1.9f, 0.0f, 0.0f);  // 2 below the lights; off the spot's cone
+  LightSample ls;
+  ASSERT_TRUE(lights.fixed_light_sample(0, below, &ls));  // the point: I / d^2
+  EXPECT_TRUE(ls.delta);
+  EXPECT_EQ(ls.pdf, 1.0f);
+  EXPECT_NEAR(ls.distance, 2.0f, 1e-6f);
+  EXPECT_NEAR(glm::length(ls.radiance - glm::vec3(0.75f)), 0.0f, 1e-6f);
+  ASSERT_TRUE(lights.fixed_light_sample(1, below, &ls));  // the spot, inside its inner cone
+  EXPECT_NEAR(glm::length(ls.radiance - glm::vec3(1.25f)), 0.0f, 1e-6f);
+  EXPECT_FALSE(lights.fixed_light_sample(1, aside, &ls));  // outside its cone: no light
+  ASSERT_TRUE(lights.fixed_light_sample(2, aside, &ls));   // the sun: towards where its light comes from, E x colour
+  EXPECT_EQ(ls.pdf, 1.0f);
+  EXPECT_TRUE(std::isinf(ls.distance));
+  EXPECT_NEAR(glm::length(ls.wi - glm::vec3(0.0f, 0.6f, 0.8f)), 0.0f, 1e-6f);
+  EXPECT_NEAR(glm::length(ls.radiance - glm::vec3(1.5f, 1.2f, 0.75f)), 0.0f, 1e-6f);
+}
+
+TEST(Lights, PunctualLightsBeyondTheLimitAreChosenBySampling) {
+  // kMaxFixedLights suns are each sampled at every vertex; one more and they all join the punctual
   // category, chosen by power (pi r^2 E each; r = 3 for the 4 x 2 x 4 box) against the sky.
   Scene scene;
   scene.materials = {make_diffuse(glm::vec3(0.5f))};
@@ -521,16 +557,16 @@ TEST(Lights, SunsBeyondTheLimitAreChosenLikeOtherPunctualLights) {
   PunctualLight sun;
   sun.type = PunctualLight::Type::Directional;
   sun.intensity = 0.5f;
-  for (size_t k = 0; k < LightSampler::kMaxSuns; ++k) scene.lights.push_back(sun);
+  for (size_t k = 0; k < LightSampler::kMaxFixedLights; ++k) scene.lights.push_back(sun);
   {
     const LightSampler lights(scene);
-    EXPECT_EQ(lights.sun_count(), LightSampler::kMaxSuns);
+    EXPECT_EQ(lights.fixed_light_count(), LightSampler::kMaxFixedLights);
     EXPECT_EQ(lights.punctual_probability(), 0.0f);
     EXPECT_EQ(lights.environment_probability(), 1.0f);
   }
   scene.lights.push_back(sun);
   const LightSampler lights(scene);
-  EXPECT_EQ(lights.sun_count(), 0u);
+  EXPECT_EQ(lights.fixed_light_count(), 0u);
   const double suns = 5 * kPi * 9.0 * 0.5, sky = LightSampler::environment_power(env, 3.0f);
   EXPECT_NEAR(lights.punctual_probability(), suns / (suns + sky), 1e-6);
   LightSample ls;
@@ -603,15 +639,15 @@ TEST(Lights, PunctualFalloffs) {
   scene.lights.push_back(spot);
   LightSampler lights(scene);
   LightSample ls;
-  ASSERT_TRUE(lights.sample(glm::vec3(0, 0, 0), 0.5f, glm::vec2(0.5f), &ls));
+  ASSERT_TRUE(lights.fixed_light_sample(0, glm::vec3(0, 0, 0), &ls));
   EXPECT_TRUE(ls.delta);
   EXPECT_NEAR(ls.radiance.x, 8.0f / 4.0f, 1e-5f);  // inside the inner cone: I / d^2
   EXPECT_NEAR(ls.distance, 2.0f, 1e-6f);
   float inside_outer = std::tan(0.3f) * 2.0f;    // between the cones: partial
-  EXPECT_TRUE(lights.sample(glm::vec3(inside_outer, 0, 0), 0.5f, glm::vec2(0.5f), &ls));
+  EXPECT_TRUE(lights.fixed_light_sample(0, glm::vec3(inside_outer, 0, 0), &ls));
   EXPECT_GT(ls.radiance.x, 0.0f);
   EXPECT_LT(ls.radiance.x, 8.0f / (4.0f + inside_outer * inside_outer));
-  EXPECT_FALSE(lights.sample(glm::vec3(std::tan(0.5f) * 2.0f, 0, 0), 0.5f, glm::vec2(0.5f), &ls));  // outside
+  EXPECT_FALSE(lights.fixed_light_sample(0, glm::vec3(std::tan(0.5f) * 2.0f, 0, 0), &ls));  // outside
 }
 
 // Path guiding's training photons (sample_emission): on average a photon carries the lights' total

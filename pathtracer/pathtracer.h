@@ -19,7 +19,7 @@ namespace pxf {
 struct TraceParams {
   int max_vertices = 6;     // path length in vertices, camera and light vertex included
   int rr_start_vertex = 3;  // Russian roulette from this vertex on
-  bool all_hv = false;      // every contribution but E S* L goes to HV (environment-lit scenes)
+  bool all_hv = false;      // the emitters' first-surface light to HV too, not only the environment's (PathSample)
   uint64_t seed = 1;
   int threads = 0;          // 0 = all cores
   SamplerType sampler = SamplerType::Sobol;  // see pathtracer/sampler.h for the dimension table
@@ -94,6 +94,10 @@ struct TraceStats {
   uint64_t nan_samples_dropped = 0;
   double last_frame_ms = 0;
 };
+
+// The environment's share of the scene's light, as next event estimation weighs its light types by
+// their estimated power (LightSampler); 0 without an environment.
+float environment_light_share(const Scene& scene);
 
 class PathTracer;  // Embree scene, light and environment samplers (pathtracer internals)
 

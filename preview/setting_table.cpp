@@ -193,8 +193,9 @@ std::vector<SettingDescriptor> make_table() {
                      "MIS-combined with BSDF sampling: unbiased (docs/guiding.md)",
                      [](PreviewSettings& s) -> bool& { return s.trace.guiding; }, E::Retrace, "path guiding"));
   t.push_back(on_off("all_hv", "--all-hv",
-                     "put every contribution into the HV buffer but what the camera sees directly or through\n"
-                     "mirrors and glass (environment-lit scenes)",
+                     "put the emitters' light at the first surface into the HV buffer too (the environment's always\n"
+                     "goes there): only what the camera sees directly or through mirrors and glass, and the exact\n"
+                     "light of up to 4 punctual lights, stays unfiltered",
                      [](PreviewSettings& s) -> bool& { return s.trace.all_hv; }, E::Retrace, "all HV", /*bare_flag=*/true));
   // The display.
   t.push_back(number("key", "--key", "Reinhard key a", 1e-4, 100.0, [](PreviewSettings& s) -> float& { return s.tonemap.key; },

@@ -168,4 +168,5 @@ struct Scene {
   size_t triangle_count() const;
 };
 
+
 }  // namespace pxf

@@ -8,6 +8,8 @@
 layout(binding = kUnitGuardSums) uniform sampler2D rows_tex;          // row sums, x in [-r, r]
 layout(binding = kUnitGuardRowsLowX) uniform sampler2D low_x_tex;     // x in [-r, 0]
 layout(binding = kUnitGuardRowsHighX) uniform sampler2D high_x_tex;   // x in [0, r]
+layout(binding = kUnitHv) uniform sampler2D hv_tex;                   // the pixel's own window
+layout(binding = kUnitFiltered) uniform sampler2D filtered_tex;
 layout(location = 0) out vec2 out_estimate;  // (b2, var_u) of BiasGuardEstimate
 
 void main() {
@@ -24,6 +26,7 @@ void main() {
     low_x += texelFetch(low_x_tex, q, 0);
     high_x += texelFetch(high_x_tex, q, 0);
   }
-  BiasGuardEstimate e = bias_guard_estimate(low_y + centre + high_y, low_y + centre, centre + high_y, low_x, high_x);
+  BiasGuardEstimate e = bias_guard_estimate(low_y + centre + high_y, low_y + centre, centre + high_y, low_x, high_x,
+                                            bias_guard_texel(hv_tex, filtered_tex, p));
   out_estimate = vec2(e.b2, e.var_u);
 }

@@ -431,8 +431,12 @@ PXF_INLINE float blend_factor_covariance(float u, float f, float t, float w, PXF
 // and above it, 3 wide and 5 tall left and right of it) at kBiasGuardHalfZ, stricter against the
 // more tests, each with its own mean Var[L_u] (the shadow side's variance, not the caustic's), and
 // keeps the window that asks for the largest s (consider_window).
+// Windows of 5 or 3 pixels average out a bias that changes sign from pixel to pixel: the detail of a
+// normal map or of an environment's reflection in a glossy coat, which the filter blurs. So the guard
+// judges the pixel alone too, at kBiasGuardPixelZ (docs/notebook/measurements.md, "Pixel window").
 PXF_CONST float kBiasGuardZ = 2.0f;
 PXF_CONST float kBiasGuardHalfZ = 4.0f;
+PXF_CONST float kBiasGuardPixelZ = 2.5f;
 PXF_CONST int kBiasGuardRadius = 2;
 
 // What the guard reads from a window (the 5x5 neighbourhood or one of its halves): sums over its
@@ -547,14 +551,30 @@ PXF_INLINE void consider_window(BiasGuardSums sums, float z, PXF_INOUT(BiasGuard
   best.var_u = var_u;
 }
 
+// The pixel's own window (its bias_guard_texel), its Var[L_u] taken no lower than the mean over the
+// 5x5 window's known variances: from few heavy-tailed samples a pixel's variance is low far more
+// often than high, and with its own the test fired on the noise at 16 spp and raised s into speckles.
+PXF_INLINE BiasGuardSums pixel_window(vec4 pixel, vec4 full) {
+  BiasGuardSums own = bias_guard_sums_of(pixel), around = bias_guard_sums_of(full);
+  if (own.known > 0 && around.known > 0) {
+    wide_float var_f = own.var_d - own.var_u;
+    own.var_u = max(own.var_u, around.var_u / wide_float(around.known));
+    own.var_d = own.var_u + var_f;
+  }
+  return own;
+}
+
 // The guard's finding from the packed sums (bias_guard_window_sums) of the 5x5 window at
-// kBiasGuardZ and of its four half windows at kBiasGuardHalfZ: y from -r to 0 and from 0 to r (all
-// five columns), x from -r to 0 and from 0 to r (all five rows).
-PXF_INLINE BiasGuardEstimate bias_guard_estimate(vec4 full, vec4 low_y, vec4 high_y, vec4 low_x, vec4 high_x) {
+// kBiasGuardZ, of the pixel alone at kBiasGuardPixelZ (pixel_window), and of its four half windows
+// at kBiasGuardHalfZ: y from -r to 0 and from 0 to r (all five columns), x from -r to 0 and from 0
+// to r (all five rows).
+PXF_INLINE BiasGuardEstimate bias_guard_estimate(vec4 full, vec4 low_y, vec4 high_y, vec4 low_x, vec4 high_x,
+                                                 vec4 pixel) {
   BiasGuardEstimate best;
   best.b2 = 0.0f;
   best.var_u = 0.0f;
   consider_window(bias_guard_sums_of(full), kBiasGuardZ, best);
+  consider_window(pixel_window(pixel, full), kBiasGuardPixelZ, best);
   consider_window(bias_guard_sums_of(low_y), kBiasGuardHalfZ, best);
   consider_window(bias_guard_sums_of(high_y), kBiasGuardHalfZ, best);
   consider_window(bias_guard_sums_of(low_x), kBiasGuardHalfZ, best);
@@ -569,7 +589,8 @@ PXF_SAMPLER_FN BiasGuardEstimate bias_guard_estimate_at(sampler2D hv, sampler2D 
                              bias_guard_window_sums(hv, filtered, p, ivec2(-r, -r), ivec2(r, 0)),
                              bias_guard_window_sums(hv, filtered, p, ivec2(-r, 0), ivec2(r, r)),
                              bias_guard_window_sums(hv, filtered, p, ivec2(-r, -r), ivec2(0, r)),
-                             bias_guard_window_sums(hv, filtered, p, ivec2(0, -r), ivec2(r, r)));
+                             bias_guard_window_sums(hv, filtered, p, ivec2(0, -r), ivec2(r, r)),
+                             bias_guard_texel(hv, filtered, p));
 }
 
 // The guard as the blend applies it (blend_pixel): in cases 1 and 3 only, s and the

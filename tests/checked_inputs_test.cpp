@@ -46,21 +46,36 @@ std::string folder(const std::string& name) {
   return dir;
 }
 
+// One triangle in the z = 0 plane lit by a sun straight down -z onto its front: a fixed light, whose
+// light at the first surface is exact (LV), and nothing else to bounce off: HV stays 0.
+std::string write_sunlit_triangle(const std::string& dir) {
+  const std::string path = dir + "/sunlit.gltf";
+  std::ofstream(path) << R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0,1]}],"nodes":[{"mesh":0},)"
+                         R"({"extensions":{"KHR_lights_punctual":{"light":0}}}],)"
+                         R"("extensionsUsed":["KHR_lights_punctual"],)"
+                         R"("extensions":{"KHR_lights_punctual":{"lights":[{"type":"directional","intensity":2}]}},)"
+                         R"("meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],)"
+                         R"("accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}],)"
+                         R"("bufferViews":[{"buffer":0,"byteLength":36}],)"
+                         R"("buffers":[{"byteLength":36,"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA"}]})";
+  return path;
+}
+
 }  // namespace
 
-// --until-clean where the filter has nothing to do (a black scene; one triangle under the sky, whose
-// HV is below the filter's 1 % share): clean at the first check, not 2^24 frames later.
+// --until-clean where the filter has nothing to do (a black scene; one triangle lit by a sun, whose
+// light is exact and has no HV): clean at the first check, not 2^24 frames later.
 TEST(CheckedInputs, UntilCleanEndsAtOnceWhereNothingNeedsTheFilter) {
   const std::string dir = folder("until_clean");
-  const std::string scene = test_support::write_bare_triangle(dir, "triangle.gltf");
-  for (const std::string light : {"none", "sky"}) {
-    const Result r = run_in(dir, "render --scene triangle.gltf --default-light " + light +
-                                     " --size 16x16 --until-clean --quiet --out " + light);
-    ASSERT_EQ(r.code, 0) << light << " (124: it never ended): " << r.err;
-    const auto stats = nlohmann::json::parse(test_support::slurp(dir + "/" + light + "/stats.json"));
-    EXPECT_TRUE(stats["clean"].get<bool>()) << light;
-    EXPECT_TRUE(stats["until_clean"]["time_to_clean_ms"].is_number()) << light;
-    EXPECT_LE(stats["settings"]["spp"].get<int>(), 16) << light << ": not at the first check";
+  test_support::write_bare_triangle(dir, "triangle.gltf");
+  write_sunlit_triangle(dir);
+  for (const std::string scene : {"triangle.gltf --default-light none", "sunlit.gltf"}) {
+    const Result r = run_in(dir, "render --scene " + scene + " --size 16x16 --until-clean --quiet --out out");
+    ASSERT_EQ(r.code, 0) << scene << " (124: it never ended): " << r.err;
+    const auto stats = nlohmann::json::parse(test_support::slurp(dir + "/out/stats.json"));
+    EXPECT_TRUE(stats["clean"].get<bool>()) << scene;
+    EXPECT_TRUE(stats["until_clean"]["time_to_clean_ms"].is_number()) << scene;
+    EXPECT_LE(stats["settings"]["spp"].get<int>(), 16) << scene << ": not at the first check";
     EXPECT_NE(r.out.find("until-clean: clean at"), std::string::npos) << r.out;
   }
   // A threshold of 0 can never be clean: a flag error, not a render that never ends.

@@ -202,7 +202,7 @@ TEST(Cli, SceneWithoutLightsIsLitByDefaultAndNoneWarnsOfBlack) {
   EXPECT_NE(wrong.err.find("not a scene"), std::string::npos) << wrong.err;
 }
 
-TEST(Cli, AllHvRendersDefaultToAtrousUnlessFilterIsGiven) {
+TEST(Cli, AllHvAndEnvironmentLitRendersDefaultToAtrousUnlessFilterIsGiven) {
   const std::string out = temp_dir("allhv");
   const Result r = run("render --scene envmap --all-hv --size 24x16 --spp 2 --quiet --out " + out);
   ASSERT_EQ(r.code, 0) << r.err;
@@ -211,14 +211,17 @@ TEST(Cli, AllHvRendersDefaultToAtrousUnlessFilterIsGiven) {
   const Result chosen = run("render --scene envmap --all-hv --size 24x16 --spp 2 --quiet --filter grid --out " + out);
   ASSERT_EQ(chosen.code, 0) << chosen.err;
   EXPECT_EQ(nlohmann::json::parse(slurp(out + "/stats.json"))["settings"]["filter"], "grid");
-  // envmap itself renders with the LV/HV split and the default filter (docs/measurements.md,
-  // "Environment-lit scenes").
+  // envmap, lit by its environment alone, takes it without all_hv; cornell, lit by an emitter, keeps
+  // the default (docs/measurements.md, "Environment-lit scenes").
   const Result plain = run("render --scene envmap --size 24x16 --spp 2 --quiet --out " + out);
   ASSERT_EQ(plain.code, 0) << plain.err;
-  EXPECT_EQ(plain.err.find("all-HV"), std::string::npos) << plain.err;
+  EXPECT_NE(plain.err.find("lit mostly by its environment: filter atrous"), std::string::npos) << plain.err;
   const nlohmann::json stats = nlohmann::json::parse(slurp(out + "/stats.json"));
-  EXPECT_EQ(stats["settings"]["filter"], "grid");
+  EXPECT_EQ(stats["settings"]["filter"], "atrous");
   EXPECT_EQ(stats["settings"]["all_hv"], false);
+  const Result emitter = run("render --scene cornell --size 24x16 --spp 2 --quiet --out " + out);
+  ASSERT_EQ(emitter.code, 0) << emitter.err;
+  EXPECT_EQ(nlohmann::json::parse(slurp(out + "/stats.json"))["settings"]["filter"], "grid");
 }
 
 // --adaptive on: off by default, recorded in stats.json with the paths per pixel; after

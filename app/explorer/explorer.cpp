@@ -149,7 +149,8 @@ class Explorer {
                                                       load_limits(options_.scene)));
       print_scene_messages(*scene);
       if (!options_.all_hv_given) settings_.trace.all_hv = scene->defaults.all_hv;
-      if (!options_.filter_given) settings_.filter.kind = settings_.trace.all_hv ? kAllHvFilter : options_.preview.filter.kind;
+      if (!options_.filter_given)
+        settings_.filter.kind = takes_all_hv_filter(*scene, settings_) ? kAllHvFilter : options_.preview.filter.kind;
       if (first) size_image(*scene);
       if (scene->automatic_camera) scene->camera = frame_scene(*scene, static_cast<float>(width_) / height_);
       auto preview = std::make_unique<Preview>(*scene, settings_, width_, height_);
