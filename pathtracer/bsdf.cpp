@@ -189,8 +189,7 @@ Bsdf::Bsdf(const BsdfMaterial& k, glm::vec3 shading_normal, glm::vec3 geometric_
   nondelta_albedo_ = diffuse_factor_ * kPi + k.sheen_color * (coat_share * sheen_albedo_o);
   if (!glossy_delta_) nondelta_albedo_ += glossy_albedo;
   if (!coat_delta_) nondelta_albedo_ += glm::vec3(clearcoat_ * coat_albedo);
-  // Rough glass reflects and transmits nearly all it receives, the transmission tinted by the base.
-  if (!glass_delta_) nondelta_albedo_ += c_glass_ * base_color_;
+  if (!glass_delta_ && p_glass_ > 0.0f) nondelta_albedo_ += set_up_glass_compensation();
   inv_4cos_o_ = 1.0f / (4.0f * wo_local_.z);
   glossy_pdf_scale_ = p_glossy_ * inv_4cos_o_ * g1_o_;
 }
@@ -220,6 +219,46 @@ glm::vec3 Bsdf::set_up_base(const BsdfMaterial& k, float base_share) {
   diffuse_factor_ = k.diffuse_albedo * glm::max(glm::vec3(1.0f) - specular_albedo, glm::vec3(0.0f)) * base_share;
   c_glass_ *= base_share;
   return (fresnel_at_0_ * e.total + fresnel_slope_ * e.schlick) * glossy_compensation_;
+}
+
+// The rough glass's compensation (Kulla and Conty 2017). Single scattering sends on E(cos_o) of the
+// light (glass_albedo.h: reflected and transmitted, in energy); the lobe
+//   f_ms = (1 - E_s(cos_o)) (1 - E_t(cos_i)) / (pi (1 - Eavg_t)) x r_s on wo's side t = s
+//                                                               x (1 - r_s) / eta^2 across, t = s'
+// (E_s the albedo seen from side s, Eavg its cosine-weighted average) sends on the rest, 1 - E_s,
+// the share r_s reflected. The split is theirs: 1 - r_s = x (1 - Favg_s) with Favg the smooth
+// interface's average Fresnel, and x chosen so that both sides agree (reciprocity: f(wo, wi) /
+// eta_o^2 = f(wi, wo) / eta_i^2): x = b / (a + b), a = (1 - Favg_s) / (1 - Eavg_s'), b = eta^2 (1 -
+// Favg_s') / (1 - Eavg_s). From the other side the same formula gives 1 - x. Returns the lobe's
+// directional albedo in energy, c_glass (R + T base), single and multiple scattering together.
+glm::vec3 Bsdf::set_up_glass_compensation() {
+  glass_ss_pdf_scale_ = p_glass_;
+  glass_albedo_ = GlassAlbedoLookup(alpha_, ior_);
+  glass_side_ = front_face_ ? 0 : 1;
+  const GlassAlbedo e = glass_albedo_.at(glass_side_, wo_local_.z);
+  float reflected = e.reflected, transmitted = e.total - e.reflected;
+#ifndef PXF_CYCLES_GLASS_FRESNEL  // Cycles' Glass BSDF, which that build matches, is not compensated
+  const int side = glass_side_, other = 1 - side;
+  const float loss_here = 1.0f - glass_albedo_.average(side), loss_there = 1.0f - glass_albedo_.average(other);
+  const float lost = 1.0f - e.total;
+  // Below this the table holds no loss worth a lobe (it is printed to 5 decimals); the test is the
+  // same from both sides, so the lobe stays reciprocal.
+  constexpr float kMinLoss = 1e-5f;
+  if (loss_here > kMinLoss && loss_there > kMinLoss && lost > 0.0f) {
+    const float eta = this->eta(), f_here = glass_albedo_.fresnel_average(side), f_there = glass_albedo_.fresnel_average(other);
+    const float a = (1.0f - f_here) / loss_there, b = eta * eta * (1.0f - f_there) / loss_here;
+    glass_ms_reflect_ = 1.0f - b / (a + b) * (1.0f - f_here);
+    glass_ms_prob_ = lost;
+    glass_ss_pdf_scale_ = p_glass_ * (1.0f - lost);
+    glass_ms_[0] = c_glass_ * lost * glass_ms_reflect_ / (kPi * loss_here);
+    glass_ms_[1] = c_glass_ * lost * (1.0f - glass_ms_reflect_) / (kPi * loss_there * eta * eta);
+    glass_ms_pdf_[0] = p_glass_ * lost * glass_ms_reflect_ / (kPi * loss_here);
+    glass_ms_pdf_[1] = p_glass_ * lost * (1.0f - glass_ms_reflect_) / (kPi * loss_there);
+    reflected += lost * glass_ms_reflect_;
+    transmitted += lost * (1.0f - glass_ms_reflect_);
+  }
+#endif
+  return c_glass_ * (glm::vec3(reflected) + transmitted * base_color_);
 }
 
 // Lobe selection probabilities in proportion to the lobes' weights (their albedos at wo).
@@ -266,7 +305,11 @@ glm::vec3 Bsdf::glossy_fresnel(float cos_oh) const {
 
 glm::vec3 Bsdf::eval_local(glm::vec3 wi, float* pdf) const {
   *pdf = 0.0f;
-  if (wi.z < 0.0f) return p_glass_ > 0.0f && !glass_delta_ ? eval_glass_transmission(wi, pdf) : glm::vec3(0.0f);
+  if (wi.z < 0.0f) {
+    if (!(p_glass_ > 0.0f) || glass_delta_) return glm::vec3(0.0f);
+    const glm::vec3 f = eval_glass_transmission(wi, pdf);
+    return glass_ms_prob_ > 0.0f ? f + eval_glass_compensation(wi, pdf) : f;
+  }
   if (wi.z == 0.0f) return glm::vec3(0.0f);
   glm::vec3 f = diffuse_factor_ * wi.z;
   *pdf = (p_diffuse_ + p_sheen_) * wi.z * kInvPi;  // the sheen is cosine-sampled too
@@ -285,7 +328,8 @@ glm::vec3 Bsdf::eval_local(glm::vec3 wi, float* pdf) const {
     if (glass) {  // reflected with probability F(wo.h) of the sampled microfacet
       float fresnel = glass_fresnel(cos_oh);
       f += glm::vec3(c_glass_ * fresnel * spec);
-      *pdf += p_glass_ * fresnel * g1_o_ * d * inv_4cos_o_;
+      *pdf += glass_ss_pdf_scale_ * fresnel * g1_o_ * d * inv_4cos_o_;
+      if (glass_ms_prob_ > 0.0f) f += eval_glass_compensation(wi, pdf);
     }
   }
   return f;
@@ -309,8 +353,17 @@ glm::vec3 Bsdf::eval_glass_transmission(glm::vec3 wi, float* pdf) const {
   const float d = ggx_d(h, alpha_);
   const float g2 = 1.0f / (1.0f + lambda_o_ + ggx_lambda(wi, alpha_));
   const float cos_o = wo_local_.z;
-  *pdf = p_glass_ * transmitted * g1_o_ * d * cos_oh / cos_o * jacobian;
+  *pdf += glass_ss_pdf_scale_ * transmitted * g1_o_ * d * cos_oh / cos_o * jacobian;
   return base_color_ * (c_glass_ * transmitted * d * g2 * cos_oh * jacobian / (cos_o * eta * eta));
+}
+
+// The compensation lobe at wi (either side): set_up_glass_compensation's f_ms cos, and its pdf.
+glm::vec3 Bsdf::eval_glass_compensation(glm::vec3 wi, float* pdf) const {
+  const int across = wi.z < 0.0f ? 1 : 0;
+  const float cos_i = std::abs(wi.z);
+  const float shape = (1.0f - glass_albedo_.at(across ? 1 - glass_side_ : glass_side_, cos_i).total) * cos_i;
+  *pdf += glass_ms_pdf_[across] * shape;
+  return across ? base_color_ * (glass_ms_[1] * shape) : glm::vec3(glass_ms_[0] * shape);
 }
 
 glm::vec3 Bsdf::eval(glm::vec3 wi, float* pdf) const {
@@ -418,8 +471,12 @@ float Bsdf::glass_fresnel(float cos_oh) const {
 #endif
 }
 
-// A visible microfacet normal, then reflection with probability F(wo.h), else refraction through it.
+// The compensation lobe with probability glass_ms_prob_; else a visible microfacet normal, then
+// reflection with probability F(wo.h), else refraction through it.
 bool Bsdf::sample_rough_glass(float u_choice, glm::vec2 u, BsdfSample* out) const {
+  const float single = 1.0f - glass_ms_prob_;
+  if (u_choice >= single) return sample_glass_compensation((u_choice - single) / glass_ms_prob_, u, out);
+  u_choice /= single;
   const glm::vec3& wo = wo_local_;
   const glm::vec3 h = ggx_sample_vndf(wo, alpha_, u);
   const float cos_oh = glm::dot(wo, h);
@@ -434,6 +491,17 @@ bool Bsdf::sample_rough_glass(float u_choice, glm::vec2 u, BsdfSample* out) cons
   const float cos_t = std::sqrt(1.0f - sin2_t);
   const glm::vec3 wi = glm::normalize(-wo / eta + (cos_oh / eta - cos_t) * h);
   return wi.z < 0.0f && finish_nondelta_sample(frame_.to_world(wi), true, out);
+}
+
+// Reflection with probability glass_ms_reflect_, else transmission; cos theta_i in proportion to the
+// loss 1 - E on wi's side, so that the lobe's own weight is constant; the azimuth uniform.
+bool Bsdf::sample_glass_compensation(float u_choice, glm::vec2 u, BsdfSample* out) const {
+  const bool across = u_choice >= glass_ms_reflect_;
+  const float cos_i = glass_albedo_.sample_loss_cos(across ? 1 - glass_side_ : glass_side_, u.x);
+  if (!(cos_i > 0.0f)) return false;
+  const float sin_i = std::sqrt(std::max(0.0f, 1.0f - cos_i * cos_i)), phi = 2.0f * kPi * u.y;
+  const glm::vec3 wi(sin_i * std::cos(phi), sin_i * std::sin(phi), across ? -cos_i : cos_i);
+  return finish_nondelta_sample(frame_.to_world(wi), across, out);
 }
 
 // Reflect with probability F, else refract (tinted by the base color).

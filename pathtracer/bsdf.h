@@ -8,13 +8,16 @@
 // + (1 - metallic) * transmission * GGX dielectric (Walter 2007: exact Fresnel, reflection and
 //                                     refraction, the refraction tinted by the base color).
 // The GGX reflection lobes are energy-compensated (Turquin 2019: scaled by 1 + F0 (1 / E - 1), E
-// the single-scattering albedo, ggx_albedo.h). Roughness below kDeltaRoughness makes the GGX lobes
+// the single-scattering albedo, ggx_albedo.h); the GGX dielectric by Kulla and Conty's (2017)
+// reciprocal lobe (1 - E(cos_o)) (1 - E(cos_i)) / (pi (1 - E_avg)), split between reflection and
+// transmission (glass_albedo.h). Roughness below kDeltaRoughness makes the GGX lobes
 // delta lobes (a mirror, smooth glass). Lobes are picked stochastically by their albedo at wo;
 // pdf() is the combined pdf of the non-delta lobes.
 #pragma once
 #include <vector>
 
 #include <glm/glm.hpp>
+#include "pathtracer/glass_albedo.h"
 #include "pathtracer/pathtracer.h"  // SurfaceLobe
 #include "pathtracer/sampling.h"
 #include "scene/material.h"  // kDeltaRoughness
@@ -117,7 +120,9 @@ class Bsdf {
   bool is_black() const { return black_; }
   // The directional albedo at wo of the non-delta lobes, RGB: the share of light from all
   // directions that they reflect or transmit toward wo. Illumination demodulation divides the
-  // light these lobes carry by it (PathSample::albedo), so it counts the specular lobes too.
+  // light these lobes carry by it (PathSample::albedo), so it counts the specular lobes too. Rough
+  // glass counts the energy it transmits (the sample weight times eta^2: the radiance it passes on
+  // from a surrounding as bright on both sides, which is eta^2 brighter inside a dense medium).
   glm::vec3 nondelta_albedo() const { return nondelta_albedo_; }
   glm::vec3 shading_normal() const { return frame_.n; }
   // The lobes sample() picks from, each with its probability and whether it is a delta lobe (the
@@ -127,6 +132,8 @@ class Bsdf {
  private:
   glm::vec3 eval_local(glm::vec3 wi, float* pdf) const;
   glm::vec3 eval_glass_transmission(glm::vec3 wi, float* pdf) const;
+  glm::vec3 eval_glass_compensation(glm::vec3 wi, float* pdf) const;  // adds its pdf to *pdf
+  glm::vec3 set_up_glass_compensation();
   glm::vec3 eval_coat(glm::vec3 wi_coat, float* pdf) const;  // adds the coat's pdf to *pdf
   float set_up_coat(const BsdfMaterial& material, glm::vec3 coat_normal, glm::vec3 ns, glm::vec3 wo);
   glm::vec3 eval_sheen(glm::vec3 wi) const;  // f cos of the sheen lobe (local, wi.z > 0)
@@ -137,6 +144,7 @@ class Bsdf {
   glm::vec3 glossy_fresnel(float cos_oh) const;
   bool sample_smooth_glass(glm::vec2 u, BsdfSample* out) const;
   bool sample_rough_glass(float u_choice, glm::vec2 u, BsdfSample* out) const;
+  bool sample_glass_compensation(float u_choice, glm::vec2 u, BsdfSample* out) const;
   bool finish_nondelta_sample(glm::vec3 wi, bool transmitted, BsdfSample* out) const;
   // The rough glass's Fresnel reflectance at a microfacet seen at cos_oh (Walter et al. 2007).
   float glass_fresnel(float cos_oh) const;
@@ -175,6 +183,16 @@ class Bsdf {
   bool has_nondelta_ = false;
   bool black_ = true;
   glm::vec3 nondelta_albedo_{0.0f};
+  // The rough glass's compensation lobe (Kulla and Conty 2017): the tabulated single-scattering
+  // albedo at this roughness and ior, wo's side of it (0 outside), and the lobe's weights:
+  // f cos = glass_ms_[t] (1 - E(cos_i)) |cos_i| on wi's side, t = 1 for transmission (tinted by the
+  // base), and its pdf glass_ms_pdf_[t] times the same. sample_rough_glass picks it with probability
+  // glass_ms_prob_ = 1 - E(cos_o), the single-scattering lobe with the rest (glass_ss_pdf_scale_ =
+  // p_glass (1 - glass_ms_prob_)), and its reflection with probability glass_ms_reflect_.
+  GlassAlbedoLookup glass_albedo_{};
+  int glass_side_ = 0;
+  float glass_ms_prob_ = 0.0f, glass_ms_reflect_ = 1.0f, glass_ss_pdf_scale_ = 0.0f;
+  float glass_ms_[2] = {0.0f, 0.0f}, glass_ms_pdf_[2] = {0.0f, 0.0f};
 };
 
 // GGX helpers (local frame, n = +z), exposed for tests.

@@ -150,6 +150,21 @@ TEST(Integrator, WhiteFurnaceRoughConductorSphere) {
   std::printf("mean %.5f worst %.4f\n", mean, worst);
 }
 
+// A white rough glass sphere (no absorption) keeps all the light: Walter's single-scattering lobe
+// loses what scatters between microfacets more than once, inside most, and the compensation lobe
+// gives it back (docs/materials.md). Without it the means were 0.996, 0.965, 0.856 and 0.722. At
+// roughness 0.1 what is missing (0.3 %) is light that total internal reflection keeps circling
+// inside the sphere beyond the 64 vertices (0.9996 with 1000).
+TEST(Integrator, WhiteFurnaceRoughGlassSphere) {
+  for (float roughness : {0.1f, 0.3f, 0.5f, 0.7f}) {
+    Material glass = make_glass(1.5f);
+    glass.roughness = roughness;
+    const double mean = render_mean(sphere_in_furnace(glass), furnace_params(), 16, 256);
+    std::printf("rough glass %.1f: mean %.5f\n", roughness, mean);
+    EXPECT_NEAR(mean, 1.0, 0.01) << "roughness " << roughness;
+  }
+}
+
 TEST(Integrator, ClosedDiffuseSphereSumsBounces) {
   const float rho = 0.5f, le = 1.0f;
   Material m = make_diffuse(glm::vec3(rho));

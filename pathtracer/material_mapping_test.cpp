@@ -404,31 +404,27 @@ TEST(MaterialMapping, SmoothGlassIsEnergyConservingInTheWhiteFurnace) {
   EXPECT_NEAR(r.mean, 1.0, 0.01);
 }
 
-TEST(MaterialMapping, RoughGlassLosesOnlySingleScatteringEnergy) {
+TEST(MaterialMapping, RoughGlassIsEnergyConservingInTheWhiteFurnace) {
   // transmission 1 above the delta roughness: Walter's rough dielectric, reflecting and refracting
-  // at every crossing. White, it keeps all the light but what single scattering loses (no
-  // compensation of the glass lobe): a little at roughness 0.3, a quarter at 0.6, where light
-  // crosses the rough interface many times inside the sphere (bsdf_test.cpp measures one crossing).
-  // Its image is not the smooth glass's.
+  // at every crossing, and the compensation lobe that sends on what single scattering loses
+  // between microfacets (without it: 0.976 at roughness 0.3, 0.734 at 0.6, where light crosses the
+  // rough interface many times inside the sphere). White, it keeps all the light, as the smooth
+  // glass does; its image is not the smooth glass's.
   const std::string ext = R"("KHR_materials_transmission":{"transmissionFactor":1},"KHR_materials_ior":{"ior":1.5})";
   const std::string used = R"("KHR_materials_transmission","KHR_materials_ior")";
   Scene smooth = load_furnace(material(1.0f, 0.0f, 0.0f, ext), used);
   const RenderResult reference = render(smooth, furnace_params(), 32);
-  struct Bound {
-    float roughness, lowest;
-  };
-  for (const Bound& b : {Bound{0.3f, 0.96f}, Bound{0.6f, 0.7f}}) {  // a margin under what the furnace renders
-    Scene rough = load_furnace(material(1.0f, 0.0f, b.roughness, ext), used);
+  for (float roughness : {0.3f, 0.6f}) {
+    Scene rough = load_furnace(material(1.0f, 0.0f, roughness, ext), used);
     EXPECT_FALSE(material_is_perfect_specular(rough.materials[0]));
     RenderResult r = render(rough, furnace_params(), 64);
     double largest_difference = 0;
     for (size_t i = 0; i < r.pixels.size(); ++i)
       largest_difference = std::max(largest_difference, std::abs(r.pixels[i] - reference.pixels[i]));
-    std::printf("white rough glass %.1f: mean %.5f (smooth %.5f), largest pixel difference %.4f\n", b.roughness,
+    std::printf("white rough glass %.1f: mean %.5f (smooth %.5f), largest pixel difference %.4f\n", roughness,
                 r.mean, reference.mean, largest_difference);
-    EXPECT_GE(r.mean, b.lowest) << b.roughness;
-    EXPECT_LE(r.mean, 1.005) << b.roughness;
-    EXPECT_GT(largest_difference, 0.02) << b.roughness;
+    EXPECT_NEAR(r.mean, 1.0, 0.01) << roughness;
+    EXPECT_GT(largest_difference, 0.02) << roughness;
   }
 }
 
