@@ -34,8 +34,9 @@ void add_scene_options(CommandLine& cli, SceneOptions& o, bool headless) {
 
 namespace {
 // The default a help line shows: the value of a default-constructed PreviewSettings.
-std::string default_text(const SettingDescriptor& d) {
-  const nlohmann::json value = d.to_json(PreviewSettings{});
+// The command's own default: the value its settings hold before the command line is parsed.
+std::string default_text(const SettingDescriptor& d, const PreviewSettings& defaults) {
+  const nlohmann::json value = d.to_json(defaults);
   if (value.is_boolean()) return value.get<bool>() ? "on" : "off";
   if (value.is_string()) return value.get<std::string>();
   if (value.is_number_float()) {
@@ -49,7 +50,7 @@ std::string default_text(const SettingDescriptor& d) {
 
 void add_preview_options(CommandLine& cli, PreviewSettings& s) {
   for (const SettingDescriptor& d : setting_table()) {
-    const std::string help = d.help + (d.bare_flag ? "" : " (default " + default_text(d) + ")");
+    const std::string help = d.help + (d.bare_flag ? "" : " (default " + default_text(d, s) + ")");
     switch (d.type) {
       case SettingType::Float: cli.option(d.flag, &d.float_field(s), help, static_cast<float>(d.min), static_cast<float>(d.max)); break;
       case SettingType::Int: cli.option(d.flag, &d.int_field(s), help, static_cast<int>(d.min), static_cast<int>(d.max)); break;

@@ -32,7 +32,7 @@ TEST(PreviewOptions, DefaultsAreThoseOfPreviewSettings) {
   EXPECT_EQ(s.threshold, d.threshold);
   EXPECT_EQ(s.filter.kind, FilterKind::Grid);
   EXPECT_TRUE(s.filtering());
-  EXPECT_EQ(s.schedule, FilterSchedule::Budget);
+  EXPECT_EQ(s.schedule, FilterSchedule::Final);  // headless; the explorer sets Budget
   EXPECT_EQ(s.trace.sampler, SamplerType::Sobol);
   EXPECT_TRUE(s.demodulate);
   EXPECT_TRUE(s.bias_guard);

@@ -57,7 +57,7 @@ struct PreviewSettings {
   // Off by default until pxf bench shows it wins.
   bool adaptive = false;
   AdaptiveParams adaptive_params;
-  FilterSchedule schedule = FilterSchedule::Budget;
+  FilterSchedule schedule = FilterSchedule::Final;  // headless jobs; the explorer's is Budget
   TonemapParams tonemap;
   RangeSettings range;
   // Reprojected history (docs/method.md section 4.1): a camera move keeps what the view showed and

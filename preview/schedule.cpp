@@ -7,7 +7,7 @@
 namespace pxf {
 
 const std::vector<std::string>& filter_schedule_names() {
-  static const std::vector<std::string> names = {"pow2", "every", "budget"};
+  static const std::vector<std::string> names = {"pow2", "every", "budget", "final"};
   return names;
 }
 
@@ -15,6 +15,7 @@ FilterSchedule parse_filter_schedule(const std::string& name) {
   if (name == "pow2") return FilterSchedule::PowersOfTwo;
   if (name == "every") return FilterSchedule::EveryFrame;
   if (name == "budget") return FilterSchedule::Budget;
+  if (name == "final") return FilterSchedule::Final;
   throw Error("unknown filter schedule '" + name + "'");
 }
 
@@ -32,6 +33,7 @@ bool run_fits_share(const ScheduleState& s) {
 bool filter_due(FilterSchedule schedule, int samples, bool last_frame, const ScheduleState& state) {
   if (samples < 1 || state.hv_empty || state.all_pixels_case2) return false;
   if (last_frame || schedule == FilterSchedule::EveryFrame || state.history_active) return true;
+  if (schedule == FilterSchedule::Final) return state.last_run_ms <= 0;  // the first run: its cost
   if (!is_power_of_two(samples)) return false;
   return schedule == FilterSchedule::PowersOfTwo || run_fits_share(state);
 }

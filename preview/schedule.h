@@ -8,10 +8,12 @@
 
 namespace pxf {
 
-// pow2: at power-of-two sample counts. every: each frame. budget (default): at power-of-two
+// pow2: at power-of-two sample counts. every: each frame. budget (the explorer's): at power-of-two
 // sample counts, but only while filter + range stay within kPassShare of the tracing time.
-enum class FilterSchedule { PowersOfTwo, EveryFrame, Budget };
-const std::vector<std::string>& filter_schedule_names();  // "pow2", "every", "budget"
+// final (the default of headless jobs: they show only their last frame): once at the first frame
+// with HV light, which measures a run's cost for the --time reserve, then on the last frame.
+enum class FilterSchedule { PowersOfTwo, EveryFrame, Budget, Final };
+const std::vector<std::string>& filter_schedule_names();  // "pow2", "every", "budget", "final"
 FilterSchedule parse_filter_schedule(const std::string& name);
 
 // The budget schedule's bound: filter + range time at most this share of the path-tracing time.
@@ -33,7 +35,8 @@ struct ScheduleState {
 // Whether the filter runs after the frame that brought the sample count to `samples`.
 // Budget: a run is due at a power of two when the passes so far plus the predicted run (the newest
 // run's cost) fit in kPassShare of the tracing so far. The first run (nothing measured yet) comes
-// at the first power of two: it is what measures the cost. The last frame always filters.
+// at the first power of two: it is what measures the cost. Final: that first run only. The last
+// frame always filters.
 bool filter_due(FilterSchedule schedule, int samples, bool last_frame, const ScheduleState& state);
 
 // `--time`: a wall-clock budget for a whole job. Times in ms from the start of the job.

@@ -48,13 +48,13 @@ struct FakeRun {
   double worst_share_after_first = 0;
 };
 
-FakeRun simulate_budget_schedule(double frame_ms, double run_ms, int frames) {
+FakeRun simulate_schedule(FilterSchedule schedule, double frame_ms, double run_ms, int frames) {
   FakeRun r;
   ScheduleState s;
   s.hv_empty = false;
   for (int n = 1; n <= frames; ++n) {
     s.tracing_ms += frame_ms;
-    if (filter_due(FilterSchedule::Budget, n, n == frames, s)) {
+    if (filter_due(schedule, n, n == frames, s)) {
       s.last_run_ms = run_ms;
       s.pass_ms += run_ms;
       r.runs.push_back(n);
@@ -68,6 +68,10 @@ FakeRun simulate_budget_schedule(double frame_ms, double run_ms, int frames) {
     }
   }
   return r;
+}
+
+FakeRun simulate_budget_schedule(double frame_ms, double run_ms, int frames) {
+  return simulate_schedule(FilterSchedule::Budget, frame_ms, run_ms, frames);
 }
 
 bool is_pow2(int n) { return n > 0 && (n & (n - 1)) == 0; }
@@ -92,6 +96,21 @@ TEST(FilterSchedule, BudgetBoundsTheShareOfFilterAndRangeForEveryCost) {
 TEST(FilterSchedule, BudgetIsPowersOfTwoWhenPassesAreFree) {
   const FakeRun r = simulate_budget_schedule(90.0, 0.0, 40);
   EXPECT_EQ(r.runs, (std::vector<int>{1, 2, 4, 8, 16, 32, 40}));
+}
+
+// A headless job shows its last frame only: one run to measure the cost (which --time reserves
+// for the last frame), then the last frame's, whatever a run costs; and only the last frame's once
+// a cost is known (after a camera change, say).
+TEST(FilterSchedule, FinalRunsToMeasureThenOnTheLastFrameOnly) {
+  for (double run_ms : {0.5, 5.0, 2000.0}) {
+    const FakeRun r = simulate_schedule(FilterSchedule::Final, 90.0, run_ms, 300);
+    EXPECT_EQ(r.runs, (std::vector<int>{1, 300})) << run_ms;
+  }
+  ScheduleState measured;
+  measured.hv_empty = false;
+  measured.last_run_ms = 30;
+  for (int n = 1; n < 64; ++n) EXPECT_FALSE(filter_due(FilterSchedule::Final, n, false, measured)) << n;
+  EXPECT_TRUE(filter_due(FilterSchedule::Final, 64, true, measured));
 }
 
 TEST(FilterSchedule, BudgetStillFiltersTheLastFrame) {

@@ -131,9 +131,10 @@ std::vector<SettingDescriptor> make_table() {
                      "published blend, noise held at t everywhere; docs/method.md section 3.7)",
                      [](PreviewSettings& s) -> bool& { return s.bias_guard; }, E::Redisplay, "bias guard"));
   t.push_back(choice<&schedule>("schedule", "--schedule",
-                               "when the filter runs: budget = at power-of-two sample counts while filter + range stay within\n"
-                               "10 % of the tracing time; pow2 = at every power of two; every = each frame; all also\n"
-                               "the last frame",
+                               "when the filter runs: final = once to measure its cost, then on the last frame (a headless\n"
+                               "job shows only that); budget = at power-of-two sample counts while filter + range stay\n"
+                               "within 10 % of the tracing time (the explorer's default); pow2 = at every power of two;\n"
+                               "every = each frame; all also the last frame",
                                filter_schedule_names(), E::Redisplay, "schedule"));
   t.push_back(on_off("motion_history", "--motion-history",
                      "after a camera move, reproject what the view showed into the new view beside the fresh samples,\n"

@@ -15,6 +15,8 @@ int run_explore(const Args& args) {
                   "right drag: pan, wheel: zoom, WASD/QE: fly, R: reset), capture (P) into --out DIR with the\n"
                   "same files as `pxf render`. Drop a .gltf/.glb onto the window to load it.");
   add_scene_options(cli, o.scene, /*headless=*/false);
+  // The explorer shows every frame: the filter runs on the budget schedule, not on the last frame only.
+  o.preview.schedule = FilterSchedule::Budget;
   add_preview_options(cli, o.preview);
   cli.choice("--view", &o.view, buffer_view_names(), "initial buffer view (default final)");
   std::string inspect;
