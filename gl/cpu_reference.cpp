@@ -147,6 +147,12 @@ FilterOutput atrous_pass(const Image& signal, const Image& signal_var, const Ima
   const RangeWeights range = range_weights(p);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
+      if (depth.at(x, y, 0) >= shared::kBackgroundOnlyDistance) {  // as it is (kBackgroundOnlyDistance)
+        const Px own = rgb_at(signal, x, y);
+        for (int c = 0; c < 3; ++c) out.filtered.at(x, y, c) = own.c[c];
+        out.variance.at(x, y, 0) = final_pass ? kVarSkipped : signal_var.at(x, y, 0);
+        continue;
+      }
       if (final_pass && p.skip_case2 && skip_as_case2(hv, var_u, lv, range_color, depth, p, t, x, y, out, surface)) continue;
       KernelSums sums;
       double h_sum = 0;

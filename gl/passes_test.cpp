@@ -316,6 +316,45 @@ class WhiteNoiseOnFlatGuide {
   std::uniform_real_distribution<float> noise_{0.0f, 2.0f};
 };
 
+// The background skip (kBackgroundOnlyDistance): a third of the image is sky in the guide (distance
+// kBackgroundDepth). The filter leaves those pixels as they are (kVarSkipped: the blend shows L_u),
+// and the surface pixels come out the same whatever the sky's pixels hold, as the distance term
+// gives the sky no weight. GPU against CPU.
+TEST(Atrous, LeavesTheBackgroundAsItIsAndTheSurfaceWithoutIt) {
+  test::osmesa_context();
+  FilterParams p;
+  p.kind = FilterKind::Atrous;
+  p.skip_case2 = false;
+  const float t = 0.05f;
+  auto with_sky = [](float sky_hv) {
+    Scenario s = make_scenario(11);
+    for (int y = 0; y < H; ++y)
+      for (int x = 0; x < W / 3; ++x) {
+        s.depth.at(x, y, 0) = kBackgroundDepth;
+        for (int c = 0; c < 3; ++c) s.hv.at(x, y, c) = sky_hv * float(1 + (x + y) % 3);
+      }
+    return s;
+  };
+  const Scenario dark = with_sky(0.0f), lit = with_sky(5.0f);
+  const FilterOutput a = cpu_filter(dark.hv, dark.var, dark.lv, dark.range, dark.depth, p, t);
+  const FilterOutput b = cpu_filter(lit.hv, lit.var, lit.lv, lit.range, lit.depth, p, t);
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x)
+      for (int c = 0; c < 3; ++c) {
+        if (x < W / 3) {
+          ASSERT_EQ(b.filtered.at(x, y, c), lit.hv.at(x, y, c)) << x << "," << y;
+          ASSERT_EQ(b.variance.at(x, y, 0), kVarSkipped) << x << "," << y;
+        } else {
+          ASSERT_EQ(a.filtered.at(x, y, c), b.filtered.at(x, y, c)) << x << "," << y;
+        }
+      }
+  GpuFixture gpu(lit);
+  FilterPass filter(W, H);
+  filter.run(gpu.inputs, gpu.guide, p, t);
+  expect_close(filter.filtered_image(), b.filtered, 1e-4f, 1e-7f, "L_f");
+  expect_close(filter.raw_variance_image(), b.variance, 1e-4f, 1e-12f, "Var[L_f]");
+}
+
 TEST(Atrous, WhiteNoiseVarianceShrinksBySumOfSquaredWeights) {
   // On a flat guide the à-trous filter is a fixed linear kernel W (the composite of the passes),
   // so white noise of variance v comes out with variance v sum W^2 = v (sum_i c_i^2)^2 (c: the

@@ -6,7 +6,7 @@
 // (luminance_edge_exponent): L_f = sum w L / sum w, Var[L_f] = c sum w^2 Var / (sum w)^2 with the
 // correction c for the correlation between the previous pass's pixels: atrous_variance_correction
 // scaled by the share of the kernel the range weights keep (atrous_local_correction).
-// Taps outside the image are left out.
+// Taps outside the image are left out; background pixels are left as they are (kBackgroundOnlyDistance).
 // Mirrors atrous_pass() in gl/cpu_reference.cpp.
 #include "pass_formulas.h"
 
@@ -32,12 +32,17 @@ layout(location = 0) out vec4 out_filtered;  // rgb L_f, a Var[L_f] (kVarUnknown
 void main() {
   ivec2 p = ivec2(gl_FragCoord.xy);
   ivec2 size = textureSize(hv_tex, 0);
+  vec4 g_p = texelFetch(guide_tex, p, 0);
+  if (g_p.a >= kBackgroundOnlyDistance) {
+    vec4 own = texelFetch(signal_tex, p, 0);
+    out_filtered = vec4(clean(own.rgb), final_pass != 0 ? kVarSkipped : own.a);
+    return;
+  }
   if (final_pass != 0 && skip_case2 != 0 && skip_as_case2(hv_tex, lv_tex, guide_tex, surface_tex, p, k_c, k_d, k_n, k_r, t)) {
     out_filtered = vec4(clean(texelFetch(hv_tex, p, 0).rgb), kVarSkipped);
     return;
   }
   if (final_pass != 0) atomicAdd(filtered_pixels, 1u);
-  vec4 g_p = texelFetch(guide_tex, p, 0);
   vec4 s_p = texelFetch(surface_tex, p, 0);
   vec4 signal_p = texelFetch(signal_tex, p, 0);
   vec3 l_p = clean(signal_p.rgb);

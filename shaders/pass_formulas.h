@@ -46,6 +46,12 @@ PXF_CONST float kBackgroundDepth = 1.0e4f;
 // and no L_f is blended in (case 2, s = 1). Without it, the zero-variance rule lets filtered light
 // of the objects before an environment bleed into it as a halo.
 PXF_CONST float kBackgroundDistanceMin = 0.5f * kBackgroundDepth;
+// The a-trous filter's background skip: a pixel whose guide saw the background in (nearly) every
+// antialiasing frame. Its range weight to any surface pixel is 0 (the distance term underflows), and
+// every pixel it weighs is background too, so the filter leaves it as it is, for two reads instead
+// of 25 taps (an object under a sky is mostly sky); the final pass marks it kVarSkipped and the
+// blend shows L_u there.
+PXF_CONST float kBackgroundOnlyDistance = 0.99f * kBackgroundDepth;
 
 // Albedo demodulation (gl/demodulation.h): a pixel whose mean albedo's luminance is below this is
 // not demodulated (factor 1), so that dividing never amplifies by more than 1 / kAlbedoEpsilon.
