@@ -75,7 +75,7 @@ nlohmann::json stats_json(Preview& preview, const RenderReport& r) {
                       {"time_to_clean_ms", r.clean_ms >= 0 ? nlohmann::json(r.clean_ms) : nlohmann::json(nullptr)},
                       {"case2_share_over_time", r.case2_share_over_time}};
   const auto& counts = preview.case_counts();
-  j["blend_case_pixels"] = {{"no_filtered", counts[kCaseNoFiltered]}, {"case1", counts[kCaseFilteredOnly]},
+  j["blend_case_pixels"] = {{"no_filtered", counts[kCaseNoFiltered]}, {"case1", counts[kCaseLeastVariance]},
                             {"case2", counts[kCaseUnfiltered]},       {"case3", counts[kCaseMixed]},
                             {"unknown_variance", counts[kCaseUnknownVar]}, {"bias_guard", counts[kCaseBiasGuard]}};
   if (r.final_vs_reference) j["final_vs_reference"] = metrics_json(*r.final_vs_reference);

@@ -29,8 +29,11 @@ void check_decision(float u, float f, float t, BlendDecision d) {
   if (d.blend_case == kCaseUnfiltered) {
     EXPECT_EQ(d.s, 1.0f);
   }
-  if (d.blend_case == kCaseFilteredOnly) {
-    EXPECT_EQ(d.s, 0.0f);
+  if (d.blend_case == kCaseLeastVariance && std::isfinite(u) && std::isfinite(f) && double(u) + f > 0) {
+    // No s reaches t: the minimizer of g, f / (u + f), whose g is no more than L_f's alone.
+    EXPECT_NEAR(d.s, double(f) / (double(u) + f), 1e-6);
+    double s = d.s, g = s * s * double(u) + (1 - s) * (1 - s) * double(f);
+    EXPECT_LE(g, double(f) * (1 + 1e-5) + 1e-37);
   }
 }
 
@@ -48,7 +51,7 @@ TEST(BlendFactorCpu, SpecCases) {
   EXPECT_EQ(blend_decision(0, 0, 0.01f).blend_case, kCaseUnfiltered);  // u = f = 0: case 2
   EXPECT_EQ(blend_factor(0, 0, 0.0f), 1.0f);                          // ... even with t = 0
   EXPECT_EQ(blend_factor(0.5f, 0.0f, 0.0f), 0.0f);                    // t = 0, u > 0: s = 0
-  EXPECT_EQ(blend_factor(0.5f, 0.3f, 0.0f), 0.0f);
+  EXPECT_FLOAT_EQ(blend_factor(0.5f, 0.3f, 0.0f), 0.375f);         // ... and f > 0: g's minimizer f / (u + f)
   EXPECT_EQ(blend_decision(0.01f, 0.5f, 0.01f).s, 1.0f);              // u = t: case 2 first
   EXPECT_EQ(blend_decision(0.01f, 0.5f, 0.01f).blend_case, kCaseUnfiltered);
   // D = t u + t f - u f = 0 at t = 0.25, u = f = 0.5: case 3 with s = f / (u + f).
@@ -56,14 +59,14 @@ TEST(BlendFactorCpu, SpecCases) {
   EXPECT_EQ(d.blend_case, kCaseMixed);
   EXPECT_FLOAT_EQ(d.s, 0.5f);
   // Just past D = 0: case 1.
-  EXPECT_EQ(blend_decision(0.5f, 0.5001f, 0.25f).blend_case, kCaseFilteredOnly);
+  EXPECT_EQ(blend_decision(0.5f, 0.5001f, 0.25f).blend_case, kCaseLeastVariance);
   // f = 0 and u > t: s = sqrt(t / u).
   EXPECT_NEAR(blend_factor(0.04f, 0.0f, 0.01f), 0.5f, 1e-6f);
   // L_b = 0: relative variances are infinite (or 0 without noise).
   EXPECT_EQ(relative_variance(1.0f, 0.0f), kInf);
   EXPECT_EQ(relative_variance(0.0f, 0.0f), 0.0f);
   EXPECT_EQ(relative_variance(1e30f, 1e-30f), kInf);
-  EXPECT_EQ(blend_factor(kInf, kInf, 0.01f), 0.0f);
+  EXPECT_EQ(blend_factor(kInf, kInf, 0.01f), 0.5f);
   EXPECT_EQ(blend_factor(kInf, 0.0f, 0.01f), 0.0f);
   EXPECT_EQ(blend_factor(0.0f, kInf, 0.01f), 1.0f);
   // Non-finite inputs stay finite.
@@ -114,7 +117,7 @@ TEST(BlendFactorCpu, CovarianceTermHitsTheThreshold) {
   EXPECT_EQ(d.blend_case, kCaseMixed);
   EXPECT_NEAR(d.s, -0.2 + std::sqrt(0.24), 1e-6);
   // w = 1 and f = u: the filter returned the pixel itself, g(s) = u > t for every s: case 1.
-  EXPECT_EQ(blend_decision(0.04f, 0.04f, 0.01f, 1.0f).blend_case, kCaseFilteredOnly);
+  EXPECT_EQ(blend_decision(0.04f, 0.04f, 0.01f, 1.0f).blend_case, kCaseLeastVariance);
   // Random u, f >= w^2 u (the filter's variance holds the centre's share), t and w: s in [0, 1]; in
   // case 3 g(s) = t unless s was clamped to 1; in case 1 t lies below g on all of [0, 1] (sampled).
   std::mt19937 rng(3);
@@ -130,7 +133,7 @@ TEST(BlendFactorCpu, CovarianceTermHitsTheThreshold) {
       ++mixed;
       ASSERT_NEAR(blend_variance(d.s, u, f, w), t, 1e-4 * t + 1e-6 * std::max(u, f));
     }
-    if (d.blend_case == kCaseFilteredOnly) {
+    if (d.blend_case == kCaseLeastVariance) {
       for (int k = 0; k <= 100; ++k) ASSERT_GT(blend_variance(k / 100.0, u, f, w), t * (1 - 1e-4));
     }
     if (d.blend_case == kCaseUnfiltered) {
@@ -172,9 +175,9 @@ TEST(BlendFactorCpu, BiasGuardRaisesSToTheLeastErrorAndNeverLowersIt) {
       ASSERT_EQ(s, s0);
       ASSERT_EQ(blend_case, kCaseMixed);
     }
-    int unchanged = kCaseFilteredOnly;
+    int unchanged = kCaseLeastVariance;
     ASSERT_EQ(shared::bias_guard_factor(s0, u, f, w, 0.0f, unchanged), s0);
-    ASSERT_EQ(unchanged, kCaseFilteredOnly);
+    ASSERT_EQ(unchanged, kCaseLeastVariance);
   }
   EXPECT_GT(raised, 2000);
   // By hand: u = 0.04, f = 0, w = 0, b2 = 0.01: s = 0.01 / 0.05 = 0.2 (from the blend's 0.1).
@@ -240,7 +243,7 @@ TEST(BlendFactorShader, MatchesCpuOnGridAndBoundaries) {
     }
     EXPECT_EQ(cases.at(1, r, 0), float(kCaseUnknownVar));  // n < 2: s = 0
     EXPECT_EQ(s.at(1, r, 0), 0.0f);
-    EXPECT_EQ(s.at(2, r, 0), 0.0f);                        // L_b = 0 with noise: filtered only
+    EXPECT_EQ(s.at(2, r, 0), 0.5f);                        // L_b = 0 with noise: u = f = inf, g least at 1/2
     EXPECT_EQ(s.at(3, r, 0), 1.0f);                        // L_b = 0, no noise: case 2
     EXPECT_NEAR(s.at(5, r, 0), std::min(1.0f, std::sqrt(t)), 1e-6f);  // g(s) = s^2 u = t
     if (t >= 1e-6f) {

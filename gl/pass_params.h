@@ -17,7 +17,7 @@ using shared::kAlbedoEpsilon;
 using shared::kBackgroundDepth;
 using shared::kBackgroundDistanceMin;
 using shared::kBlendCaseCount;
-using shared::kCaseFilteredOnly;
+using shared::kCaseLeastVariance;
 using shared::kCaseMixed;
 using shared::kCaseNoFiltered;
 using shared::kCaseUnfiltered;

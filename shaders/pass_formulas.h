@@ -22,7 +22,7 @@ PXF_CONST float kVarSkippedBelow = -1.5f;
 
 // Blend case per pixel (the "case" buffer), tested in the order of docs/method.md section 3.2.
 PXF_CONST int kCaseNoFiltered = 0;    // no L_f exists yet (the filter never ran): s = 1
-PXF_CONST int kCaseFilteredOnly = 1;  // D < 0: s = 0
+PXF_CONST int kCaseLeastVariance = 1;  // D < 0, no s reaches t: the s of least variance (mostly L_f)
 PXF_CONST int kCaseUnfiltered = 2;    // u <= t (or the filter skipped the pixel): s = 1
 PXF_CONST int kCaseMixed = 3;         // s = (f + sqrt(D)) / (u + f)
 PXF_CONST int kCaseUnknownVar = 4;    // n < 2, variance unknown: s = 0 (filtered value only)
@@ -31,7 +31,7 @@ PXF_CONST int kBlendCaseCount = 6;
 // The color of each case in the explorer's case view and its legend; yellow for any other code.
 PXF_INLINE vec3 case_color(int code) {
   if (code == kCaseNoFiltered) return vec3(0.35f, 0.35f, 0.35f);
-  if (code == kCaseFilteredOnly) return vec3(0.90f, 0.20f, 0.15f);
+  if (code == kCaseLeastVariance) return vec3(0.90f, 0.20f, 0.15f);
   if (code == kCaseUnfiltered) return vec3(0.20f, 0.75f, 0.25f);
   if (code == kCaseMixed) return vec3(0.20f, 0.45f, 0.95f);
   if (code == kCaseUnknownVar) return vec3(0.85f, 0.30f, 0.85f);
@@ -367,8 +367,10 @@ PXF_INLINE float blend_factor(float u, float f, float t, PXF_OUT(int) blend_case
   float r = isinf(hi) ? (isinf(lo) ? 1.0f : 0.0f) : lo / hi;
   float harmonic = isinf(lo) ? kInf : lo / (1.0f + r);
   if (t < harmonic) {
-    blend_case = kCaseFilteredOnly;
-    return 0.0f;
+    blend_case = kCaseLeastVariance;
+    float uh0 = isinf(hi) ? (isinf(u) ? 1.0f : 0.0f) : u / hi;
+    float fh0 = isinf(hi) ? (isinf(f) ? 1.0f : 0.0f) : f / hi;
+    return fh0 / (uh0 + fh0);
   }
   // The first term is the minimizer of g (g = H <= t there), so an underflowing second term stays
   // under t.
@@ -402,11 +404,11 @@ PXF_INLINE float blend_factor_covariance(float u, float f, float t, float w, PXF
   wide_float uh = wide_float(u) / hi, fh = wide_float(f) / hi, th = wide_float(t) / hi;
   wide_float c = min(wide_float(min(w, 1.0f)) * uh, sqrt(uh * fh));
   wide_float a = uh + fh - 2.0f * c;  // >= (sqrt(uh) - sqrt(fh))^2 >= 0
-  blend_case = kCaseFilteredOnly;
+  blend_case = kCaseLeastVariance;
   if (!(a > kBlendFlatCurvature)) return 0.0f;
   // g's minimum lies at s* = (f - c) / a, below 0 where c > f: then the lowest g on [0, 1] is g(0) = f.
   wide_float s_min = (fh - c) / a, g_min = max((uh * fh - c * c) / a, wide_float(0.0f));
-  if (th < (s_min >= 0.0f ? g_min : fh)) return 0.0f;
+  if (th < (s_min >= 0.0f ? g_min : fh)) return float(max(s_min, wide_float(0.0f)));
   blend_case = kCaseMixed;
   return float(clamp(s_min + sqrt((th - g_min) / a), wide_float(0.0f), wide_float(1.0f)));
 }
@@ -605,7 +607,7 @@ PXF_SAMPLER_FN BiasGuardEstimate bias_guard_estimate_at(sampler2D hv, sampler2D 
 // none).
 PXF_INLINE float guarded_blend_factor(BiasGuardEstimate e, float s, float u, float f, float w, float lb,
                                       PXF_INOUT(int) blend_case) {
-  if (blend_case != kCaseMixed && blend_case != kCaseFilteredOnly) return s;
+  if (blend_case != kCaseMixed && blend_case != kCaseLeastVariance) return s;
   if (!(e.b2 > 0.0f)) return s;
   float u_guard = max(u, relative_variance(e.var_u, lb));
   return bias_guard_factor(s, u_guard, f, w, relative_variance(e.b2, lb), blend_case);

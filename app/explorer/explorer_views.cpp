@@ -42,7 +42,7 @@ CaseStyle case_style(const char* label, int code) {
 }
 const std::array<CaseStyle, kBlendCaseCount> kCaseStyles = {{
     case_style("0  no L_f yet (s = 1)", kCaseNoFiltered),
-    case_style("1  filtered only (s = 0)", kCaseFilteredOnly),
+    case_style("1  least variance (mostly filtered)", kCaseLeastVariance),
     case_style("2  unfiltered (s = 1)", kCaseUnfiltered),
     case_style("3  mixed (0 < s < 1)", kCaseMixed),
     case_style("4  n < 2 (s = 0)", kCaseUnknownVar),
