@@ -117,6 +117,17 @@ Texture2D filtered_texture(const FilterOutput& f) {
   return texture;
 }
 
+// The blend pass on the GPU against the CPU reference's output `cpu` for the same inputs.
+void expect_gpu_blend_matches(const Scenario& s, const FilterOutput& f, float t, const BlendParams& params,
+                              const BlendOutput& cpu) {
+  GpuFixture gpu(s);
+  const Texture2D filtered = filtered_texture(f);
+  BlendPass blend(W, H);
+  blend.run(gpu.inputs, &filtered, &gpu.guide, t, params);
+  expect_close(blend.s_image(), cpu.s, 1e-4f, 1e-5f, "s");
+  expect_close(blend.case_image(), cpu.blend_case, 0.0f, 0.0f, "case");
+}
+
 class FilterVsCpu : public ::testing::TestWithParam<std::tuple<FilterKind, bool, float>> {};
 
 TEST_P(FilterVsCpu, MatchesReference) {
@@ -701,12 +712,7 @@ TEST(BlendVsCpu, BiasGuardFindsABiasOnOneSideOfASharpChange) {
         ++checked;
       }
     EXPECT_GE(checked, 50u);  // 2 rows or columns of 25 or more
-    GpuFixture gpu(s);
-    const Texture2D filtered = filtered_texture(f);
-    BlendPass blend(W, H);
-    blend.run(gpu.inputs, &filtered, &gpu.guide, t, guarded);
-    expect_close(blend.s_image(), out.s, 1e-4f, 1e-5f, "s");
-    expect_close(blend.case_image(), out.blend_case, 0.0f, 0.0f, "case");
+    expect_gpu_blend_matches(s, f, t, guarded, out);
   }
 }
 
@@ -738,12 +744,7 @@ TEST(BlendVsCpu, BiasGuardFindsABiasThatChangesSignFromPixelToPixel) {
       ASSERT_EQ(out.blend_case.at(x, y, 0), float(kCaseBiasGuard)) << x << "," << y;
       ASSERT_NEAR(out.s.at(x, y, 0), 0.25f / 0.26f, 1e-4f) << x << "," << y;
     }
-  GpuFixture gpu(s);
-  const Texture2D filtered = filtered_texture(f);
-  BlendPass blend(W, H);
-  blend.run(gpu.inputs, &filtered, &gpu.guide, t, guarded);
-  expect_close(blend.s_image(), out.s, 1e-4f, 1e-5f, "s");
-  expect_close(blend.case_image(), out.blend_case, 0.0f, 0.0f, "case");
+  expect_gpu_blend_matches(s, f, t, guarded, out);
 }
 
 // The full bilateral's centre weight feeds the blend's covariance term: GPU against CPU, and the

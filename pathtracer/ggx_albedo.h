@@ -21,6 +21,17 @@ constexpr int kGgxAlbedoSize = 32;  // table points along cos theta_o and along 
 // roughness i / (kGgxAlbedoSize - 1), alpha = max(roughness^2, kMinAlpha).
 constexpr float kGgxAlbedoMinCos = 1e-4f;
 
+// Point j of n along the cosine (squared spacing) and point i of n along roughness (alpha = max(r^2,
+// min_alpha)): the grids of this table and of the glass table (glass_albedo.h), for their tests.
+inline float albedo_grid_cos(int j, int n) {
+  const float s = static_cast<float>(j) / static_cast<float>(n - 1);
+  return s * s;
+}
+inline float albedo_grid_alpha(int i, int n, float min_alpha) {
+  const float r = static_cast<float>(i) / static_cast<float>(n - 1);
+  return r * r > min_alpha ? r * r : min_alpha;
+}
+
 // Deterministic quadrature: a midpoint grid of n x n points over the visible-normal sampling's unit
 // square, each weighted by G2 / G1(wo) (the exact estimator of VNDF sampling). The generator's.
 GgxAlbedo ggx_albedo_quadrature(float cos_o, float alpha, int n);

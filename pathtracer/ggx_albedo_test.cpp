@@ -13,14 +13,8 @@ namespace {
 
 constexpr int kGeneratorQuadrature = 1024;  // make_albedo_table's
 
-float grid_cos(int j) {
-  const float s = static_cast<float>(j) / (kGgxAlbedoSize - 1);
-  return s * s;
-}
-float grid_alpha(int i) {
-  const float r = static_cast<float>(i) / (kGgxAlbedoSize - 1);
-  return std::max(r * r, kMinAlpha);
-}
+float grid_cos(int j) { return albedo_grid_cos(j, kGgxAlbedoSize); }
+float grid_alpha(int i) { return albedo_grid_alpha(i, kGgxAlbedoSize, kMinAlpha); }
 
 TEST(GgxAlbedo, TableIsTheGeneratorsOutput) {
   // A stale table (the BSDF's G2 or the grid changed without regenerating) fails here.

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "pathtracer/bsdf.h"
+#include "pathtracer/ggx_albedo.h"
 #include "pathtracer/glass_albedo.h"
 #include "pathtracer/rng.h"
 #include "testing/stat_tests.h"
@@ -19,14 +20,8 @@ namespace {
 
 constexpr int kGeneratorQuadrature = 512;  // make_albedo_table's
 
-float grid_cos(int j) {
-  const float s = static_cast<float>(j) / (kGlassAlbedoCosSize - 1);
-  return s * s;
-}
-float grid_alpha(int i) {
-  const float r = static_cast<float>(i) / (kGlassAlbedoRoughnessSize - 1);
-  return std::max(r * r, kMinAlpha);
-}
+float grid_cos(int j) { return albedo_grid_cos(j, kGlassAlbedoCosSize); }
+float grid_alpha(int i) { return albedo_grid_alpha(i, kGlassAlbedoRoughnessSize, kMinAlpha); }
 
 TEST(GlassAlbedo, TableIsTheGeneratorsOutput) {
   // A stale table (the lobe, its G2 or Fresnel, or the grid changed without regenerating) fails here.

@@ -435,6 +435,26 @@ TEST(Lights, EnvironmentImportanceMapIsCoarseOnlyWhereThatCostsLittleVariance) {
   }
 }
 
+// A point light (I = 3) and a spot (I = 5, cone 0.2 to 0.4 around straight down) at (0, 3, 0), and
+// a sun (E = 1.5) from (0, 0.6, 0.8), white.
+struct PointSpotSun {
+  PunctualLight point, spot, sun;
+};
+PointSpotSun point_spot_and_sun() {
+  PointSpotSun l;
+  l.point.intensity = 3.0f;
+  l.point.position = l.spot.position = glm::vec3(0, 3, 0);
+  l.spot.direction = glm::vec3(0, -1, 0);
+  l.spot.type = PunctualLight::Type::Spot;
+  l.spot.intensity = 5.0f;
+  l.spot.inner_cone = 0.2f;
+  l.spot.outer_cone = 0.4f;
+  l.sun.type = PunctualLight::Type::Directional;
+  l.sun.intensity = 1.5f;
+  l.sun.direction = glm::vec3(0.0f, -0.6f, -0.8f);
+  return l;
+}
+
 TEST(Lights, LightTypesAreSelectedByPower) {
   // A one-sided emitter quad (L = 2, area 0.5), a uniform sky (L = 0.25), a point light (I = 3), a
   // spot (I = 5, mean cone angle 0.3), a sun (E = 1.5) and two dim points (I = 1), white: more
@@ -450,17 +470,7 @@ TEST(Lights, LightTypesAreSelectedByPower) {
   env.image.height = 32;
   env.image.texels.assign(64 * 32, glm::vec4(0.25f, 0.25f, 0.25f, 1.0f));
   scene.environment = env;
-  PunctualLight point, spot, sun;
-  point.intensity = 3.0f;
-  point.position = spot.position = glm::vec3(0, 3, 0);
-  spot.direction = glm::vec3(0, -1, 0);
-  spot.type = PunctualLight::Type::Spot;
-  spot.intensity = 5.0f;
-  spot.inner_cone = 0.2f;
-  spot.outer_cone = 0.4f;
-  sun.type = PunctualLight::Type::Directional;
-  sun.intensity = 1.5f;
-  sun.direction = glm::vec3(0.0f, -0.6f, -0.8f);
+  const auto [point, spot, sun] = point_spot_and_sun();
   PunctualLight dim = point;
   dim.intensity = 1.0f;
   scene.lights = {point, spot, sun, dim, dim};
@@ -507,18 +517,8 @@ TEST(Lights, FewPunctualLightsAreTakenAtEveryVertex) {
   Scene scene;
   scene.materials = {make_diffuse(glm::vec3(0.5f))};
   scene.meshes.push_back(make_quad(glm::vec3(-2, 0, -2), glm::vec3(4, 0, 0), glm::vec3(0, 0, 4), 0));
-  PunctualLight point, spot, sun;
-  point.intensity = 3.0f;
-  point.position = spot.position = glm::vec3(0, 3, 0);
-  spot.direction = glm::vec3(0, -1, 0);
-  spot.type = PunctualLight::Type::Spot;
-  spot.intensity = 5.0f;
-  spot.inner_cone = 0.2f;
-  spot.outer_cone = 0.4f;
-  sun.type = PunctualLight::Type::Directional;
-  sun.intensity = 1.5f;
+  auto [point, spot, sun] = point_spot_and_sun();
   sun.color = glm::vec3(1.0f, 0.8f, 0.5f);
-  sun.direction = glm::vec3(0.0f, -0.6f, -0.8f);
   scene.lights = {point, spot, sun};
   const LightSampler lights(scene);
   ASSERT_EQ(lights.fixed_light_count(), 3u);
