@@ -17,7 +17,7 @@ namespace pxf {
 // guiding (the flag, the serialized field); 7: adaptive frames trace up to kMaxPathsPerFrame paths per
 // pixel (counts, rates above 1, a shard's sample indices from its first frame * kMaxPathsPerFrame)
 // and the flag names the allocation's goal
-constexpr uint32_t kStateFormatVersion = 7;
+constexpr uint32_t kStateFormatVersion = 8;
 
 // Frame counts: one render traces at most kMaxRenderFrames frames (--spp, --frames, --shard); a
 // state, also a merge of many shards, holds at most kMaxStateFrames in all, the most the preview's
