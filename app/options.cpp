@@ -33,8 +33,8 @@ void add_scene_options(CommandLine& cli, SceneOptions& o, bool headless) {
 }
 
 namespace {
-// The default a help line shows: the value of a default-constructed PreviewSettings.
-// The command's own default: the value its settings hold before the command line is parsed.
+// The default a help line shows: the command's own, the value its settings hold before the command
+// line is parsed.
 std::string default_text(const SettingDescriptor& d, const PreviewSettings& defaults) {
   const nlohmann::json value = d.to_json(defaults);
   if (value.is_boolean()) return value.get<bool>() ? "on" : "off";
