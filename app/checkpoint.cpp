@@ -74,6 +74,7 @@ void apply_sample_settings(const SampleSettings& s, SceneOptions& scene, Preview
   preview.adaptive = s.adaptive != 0;
   if (s.adaptive != 0) preview.adaptive_params.goal = s.adaptive == 2 ? AdaptiveGoal::Clean : AdaptiveGoal::Error;
   preview.trace.guiding = s.guiding != 0;
+  preview.trace.environment_visibility = s.environment_visibility != 0;
   const auto mode = static_cast<SpecularSamplingMode>(s.specular_sampling);
   preview.trace.specular_sampling = mode == SpecularSamplingMode::All;
   preview.trace.specular_chains = mode == SpecularSamplingMode::Chains;
@@ -113,6 +114,7 @@ AccumulationState Checkpointer::state_of(const Preview& preview) const {
   state.acc = preview.renderer().accumulation();
   state.traced = preview.pixel_samples();
   if (settings_.guiding) state.guiding_field = preview.renderer().guiding_field();
+  if (settings_.environment_visibility) state.environment_visibility = preview.renderer().environment_visibility();
   if (settings_.adaptive) {
     const size_t pixels = state.traced.size();
     state.rate = preview.allocation_rates_now();

@@ -54,6 +54,8 @@ nlohmann::json stats_json(Preview& preview, const RenderReport& r) {
   j["load_ms"] = r.load_ms;
   j["peak_memory_mib"] = peak_memory_mib();
   if (s.trace.guiding) j["guiding_field_bytes"] = preview.renderer().guiding_memory_bytes();  // docs/guiding.md
+  // Light through openings: the regions that sample what they learned of the visible sky (docs/sampling.md).
+  if (s.trace.environment_visibility) j["environment_visibility_regions"] = preview.renderer().environment_visibility_regions();
   // The loader's estimate (docs/robustness.md), beside the peak it bounds: 0 for a built-in scene.
   j["estimated_load_mib"] = preview.renderer().scene().estimated_load_bytes / (1024.0 * 1024.0);
   j["paths_per_second"] = total.path_tracing > 0 ? trace.paths / (total.path_tracing / 1000.0) : 0.0;

@@ -2,7 +2,7 @@
 # Writes the named state_reader seeds of fuzz/corpus/state_reader/ with the pxf given (default
 # build/app/pxf). Run it after every state format version bump: a seed of another version stops at
 # the version check and reaches nothing behind it. The seeds:
-#   cornell_4x3, envmap_3x2   uniform renders (--spp 3, --spp 2)
+#   cornell_4x3, envmap_3x2   uniform renders (--spp 3, --spp 2; the envmap's holds its environment visibility)
 #   shard_replicates          a shard (--frames 4:8) with --replicates 4: the replicate arrays
 #   adaptive_6x4              an adaptive render past its warm-up (--spp 20): traced counts and the allocation
 #   adaptive_merged           the merge of two adaptive shards 0:18 and 18:36, adjacent ranges kept apart
@@ -36,9 +36,9 @@ head -c 400 c/state.pxfs > "$SEEDS/truncated.pxfs"
 python3 - f/state.pxfs "$SEEDS/frames_2pow31.pxfs" <<'PY'
 import struct, sys
 data = bytearray(open(sys.argv[1], "rb").read()[:-8])
-# After the magic (8), version (4) and settings (56 bytes at version 6), the range count (4), then
+# After the magic (8), version (4) and settings (60 bytes at version 9), the range count (4), then
 # the first range's begin and end.
-settings_end = 8 + 4 + 56
+settings_end = 8 + 4 + 60
 assert struct.unpack_from("<I", data, settings_end)[0] == 1, "one frame range expected"
 struct.pack_into("<I", data, settings_end + 8, 1 << 31)
 h = 0xcbf29ce484222325

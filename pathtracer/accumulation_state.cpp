@@ -28,6 +28,8 @@ constexpr uint32_t kMaxReplicates = 64;       // --replicates' bound
 // A serialized guiding field: its trees are bounded by GuidingSettings::max_bytes (16 MiB by
 // default) and its pending records are flushed after every frame, so this is far beyond any pxf writes.
 constexpr uint64_t kMaxGuidingFieldBytes = uint64_t(1) << 30;
+// A serialized EnvironmentVisibility: at most about 4 KiB for each of its 24576 regions.
+constexpr uint64_t kMaxEnvironmentVisibilityBytes = uint64_t(1) << 28;
 
 bool little_endian() {
   const uint16_t one = 1;
@@ -84,6 +86,7 @@ void put_settings(ByteWriter& w, const SampleSettings& s) {
   w.put(s.specular_sampling);
   w.put(s.adaptive);
   w.put(s.guiding);
+  w.put(s.environment_visibility);
 }
 
 // The adaptive flag as a phrase (SampleSettings::adaptive).
@@ -105,9 +108,11 @@ SampleSettings get_settings(ByteReader& r) {
   s.specular_sampling = r.get<uint32_t>("header");
   s.adaptive = r.get<uint32_t>("header");
   s.guiding = r.get<uint32_t>("header");
+  s.environment_visibility = r.get<uint32_t>("header");
   if (s.all_hv > 1 || s.specular_sampling > static_cast<uint32_t>(SpecularSamplingMode::Chains) || s.sampler > 1 ||
-      s.adaptive > 2 || s.guiding > 1)
-    throw Error("state file has an invalid setting flag (all-hv, sampler, specular sampling, adaptive or guiding)");
+      s.adaptive > 2 || s.guiding > 1 || s.environment_visibility > 1)
+    throw Error("state file has an invalid setting flag (all-hv, sampler, specular sampling, adaptive, guiding or "
+                "env-visibility)");
   if (s.replicates < 1 || s.replicates > kMaxReplicates)
     throw Error("state file has an invalid replicate count " + std::to_string(s.replicates));
   if (s.width == 0 || s.height == 0 || s.width > kMaxSide || s.height > kMaxSide)
@@ -242,6 +247,9 @@ std::string SampleSettings::difference(const SampleSettings& o) const {
   if (specular_sampling != o.specular_sampling) return diff("specular sampling", specular_sampling, o.specular_sampling);
   if (adaptive != o.adaptive) return "adaptive sampling " + adaptive_name(adaptive) + " vs " + adaptive_name(o.adaptive);
   if (guiding != o.guiding) return std::string("guiding ") + (guiding ? "on" : "off") + " vs " + (o.guiding ? "on" : "off");
+  if (environment_visibility != o.environment_visibility)
+    return std::string("env-visibility ") + (environment_visibility ? "on" : "off") + " vs " +
+           (o.environment_visibility ? "on" : "off");
   return "";
 }
 
@@ -262,6 +270,7 @@ SampleSettings sample_settings(uint64_t scene_hash, int width, int height, const
   s.replicates = static_cast<uint32_t>(std::max(params.replicates, 1));
   s.specular_sampling = static_cast<uint32_t>(specular_sampling_mode(params));
   s.guiding = params.guiding ? 1u : 0u;
+  s.environment_visibility = params.environment_visibility ? 1u : 0u;
   return s;
 }
 
@@ -307,6 +316,14 @@ std::vector<uint8_t> encode_state(const AccumulationState& state) {
     w.put_array(state.guiding_field);
   } else if (!state.guiding_field.empty()) {
     throw Error("cannot save a guiding field in a state without guiding");
+  }
+  if (state.settings.environment_visibility) {  // length-prefixed (0: none)
+    if (state.environment_visibility.size() > kMaxEnvironmentVisibilityBytes)
+      throw Error("cannot save an environment visibility this large");
+    w.put(static_cast<uint64_t>(state.environment_visibility.size()));
+    w.put_array(state.environment_visibility);
+  } else if (!state.environment_visibility.empty()) {
+    throw Error("cannot save an environment visibility in a state without it");
   }
   w.put(fnv1a64(w.bytes.data(), w.bytes.size()));
   return std::move(w.bytes);
@@ -358,6 +375,12 @@ AccumulationState decode_state(const uint8_t* data, size_t size) {
       }
     }
   }
+  if (state.settings.environment_visibility) {
+    const uint64_t bytes = r.get<uint64_t>("the environment visibility");
+    if (bytes > kMaxEnvironmentVisibilityBytes || bytes > r.remaining())
+      throw Error("state file has an invalid environment visibility size");
+    r.get_array(state.environment_visibility, static_cast<size_t>(bytes), "the environment visibility");
+  }
   if (r.remaining() != sizeof(uint64_t)) throw Error("state file has trailing bytes");
   check_pixels(state);
   return state;
@@ -390,7 +413,7 @@ void write_state_file(const std::string& path, const AccumulationState& state) {
 namespace {
 // The largest file decode_state can accept, every count at its bound: the header, kMaxFrameRanges
 // frame ranges, kMaxSide^2 pixels with kMaxReplicates replicate slots each, the largest guiding
-// field, the checksum. About
+// field and environment visibility, the checksum. About
 // 824 GiB: no practical size, but a bound on what is read, derived from the format itself.
 uint64_t max_state_file_bytes() {
   ByteWriter header;
@@ -406,7 +429,8 @@ uint64_t max_state_file_bytes() {
     per_pixel += slots * sizeof(typename std::decay_t<decltype(array)>::value_type);
   });
   return header.bytes.size() + uint64_t{kMaxFrameRanges} * 2 * sizeof(uint32_t) +
-         uint64_t{kMaxSide} * kMaxSide * per_pixel + sizeof(uint64_t) + kMaxGuidingFieldBytes + sizeof(uint64_t);
+         uint64_t{kMaxSide} * kMaxSide * per_pixel + sizeof(uint64_t) + kMaxGuidingFieldBytes + sizeof(uint64_t) +
+         kMaxEnvironmentVisibilityBytes + sizeof(uint64_t);
 }
 }  // namespace
 
@@ -439,7 +463,11 @@ AccumulationState merge_states(const std::vector<AccumulationState>& states) {
   }
   // Each shard learned its own guiding field; their samples average exactly, but no field continues
   // them: a merged guided state keeps none and is not resumed (Checkpointer refuses it).
-  if (states.size() > 1) merged.guiding_field.clear();
+  // The same for what light through openings learned: a merged state resumes learning anew.
+  if (states.size() > 1) {
+    merged.guiding_field.clear();
+    merged.environment_visibility.clear();
+  }
   std::sort(merged.frames.begin(), merged.frames.end(),
             [](const FrameRange& a, const FrameRange& b) { return a.begin < b.begin; });
   for (size_t i = 1; i < merged.frames.size(); ++i)

@@ -16,8 +16,9 @@ namespace pxf {
 // state; 6: adaptive sampling (the flag, per-pixel traced counts, the allocation's credits and next mask) and path
 // guiding (the flag, the serialized field); 7: adaptive frames trace up to kMaxPathsPerFrame paths per
 // pixel (counts, rates above 1, a shard's sample indices from its first frame * kMaxPathsPerFrame)
-// and the flag names the allocation's goal
-constexpr uint32_t kStateFormatVersion = 8;
+// and the flag names the allocation's goal; 8: the light split of issue 57; 9: light through
+// openings (the flag, the serialized EnvironmentVisibility)
+constexpr uint32_t kStateFormatVersion = 9;
 
 // Frame counts: one render traces at most kMaxRenderFrames frames (--spp, --frames, --shard); a
 // state, also a merge of many shards, holds at most kMaxStateFrames in all, the most the preview's
@@ -52,6 +53,9 @@ struct SampleSettings {
   // 1: path guiding (TraceParams::guiding): a sample depends on the field learned before it, so a
   // resume must continue the same field (AccumulationState::guiding_field).
   uint32_t guiding = 0;
+  // 1: light through openings (TraceParams::environment_visibility): as with guiding, a sample
+  // depends on what was learned before it (AccumulationState::environment_visibility).
+  uint32_t environment_visibility = 0;
   bool operator==(const SampleSettings& o) const;
   // "" when equal, else one phrase naming the first difference ("seed 1 vs 2").
   std::string difference(const SampleSettings& o) const;
@@ -77,6 +81,10 @@ struct AccumulationState {
   // learned, so that a resumed render continues exactly; empty in a merged state (each shard learned
   // its own field), which is therefore not resumed.
   std::vector<uint8_t> guiding_field;
+  // What light through openings learned (settings.environment_visibility only, and only in a scene
+  // with an environment): EnvironmentVisibility::serialize(). Empty in a merged state; a resume
+  // from it starts learning anew, which stays unbiased but is not the uninterrupted render.
+  std::vector<uint8_t> environment_visibility;
   uint32_t frame_count() const;
 };
 

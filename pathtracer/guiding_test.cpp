@@ -12,6 +12,7 @@
 #include "pathtracer/accumulation_state.h"
 #include "pathtracer/guiding_field.h"
 #include "pathtracer/integrator.h"
+#include "testing/block_z_test.h"
 #include "testing/shapes.h"
 
 namespace pxf {
@@ -79,28 +80,6 @@ TEST(Guiding, WhiteFurnaceStaysOne) {
   for (int i = 0; i < frames; ++i) plain.add_frame();
   EXPECT_FALSE(same_accumulation(acc, plain.accumulation()));
   EXPECT_GT(GuidingField::deserialize(guided.guiding_field().data(), guided.guiding_field().size()).iteration(), 5);
-}
-
-// The mean luminance of each 4x4 block and the variance of that mean, from the accumulation's
-// Welford states of LV and HV (Var[LV + HV] <= (sd_LV + sd_HV)^2: no covariance is kept).
-struct Blocks {
-  std::vector<double> mean, variance;
-};
-Blocks blocks_of(const Accumulation& acc, int block) {
-  Blocks b;
-  const int bx = acc.width / block, by = acc.height / block;
-  b.mean.assign(static_cast<size_t>(bx * by), 0.0);
-  b.variance.assign(b.mean.size(), 0.0);
-  const double pixels = block * block;
-  for (int y = 0; y < by * block; ++y)
-    for (int x = 0; x < bx * block; ++x) {
-      const size_t p = static_cast<size_t>(y) * acc.width + x, k = static_cast<size_t>((y / block) * bx + x / block);
-      const double n = acc.samples[p];
-      const double sd = std::sqrt(acc.lv_lum_m2[p] / (n - 1)) + std::sqrt(acc.hv_lum_m2[p] / (n - 1));
-      b.mean[k] += luminance(acc.lv_mean[p] + acc.hv_mean[p]) / pixels;
-      b.variance[k] += sd * sd / n / (pixels * pixels);
-    }
-  return b;
 }
 
 // The guiding learns what it is for. In the cornell box the heaviest-tailed light is the ceiling
@@ -210,23 +189,10 @@ TEST(Guiding, GuidedImageAgreesWithUnguidedReference) {
     guided.add_frame();
     plain.add_frame();
   }
-  const Blocks g = blocks_of(guided.accumulation(), block), r = blocks_of(plain.accumulation(), block);
-  double worst = 0, sum_g = 0, sum_r = 0, var = 0;
-  int beyond3 = 0;
-  for (size_t k = 0; k < g.mean.size(); ++k) {
-    const double z = (g.mean[k] - r.mean[k]) / std::sqrt(g.variance[k] + r.variance[k]);
-    worst = std::max(worst, std::abs(z));
-    beyond3 += std::abs(z) > 3.0;
-    sum_g += g.mean[k];
-    sum_r += r.mean[k];
-    var += g.variance[k] + r.variance[k];
-  }
-  const double z_image = (sum_g - sum_r) / std::sqrt(var);
-  std::printf("guided vs unguided: %zu blocks, worst |z| %.2f, %d beyond 3, image z %.2f (means %.5f, %.5f)\n",
-              g.mean.size(), worst, beyond3, z_image, sum_g / g.mean.size(), sum_r / r.mean.size());
-  EXPECT_LT(worst, 4.5);
-  EXPECT_LE(beyond3, 2);
-  EXPECT_LT(std::abs(z_image), 4.0);
+  const BlockComparison c = compare_blocks(guided.accumulation(), plain.accumulation(), block, "guided vs unguided");
+  EXPECT_LT(c.worst_z, 4.5);
+  EXPECT_LE(c.beyond3, 2);
+  EXPECT_LT(std::abs(c.image_z), 4.0);
 }
 
 // Before the first iteration ends (frame 1) the field is untrained: the guided renderer traces the

@@ -37,6 +37,10 @@ struct PathState {
   // direction toward bright light has a small weight f / p_mixture; rouletting on that weight
   // would kill most such paths and give the survivors back the weight guiding took away.
   float roulette_scale = 1.0f;
+  // What the last non-delta vertex's region learned of the visible sky: an escaped ray's MIS
+  // weight needs the pdf NEE had there.
+  VisibleSky prev_sky;
+  uint32_t prev_sky_region = EnvironmentVisibility::kNoRegion;
 };
 
 // The factor from a guided vertex's weight f / p_mixture to BSDF sampling's f / p_bsdf, for
@@ -130,6 +134,9 @@ struct PathTracer::ShadowQueue {
     PathSample* out;
     glm::vec3 contribution;  // added when the shadow ray reaches the light
     bool lv;
+    // An environment sample: recorded in this region of the visibility field when unblocked.
+    uint32_t sky_region = EnvironmentVisibility::kNoRegion;
+    float sky_value = 0.0f;  // luminance / pdf
   };
   // Per path and vertex: the chosen light's shadow ray and one per fixed light.
   static constexpr size_t kCapacity = kBatchPaths * (1 + LightSampler::kMaxFixedLights);
@@ -147,15 +154,18 @@ struct PathTracer::ShadowQueue {
     ++count;
   }
   template <bool kClassify>
-  void resolve(const EmbreeScene& geometry) {
+  void resolve(const EmbreeScene& geometry, EnvironmentVisibility* visibility) {
     geometry.occluded(rays, static_cast<size_t>(count), occluded);
-    for (int i = 0; i < count; ++i)
+    for (int i = 0; i < count; ++i) {
+      if (pending[i].sky_region != EnvironmentVisibility::kNoRegion)
+        visibility->record(pending[i].sky_region, rays[i].direction, pending[i].sky_value, !occluded[i], true);
       if (!occluded[i]) {
         const bool lv = pending[i].lv;
         add_contribution(*pending[i].out, pending[i].contribution, lv);
         if constexpr (kClassify)
           if (!lv) record_hv(*class_out[i], pending[i].contribution, classes[i]);
       }
+    }
     count = 0;
   }
 };
@@ -168,6 +178,8 @@ struct PathTracer::Vertex {
   const Bsdf& bsdf;
   GuidingMixture mixture;
   int index;
+  uint32_t sky_region;  // in the visibility field (kNoRegion: none)
+  VisibleSky sky;       // what that region learned
 };
 
 bool PathSample::finite() const { return is_finite(lv) && is_finite(hv); }
@@ -277,7 +289,7 @@ void PathTracer::trace_batch(const Camera& camera, int width, int height, const 
                                   kClassify ? &class_states[live[k]] : nullptr))
         live[still_live++] = live[k];
     live_count = still_live;
-    shadows.resolve<kClassify>(geometry_);
+    shadows.resolve<kClassify>(geometry_, visibility_);
   }
 }
 
@@ -423,8 +435,13 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
   ++out.rays;
   if (!hit.valid()) {  // the environment is the light vertex
     if (lights_.has_environment()) {
-      float w = s.prev_delta ? s.chain_mis : power_heuristic(s.prev_pdf, lights_.pdf_environment(path.ray.direction));
-      const glm::vec3 value = s.throughput * lights_.environment_radiance(path.ray.direction) * w;
+      float w = s.prev_delta ? s.chain_mis
+                             : power_heuristic(s.prev_pdf, lights_.pdf_environment(path.ray.direction, &s.prev_sky));
+      const glm::vec3 radiance = lights_.environment_radiance(path.ray.direction);
+      const glm::vec3 value = s.throughput * radiance * w;
+      // The sky seen through the BSDF's sample teaches the last vertex's region as NEE's does.
+      if (s.prev_sky_region != EnvironmentVisibility::kNoRegion && !s.prev_delta)
+        visibility_->record(s.prev_sky_region, path.ray.direction, luminance(radiance) / s.prev_pdf, true, false);
       const bool lv = emission_goes_to_lv(s, true, params.all_hv);
       add_contribution(out, value, lv);
       if constexpr (kClassify)
@@ -463,7 +480,13 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
   }
   if (last_vertex || bsdf.is_black()) return false;
 
-  const Vertex v{sp, bsdf_params, bsdf, guiding_mixture(sp, bsdf, wo, s.nonspecular == 0, params), vertex};
+  const uint32_t sky_region = visibility_ && bsdf.has_nondelta()
+                                  ? visibility_->region(sp.position, glm::dot(sp.geometric_normal, wo) >= 0.0f
+                                                                        ? sp.geometric_normal
+                                                                        : -sp.geometric_normal)
+                                  : EnvironmentVisibility::kNoRegion;
+  const Vertex v{sp, bsdf_params, bsdf, guiding_mixture(sp, bsdf, wo, s.nonspecular == 0, params), vertex,
+                 sky_region, visibility_ ? visibility_->sky(sky_region) : VisibleSky{}};
   // Next event estimation (the light vertex is vertex + 1 <= max_vertices).
   const PathSampler::LightNumbers u_light = numbers ? numbers->light : sampler.light_numbers(vertex, bsdf.has_nondelta());
   if (bsdf.has_nondelta()) sample_direct_light<kClassify>(path, v, u_light, params.all_hv, shadows, cls);
@@ -521,11 +544,16 @@ void PathTracer::sample_direct_light(Path& path, const Vertex& v, const PathSamp
       shadows.class_out[shadows.count] = cls->out;
       shadows.classes[shadows.count] = cls->classify(s.nonspecular, false);
     }
-    shadows.push(ray, {&out, s.throughput * f * ls.radiance * (w / ls.pdf), lv});
+    ShadowQueue::Pending pending{&out, s.throughput * f * ls.radiance * (w / ls.pdf), lv};
+    if (environment && v.sky_region != EnvironmentVisibility::kNoRegion) {
+      pending.sky_region = v.sky_region;
+      pending.sky_value = luminance(ls.radiance) / ls.pdf;
+    }
+    shadows.push(ray, pending);
   };
   LightSample ls;
-  if (u_light.shared ? lights_.sample(sp.position, u_light.point, &ls)
-                     : lights_.sample(sp.position, u_light.select, u_light.point, &ls))
+  if (u_light.shared ? lights_.sample(sp.position, u_light.point, &ls, &v.sky)
+                     : lights_.sample(sp.position, u_light.select, u_light.point, &ls, &v.sky))
     queue_light(ls, false);
   for (size_t k = 0; k < lights_.fixed_light_count(); ++k)
     if (lights_.fixed_light_sample(k, sp.position, &ls)) queue_light(ls, true);
@@ -633,6 +661,10 @@ bool PathTracer::continue_path(Path& path, const Vertex& v, const SpecularChainS
     s.throughput /= q;
   }
   s.prev_position = sp.position;
+  if (!bs.delta) {
+    s.prev_sky = v.sky;
+    s.prev_sky_region = v.sky_region;
+  }
   path.ray.origin = offset_ray_origin(sp.position, sp.geometric_normal, bs.wi);
   path.ray.direction = bs.wi;
   return true;

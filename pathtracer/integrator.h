@@ -106,6 +106,11 @@ class PathTracer {
   // default) traces without guiding whatever params.guiding says. The field must not change
   // (apply_records, end_iteration) while a trace runs.
   void set_guiding(GuidingField* field) { guiding_ = field; }
+  // Light through openings (TraceParams::environment_visibility, environment_visibility.h): NEE
+  // toward the environment samples what each vertex's region learned of the visible sky, and every
+  // unblocked environment sample is recorded there. nullptr (the default): the environment is
+  // sampled by its radiance alone. The field must not change (end_frame) while a trace runs.
+  void set_environment_visibility(EnvironmentVisibility* field) { visibility_ = field; }
 
   // Path guiding's training light (docs/guiding.md): `count` photons of frame `frame`, traced from
   // the lights; at every non-delta surface a photon reaches after its first bounce (light NEE does
@@ -152,6 +157,7 @@ class PathTracer {
   BsdfMaterials materials_;
   SpecularChainSampler chains_;  // light through specular chains (caustics)
   GuidingField* guiding_ = nullptr;
+  EnvironmentVisibility* visibility_ = nullptr;
 };
 
 }  // namespace pxf

@@ -218,16 +218,17 @@ LightSampler::LightSampler(const Scene& scene) : scene_(scene) {
   p_punctual_ = has_punctual ? std::max(0.0f, 1.0f - p_triangles_ - p_environment_) : 0.0f;
 }
 
-bool LightSampler::sample(glm::vec3 position, float u_select, glm::vec2 u, LightSample* out) const {
-  return sample_light(position, u_select, u, false, out);
+bool LightSampler::sample(glm::vec3 position, float u_select, glm::vec2 u, LightSample* out,
+                          const VisibleSky* sky) const {
+  return sample_light(position, u_select, u, false, sky, out);
 }
 
-bool LightSampler::sample(glm::vec3 position, glm::vec2 u, LightSample* out) const {
-  return sample_light(position, u.x, u, true, out);
+bool LightSampler::sample(glm::vec3 position, glm::vec2 u, LightSample* out, const VisibleSky* sky) const {
+  return sample_light(position, u.x, u, true, sky, out);
 }
 
 bool LightSampler::sample_light(glm::vec3 position, float u_select, glm::vec2 u, bool reuse_select,
-                                LightSample* out) const {
+                                const VisibleSky* sky, LightSample* out) const {
   if (category_count_ == 0) return false;
   // Remap u_select within the chosen category so it can pick the light inside it.
   if (u_select < p_triangles_) {
@@ -240,7 +241,7 @@ bool LightSampler::sample_light(glm::vec3 position, float u_select, glm::vec2 u,
   u_select -= p_triangles_;
   if (u_select < p_environment_) {
     if (reuse_select) u.x = std::min(u_select / p_environment_, 0x1.fffffep-1f);
-    return sample_environment(position, u, out);
+    return sample_environment(u, sky, out);
   }
   u_select -= p_environment_;
   if (p_punctual_ <= 0.0f) return false;
@@ -530,9 +531,26 @@ float LightSampler::environment_direction_pdf(glm::vec3 direction) const {
   return sin_theta > 0.0f ? env_dist_.pdf(uv) / (2.0f * kPi * kPi * sin_theta) : 0.0f;
 }
 
-bool LightSampler::sample_environment(glm::vec3, glm::vec2 u, LightSample* out) const {
+// With a learned sky, u.x picks the strategy (the sky's share of [0, 1) the learned one) and,
+// rescaled, stays the chosen strategy's first coordinate; either direction's pdf is the mixture's.
+bool LightSampler::sample_environment(glm::vec2 u, const VisibleSky* sky, LightSample* out) const {
   float pdf;
-  glm::vec3 wi = sample_environment_direction(u, &pdf);
+  glm::vec3 wi;
+  if (sky && sky->learned() && sky->share() > 0.0f) {
+    const float share = sky->share();
+    float learned_pdf, radiance_pdf;
+    if (u.x < share) {
+      wi = sky->sample(glm::vec2(u.x / share, u.y), &learned_pdf);
+      radiance_pdf = environment_direction_pdf(wi);
+    } else {
+      wi = sample_environment_direction(glm::vec2(std::min((u.x - share) / (1.0f - share), 0x1.fffffep-1f), u.y),
+                                        &radiance_pdf);
+      learned_pdf = sky->pdf(wi);
+    }
+    pdf = share * learned_pdf + (1.0f - share) * radiance_pdf;
+  } else {
+    wi = sample_environment_direction(u, &pdf);
+  }
   if (!(pdf > 0.0f)) return false;
   out->wi = wi;
   out->distance = kInf;
@@ -542,8 +560,11 @@ bool LightSampler::sample_environment(glm::vec3, glm::vec2 u, LightSample* out) 
   return true;
 }
 
-float LightSampler::pdf_environment(glm::vec3 direction) const {
-  return p_environment_ * environment_direction_pdf(direction);
+float LightSampler::pdf_environment(glm::vec3 direction, const VisibleSky* sky) const {
+  const float radiance_pdf = environment_direction_pdf(direction);
+  if (!(sky && sky->learned() && sky->share() > 0.0f)) return p_environment_ * radiance_pdf;
+  const float share = sky->share();
+  return p_environment_ * (share * sky->pdf(direction) + (1.0f - share) * radiance_pdf);
 }
 
 glm::vec3 LightSampler::environment_radiance(glm::vec3 direction) const {

@@ -10,6 +10,7 @@
 #include <limits>
 #include <vector>
 #include <glm/glm.hpp>
+#include "pathtracer/environment_visibility.h"
 #include "pathtracer/sampling.h"
 #include "scene/scene.h"
 
@@ -38,12 +39,15 @@ class LightSampler {
   bool empty() const { return category_count_ == 0 && fixed_.empty(); }  // nothing emits: the image is black
   bool has_environment() const { return env_ != nullptr; }
 
-  bool sample(glm::vec3 position, float u_select, glm::vec2 u, LightSample* out) const;
+  // `sky`: what the point's region learned of the environment's visible part (light through
+  // openings, environment_visibility.h); an environment sample then comes from the mixture of it
+  // and the environment's own distribution, with the mixture's pdf.
+  bool sample(glm::vec3 position, float u_select, glm::vec2 u, LightSample* out, const VisibleSky* sky = nullptr) const;
   // The same distribution from one 2D number: u.x picks the light and, rescaled to the chosen
   // light's share of [0,1), is reused as the first coordinate of the point on it. A stratified
   // (low-discrepancy) u then stays stratified on every light, which a separate selection number
   // does not give.
-  bool sample(glm::vec3 position, glm::vec2 u, LightSample* out) const;
+  bool sample(glm::vec3 position, glm::vec2 u, LightSample* out, const VisibleSky* sky = nullptr) const;
 
   // A photon from all the lights' emission, each light chosen in proportion to its power (suns
   // and the environment enter through a disc facing them that covers the scene). Emissive
@@ -54,7 +58,8 @@ class LightSampler {
   // Solid-angle pdf (incl. selection) with which sample() would pick this point of an emissive
   // triangle seen from `from`; 0 for triangles that are not lights.
   float pdf_triangle(unsigned mesh, unsigned prim, glm::vec3 from, glm::vec3 point, glm::vec3 face_normal) const;
-  float pdf_environment(glm::vec3 direction) const;   // incl. selection
+  // Incl. selection; `sky`: the point's learned sky, as sample() was given it.
+  float pdf_environment(glm::vec3 direction, const VisibleSky* sky = nullptr) const;
   glm::vec3 environment_radiance(glm::vec3 direction) const;  // 0 without an environment
 
   // Parts exposed for the statistical tests.
@@ -167,7 +172,8 @@ class LightSampler {
  private:
   // Both sample() overloads: with reuse_select, u.x is replaced by u_select rescaled within the
   // chosen category and light.
-  bool sample_light(glm::vec3 position, float u_select, glm::vec2 u, bool reuse_select, LightSample* out) const;
+  bool sample_light(glm::vec3 position, float u_select, glm::vec2 u, bool reuse_select, const VisibleSky* sky,
+                    LightSample* out) const;
   size_t triangle_point(glm::vec3 from, float u_select, glm::vec2 u, bool reuse_select, glm::vec3* point,
                         glm::vec2* barycentrics, float* area_pdf) const;
   // Picks an emissive triangle for a shading point at `from`; u_remapped (may be null): u_select
@@ -179,7 +185,7 @@ class LightSampler {
   void cluster_probabilities(glm::vec3 from, float* out) const;
   bool triangle_sample(glm::vec3 position, size_t light, glm::vec3 point, glm::vec2 barycentrics, float area_pdf,
                        LightSample* out) const;
-  bool sample_environment(glm::vec3 position, glm::vec2 u, LightSample* out) const;
+  bool sample_environment(glm::vec2 u, const VisibleSky* sky, LightSample* out) const;
   bool sample_punctual(glm::vec3 position, float u_select, LightSample* out) const;
   static bool punctual_sample(const PunctualLight& light, glm::vec3 position, float pdf, LightSample* out);
 

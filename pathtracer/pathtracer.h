@@ -50,6 +50,12 @@ struct TraceParams {
   // NEE and specular sampling MIS against that mixture). Off by default; off traces the samples
   // of before, bit for bit.
   bool guiding = false;
+  // Light through openings (docs/sampling.md#light-through-openings): in a scene with an
+  // environment, next event estimation learns per region which parts of the sky its shadow rays
+  // find unblocked, and draws half of its environment directions from that (MIS-combined with
+  // the environment's own distribution: unbiased). On by default; without an environment it does
+  // nothing.
+  bool environment_visibility = true;
 };
 
 // The specular sampling a TraceParams asks for, as the state files number it: specular_chains
@@ -152,12 +158,18 @@ class ProgressiveRenderer {
   // (guiding_field()); with TraceParams::guiding an empty one starts a new field (the render then
   // does not continue exactly), without guiding it is ignored. Throws pxf::Error on a field that
   // does not deserialize.
+  // `environment_visibility`: EnvironmentVisibility's serialized state (environment_visibility());
+  // empty starts a new one, which continues unbiased but not bit for bit.
   void restore(const Accumulation& acc, uint32_t first, int frames, const std::vector<uint32_t>& traced = {},
-               const std::vector<uint8_t>& guiding_field = {});
+               const std::vector<uint8_t>& guiding_field = {}, const std::vector<uint8_t>& environment_visibility = {});
   // The guiding field learned so far, serialized (empty without TraceParams::guiding), and its
   // memory (GuidingField::memory_bytes(), 0 without guiding).
   std::vector<uint8_t> guiding_field() const;
   size_t guiding_memory_bytes() const;
+  // What light through openings learned so far, serialized (empty where it is off or the scene has
+  // no environment), and its regions with a learned distribution.
+  std::vector<uint8_t> environment_visibility() const;
+  size_t environment_visibility_regions() const;
 
   const Accumulation& accumulation() const;
   const TraceStats& stats() const;

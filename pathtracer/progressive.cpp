@@ -9,6 +9,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include "pathtracer/environment_visibility.h"
 #include "pathtracer/guiding_field.h"
 #include <cstdio>
 #include "pathtracer/integrator.h"
@@ -85,6 +86,8 @@ struct ProgressiveRenderer::Impl {
   std::vector<size_t> chunk_starts;    // where each batch of at most kChunk jobs starts, then the end
   // Path guiding (params.guiding): learned since the last reset, read by the tracing threads.
   std::unique_ptr<GuidingField> guiding;
+  // Light through openings (params.environment_visibility, a scene with an environment).
+  std::unique_ptr<EnvironmentVisibility> visibility;
 
   Impl(const Scene& s, const TraceParams& p, int w, int h) : scene(s), camera(s.camera), params(p), width(w), height(h) {
     if (w <= 0 || h <= 0) throw Error("path tracer: image size must be positive");
@@ -93,6 +96,18 @@ struct ProgressiveRenderer::Impl {
     pixel_frames.assign(static_cast<size_t>(w) * h, 0u);
     make_arena();
     reset_guiding();
+    reset_visibility();
+  }
+
+  // A new field that has learned nothing (with an environment and params.environment_visibility).
+  void reset_visibility() {
+    visibility.reset();
+    if (params.environment_visibility && tracer->lights().has_environment()) {
+      glm::vec3 lo, hi;
+      guiding_box(scene, &lo, &hi);
+      visibility = std::make_unique<EnvironmentVisibility>(*scene.environment, lo, hi);
+    }
+    tracer->set_environment_visibility(visibility.get());
   }
 
   // A new, untrained field (params.guiding), or none.
@@ -219,6 +234,7 @@ void ProgressiveRenderer::reset() {
   impl_->stats = TraceStats{};
   impl_->frames = 0;
   impl_->reset_guiding();
+  impl_->reset_visibility();
 }
 
 void ProgressiveRenderer::set_camera(const Camera& camera) {
@@ -255,6 +271,7 @@ bool ProgressiveRenderer::add_frame_of(const uint8_t* active) {
   impl_->count_traced_pixels();
   ++impl_->frames;
   impl_->learn_guiding();
+  if (impl_->visibility) impl_->visibility->end_frame();
   impl_->stats.last_frame_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return true;
 }
@@ -276,7 +293,8 @@ void ProgressiveRenderer::set_sample_stride(uint32_t stride) {
 }
 
 void ProgressiveRenderer::restore(const Accumulation& acc, uint32_t first, int frames,
-                                  const std::vector<uint32_t>& traced, const std::vector<uint8_t>& guiding_field) {
+                                  const std::vector<uint32_t>& traced, const std::vector<uint8_t>& guiding_field,
+                                  const std::vector<uint8_t>& environment_visibility) {
   if (acc.width != impl_->width || acc.height != impl_->height || acc.samples.size() != impl_->acc.samples.size())
     throw Error("saved accumulation is " + std::to_string(acc.width) + "x" + std::to_string(acc.height) +
                 ", the render " + std::to_string(impl_->width) + "x" + std::to_string(impl_->height));
@@ -294,6 +312,9 @@ void ProgressiveRenderer::restore(const Accumulation& acc, uint32_t first, int f
       impl_->tracer->set_guiding(impl_->guiding.get());
     }
   }
+  impl_->reset_visibility();
+  if (impl_->visibility && !environment_visibility.empty())
+    impl_->visibility->deserialize(environment_visibility.data(), environment_visibility.size());
   impl_->acc = acc;
   impl_->first_frame = first;
   impl_->frames = frames;
@@ -307,6 +328,12 @@ std::vector<uint8_t> ProgressiveRenderer::guiding_field() const {
   return impl_->guiding ? impl_->guiding->serialize() : std::vector<uint8_t>{};
 }
 size_t ProgressiveRenderer::guiding_memory_bytes() const { return impl_->guiding ? impl_->guiding->memory_bytes() : 0; }
+std::vector<uint8_t> ProgressiveRenderer::environment_visibility() const {
+  return impl_->visibility ? impl_->visibility->serialize() : std::vector<uint8_t>{};
+}
+size_t ProgressiveRenderer::environment_visibility_regions() const {
+  return impl_->visibility ? impl_->visibility->learned_regions() : 0;
+}
 const Accumulation& ProgressiveRenderer::accumulation() const { return impl_->acc; }
 const TraceStats& ProgressiveRenderer::stats() const { return impl_->stats; }
 const Scene& ProgressiveRenderer::scene() const { return impl_->scene; }

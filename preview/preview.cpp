@@ -151,7 +151,7 @@ void Preview::load_accumulation(const Accumulation& acc, uint32_t first, int fra
 void Preview::load_state(const AccumulationState& state) {
   reset();
   renderer_->restore(state.acc, state.frames.front().begin, static_cast<int>(state.frame_count()), state.traced,
-                     state.guiding_field);
+                     state.guiding_field, state.environment_visibility);
   update_hv_empty();
   if (!state.settings.adaptive) return;
   replans_ = replan_schedule(samples());

@@ -193,6 +193,12 @@ std::vector<SettingDescriptor> make_table() {
                      "an SD-tree's regions) and send a learned share of the first diffuse bounce there,\n"
                      "MIS-combined with BSDF sampling: unbiased (docs/guiding.md)",
                      [](PreviewSettings& s) -> bool& { return s.trace.guiding; }, E::Retrace, "path guiding"));
+  t.push_back(on_off("environment_visibility", "--env-visibility",
+                     "light through openings: learn per region which parts of the environment its shadow rays\n"
+                     "find unblocked (a window) and draw half of the environment's light samples there,\n"
+                     "MIS-combined with sampling by radiance: unbiased (docs/sampling.md#light-through-openings)",
+                     [](PreviewSettings& s) -> bool& { return s.trace.environment_visibility; }, E::Retrace,
+                     "light through openings"));
   t.push_back(on_off("all_hv", "--all-hv",
                      "put the emitters' light at the first surface into the HV buffer too (the environment's always\n"
                      "goes there): only what the camera sees directly or through mirrors and glass, and the exact\n"

@@ -1,5 +1,9 @@
 #include "testing/shapes.h"
 
+#include <algorithm>
+
+#include "scene/texture.h"
+
 #include <cmath>
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -142,6 +146,41 @@ Scene make_cornell_box(bool with_specular_spheres) {
   }
   scene.camera = look_at_camera(glm::vec3(0, 0, 3.4f), glm::vec3(0, 0, 0), glm::vec3(0, 1, 0), 0.69f);
   return scene;
+}
+
+Scene make_room_with_window() {
+  Scene scene;
+  scene.materials = {make_diffuse(glm::vec3(0.7f))};
+  const auto wall = [&](glm::vec3 corner, glm::vec3 u, glm::vec3 v) { scene.meshes.push_back(make_quad(corner, u, v, 0)); };
+  wall(glm::vec3(-1, -1, -1), glm::vec3(0, 0, 2), glm::vec3(2, 0, 0));  // floor, facing +y
+  wall(glm::vec3(-1, 1, -1), glm::vec3(2, 0, 0), glm::vec3(0, 0, 2));   // ceiling, facing -y
+  wall(glm::vec3(-1, -1, -1), glm::vec3(2, 0, 0), glm::vec3(0, 2, 0));  // back (-z), facing +z
+  wall(glm::vec3(-1, -1, 1), glm::vec3(0, 2, 0), glm::vec3(2, 0, 0));   // front (+z), facing -z
+  wall(glm::vec3(-1, -1, -1), glm::vec3(0, 2, 0), glm::vec3(0, 0, 2));  // -x, facing +x
+  // The +x wall, facing -x, around the window y in [0, 0.6], z in [-0.4, 0.4].
+  wall(glm::vec3(1, -1, -1), glm::vec3(0, 0, 2), glm::vec3(0, 1, 0));       // below
+  wall(glm::vec3(1, 0.6f, -1), glm::vec3(0, 0, 2), glm::vec3(0, 0.4f, 0));  // above
+  wall(glm::vec3(1, 0, -1), glm::vec3(0, 0, 0.6f), glm::vec3(0, 0.6f, 0));  // beside, -z
+  wall(glm::vec3(1, 0, 0.4f), glm::vec3(0, 0, 0.6f), glm::vec3(0, 0.6f, 0));  // beside, +z
+  scene.environment = sky_with_sun();
+  scene.camera = look_at_camera(glm::vec3(-0.9f, 0.3f, 0.85f), glm::vec3(0.4f, -0.5f, -0.4f), glm::vec3(0, 1, 0), 1.2f);
+  return scene;
+}
+
+Environment sky_with_sun() {
+  Environment env;
+  env.image.width = 64;
+  env.image.height = 32;
+  env.image.texels.resize(64 * 32);
+  for (int y = 0; y < 32; ++y)
+    for (int x = 0; x < 64; ++x) {
+      const float r = y < 16 ? 0.5f : 0.1f;  // v = theta / pi: the upper half is the sky
+      env.image.texels[static_cast<size_t>(y) * 64 + x] = glm::vec4(r, r, r, 1.0f);
+    }
+  const glm::vec2 uv = equirect_uv(glm::normalize(glm::vec3(1.0f, 0.8f, 0.1f)));
+  const int sx = std::min(static_cast<int>(uv.x * 64), 63), sy = std::min(static_cast<int>(uv.y * 32), 31);
+  env.image.texels[static_cast<size_t>(sy) * 64 + sx] = glm::vec4(2000.0f, 2000.0f, 2000.0f, 1.0f);
+  return env;
 }
 
 Environment uniform_environment(float radiance) {

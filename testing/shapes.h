@@ -24,6 +24,14 @@ Material make_glass(float ior = 1.5f, glm::vec3 tint = glm::vec3(1.0f));
 Material make_conductor(glm::vec3 f0, float roughness);
 Material make_emitter(glm::vec3 radiance);  // black diffuse surface that emits from its front side
 
+// A closed room ([-1,1]^3, white diffuse walls facing in) lit only through a window in its +x wall
+// (y in [0, 0.6], z in [-0.4, 0.4]) by sky_with_sun(); the camera stands inside, near the -x wall,
+// looking at the floor where the sun falls and at the walls it lights.
+Scene make_room_with_window();
+// An 64 x 32 equirect sky: radiance 0.5 above the horizon, 0.1 below, and a sun of radiance 2000
+// in the texel toward normalize(1, 0.8, 0.1) (through make_room_with_window's window onto its floor).
+Environment sky_with_sun();
+
 // Cornell-like box ([-1,1]^3, open towards +z, ceiling light), optionally with a mirror and a glass
 // sphere; camera at z = 3.4 looking down -z.
 Scene make_cornell_box(bool with_specular_spheres);
