@@ -69,6 +69,72 @@ void blur_bins(const double* sums, float* weights) {
     }
 }
 
+// The environment's luminance integrated over the sphere (the texels as constant cells).
+double environment_integral(const Environment& environment) {
+  const Texture& image = environment.image;
+  double integral = 0.0;
+  for (int y = 0; y < image.height; ++y) {
+    const double sin_theta = std::sin(kPi * (y + 0.5) / image.height);
+    for (int x = 0; x < image.width; ++x) {
+      const double l = luminance(glm::vec3(image.texel(static_cast<size_t>(y) * image.width + x)));
+      if (std::isfinite(l) && l > 0.0) integral += l * sin_theta;
+    }
+  }
+  return integral * environment.strength * 2.0 * kPi * kPi / (static_cast<double>(image.width) * image.height);
+}
+
+// A CDF over n entries from weights (a uniform one where they sum to 0): cdf[0] = 0, cdf[n] = 1.
+void build_cdf(const double* weights, int n, float* cdf) {
+  double total = 0.0;
+  for (int i = 0; i < n; ++i) total += weights[i];
+  double sum = 0.0;
+  cdf[0] = 0.0f;
+  for (int i = 0; i < n; ++i) {
+    sum += total > 0.0 ? weights[i] : 1.0;
+    cdf[i + 1] = static_cast<float>(sum / (total > 0.0 ? total : n));
+  }
+  cdf[n] = 1.0f;
+}
+
+// The entry of CDF cdf[0..n] holding u, skipping empty entries, and u's place in it (in [0, 1)).
+int find_in_cdf(const float* cdf, int n, float u, float* t) {
+  int i = static_cast<int>(sorted_upper_bound(cdf, static_cast<size_t>(n) + 1, u, 9)) - 1;
+  i = std::clamp(i, 0, n - 1);
+  while (!(cdf[i + 1] > cdf[i]) && i + 1 < n) ++i;
+  const float width = cdf[i + 1] - cdf[i];
+  *t = std::clamp(width > 0.0f ? (u - cdf[i]) / width : 0.5f, 0.0f, 0x1.fffffep-1f);
+  return i;
+}
+
+// Each CDF runs from 0 to 1 without stepping back, and the share is one learned_share gives.
+bool valid(const LearnedBins& b) {
+  const auto monotone = [](const float* cdf, int n) {
+    if (cdf[0] != 0.0f || cdf[n] != 1.0f) return false;
+    for (int i = 0; i < n; ++i)
+      if (!(cdf[i + 1] >= cdf[i])) return false;
+    return true;
+  };
+  if (!monotone(b.row_cdf, LearnedBins::kV) || !(b.share >= 0.0f && b.share <= EnvironmentVisibility::kMaxLearnedShare))
+    return false;
+  for (int y = 0; y < LearnedBins::kV; ++y)
+    if (!monotone(b.cdf[y], LearnedBins::kU)) return false;
+  return true;
+}
+
+// A region's learned bins from its blurred sums.
+LearnedBins learned_bins(const float* weights, float share) {
+  LearnedBins b;
+  double row[LearnedBins::kV], col[LearnedBins::kU];
+  for (int y = 0; y < LearnedBins::kV; ++y) {
+    row[y] = 0.0;
+    for (int x = 0; x < LearnedBins::kU; ++x) row[y] += col[x] = weights[y * LearnedBins::kU + x];
+    build_cdf(col, LearnedBins::kU, b.cdf[y]);
+  }
+  build_cdf(row, LearnedBins::kV, b.row_cdf);
+  b.share = share;
+  return b;
+}
+
 }  // namespace
 
 EnvironmentVisibility::EnvironmentVisibility(const Environment& environment, glm::vec3 lo, glm::vec3 hi)
@@ -89,55 +155,12 @@ EnvironmentVisibility::EnvironmentVisibility(const Environment& environment, glm
   sums_ = std::make_unique<std::atomic<Sums*>[]>(region_count());
   for (uint32_t r = 0; r < region_count(); ++r) sums_[r].store(nullptr, std::memory_order_relaxed);
   table_of_.assign(region_count(), -1);
-  build_bin_interiors(environment);
+  unit_ = environment_integral(environment) / 16777216.0;
+  if (!(unit_ > 0.0) || !std::isfinite(unit_)) unit_ = 1.0;
 }
 
 EnvironmentVisibility::~EnvironmentVisibility() {
   for (uint32_t r = 0; r < region_count(); ++r) delete sums_[r].load(std::memory_order_relaxed);
-}
-
-// Each bin's inside: the environment's luminance x sin theta averaged over the texels whose centres
-// fall in each of its kSubcells^2 cells (at the cell's centre where none does), and the
-// fixed-point unit: 2^-24 of the environment's luminance integrated over the sphere.
-void EnvironmentVisibility::build_bin_interiors(const Environment& environment) {
-  const Texture& image = environment.image;
-  const int width = kBinsU * kSubcells, height = kBinsV * kSubcells;
-  std::vector<double> sums(static_cast<size_t>(width) * height, 0.0);
-  std::vector<int> counts(sums.size(), 0);
-  double integral = 0.0;
-  for (int y = 0; y < image.height; ++y) {
-    const double sin_theta = std::sin(kPi * (y + 0.5) / image.height);
-    for (int x = 0; x < image.width; ++x) {
-      const double l = luminance(glm::vec3(image.texels[static_cast<size_t>(y) * image.width + x])) * environment.strength;
-      if (!(std::isfinite(l) && l > 0.0)) continue;
-      const size_t cx = static_cast<size_t>((2 * x + 1) * static_cast<int64_t>(width) / (2 * image.width));
-      const size_t cy = static_cast<size_t>((2 * y + 1) * static_cast<int64_t>(height) / (2 * image.height));
-      sums[cy * width + cx] += l * sin_theta;
-      ++counts[cy * width + cx];
-      integral += l * sin_theta * 2.0 * kPi * kPi / (static_cast<double>(image.width) * image.height);
-    }
-  }
-  unit_ = integral > 0.0 && std::isfinite(integral) ? integral / 16777216.0 : 1.0;
-  interiors_.clear();
-  interiors_.reserve(kBins);
-  std::vector<float> weights(kSubcells * kSubcells);
-  for (int bin = 0; bin < kBins; ++bin) {
-    const int bx = bin % kBinsU, by = bin / kBinsU;
-    for (int j = 0; j < kSubcells; ++j)
-      for (int i = 0; i < kSubcells; ++i) {
-        const int x = bx * kSubcells + i, y = by * kSubcells + j;
-        const size_t c = static_cast<size_t>(y) * width + x;
-        double w = counts[c] > 0 ? sums[c] / counts[c] : 0.0;
-        if (counts[c] == 0 && !image.texels.empty()) {
-          const glm::vec2 uv((x + 0.5f) / width, (y + 0.5f) / height);
-          w = luminance(glm::vec3(sample_texture(image, uv))) * environment.strength * std::sin(kPi * uv.y);
-        }
-        weights[static_cast<size_t>(j) * kSubcells + i] = std::isfinite(w) && w > 0.0 ? static_cast<float>(w) : 0.0f;
-      }
-    Distribution2D inside(weights, kSubcells, kSubcells);
-    if (!inside.valid()) inside = Distribution2D(std::vector<float>(weights.size(), 1.0f), kSubcells, kSubcells);
-    interiors_.push_back(std::move(inside));
-  }
 }
 
 uint32_t EnvironmentVisibility::region(const glm::vec3& position, const glm::vec3& normal) const {
@@ -155,7 +178,7 @@ VisibleSky EnvironmentVisibility::sky(uint32_t region) const {
   s.field_ = this;
   s.bins_ = &tables_[static_cast<size_t>(table_of_[region])];
   s.region_ = region;
-  s.share_ = shares_[static_cast<size_t>(table_of_[region])];
+  s.share_ = s.bins_->share;
   return s;
 }
 
@@ -186,7 +209,13 @@ void EnvironmentVisibility::record(uint32_t region, const glm::vec3& direction, 
 
 void EnvironmentVisibility::end_frame() {
   ++frames_;
-  if ((frames_ & (frames_ - 1)) != 0) return;
+  if (dormant_ || (frames_ & (frames_ - 1)) != 0) return;
+  if (frames_ == kDormantCheckFrame && sees_open_sky()) {
+    dormant_ = true;
+    table_of_.assign(region_count(), -1);
+    tables_.clear();
+    return;
+  }
   std::vector<float> weights(kBins);
   std::vector<double> sums(kBins);
   for (uint32_t r = 0; r < region_count(); ++r) {
@@ -194,21 +223,30 @@ void EnvironmentVisibility::end_frame() {
     if (!s || s->records.load(std::memory_order_relaxed) < kMinRecords) continue;
     for (int b = 0; b < kBins; ++b) sums[b] = static_cast<double>(s->bins[b].load(std::memory_order_relaxed));
     blur_bins(sums.data(), weights.data());
-    const Distribution1D built(weights);
-    if (!built.valid()) continue;
-    // Rebuilt from its own pmf, which is what the state file keeps: a resumed render rebuilds it
-    // from the same floats and samples bit for bit what this one does.
-    for (int b = 0; b < kBins; ++b) weights[b] = built.pmf(static_cast<size_t>(b));
+    double total = 0.0;
+    for (float w : weights) total += w;
+    if (!(total > 0.0)) continue;
     const uint64_t offered = s->offered.load(std::memory_order_relaxed);
     const double visible = offered > 0 ? static_cast<double>(s->visible.load(std::memory_order_relaxed)) / offered : 0.0;
+    const float share = learned_share(visible);
+    if (table_of_[r] < 0 && share == 0.0f) continue;  // it would not be sampled
     if (table_of_[r] < 0) {
       table_of_[r] = static_cast<int32_t>(tables_.size());
       tables_.emplace_back();
-      shares_.push_back(0.0f);
     }
-    tables_[static_cast<size_t>(table_of_[r])] = Distribution1D(weights);
-    shares_[static_cast<size_t>(table_of_[r])] = learned_share(visible);
+    tables_[static_cast<size_t>(table_of_[r])] = learned_bins(weights.data(), share);
   }
+}
+
+// More than kOpenSkyFraction of all NEE's environment light got through.
+bool EnvironmentVisibility::sees_open_sky() const {
+  uint64_t offered = 0, visible = 0;
+  for (uint32_t r = 0; r < region_count(); ++r)
+    if (const Sums* s = sums_[r].load(std::memory_order_relaxed)) {
+      offered += s->offered.load(std::memory_order_relaxed);
+      visible += s->visible.load(std::memory_order_relaxed);
+    }
+  return static_cast<double>(visible) > kOpenSkyFraction * static_cast<double>(offered);
 }
 
 size_t EnvironmentVisibility::learned_regions() const { return tables_.size(); }
@@ -217,30 +255,25 @@ size_t EnvironmentVisibility::memory_bytes() const {
   size_t allocated = 0;
   for (uint32_t r = 0; r < region_count(); ++r)
     if (sums_[r].load(std::memory_order_relaxed)) ++allocated;
-  return allocated * sizeof(Sums) + tables_.size() * (2 * kBins + 1) * sizeof(float) +
-         region_count() * (sizeof(Sums*) + sizeof(int32_t)) + interiors_.size() * kSubcells * (kSubcells + 2) * 2 * sizeof(float);
+  return allocated * sizeof(Sums) + tables_.size() * sizeof(LearnedBins) +
+         region_count() * (sizeof(Sums*) + sizeof(int32_t));
 }
 
-float EnvironmentVisibility::bin_density(int bin, glm::vec2 local) const { return interiors_[bin].pdf(local); }
-
+// A bin drawn from the rows' CDF by u.y and the row's by u.x, then uniform inside it on the map.
 glm::vec3 VisibleSky::sample(glm::vec2 u, float* pdf) const {
-  float bin_u, bin_pmf;
-  const int bin = static_cast<int>(bins_->sample(u.x, &bin_u, &bin_pmf));
-  float inside_pdf;
-  const glm::vec2 local = field_->interiors_[bin].sample(glm::vec2(bin_u, u.y), &inside_pdf);
-  const glm::vec2 uv((bin % EnvironmentVisibility::kBinsU + local.x) / EnvironmentVisibility::kBinsU,
-                     (bin / EnvironmentVisibility::kBinsU + local.y) / EnvironmentVisibility::kBinsV);
+  float tx, ty;
+  const int y = find_in_cdf(bins_->row_cdf, LearnedBins::kV, u.y, &ty);
+  const int x = find_in_cdf(bins_->cdf[y], LearnedBins::kU, u.x, &tx);
+  const glm::vec2 uv((x + tx) / LearnedBins::kU, (y + ty) / LearnedBins::kV);
   const glm::vec3 d = equirect_direction(uv);
-  *pdf = solid_angle_density(bin_pmf * inside_pdf * EnvironmentVisibility::kBins, d);
+  *pdf = solid_angle_density(bins_->pmf(x, y) * EnvironmentVisibility::kBins, d);
   return d;
 }
 
 float VisibleSky::pdf(const glm::vec3& direction) const {
-  glm::vec2 local;
-  const int bin = bin_of(equirect_uv(direction), &local);
-  const float pmf = bins_->pmf(static_cast<size_t>(bin));
-  if (!(pmf > 0.0f)) return 0.0f;
-  return solid_angle_density(pmf * field_->bin_density(bin, local) * EnvironmentVisibility::kBins, direction);
+  const int bin = bin_of(equirect_uv(direction), nullptr);
+  const float pmf = bins_->pmf(bin % LearnedBins::kU, bin / LearnedBins::kU);
+  return pmf > 0.0f ? solid_angle_density(pmf * EnvironmentVisibility::kBins, direction) : 0.0f;
 }
 
 // --- The state file's part: the box and grid (checked against this field's), every region's
@@ -255,6 +288,7 @@ std::vector<uint8_t> EnvironmentVisibility::serialize() const {
   for (int a = 0; a < 3; ++a) w.put(hi_[a]);
   w.put(unit_);
   w.put(frames_);
+  w.put(static_cast<uint8_t>(dormant_));
   std::vector<uint32_t> allocated;
   for (uint32_t r = 0; r < region_count(); ++r)
     if (sums_[r].load(std::memory_order_relaxed)) allocated.push_back(r);
@@ -270,10 +304,8 @@ std::vector<uint8_t> EnvironmentVisibility::serialize() const {
   w.put(static_cast<uint64_t>(tables_.size()));
   for (uint32_t r = 0; r < region_count(); ++r) {  // in region order: the bytes do not depend on threads
     if (table_of_[r] < 0) continue;
-    const Distribution1D& t = tables_[static_cast<size_t>(table_of_[r])];
     w.put(r);
-    w.put(shares_[static_cast<size_t>(table_of_[r])]);
-    for (int b = 0; b < kBins; ++b) w.put(t.pmf(static_cast<size_t>(b)));
+    w.put(tables_[static_cast<size_t>(table_of_[r])]);
   }
   w.put(fnv1a64(w.bytes.data(), w.bytes.size()));
   return std::move(w.bytes);
@@ -296,6 +328,8 @@ void EnvironmentVisibility::deserialize(const uint8_t* data, size_t size) {
       if (r.get<float>("grid") != (*corner)[a]) throw Error("environment visibility was learned on another scene's box");
   if (r.get<double>("header") != unit_) throw Error("environment visibility was learned under another environment");
   const uint64_t frames = r.get<uint64_t>("header");
+  const uint8_t dormant = r.get<uint8_t>("header");
+  if (dormant > 1) throw Error("environment visibility has an invalid dormant flag");
   std::vector<std::unique_ptr<Sums>> sums(region_count());
   const size_t allocated = r.get_count(sizeof(uint32_t) * 2 + sizeof(uint64_t) * (kBins + 2), "sums");
   for (size_t i = 0; i < allocated; ++i) {
@@ -308,29 +342,23 @@ void EnvironmentVisibility::deserialize(const uint8_t* data, size_t size) {
     for (auto& b : sums[region]->bins) b.store(r.get<uint64_t>("sums"), std::memory_order_relaxed);
   }
   std::vector<int32_t> table_of(region_count(), -1);
-  std::vector<Distribution1D> tables;
-  std::vector<float> shares;
-  const size_t count = r.get_count(sizeof(uint32_t) + sizeof(float) * (kBins + 1), "distributions");
-  std::vector<float> weights(kBins);
+  std::vector<LearnedBins> tables;
+  const size_t count = r.get_count(sizeof(uint32_t) + sizeof(LearnedBins), "distributions");
   for (size_t i = 0; i < count; ++i) {
     const uint32_t region = r.get<uint32_t>("distributions");
     if (region >= region_count() || table_of[region] >= 0) throw Error("environment visibility has an invalid region");
-    const float share = r.get<float>("distributions");
-    if (!(share >= 0.0f && share <= kMaxLearnedShare)) throw Error("environment visibility has an invalid share");
-    shares.push_back(share);
-    for (float& w : weights) w = r.get<float>("distributions");
-    Distribution1D table(weights);
-    if (!table.valid()) throw Error("environment visibility has an empty distribution");
+    const LearnedBins b = r.get<LearnedBins>("distributions");
+    if (!valid(b)) throw Error("environment visibility has an invalid distribution");
     table_of[region] = static_cast<int32_t>(tables.size());
-    tables.push_back(std::move(table));
+    tables.push_back(b);
   }
   if (r.remaining() != 0) throw Error("environment visibility has trailing bytes");
   for (uint32_t region = 0; region < region_count(); ++region)
     delete sums_[region].exchange(sums[region].release(), std::memory_order_relaxed);
   frames_ = frames;
+  dormant_ = dormant != 0;
   table_of_ = std::move(table_of);
   tables_ = std::move(tables);
-  shares_ = std::move(shares);
 }
 
 }  // namespace pxf

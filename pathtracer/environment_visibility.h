@@ -9,9 +9,9 @@
 //
 // Regions: a uniform grid of at most kMaxCells cells over the scene's box, each cell split by the
 // side its surfaces face (the axis nearest the normal, with its sign: the two sides of a wall, or
-// of a thin object, see different skies). Directions: kBinsU x kBinsV bins of the equirect map;
-// inside a bin a direction follows the environment's own radiance (luminance x sin theta, at
-// kSubcells x kSubcells cells a bin), so a sun inside a visible bin is still found.
+// of a thin object, see different skies). Directions: kBinsU x kBinsV bins of the equirect map,
+// uniform inside a bin (on the map): a sun is found by the other half of the samples, drawn by
+// radiance, and a learned region sees little of it anyway.
 //
 // Learning: every unblocked environment sample of NEE adds luminance(L) / pdf to its region's bin,
 // an unbiased estimate of the light the bin brings to the region's points; so does the sky a BSDF
@@ -19,6 +19,11 @@
 // thread count or the order of the adds. After the field's frames 1, 2, 4, 8, ... (end_frame)
 // each region with at least kMinRecords unblocked records samples its bins in proportion to its
 // sums (each bin lent a share of its neighbours'); the sums keep growing over the whole render.
+//
+// A scene that sees most of its sky does not need any of this: when at the field's frame
+// kDormantCheckFrame more than kOpenSkyFraction of all NEE's environment light got through, the
+// field goes dormant (dormant()): the renderer stops asking it and the scene is sampled by radiance
+// alone, at no cost (an object under a sky, a landscape).
 //
 // How much a region draws from what it learned follows the share of NEE's environment light that
 // its shadow rays found unblocked (learned_share): where most of the sky is visible, sampling by
@@ -39,6 +44,16 @@ namespace pxf {
 
 class EnvironmentVisibility;
 
+// One region's learned distribution over the bins, flat (a sample reads about three cache lines):
+// the rows' CDF over v, each row's CDF over u, and the share of the region's samples drawn from it.
+struct LearnedBins {
+  static constexpr int kU = 32, kV = 16;
+  float share;  // first: read with the rows' CDF, in the same cache line
+  float row_cdf[kV + 1];
+  float cdf[kV][kU + 1];
+  float pmf(int x, int y) const { return (row_cdf[y + 1] - row_cdf[y]) * (cdf[y][x + 1] - cdf[y][x]); }
+};
+
 // One region's learned sky, as a vertex there samples it: the light sampler mixes it with the
 // environment's own distribution (LightSampler::sample's `sky`).
 class VisibleSky {
@@ -55,15 +70,14 @@ class VisibleSky {
  private:
   friend class EnvironmentVisibility;
   const EnvironmentVisibility* field_ = nullptr;
-  const Distribution1D* bins_ = nullptr;
+  const LearnedBins* bins_ = nullptr;
   uint32_t region_ = 0;
   float share_ = 0.0f;
 };
 
 class EnvironmentVisibility {
  public:
-  static constexpr int kBinsU = 32, kBinsV = 16, kBins = kBinsU * kBinsV;
-  static constexpr int kSubcells = 16;  // per bin side: the radiance inside a bin
+  static constexpr int kBinsU = LearnedBins::kU, kBinsV = LearnedBins::kV, kBins = kBinsU * kBinsV;
   static constexpr uint32_t kMaxCells = 4096;
   static constexpr int kSides = 6;
   // A region needs this many unblocked records before its distribution is sampled.
@@ -74,9 +88,10 @@ class EnvironmentVisibility {
   static constexpr float kMaxLearnedShare = 0.5f;
   static float learned_share(double visible_fraction);
   static constexpr uint32_t kNoRegion = 0xffffffffu;
+  static constexpr uint64_t kDormantCheckFrame = 4;
+  static constexpr double kOpenSkyFraction = 0.5;
 
-  // The environment's radiance (for the bins' insides and the fixed-point unit) and the box the
-  // regions cover. Throws pxf::Error on a box that is not finite or not ordered.
+  // The environment's radiance (for the fixed-point unit) and the box the regions cover. Throws pxf::Error on a box that is not finite or not ordered.
   EnvironmentVisibility(const Environment& environment, glm::vec3 lo, glm::vec3 hi);
   ~EnvironmentVisibility();
 
@@ -92,6 +107,8 @@ class EnvironmentVisibility {
   // ... frame every region's distribution becomes what it has summed so far.
   void end_frame();
   uint64_t frames() const { return frames_; }
+  // Learned nothing worth sampling and never will: see kOpenSkyFraction. Sticky; no regions learned.
+  bool dormant() const { return dormant_; }
 
   size_t learned_regions() const;
   size_t memory_bytes() const;
@@ -106,9 +123,8 @@ class EnvironmentVisibility {
  private:
   friend class VisibleSky;
   struct Sums;  // one region's fixed-point sums and record count
-  void build_bin_interiors(const Environment& environment);
-  float bin_density(int bin, glm::vec2 local) const;  // inside bin `bin`, over its unit square
   Sums* sums_of(uint32_t region);
+  bool sees_open_sky() const;
 
   glm::vec3 lo_, hi_;
   glm::ivec3 dims_{1};
@@ -116,11 +132,10 @@ class EnvironmentVisibility {
   size_t cells_ = 1;
   double unit_ = 1.0;  // the luminance / pdf of one fixed-point step
   uint64_t frames_ = 0;  // frames recorded since the field started
-  std::vector<Distribution2D> interiors_;  // per bin: the radiance inside it
+  bool dormant_ = false;
   std::unique_ptr<std::atomic<Sums*>[]> sums_;    // per region, allocated at its first record
   std::vector<int32_t> table_of_;                 // per region: its index in tables_, -1 none
-  std::vector<Distribution1D> tables_;            // the learned distributions over the bins
-  std::vector<float> shares_;                     // and their learned_share
+  std::vector<LearnedBins> tables_;               // the learned distributions over the bins
 };
 
 }  // namespace pxf

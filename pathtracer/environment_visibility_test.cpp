@@ -67,14 +67,13 @@ TEST(EnvironmentVisibility, LearnsFromEnoughRecordsAtDoublingFrames) {
   field.end_frame();  // frame 3: no rebuild
   EXPECT_FALSE(field.sky(open).learned());
   field.end_frame();  // frame 4
-  ASSERT_TRUE(field.sky(open).learned());
-  EXPECT_EQ(field.sky(open).share(), 0.0f);
+  EXPECT_FALSE(field.sky(open).learned());  // nothing to draw from it: no distribution kept
   EXPECT_FLOAT_EQ(EnvironmentVisibility::learned_share(0.5), 0.5f * EnvironmentVisibility::kMaxLearnedShare);
 }
 
-// The learned sky's sample() draws from its pdf(): chi-square over a 32 x 16 equirect grid, the
-// expected counts from the pdf integrated over the 512 x 256 cells inside which its density over
-// the equirect square is constant (so the sum is exact); the pdf it returns is pdf() (but where a
+// The learned sky's sample() draws from its pdf(): chi-square over its 32 x 16 equirect bins, the
+// expected counts from the pdf integrated over each bin, inside which its density over the
+// equirect square is constant (so the sum is exact); the pdf it returns is pdf() (but where a
 // direction lands on a bin's edge and reads as the next bin), and the pdf integrates to 1.
 TEST(EnvironmentVisibility, LearnedSkySamplesItsPdf) {
   EnvironmentVisibility field(sky_with_sun(), kLo, kHi);
@@ -84,7 +83,7 @@ TEST(EnvironmentVisibility, LearnedSkySamplesItsPdf) {
   field.end_frame();
   const VisibleSky sky = field.sky(r);
   ASSERT_TRUE(sky.learned());
-  constexpr int nu = 32, nv = 16, fine = EnvironmentVisibility::kSubcells;
+  constexpr int nu = 32, nv = 16, fine = 4;
   std::vector<double> expected(nu * nv, 0.0), observed(nu * nv, 0.0);
   double integral = 0.0;
   for (int y = 0; y < nv * fine; ++y)
@@ -218,6 +217,28 @@ TEST(EnvironmentVisibility, RoomAgreesWithRadianceSamplingWithLessNoise) {
   EXPECT_GT(learned.environment_visibility_regions(), 10u);
   EXPECT_LT(c.variance_a, 0.7 * c.variance_b * reference_frames / frames);
   EXPECT_TRUE(plain.environment_visibility().empty());
+}
+
+// A scene that sees most of its sky (spheres under a uniform sky) goes dormant at the field's 4th
+// frame: nothing learned, nothing asked, and the state says so.
+TEST(EnvironmentVisibility, OpenSkyGoesDormant) {
+  Scene scene;
+  scene.materials = {make_diffuse(glm::vec3(0.8f))};
+  scene.meshes.push_back(make_sphere(glm::vec3(0.0f), 0.5f, 0));
+  scene.meshes.push_back(make_quad(glm::vec3(-2, -0.5f, 2), glm::vec3(4, 0, 0), glm::vec3(0, 0, -4), 0));
+  scene.environment = sky_with_sun();
+  scene.camera = look_at_camera(glm::vec3(0, 0.5f, 3.0f), glm::vec3(0), glm::vec3(0, 1, 0), 0.8f);
+  ProgressiveRenderer renderer(scene, room_params(true, 8), 24, 20);
+  for (int i = 0; i < 3; ++i) renderer.add_frame();
+  EXPECT_GT(renderer.environment_visibility_regions(), 0u);  // regions in the sphere's shadow learned
+  renderer.add_frame();
+  EXPECT_EQ(renderer.environment_visibility_regions(), 0u);
+  EXPECT_FALSE(renderer.environment_visibility().empty());  // the state keeps the dormant field
+  // The room, enclosed, stays awake.
+  const Scene enclosed = make_room_with_window();
+  ProgressiveRenderer room(enclosed, room_params(true, 8), 24, 20);
+  for (int i = 0; i < 8; ++i) room.add_frame();
+  EXPECT_GT(room.environment_visibility_regions(), 0u);
 }
 
 // A scene without an environment has nothing to learn: the same samples either way, and no state.

@@ -99,6 +99,14 @@ struct ProgressiveRenderer::Impl {
     reset_visibility();
   }
 
+  // After a complete frame: what the frame found goes into the field; a dormant field (a scene
+  // that sees most of its sky) is no longer asked.
+  void learn_visibility() {
+    if (!visibility) return;
+    visibility->end_frame();
+    if (visibility->dormant()) tracer->set_environment_visibility(nullptr);
+  }
+
   // A new field that has learned nothing (with an environment and params.environment_visibility).
   void reset_visibility() {
     visibility.reset();
@@ -271,7 +279,7 @@ bool ProgressiveRenderer::add_frame_of(const uint8_t* active) {
   impl_->count_traced_pixels();
   ++impl_->frames;
   impl_->learn_guiding();
-  if (impl_->visibility) impl_->visibility->end_frame();
+  impl_->learn_visibility();
   impl_->stats.last_frame_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return true;
 }
@@ -313,8 +321,10 @@ void ProgressiveRenderer::restore(const Accumulation& acc, uint32_t first, int f
     }
   }
   impl_->reset_visibility();
-  if (impl_->visibility && !environment_visibility.empty())
+  if (impl_->visibility && !environment_visibility.empty()) {
     impl_->visibility->deserialize(environment_visibility.data(), environment_visibility.size());
+    if (impl_->visibility->dormant()) impl_->tracer->set_environment_visibility(nullptr);
+  }
   impl_->acc = acc;
   impl_->first_frame = first;
   impl_->frames = frames;

@@ -185,8 +185,39 @@ class Distribution1D {
   }
 
  private:
-  size_t upper_bound_index(float u) const { return sorted_upper_bound(cdf_.data(), cdf_.size(), u, kLinearScanEntries); }
+  // With a guide table (Chen's cutpoint method): guide_[k] counts the CDF entries <= k / K, K a power
+  // of two (so that k = floor(u K) is exact), and the answer for u lies in [guide_[k], guide_[k + 1]],
+  // a range of about one entry. The same index as the full search, at one or two cache lines instead
+  // of the search's ten: a large map's rows are sampled at random, and each step of a search in a
+  // 4 KB row missed the cache (a sky behind a window spent a fifth of its time there).
+  size_t upper_bound_index(float u) const {
+    if (guide_.empty()) return sorted_upper_bound(cdf_.data(), cdf_.size(), u, kLinearScanEntries);
+    const size_t last = guide_.size() - 2;  // K - 1
+    const double scaled = static_cast<double>(u) * static_cast<double>(last + 1);
+    // u outside [0, 1) or NaN: the first or last interval (no cast of a value out of range).
+    const size_t k = scaled >= 0.0 && scaled < static_cast<double>(last) ? static_cast<size_t>(scaled)
+                     : scaled >= static_cast<double>(last)                ? last
+                                                                          : 0;
+    const size_t lo = guide_[k], hi = guide_[k + 1];
+    return lo + sorted_upper_bound(cdf_.data() + lo, hi - lo, u, kLinearScanEntries);
+  }
   static constexpr size_t kLinearScanEntries = 9;
+  static constexpr size_t kGuidedFrom = 64;  // bins; fewer stay in a cache line or two anyway
+
+  // guide_[k] = #{i : cdf_[i] <= k / K} for k = 0 .. K, K the least power of two >= the bins.
+  void build_guide() {
+    const size_t n = cdf_.size();
+    if (n - 1 < kGuidedFrom) return;
+    size_t intervals = 1;
+    while (intervals < n - 1) intervals *= 2;
+    guide_.resize(intervals + 1);
+    size_t count = 0;
+    for (size_t k = 0; k <= intervals; ++k) {
+      const double edge = static_cast<double>(k) / static_cast<double>(intervals);
+      while (count < n && static_cast<double>(cdf_[count]) <= edge) ++count;
+      guide_[k] = static_cast<uint32_t>(count);
+    }
+  }
 
   void build(const float* weights, size_t n) {
     pmf_.assign(n, 0.0f);
@@ -203,10 +234,12 @@ class Distribution1D {
       cdf_[i + 1] = static_cast<float>(cdf[i + 1] / total_);
     }
     cdf_[n] = 1.0f;
+    build_guide();
   }
 
   std::vector<float> pmf_;
   std::vector<float> cdf_;
+  std::vector<uint32_t> guide_;  // empty below kGuidedFrom bins
   double total_ = 0.0;
 };
 

@@ -92,6 +92,35 @@ TEST(SortedUpperBound, MatchesStdUpperBound) {
   }
 }
 
+// Large distributions sample through a guide table: every u picks the bin the full search in the
+// CDF picks (runs of empty bins, a spike, exact binary fractions, u on and beside each CDF entry).
+TEST(Distribution1D, GuideTablePicksTheBinsOfTheFullSearch) {
+  for (size_t n : {size_t{64}, size_t{100}, size_t{1024}, size_t{1500}}) {
+    std::vector<float> weights(n);
+    for (size_t i = 0; i < n; ++i) weights[i] = (i / 7) % 3 == 0 ? 0.0f : static_cast<float>((i * 13) % 11);
+    weights[n / 3] = 1e5f;  // a sun
+    const Distribution1D dist(weights);
+    std::vector<float> us;
+    for (int k = 0; k < 20000; ++k) us.push_back((k + 0.37f) / 20000.0f);
+    for (size_t i = 0; i <= n; i += 3) {
+      const float c = static_cast<float>(i) / static_cast<float>(n);
+      us.insert(us.end(), {c, std::nextafter(c, 0.0f), std::nextafter(c, 1.0f)});
+    }
+    // The full search's answer, from the CDF Distribution1D builds (doubles, normalized to floats).
+    std::vector<double> sums(n + 1, 0.0);
+    for (size_t i = 0; i < n; ++i) sums[i + 1] = sums[i] + weights[i];
+    std::vector<float> cdf(n + 1);
+    for (size_t i = 0; i <= n; ++i) cdf[i] = static_cast<float>(sums[i] / sums[n]);
+    cdf[n] = 1.0f;
+    for (float u : us) {
+      size_t want = sorted_upper_bound(cdf.data(), cdf.size(), u, 0);
+      want = std::min(want == 0 ? size_t{0} : want - 1, n - 1);
+      while (weights[want] == 0.0f && want + 1 < n) ++want;
+      ASSERT_EQ(dist.sample(u), want) << "n " << n << " u " << u;
+    }
+  }
+}
+
 TEST(Distribution1D, NonFiniteUStillPicksABin) {
   for (const std::vector<float>& weights : weight_sets()) {
     const Distribution1D dist(weights);
