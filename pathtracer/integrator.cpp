@@ -485,7 +485,7 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
                                                                         ? sp.geometric_normal
                                                                         : -sp.geometric_normal)
                                   : EnvironmentVisibility::kNoRegion;
-  const Vertex v{sp, bsdf_params, bsdf, guiding_mixture(sp, bsdf, wo, s.nonspecular == 0, params), vertex,
+  const Vertex v{sp, bsdf_params, bsdf, guiding_mixture(sp, bsdf, wo, params), vertex,
                  sky_region, visibility_ ? visibility_->sky(sky_region) : VisibleSky{}};
   // Next event estimation (the light vertex is vertex + 1 <= max_vertices).
   const PathSampler::LightNumbers u_light = numbers ? numbers->light : sampler.light_numbers(vertex, bsdf.has_nondelta());
@@ -498,18 +498,19 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
   return continue_path<kClassify>(path, v, plan, params, numbers, cls);
 }
 
-// Path guiding: once the field is trained, the BSDF-side strategy of the path's first non-delta
-// vertex is the mixture that takes the guided direction with probability alpha (times the
-// BSDF's diffuse share: the field knows the incident light, not the BSDF, so it serves a diffuse
-// lobe; glossy and delta lobes keep their samples). Deeper vertices sample the BSDF alone: most
-// of the heavy-tailed light arrives at the first, and a guided vertex pays field lookups for its
-// sample and every MIS weight. A leaf that learned no light (a uniform distribution), or only
-// light behind the surface or too wide to guide, is not guided, and alpha is scaled by the
-// learned light's share the point's distribution holds. Measured in docs/guiding.md.
-GuidingMixture PathTracer::guiding_mixture(const SurfacePoint& sp, const Bsdf& bsdf, glm::vec3 wo, bool first_vertex,
+// Path guiding: once the field is trained, the BSDF-side strategy of every non-delta vertex is the
+// mixture that takes the guided direction with probability alpha (times the BSDF's diffuse share:
+// the field knows the incident light, not the BSDF, so it serves a diffuse lobe; glossy and delta
+// lobes keep their samples). Every vertex, not the first alone: in a room lit through a window
+// most of the first vertex's variance is its deeper vertices' (0.83 of it, `pxf bench
+// guiding-bound --scene window`), and guiding them all took the window's display error at equal
+// samples from 30.4 % to 25.3 % (docs/guiding.md). A leaf that learned no light (a uniform
+// distribution), or only light behind the surface or too wide to guide, is not guided, and alpha
+// is scaled by the learned light's share the point's distribution holds.
+GuidingMixture PathTracer::guiding_mixture(const SurfacePoint& sp, const Bsdf& bsdf, glm::vec3 wo,
                                            const TraceParams& params) const {
   GuidingMixture mixture;
-  if (guiding_ && params.guiding && first_vertex && bsdf.has_nondelta() && guiding_->trained()) {
+  if (guiding_ && params.guiding && bsdf.has_nondelta() && guiding_->trained()) {
     const glm::vec3 n = sp.geometric_normal;
     mixture.guide = guiding_->distribution(sp.position, glm::dot(n, wo) >= 0.0f ? n : -n);
     mixture.guided = mixture.guide.learned();

@@ -138,8 +138,7 @@ class PathTracer {
   template <bool kClassify>
   bool shade_vertex(Path& path, const Hit& hit, int vertex, const TraceParams& params, ShadowQueue& shadows,
                     const PathSampler::VertexNumbers* numbers, ClassState* cls) const;
-  GuidingMixture guiding_mixture(const SurfacePoint& sp, const Bsdf& bsdf, glm::vec3 wo, bool first_vertex,
-                                 const TraceParams& params) const;
+  GuidingMixture guiding_mixture(const SurfacePoint& sp, const Bsdf& bsdf, glm::vec3 wo, const TraceParams& params) const;
   template <bool kClassify>
   void sample_direct_light(Path& path, const Vertex& v, const PathSampler::LightNumbers& u_light, bool all_hv,
                            ShadowQueue& shadows, ClassState* cls) const;

@@ -44,8 +44,8 @@ struct TraceParams {
   // Ignored with specular_sampling, which does this and more.
   bool specular_chains = true;
   // Path guiding (docs/guiding.md): the renderer learns an SD-tree of the indirect light from
-  // photons it traces from the lights after each frame, and once trained each path's first
-  // non-delta vertex samples its direction from it with the probability its region learned (times
+  // photons it traces from the lights after each frame, and once trained every non-delta vertex of
+  // a path samples its direction from it with the probability its region learned (times
   // the BSDF's diffuse share), from the BSDF otherwise, weighted by the mixture pdf (one-sample MIS;
   // NEE and specular sampling MIS against that mixture). Off by default; off traces the samples
   // of before, bit for bit.

@@ -190,7 +190,7 @@ std::vector<SettingDescriptor> make_table() {
   t.push_back(chains);
   t.push_back(on_off("guiding", "--guiding",
                      "path guiding: learn from photons where indirect light comes from (parallax-aware lobes in\n"
-                     "an SD-tree's regions) and send a learned share of the first diffuse bounce there,\n"
+                     "an SD-tree's regions) and send a learned share of every diffuse bounce there,\n"
                      "MIS-combined with BSDF sampling: unbiased (docs/guiding.md)",
                      [](PreviewSettings& s) -> bool& { return s.trace.guiding; }, E::Retrace, "path guiding"));
   t.push_back(on_off("environment_visibility", "--env-visibility",
