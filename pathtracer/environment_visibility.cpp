@@ -155,6 +155,7 @@ EnvironmentVisibility::EnvironmentVisibility(const Environment& environment, glm
   sums_ = std::make_unique<std::atomic<Sums*>[]>(region_count());
   for (uint32_t r = 0; r < region_count(); ++r) sums_[r].store(nullptr, std::memory_order_relaxed);
   table_of_.assign(region_count(), -1);
+  share_of_.assign(region_count(), 0.0f);
   unit_ = environment_integral(environment) / 16777216.0;
   if (!(unit_ > 0.0) || !std::isfinite(unit_)) unit_ = 1.0;
 }
@@ -177,8 +178,10 @@ VisibleSky EnvironmentVisibility::sky(uint32_t region) const {
   if (region >= region_count() || table_of_[region] < 0) return s;
   s.field_ = this;
   s.bins_ = &tables_[static_cast<size_t>(table_of_[region])];
+  // The vertex samples the table after its BSDF is set up: start loading the rows' CDF now.
+  __builtin_prefetch(s.bins_->row_cdf);
   s.region_ = region;
-  s.share_ = s.bins_->share;
+  s.share_ = share_of_[region];
   return s;
 }
 
@@ -209,10 +212,11 @@ void EnvironmentVisibility::record(uint32_t region, const glm::vec3& direction, 
 
 void EnvironmentVisibility::end_frame() {
   ++frames_;
-  if (dormant_ || (frames_ & (frames_ - 1)) != 0) return;
+  if (dormant_ || frames_ > kLearningFrames || (frames_ & (frames_ - 1)) != 0) return;
   if (frames_ == kDormantCheckFrame && sees_open_sky()) {
     dormant_ = true;
     table_of_.assign(region_count(), -1);
+    share_of_.assign(region_count(), 0.0f);
     tables_.clear();
     return;
   }
@@ -235,6 +239,7 @@ void EnvironmentVisibility::end_frame() {
       tables_.emplace_back();
     }
     tables_[static_cast<size_t>(table_of_[r])] = learned_bins(weights.data(), share);
+    share_of_[r] = share;
   }
 }
 
@@ -256,22 +261,25 @@ size_t EnvironmentVisibility::memory_bytes() const {
   for (uint32_t r = 0; r < region_count(); ++r)
     if (sums_[r].load(std::memory_order_relaxed)) ++allocated;
   return allocated * sizeof(Sums) + tables_.size() * sizeof(LearnedBins) +
-         region_count() * (sizeof(Sums*) + sizeof(int32_t));
+         region_count() * (sizeof(Sums*) + sizeof(int32_t) + sizeof(float));
 }
 
 // A bin drawn from the rows' CDF by u.y and the row's by u.x, then uniform inside it on the map.
-glm::vec3 VisibleSky::sample(glm::vec2 u, float* pdf) const {
+glm::vec3 VisibleSky::sample(glm::vec2 u, float* pdf, glm::vec2* uv_out) const {
   float tx, ty;
   const int y = find_in_cdf(bins_->row_cdf, LearnedBins::kV, u.y, &ty);
   const int x = find_in_cdf(bins_->cdf[y], LearnedBins::kU, u.x, &tx);
   const glm::vec2 uv((x + tx) / LearnedBins::kU, (y + ty) / LearnedBins::kV);
   const glm::vec3 d = equirect_direction(uv);
   *pdf = solid_angle_density(bins_->pmf(x, y) * EnvironmentVisibility::kBins, d);
+  if (uv_out) *uv_out = uv;
   return d;
 }
 
-float VisibleSky::pdf(const glm::vec3& direction) const {
-  const int bin = bin_of(equirect_uv(direction), nullptr);
+float VisibleSky::pdf(const glm::vec3& direction) const { return density(equirect_uv(direction), direction); }
+
+float VisibleSky::density(glm::vec2 uv, const glm::vec3& direction) const {
+  const int bin = bin_of(uv, nullptr);
   const float pmf = bins_->pmf(bin % LearnedBins::kU, bin / LearnedBins::kU);
   return pmf > 0.0f ? solid_angle_density(pmf * EnvironmentVisibility::kBins, direction) : 0.0f;
 }
@@ -342,6 +350,7 @@ void EnvironmentVisibility::deserialize(const uint8_t* data, size_t size) {
     for (auto& b : sums[region]->bins) b.store(r.get<uint64_t>("sums"), std::memory_order_relaxed);
   }
   std::vector<int32_t> table_of(region_count(), -1);
+  std::vector<float> share_of(region_count(), 0.0f);
   std::vector<LearnedBins> tables;
   const size_t count = r.get_count(sizeof(uint32_t) + sizeof(LearnedBins), "distributions");
   for (size_t i = 0; i < count; ++i) {
@@ -350,6 +359,7 @@ void EnvironmentVisibility::deserialize(const uint8_t* data, size_t size) {
     const LearnedBins b = r.get<LearnedBins>("distributions");
     if (!valid(b)) throw Error("environment visibility has an invalid distribution");
     table_of[region] = static_cast<int32_t>(tables.size());
+    share_of[region] = b.share;
     tables.push_back(b);
   }
   if (r.remaining() != 0) throw Error("environment visibility has trailing bytes");
@@ -358,6 +368,7 @@ void EnvironmentVisibility::deserialize(const uint8_t* data, size_t size) {
   frames_ = frames;
   dormant_ = dormant != 0;
   table_of_ = std::move(table_of);
+  share_of_ = std::move(share_of);
   tables_ = std::move(tables);
 }
 

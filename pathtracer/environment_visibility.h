@@ -60,9 +60,12 @@ class VisibleSky {
  public:
   VisibleSky() = default;  // none: the environment is sampled by radiance alone
   bool learned() const { return bins_ != nullptr; }
-  // A unit direction from the region's distribution and its solid-angle density (= pdf(direction)).
-  glm::vec3 sample(glm::vec2 u, float* pdf) const;
+  // A unit direction from the region's distribution and its solid-angle density (= pdf(direction));
+  // `uv`: its place on the equirect map.
+  glm::vec3 sample(glm::vec2 u, float* pdf, glm::vec2* uv = nullptr) const;
   float pdf(const glm::vec3& direction) const;
+  // The same at a direction whose place on the map is known.
+  float density(glm::vec2 uv, const glm::vec3& direction) const;
   uint32_t region() const { return region_; }
   // The share of the region's environment samples drawn from what it learned (the rest by radiance).
   float share() const { return share_; }
@@ -89,6 +92,7 @@ class EnvironmentVisibility {
   static float learned_share(double visible_fraction);
   static constexpr uint32_t kNoRegion = 0xffffffffu;
   static constexpr uint64_t kDormantCheckFrame = 4;
+  static constexpr uint64_t kLearningFrames = 64;
   static constexpr double kOpenSkyFraction = 0.5;
 
   // The environment's radiance (for the fixed-point unit) and the box the regions cover. Throws pxf::Error on a box that is not finite or not ordered.
@@ -104,9 +108,13 @@ class EnvironmentVisibility {
   // BSDF sample that escaped); thread-safe, during tracing.
   void record(uint32_t region, const glm::vec3& direction, float luminance_over_pdf, bool unblocked, bool nee);
   // After each frame (single-threaded, not during tracing): after the field's 1st, 2nd, 4th, 8th,
-  // ... frame every region's distribution becomes what it has summed so far.
+  // ... frame every region's distribution becomes what it has summed so far, up to frame
+  // kLearningFrames; after it the distributions stay and nothing more is recorded (learning()).
   void end_frame();
   uint64_t frames() const { return frames_; }
+  // Whether record() still counts: the first kLearningFrames frames. Later records would refine
+  // distributions that a few hundred records per region already hold, at an atomic add each.
+  bool learning() const { return frames_ < kLearningFrames; }
   // Learned nothing worth sampling and never will: see kOpenSkyFraction. Sticky; no regions learned.
   bool dormant() const { return dormant_; }
 
@@ -135,6 +143,7 @@ class EnvironmentVisibility {
   bool dormant_ = false;
   std::unique_ptr<std::atomic<Sums*>[]> sums_;    // per region, allocated at its first record
   std::vector<int32_t> table_of_;                 // per region: its index in tables_, -1 none
+  std::vector<float> share_of_;                   // per region: its table's share (sky() reads no table)
   std::vector<LearnedBins> tables_;               // the learned distributions over the bins
 };
 

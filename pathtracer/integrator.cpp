@@ -435,12 +435,12 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
   ++out.rays;
   if (!hit.valid()) {  // the environment is the light vertex
     if (lights_.has_environment()) {
-      float w = s.prev_delta ? s.chain_mis
-                             : power_heuristic(s.prev_pdf, lights_.pdf_environment(path.ray.direction, &s.prev_sky));
-      const glm::vec3 radiance = lights_.environment_radiance(path.ray.direction);
+      float light_pdf;
+      const glm::vec3 radiance = lights_.environment_hit(path.ray.direction, &s.prev_sky, &light_pdf);
+      float w = s.prev_delta ? s.chain_mis : power_heuristic(s.prev_pdf, light_pdf);
       const glm::vec3 value = s.throughput * radiance * w;
       // The sky seen through the BSDF's sample teaches the last vertex's region as NEE's does.
-      if (s.prev_sky_region != EnvironmentVisibility::kNoRegion && !s.prev_delta)
+      if (s.prev_sky_region != EnvironmentVisibility::kNoRegion && !s.prev_delta && visibility_->learning())
         visibility_->record(s.prev_sky_region, path.ray.direction, luminance(radiance) / s.prev_pdf, true, false);
       const bool lv = emission_goes_to_lv(s, true, params.all_hv);
       add_contribution(out, value, lv);
@@ -546,7 +546,7 @@ void PathTracer::sample_direct_light(Path& path, const Vertex& v, const PathSamp
       shadows.classes[shadows.count] = cls->classify(s.nonspecular, false);
     }
     ShadowQueue::Pending pending{&out, s.throughput * f * ls.radiance * (w / ls.pdf), lv};
-    if (environment && v.sky_region != EnvironmentVisibility::kNoRegion) {
+    if (environment && v.sky_region != EnvironmentVisibility::kNoRegion && visibility_->learning()) {
       pending.sky_region = v.sky_region;
       pending.sky_value = luminance(ls.radiance) / ls.pdf;
     }

@@ -515,56 +515,77 @@ float LightSampler::pdf_triangle(unsigned mesh, unsigned prim, glm::vec3 from, g
   return p_triangles_ * pmf / e.area * dist2 / cos_light;
 }
 
-glm::vec3 LightSampler::sample_environment_direction(glm::vec2 u, float* pdf) const {
+glm::vec3 LightSampler::sample_environment_direction(glm::vec2 u, float* pdf, glm::vec2* uv_out) const {
   float pdf_uv;
   glm::vec2 uv = env_dist_.sample(u, &pdf_uv);
   glm::vec3 wi = equirect_direction(uv);
   float sin_theta = std::sin(uv.y * kPi);
   *pdf = sin_theta > 0.0f ? pdf_uv / (2.0f * kPi * kPi * sin_theta) : 0.0f;
+  if (uv_out) *uv_out = uv;
   return wi;
 }
 
 float LightSampler::environment_direction_pdf(glm::vec3 direction) const {
   if (!env_) return 0.0f;
-  glm::vec2 uv = equirect_uv(direction);
-  float sin_theta = std::sqrt(direction.x * direction.x + direction.z * direction.z);  // exact near the poles
+  return environment_density(equirect_uv(direction), direction);
+}
+
+// The density at a direction whose place on the map is known (no atan2 and acos again); sin theta
+// from the direction, exact near the poles.
+float LightSampler::environment_density(glm::vec2 uv, glm::vec3 direction) const {
+  const float sin_theta = std::sqrt(direction.x * direction.x + direction.z * direction.z);
   return sin_theta > 0.0f ? env_dist_.pdf(uv) / (2.0f * kPi * kPi * sin_theta) : 0.0f;
 }
 
 // With a learned sky, u.x picks the strategy (the sky's share of [0, 1) the learned one) and,
 // rescaled, stays the chosen strategy's first coordinate; either direction's pdf is the mixture's.
+// The sampled direction's place on the map serves both densities and the radiance.
 bool LightSampler::sample_environment(glm::vec2 u, const VisibleSky* sky, LightSample* out) const {
   float pdf;
   glm::vec3 wi;
+  glm::vec2 uv;
   if (sky && sky->learned() && sky->share() > 0.0f) {
     const float share = sky->share();
     float learned_pdf, radiance_pdf;
     if (u.x < share) {
-      wi = sky->sample(glm::vec2(u.x / share, u.y), &learned_pdf);
-      radiance_pdf = environment_direction_pdf(wi);
+      wi = sky->sample(glm::vec2(u.x / share, u.y), &learned_pdf, &uv);
+      radiance_pdf = environment_density(uv, wi);
     } else {
       wi = sample_environment_direction(glm::vec2(std::min((u.x - share) / (1.0f - share), 0x1.fffffep-1f), u.y),
-                                        &radiance_pdf);
-      learned_pdf = sky->pdf(wi);
+                                        &radiance_pdf, &uv);
+      learned_pdf = sky->density(uv, wi);
     }
     pdf = share * learned_pdf + (1.0f - share) * radiance_pdf;
   } else {
-    wi = sample_environment_direction(u, &pdf);
+    wi = sample_environment_direction(u, &pdf, &uv);
   }
   if (!(pdf > 0.0f)) return false;
   out->wi = wi;
   out->distance = kInf;
-  out->radiance = environment_radiance(wi);
+  out->radiance = glm::vec3(sample_texture(env_->image, uv)) * env_->strength;
   out->pdf = p_environment_ * pdf;
   out->delta = false;
   return true;
 }
 
 float LightSampler::pdf_environment(glm::vec3 direction, const VisibleSky* sky) const {
-  const float radiance_pdf = environment_direction_pdf(direction);
+  if (!env_) return 0.0f;
+  return pdf_environment_at(equirect_uv(direction), direction, sky);
+}
+
+glm::vec3 LightSampler::environment_hit(glm::vec3 direction, const VisibleSky* sky, float* pdf) const {
+  *pdf = 0.0f;
+  if (!env_) return glm::vec3(0.0f);
+  const glm::vec2 uv = equirect_uv(direction);
+  *pdf = pdf_environment_at(uv, direction, sky);
+  return glm::vec3(sample_texture(env_->image, uv)) * env_->strength;
+}
+
+float LightSampler::pdf_environment_at(glm::vec2 uv, glm::vec3 direction, const VisibleSky* sky) const {
+  const float radiance_pdf = environment_density(uv, direction);
   if (!(sky && sky->learned() && sky->share() > 0.0f)) return p_environment_ * radiance_pdf;
   const float share = sky->share();
-  return p_environment_ * (share * sky->pdf(direction) + (1.0f - share) * radiance_pdf);
+  return p_environment_ * (share * sky->density(uv, direction) + (1.0f - share) * radiance_pdf);
 }
 
 glm::vec3 LightSampler::environment_radiance(glm::vec3 direction) const {

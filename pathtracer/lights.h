@@ -61,6 +61,8 @@ class LightSampler {
   // Incl. selection; `sky`: the point's learned sky, as sample() was given it.
   float pdf_environment(glm::vec3 direction, const VisibleSky* sky = nullptr) const;
   glm::vec3 environment_radiance(glm::vec3 direction) const;  // 0 without an environment
+  // Both for a ray that escaped: the radiance, and pdf_environment() into *pdf (one map lookup).
+  glm::vec3 environment_hit(glm::vec3 direction, const VisibleSky* sky, float* pdf) const;
 
   // Parts exposed for the statistical tests.
   size_t emissive_triangle_count() const { return triangles_.size(); }
@@ -97,8 +99,9 @@ class LightSampler {
   static constexpr int kEnvironmentImportanceWidth = 256;
   static constexpr double kEnvironmentCoarseVarianceFactor = 1.1;
   bool near_field_selection() const { return !clusters_.empty(); }
-  glm::vec3 sample_environment_direction(glm::vec2 u, float* pdf) const;  // pdf without selection
-  float environment_direction_pdf(glm::vec3 direction) const;             // pdf without selection
+  // pdf without selection; `uv`: the direction's place on the equirect map.
+  glm::vec3 sample_environment_direction(glm::vec2 u, float* pdf, glm::vec2* uv = nullptr) const;
+  float environment_direction_pdf(glm::vec3 direction) const;  // pdf without selection
 
   struct EmissiveTriangle {
     unsigned mesh, prim;
@@ -186,6 +189,8 @@ class LightSampler {
   bool triangle_sample(glm::vec3 position, size_t light, glm::vec3 point, glm::vec2 barycentrics, float area_pdf,
                        LightSample* out) const;
   bool sample_environment(glm::vec2 u, const VisibleSky* sky, LightSample* out) const;
+  float environment_density(glm::vec2 uv, glm::vec3 direction) const;  // at the direction's uv
+  float pdf_environment_at(glm::vec2 uv, glm::vec3 direction, const VisibleSky* sky) const;
   bool sample_punctual(glm::vec3 position, float u_select, LightSample* out) const;
   static bool punctual_sample(const PunctualLight& light, glm::vec3 position, float pdf, LightSample* out);
 

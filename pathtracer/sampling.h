@@ -256,6 +256,13 @@ class Distribution2D {
       row_sums[y] = static_cast<float>(conditional_.back().total());
     }
     marginal_ = Distribution1D(row_sums);
+    // The densities pdf() reads, as sample() computes them: one load instead of two dependent ones
+    // (the row's Distribution1D, then its pmf), which missed the cache at every MIS weight.
+    density_.resize(static_cast<size_t>(width) * height);
+    for (int y = 0; y < height; ++y)
+      for (int x = 0; x < width; ++x)
+        density_[static_cast<size_t>(y) * width + x] =
+            marginal_.pmf(y) * conditional_[y].pmf(x) * static_cast<float>(width_) * static_cast<float>(height_);
   }
   bool valid() const { return marginal_.valid(); }
 
@@ -270,11 +277,12 @@ class Distribution2D {
   float pdf(glm::vec2 uv) const {
     int x = std::min(std::max(static_cast<int>(uv.x * width_), 0), width_ - 1);
     int y = std::min(std::max(static_cast<int>(uv.y * height_), 0), height_ - 1);
-    return marginal_.pmf(y) * conditional_[y].pmf(x) * static_cast<float>(width_) * static_cast<float>(height_);
+    return density_[static_cast<size_t>(y) * width_ + x];
   }
 
  private:
   int width_ = 0, height_ = 0;
+  std::vector<float> density_;
   std::vector<Distribution1D> conditional_;
   Distribution1D marginal_;
 };
