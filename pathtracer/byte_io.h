@@ -18,6 +18,15 @@ inline uint64_t fnv1a64(const void* data, size_t size, uint64_t hash = 0xcbf29ce
   return hash;
 }
 
+class ByteReader;
+
+// A checksummed blob: an 8-byte magic first, the FNV-1a of everything before it last. Checks the
+// size and the magic (one pxf::Error line naming `name`) and returns a reader over what lies
+// between, after the magic; *checksum_ok says whether the checksum matches (checked by the
+// caller after its version, so that another version is named as such, not as corrupt).
+inline ByteReader open_checksummed(const uint8_t* data, size_t size, const char (&magic)[8], const char* name,
+                                   bool* checksum_ok);
+
 class ByteWriter {
  public:
   template <class T>
@@ -71,5 +80,18 @@ class ByteReader {
   size_t size_, pos_ = 0;
   const char* name_;
 };
+
+inline ByteReader open_checksummed(const uint8_t* data, size_t size, const char (&magic)[8], const char* name,
+                                   bool* checksum_ok) {
+  if (data == nullptr || size < sizeof(magic) + sizeof(uint64_t))
+    throw Error(std::string(name) + " truncated (" + std::to_string(size) + " bytes)");
+  uint64_t checksum;
+  std::memcpy(&checksum, data + size - sizeof checksum, sizeof checksum);
+  ByteReader r(data, size - sizeof checksum, name);
+  for (char c : magic)
+    if (r.get<char>("header") != c) throw Error(std::string("not a ") + name + " (bad magic)");
+  *checksum_ok = checksum == fnv1a64(data, size - sizeof checksum);
+  return r;
+}
 
 }  // namespace pxf

@@ -320,15 +320,10 @@ std::vector<uint8_t> EnvironmentVisibility::serialize() const {
 }
 
 void EnvironmentVisibility::deserialize(const uint8_t* data, size_t size) {
-  if (data == nullptr || size < sizeof(kMagic) + sizeof(uint64_t))
-    throw Error("environment visibility truncated (" + std::to_string(size) + " bytes)");
-  uint64_t checksum;
-  std::memcpy(&checksum, data + size - sizeof checksum, sizeof checksum);
-  ByteReader r(data, size - sizeof checksum, "environment visibility");
-  for (char c : kMagic)
-    if (r.get<char>("header") != c) throw Error("not an environment visibility (bad magic)");
+  bool checksum_ok;
+  ByteReader r = open_checksummed(data, size, kMagic, "environment visibility", &checksum_ok);
   if (r.get<uint32_t>("header") != kFormatVersion) throw Error("environment visibility format version is not supported");
-  if (checksum != fnv1a64(data, size - sizeof checksum)) throw Error("environment visibility is corrupted (checksum mismatch)");
+  if (!checksum_ok) throw Error("environment visibility is corrupted (checksum mismatch)");
   for (int a = 0; a < 3; ++a)
     if (r.get<int32_t>("grid") != dims_[a]) throw Error("environment visibility was learned on another scene's grid");
   for (const glm::vec3* corner : {&lo_, &hi_})

@@ -768,18 +768,13 @@ std::vector<uint8_t> GuidingField::serialize() const {
 }
 
 GuidingField GuidingField::deserialize(const uint8_t* data, size_t size) {
-  if (data == nullptr || size < sizeof(kMagic) + sizeof(uint64_t))
-    throw Error("guiding field truncated (" + std::to_string(size) + " bytes)");
-  uint64_t checksum;
-  std::memcpy(&checksum, data + size - sizeof checksum, sizeof checksum);
-  ByteReader r(data, size - sizeof checksum, "guiding field");
-  for (char c : kMagic)
-    if (r.get<char>("header") != c) throw Error("not a guiding field (bad magic)");
+  bool checksum_ok;
+  ByteReader r = open_checksummed(data, size, kMagic, "guiding field", &checksum_ok);
   const uint32_t version = r.get<uint32_t>("header");
   if (version != kFormatVersion)
     throw Error("guiding field format version " + std::to_string(version) + " is not supported (expected " +
                 std::to_string(kFormatVersion) + ")");
-  if (checksum != fnv1a64(data, size - sizeof checksum)) throw Error("guiding field is corrupted (checksum mismatch)");
+  if (!checksum_ok) throw Error("guiding field is corrupted (checksum mismatch)");
 
   GuidingField f;
   f.settings_.spatial_threshold = r.get<float>("settings");
