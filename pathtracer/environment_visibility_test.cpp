@@ -14,6 +14,7 @@
 #include "pathtracer/lights.h"
 #include "scene/texture.h"
 #include "testing/block_z_test.h"
+#include "testing/learned_state_test.h"
 #include "testing/shapes.h"
 #include "testing/stat_tests.h"
 
@@ -193,12 +194,6 @@ TraceParams room_params(bool visibility, uint64_t seed) {
   return params;
 }
 
-bool same_accumulation(const Accumulation& a, const Accumulation& b) {
-  return a.samples == b.samples &&
-         std::memcmp(a.lv_mean.data(), b.lv_mean.data(), a.lv_mean.size() * sizeof(glm::vec3)) == 0 &&
-         std::memcmp(a.hv_mean.data(), b.hv_mean.data(), a.hv_mean.size() * sizeof(glm::vec3)) == 0;
-}
-
 // Unbiased and worth it: the room lit through its window agrees with a render that samples the sky
 // by radiance (another seed), block by block and over the image, and its variance at equal samples
 // is less than 0.7 of that one's. The reference traces 8 times the frames: sampled by radiance, the
@@ -257,20 +252,11 @@ TEST(EnvironmentVisibility, SceneWithoutEnvironmentTracesTheSameSamples) {
 // 1 and 2 threads, masked frames too.
 TEST(EnvironmentVisibility, DeterministicAcrossThreadCounts) {
   const Scene scene = make_room_with_window();
-  TraceParams params = room_params(true, 21);
-  params.threads = 1;
-  ProgressiveRenderer one(scene, params, 40, 30);
-  params.threads = 2;
-  ProgressiveRenderer two(scene, params, 40, 30);
-  std::vector<uint8_t> mask(40 * 30);
-  for (size_t p = 0; p < mask.size(); ++p) mask[p] = (p % 3) != 0;
-  for (int i = 0; i < 9; ++i) {
-    one.add_frame(i % 4 == 3 ? mask : std::vector<uint8_t>(mask.size(), 1));
-    two.add_frame(i % 4 == 3 ? mask : std::vector<uint8_t>(mask.size(), 1));
-  }
-  EXPECT_TRUE(same_accumulation(one.accumulation(), two.accumulation()));
-  EXPECT_EQ(one.environment_visibility(), two.environment_visibility());
-  EXPECT_GT(one.environment_visibility_regions(), 0u);
+  expect_thread_count_independent(scene, room_params(true, 21),
+                                  [](const ProgressiveRenderer& r) { return r.environment_visibility(); });
+  ProgressiveRenderer learned(scene, room_params(true, 21), 40, 30);
+  for (int i = 0; i < 4; ++i) learned.add_frame();
+  EXPECT_GT(learned.environment_visibility_regions(), 0u);  // the state compared above is not empty
 }
 
 // Restored from its accumulation and what it learned after k frames, a render continues exactly,
@@ -278,29 +264,11 @@ TEST(EnvironmentVisibility, DeterministicAcrossThreadCounts) {
 // state that is not one is refused.
 TEST(EnvironmentVisibility, RestoredRenderContinuesExactly) {
   const Scene scene = make_room_with_window();
-  const TraceParams params = room_params(true, 4);
-  const int w = 24, h = 20, frames = 10;
-  ProgressiveRenderer whole(scene, params, w, h);
-  for (int i = 0; i < frames; ++i) whole.add_frame();
-  for (int k : {3, 4}) {
-    SCOPED_TRACE(k);
-    ProgressiveRenderer first(scene, params, w, h);
-    for (int i = 0; i < k; ++i) first.add_frame();
-    ProgressiveRenderer resumed(scene, params, w, h);
-    resumed.restore(first.accumulation(), 0, k, first.pixel_frames(), {}, first.environment_visibility());
-    for (int i = k; i < frames; ++i) resumed.add_frame();
-    EXPECT_TRUE(same_accumulation(resumed.accumulation(), whole.accumulation()));
-    EXPECT_EQ(resumed.environment_visibility(), whole.environment_visibility());
-  }
-  ProgressiveRenderer first(scene, params, w, h);
-  for (int i = 0; i < 5; ++i) first.add_frame();
-  ProgressiveRenderer fresh(scene, params, w, h);
-  fresh.restore(first.accumulation(), 0, 5, first.pixel_frames());
-  for (int i = 5; i < frames; ++i) fresh.add_frame();
-  EXPECT_FALSE(same_accumulation(fresh.accumulation(), whole.accumulation()));
-  ProgressiveRenderer broken(scene, params, w, h);
-  EXPECT_THROW(broken.restore(first.accumulation(), 0, 5, first.pixel_frames(), {}, std::vector<uint8_t>{1, 2, 3}),
-               Error);
+  expect_resume_continues_exactly(
+      scene, room_params(true, 4), 24, 20, 10, {3, 4},
+      [](const ProgressiveRenderer& r) { return r.environment_visibility(); },
+      [](ProgressiveRenderer& r, const Accumulation& acc, int k, const std::vector<uint32_t>& traced,
+         const std::vector<uint8_t>& learned) { r.restore(acc, 0, k, traced, {}, learned); });
 }
 
 // The state file keeps the flag and what was learned; a merge of shards keeps nothing learned.

@@ -13,6 +13,7 @@
 #include "pathtracer/guiding_field.h"
 #include "pathtracer/integrator.h"
 #include "testing/block_z_test.h"
+#include "testing/learned_state_test.h"
 #include "testing/shapes.h"
 
 namespace pxf {
@@ -23,14 +24,6 @@ TraceParams guided_params() {
   params.guiding = true;
   params.threads = 2;
   return params;
-}
-
-bool same_accumulation(const Accumulation& a, const Accumulation& b) {
-  return a.samples == b.samples &&
-         std::memcmp(a.lv_mean.data(), b.lv_mean.data(), a.lv_mean.size() * sizeof(glm::vec3)) == 0 &&
-         std::memcmp(a.hv_mean.data(), b.hv_mean.data(), a.hv_mean.size() * sizeof(glm::vec3)) == 0 &&
-         std::memcmp(a.hv_lum_m2.data(), b.hv_lum_m2.data(), a.hv_lum_m2.size() * sizeof(double)) == 0 &&
-         std::memcmp(a.lv_lum_m2.data(), b.lv_lum_m2.data(), a.lv_lum_m2.size() * sizeof(double)) == 0;
 }
 
 // A white furnace: a white Lambertian sphere, a perfect mirror sphere and a white sphere with a
@@ -217,57 +210,20 @@ TEST(Guiding, UntrainedFieldTracesTheUnguidedSamples) {
 // The field's records are keyed and sorted, the sampling field is fixed during a frame: the image
 // and the field are the same with 1 and 2 threads, also for frames that trace a mask of pixels.
 TEST(Guiding, DeterministicAcrossThreadCounts) {
-  const Scene scene = make_cornell_box(true);
   TraceParams params = guided_params();
   params.seed = 77;
-  params.threads = 1;
-  ProgressiveRenderer one(scene, params, 40, 30);
-  params.threads = 2;
-  ProgressiveRenderer two(scene, params, 40, 30);
-  std::vector<uint8_t> mask(40 * 30);
-  for (size_t p = 0; p < mask.size(); ++p) mask[p] = (p % 3) != 0;
-  for (int i = 0; i < 9; ++i) {
-    if (i % 4 == 3) {
-      one.add_frame(mask);
-      two.add_frame(mask);
-    } else {
-      one.add_frame();
-      two.add_frame();
-    }
-  }
-  EXPECT_TRUE(same_accumulation(one.accumulation(), two.accumulation()));
-  EXPECT_EQ(one.stats().rays, two.stats().rays);
-  EXPECT_EQ(one.guiding_field(), two.guiding_field());
+  expect_thread_count_independent(make_cornell_box(true), params,
+                                  [](const ProgressiveRenderer& r) { return r.guiding_field(); });
 }
 
 // A render restored from its accumulation and its field after k frames continues exactly: the
 // same image and field as the uninterrupted render, for a k inside an iteration and at its end.
 TEST(Guiding, RestoredFieldContinuesExactly) {
-  const Scene scene = make_cornell_box(true);
-  const TraceParams params = guided_params();
-  const int w = 24, h = 20, frames = 12;
-  ProgressiveRenderer whole(scene, params, w, h);
-  for (int i = 0; i < frames; ++i) whole.add_frame();
-  for (int k : {3, 5}) {
-    SCOPED_TRACE(k);
-    ProgressiveRenderer first(scene, params, w, h);
-    for (int i = 0; i < k; ++i) first.add_frame();
-    ProgressiveRenderer resumed(scene, params, w, h);
-    resumed.restore(first.accumulation(), 0, k, first.pixel_frames(), first.guiding_field());
-    for (int i = k; i < frames; ++i) resumed.add_frame();
-    EXPECT_TRUE(same_accumulation(resumed.accumulation(), whole.accumulation()));
-    EXPECT_EQ(resumed.guiding_field(), whole.guiding_field());
-  }
-  // Without the field the render goes on with a new one: not the same samples.
-  ProgressiveRenderer first(scene, params, w, h);
-  for (int i = 0; i < 5; ++i) first.add_frame();
-  ProgressiveRenderer fresh(scene, params, w, h);
-  fresh.restore(first.accumulation(), 0, 5, first.pixel_frames());
-  for (int i = 5; i < frames; ++i) fresh.add_frame();
-  EXPECT_FALSE(same_accumulation(fresh.accumulation(), whole.accumulation()));
-  // A field that is not one is refused.
-  ProgressiveRenderer broken(scene, params, w, h);
-  EXPECT_THROW(broken.restore(first.accumulation(), 0, 5, first.pixel_frames(), std::vector<uint8_t>{1, 2, 3}), Error);
+  expect_resume_continues_exactly(
+      make_cornell_box(true), guided_params(), 24, 20, 12, {3, 5},
+      [](const ProgressiveRenderer& r) { return r.guiding_field(); },
+      [](ProgressiveRenderer& r, const Accumulation& acc, int k, const std::vector<uint32_t>& traced,
+         const std::vector<uint8_t>& field) { r.restore(acc, 0, k, traced, field); });
 }
 
 // The state file keeps the guiding flag and the field; a corrupt field is refused; a merge of

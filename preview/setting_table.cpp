@@ -195,8 +195,9 @@ std::vector<SettingDescriptor> make_table() {
                      [](PreviewSettings& s) -> bool& { return s.trace.guiding; }, E::Retrace, "path guiding"));
   t.push_back(on_off("environment_visibility", "--env-visibility",
                      "light through openings: learn per region which parts of the environment its shadow rays\n"
-                     "find unblocked (a window) and draw half of the environment's light samples there,\n"
-                     "MIS-combined with sampling by radiance: unbiased (docs/sampling.md#light-through-openings)",
+                     "find unblocked (a window) and draw up to half of the environment's light samples there,\n"
+                     "MIS-combined with sampling by radiance: unbiased; dormant under an open sky\n"
+                     "(docs/sampling.md, Light through openings)",
                      [](PreviewSettings& s) -> bool& { return s.trace.environment_visibility; }, E::Retrace,
                      "light through openings"));
   t.push_back(on_off("all_hv", "--all-hv",
