@@ -2,7 +2,7 @@
 // render at any moment of the output write leaves the old set or the new one, whole, never neither
 // and never a mix; a reader that closes the pipe does not kill the render.
 // PXF_STRESS_TRIALS (default 70) and PXF_STRESS_PAIRS (default 35) set the trial counts; the
-// figures in docs/robustness.md were taken with 1000 and 200.
+// figures in docs/notebook/reference-notes.md ("Output set stress runs") were taken with 1000 and 200.
 #include <gtest/gtest.h>
 
 #include <signal.h>
