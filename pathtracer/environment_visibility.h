@@ -3,8 +3,8 @@
 // of those directions (the sun's above all) are blocked by the walls, and the few that leave by
 // the window carry all the light, so the estimate is a field of speckles. EnvironmentVisibility
 // learns, per region of the scene and side of its surfaces, how much light each part of the sky
-// brought through the shadow rays that reached it, and a vertex there draws half of its
-// environment directions from what its region learned (VisibleSky), half by radiance as before.
+// brought through the shadow rays that reached it, and a vertex there draws up to half of its
+// environment directions from what its region learned (VisibleSky), the rest by radiance as before.
 // The two are combined as one mixture pdf, so every sample stays unbiased whatever was learned.
 //
 // Regions: a uniform grid of at most kMaxCells cells over the scene's box, each cell split by the
@@ -16,9 +16,9 @@
 // Learning: every unblocked environment sample of NEE adds luminance(L) / pdf to its region's bin,
 // an unbiased estimate of the light the bin brings to the region's points; so does the sky a BSDF
 // sample reaches. Sums are fixed-point integers added atomically, so they do not depend on the
-// thread count or the order of the adds. After the field's frames 1, 2, 4, 8, ... (end_frame)
-// each region with at least kMinRecords unblocked records samples its bins in proportion to its
-// sums (each bin lent a share of its neighbours'); the sums keep growing over the whole render.
+// thread count or the order of the adds. After the field's frames 1, 2, 4, ..., kLearningFrames
+// (end_frame) each region with at least kMinRecords unblocked records samples its bins in
+// proportion to its sums (each bin lent a share of its neighbours'); then learning stops.
 //
 // A scene that sees most of its sky does not need any of this: when at the field's frame
 // kDormantCheckFrame more than kOpenSkyFraction of all NEE's environment light got through, the
