@@ -175,12 +175,12 @@ uint32_t EnvironmentVisibility::region(const glm::vec3& position, const glm::vec
 
 VisibleSky EnvironmentVisibility::sky(uint32_t region) const {
   VisibleSky s;
+  s.region_ = region;
   if (region >= region_count() || table_of_[region] < 0) return s;
   s.field_ = this;
   s.bins_ = &tables_[static_cast<size_t>(table_of_[region])];
   // The vertex samples the table after its BSDF is set up: start loading the rows' CDF now.
   __builtin_prefetch(s.bins_->row_cdf);
-  s.region_ = region;
   s.share_ = share_of_[region];
   return s;
 }

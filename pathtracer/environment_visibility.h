@@ -66,6 +66,8 @@ class VisibleSky {
   float pdf(const glm::vec3& direction) const;
   // The same at a direction whose place on the map is known.
   float density(glm::vec2 uv, const glm::vec3& direction) const;
+  // The region it belongs to (EnvironmentVisibility::kNoRegion: none), learned or not: where
+  // the vertex's environment samples are recorded.
   uint32_t region() const { return region_; }
   // The share of the region's environment samples drawn from what it learned (the rest by radiance).
   float share() const { return share_; }
@@ -74,7 +76,7 @@ class VisibleSky {
   friend class EnvironmentVisibility;
   const EnvironmentVisibility* field_ = nullptr;
   const LearnedBins* bins_ = nullptr;
-  uint32_t region_ = 0;
+  uint32_t region_ = 0xffffffffu;  // EnvironmentVisibility::kNoRegion
   float share_ = 0.0f;
 };
 
@@ -101,7 +103,8 @@ class EnvironmentVisibility {
 
   // The region of a surface point whose side faces `normal`; kNoRegion outside the box.
   uint32_t region(const glm::vec3& position, const glm::vec3& normal) const;
-  // What region `region` learned (not learned() before it has, or for kNoRegion).
+  // What region `region` learned (not learned() before it has, or for kNoRegion); its region()
+  // is `region` either way.
   VisibleSky sky(uint32_t region) const;
   // An environment sample at a point of `region`: luminance / (its pdf without the light's
   // selection, any constant factor), whether it reached the sky, and whether NEE drew it (else a

@@ -47,6 +47,9 @@ TEST(EnvironmentVisibility, RegionsSeparateCellsAndSides) {
   EXPECT_EQ(field.region(glm::vec3(1.5f), kUp), EnvironmentVisibility::kNoRegion);
   EXPECT_EQ(field.region(glm::vec3(NAN), kUp), EnvironmentVisibility::kNoRegion);
   EXPECT_LE(field.region_count(), EnvironmentVisibility::kMaxCells * EnvironmentVisibility::kSides);
+  EXPECT_EQ(field.sky(r).region(), r);  // not learned yet, but its samples are recorded there
+  EXPECT_FALSE(field.sky(r).learned());
+  EXPECT_EQ(VisibleSky{}.region(), EnvironmentVisibility::kNoRegion);
 }
 
 // A region samples what it learned once it holds kMinRecords unblocked records, at the field's

@@ -40,7 +40,6 @@ struct PathState {
   // What the last non-delta vertex's region learned of the visible sky: an escaped ray's MIS
   // weight needs the pdf NEE had there.
   VisibleSky prev_sky;
-  uint32_t prev_sky_region = EnvironmentVisibility::kNoRegion;
 };
 
 // The factor from a guided vertex's weight f / p_mixture to BSDF sampling's f / p_bsdf, for
@@ -178,8 +177,7 @@ struct PathTracer::Vertex {
   const Bsdf& bsdf;
   GuidingMixture mixture;
   int index;
-  uint32_t sky_region;  // in the visibility field (kNoRegion: none)
-  VisibleSky sky;       // what that region learned
+  VisibleSky sky;  // the vertex's region of the visibility field, and what it learned
 };
 
 bool PathSample::finite() const { return is_finite(lv) && is_finite(hv); }
@@ -440,8 +438,8 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
       float w = s.prev_delta ? s.chain_mis : power_heuristic(s.prev_pdf, light_pdf);
       const glm::vec3 value = s.throughput * radiance * w;
       // The sky seen through the BSDF's sample teaches the last vertex's region as NEE's does.
-      if (s.prev_sky_region != EnvironmentVisibility::kNoRegion && !s.prev_delta && visibility_->learning())
-        visibility_->record(s.prev_sky_region, path.ray.direction, luminance(radiance) / s.prev_pdf, true, false);
+      if (s.prev_sky.region() != EnvironmentVisibility::kNoRegion && !s.prev_delta && visibility_->learning())
+        visibility_->record(s.prev_sky.region(), path.ray.direction, luminance(radiance) / s.prev_pdf, true, false);
       const bool lv = emission_goes_to_lv(s, true, params.all_hv);
       add_contribution(out, value, lv);
       if constexpr (kClassify)
@@ -486,7 +484,7 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
                                                                         : -sp.geometric_normal)
                                   : EnvironmentVisibility::kNoRegion;
   const Vertex v{sp, bsdf_params, bsdf, guiding_mixture(sp, bsdf, wo, params), vertex,
-                 sky_region, visibility_ ? visibility_->sky(sky_region) : VisibleSky{}};
+                 visibility_ ? visibility_->sky(sky_region) : VisibleSky{}};
   // Next event estimation (the light vertex is vertex + 1 <= max_vertices).
   const PathSampler::LightNumbers u_light = numbers ? numbers->light : sampler.light_numbers(vertex, bsdf.has_nondelta());
   if (bsdf.has_nondelta()) sample_direct_light<kClassify>(path, v, u_light, params.all_hv, shadows, cls);
@@ -546,8 +544,8 @@ void PathTracer::sample_direct_light(Path& path, const Vertex& v, const PathSamp
       shadows.classes[shadows.count] = cls->classify(s.nonspecular, false);
     }
     ShadowQueue::Pending pending{&out, s.throughput * f * ls.radiance * (w / ls.pdf), lv};
-    if (environment && v.sky_region != EnvironmentVisibility::kNoRegion && visibility_->learning()) {
-      pending.sky_region = v.sky_region;
+    if (environment && v.sky.region() != EnvironmentVisibility::kNoRegion && visibility_->learning()) {
+      pending.sky_region = v.sky.region();
       pending.sky_value = luminance(ls.radiance) / ls.pdf;
     }
     shadows.push(ray, pending);
@@ -662,10 +660,7 @@ bool PathTracer::continue_path(Path& path, const Vertex& v, const SpecularChainS
     s.throughput /= q;
   }
   s.prev_position = sp.position;
-  if (!bs.delta) {
-    s.prev_sky = v.sky;
-    s.prev_sky_region = v.sky_region;
-  }
+  if (!bs.delta) s.prev_sky = v.sky;
   path.ray.origin = offset_ray_origin(sp.position, sp.geometric_normal, bs.wi);
   path.ray.direction = bs.wi;
   return true;

@@ -104,7 +104,12 @@ struct ProgressiveRenderer::Impl {
   void learn_visibility() {
     if (!visibility) return;
     visibility->end_frame();
-    if (visibility->dormant()) tracer->set_environment_visibility(nullptr);
+    attach_visibility();
+  }
+
+  // The tracer asks the field unless there is none or it went dormant.
+  void attach_visibility() {
+    tracer->set_environment_visibility(visibility && !visibility->dormant() ? visibility.get() : nullptr);
   }
 
   // A new field that has learned nothing (with an environment and params.environment_visibility).
@@ -115,7 +120,7 @@ struct ProgressiveRenderer::Impl {
       guiding_box(scene, &lo, &hi);
       visibility = std::make_unique<EnvironmentVisibility>(*scene.environment, lo, hi);
     }
-    tracer->set_environment_visibility(visibility.get());
+    attach_visibility();
   }
 
   // A new, untrained field (params.guiding), or none.
@@ -323,7 +328,7 @@ void ProgressiveRenderer::restore(const Accumulation& acc, uint32_t first, int f
   impl_->reset_visibility();
   if (impl_->visibility && !environment_visibility.empty()) {
     impl_->visibility->deserialize(environment_visibility.data(), environment_visibility.size());
-    if (impl_->visibility->dormant()) impl_->tracer->set_environment_visibility(nullptr);
+    impl_->attach_visibility();
   }
   impl_->acc = acc;
   impl_->first_frame = first;
