@@ -51,21 +51,22 @@ glm::vec3 local_view(const Frame& frame, glm::vec3 wo) {
 }  // namespace
 
 BsdfParams eval_material(const Scene& scene, const Material& m, glm::vec2 uv0, glm::vec2 uv1,
-                         glm::vec4 vertex_color) {
+                         glm::vec4 vertex_color, float uv_width) {
+  const auto texture = [&](const TextureRef& ref) { return eval_texture(scene, ref, uv0, uv1, glm::vec4(1.0f), uv_width); };
   BsdfParams p;
-  glm::vec4 base = m.base_color * eval_texture(scene, m.base_color_texture, uv0, uv1) * vertex_color;
+  glm::vec4 base = m.base_color * texture(m.base_color_texture) * vertex_color;
   p.base_color = glm::vec3(base);
-  glm::vec4 mr = eval_texture(scene, m.metallic_roughness_texture, uv0, uv1);
+  glm::vec4 mr = texture(m.metallic_roughness_texture);
   p.metallic = saturate(m.metallic * mr.b);
   p.roughness = saturate(m.roughness * mr.g);
-  p.transmission = saturate(m.transmission * eval_texture(scene, m.transmission_texture, uv0, uv1).r);
+  p.transmission = saturate(m.transmission * texture(m.transmission_texture).r);
   p.ior = m.ior >= 1.0f ? m.ior : 1.5f;  // glTF allows ior 0 (= "no refraction"); keep it sane
-  p.specular = saturate(m.specular * eval_texture(scene, m.specular_texture, uv0, uv1).a);
-  p.specular_color = m.specular_color * glm::vec3(eval_texture(scene, m.specular_color_texture, uv0, uv1));
-  p.clearcoat = saturate(m.clearcoat * eval_texture(scene, m.clearcoat_texture, uv0, uv1).r);
-  p.clearcoat_roughness = saturate(m.clearcoat_roughness * eval_texture(scene, m.clearcoat_roughness_texture, uv0, uv1).g);
-  p.sheen_color = m.sheen_color * glm::vec3(eval_texture(scene, m.sheen_color_texture, uv0, uv1));
-  p.sheen_roughness = saturate(m.sheen_roughness * eval_texture(scene, m.sheen_roughness_texture, uv0, uv1).a);
+  p.specular = saturate(m.specular * texture(m.specular_texture).a);
+  p.specular_color = m.specular_color * glm::vec3(texture(m.specular_color_texture));
+  p.clearcoat = saturate(m.clearcoat * texture(m.clearcoat_texture).r);
+  p.clearcoat_roughness = saturate(m.clearcoat_roughness * texture(m.clearcoat_roughness_texture).g);
+  p.sheen_color = m.sheen_color * glm::vec3(texture(m.sheen_color_texture));
+  p.sheen_roughness = saturate(m.sheen_roughness * texture(m.sheen_roughness_texture).a);
   return p;
 }
 

@@ -42,9 +42,10 @@ struct BsdfParams {
   float sheen_roughness = 0.0f;
 };
 
-// The material evaluated at a surface point: base color x texture x vertex color, etc.
+// The material evaluated at a surface point: base color x texture x vertex color, etc.; its
+// textures read at the mip level of the footprint `uv_width` (SurfacePoint::texture_footprint).
 BsdfParams eval_material(const Scene& scene, const Material& material, glm::vec2 uv0, glm::vec2 uv1,
-                         glm::vec4 vertex_color);
+                         glm::vec4 vertex_color, float uv_width = 0.0f);
 // True when eval_material() reads no texture of the material: its parameters are then the same at
 // every point with a white vertex color.
 bool eval_material_is_constant(const Material& material);

@@ -40,6 +40,9 @@ struct SurfacePoint {
   glm::vec3 shading_normal{0.0f};    // vertex normal with the normal map applied
   glm::vec3 clearcoat_normal{0.0f};  // vertex normal with the clearcoat's normal map applied
   glm::vec2 uv0{0.0f}, uv1{0.0f};
+  // The width in uv0 units of the ray's footprint here (surface_point's cone_width): which mip
+  // level the material's look-ups read (normal maps excepted). 0: level 0.
+  float texture_footprint = 0.0f;
   glm::vec4 color{1.0f};             // COLOR_0
   const Material* material = nullptr;
   bool front_face = true;            // the ray arrived on the side the geometric normal faces
@@ -60,7 +63,8 @@ class EmbreeScene {
   // built-in scenes), at a lower cost per ray. hits[i] / occluded[i] belong to rays[i].
   void intersect(const Ray* rays, size_t count, RayCoherence coherence, Hit* hits) const;
   void occluded(const ShadowRay* rays, size_t count, bool* occluded) const;
-  SurfacePoint surface_point(const Hit& hit, const Ray& ray) const;
+  // cone_width: the world-space width of the ray's footprint at the hit (0: textures at level 0).
+  SurfacePoint surface_point(const Hit& hit, const Ray& ray, float cone_width = 0.0f) const;
 
   const Scene& scene() const { return scene_; }
   RTCScene handle() const { return rtc_scene_; }

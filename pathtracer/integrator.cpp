@@ -40,7 +40,22 @@ struct PathState {
   // What the last non-delta vertex's region learned of the visible sky: an escaped ray's MIS
   // weight needs the pdf NEE had there.
   VisibleSky prev_sky;
+  // Texture footprints (ray cones): the angle the path's footprint has spread by since its
+  // first rough bounce, and its world-space width at the current vertex. Both stay 0 up to the
+  // first non-delta bounce, so what the camera sees, directly or through mirrors and glass, reads
+  // the textures' finest level.
+  float cone_spread = 0.0f;
+  float cone_width = 0.0f;
 };
+
+// A non-delta sample with solid-angle pdf p stands for a lobe about 1/sqrt(p) radians wide; the
+// cone after it spreads by this share of that width. 1/16: a diffuse bounce (about 0.1 rad) makes a
+// texture 3 m away read texels 30 cm wide, which a hemisphere's worth of light averages anyway,
+// while a glossy lobe of GGX alpha 0.05 keeps detail of about a centimetre (docs/sampling.md,
+// "Texture footprints", measures the bias and the speed).
+constexpr float kFootprintLobeShare = 1.0f / 16.0f;
+
+float footprint_spread(float pdf) { return pdf > 0.0f ? kFootprintLobeShare / std::sqrt(pdf) : 0.0f; }
 
 // The factor from a guided vertex's weight f / p_mixture to BSDF sampling's f / p_bsdf, for
 // PathState::roulette_scale; bounded so that the scale stays finite (any factor keeps roulette unbiased).
@@ -447,7 +462,8 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
     }
     return false;
   }
-  SurfacePoint sp = geometry_.surface_point(hit, path.ray);
+  s.cone_width += s.cone_spread * hit.t;
+  SurfacePoint sp = geometry_.surface_point(hit, path.ray, s.cone_width);
   const Material& material = *sp.material;
   // Reaching a back face of an absorbing medium's boundary: the segment just traced ran inside it.
   if (!sp.front_face && material.has_volume()) s.throughput *= volume_transmittance(material, hit.t);
@@ -648,7 +664,10 @@ bool PathTracer::continue_path(Path& path, const Vertex& v, const SpecularChainS
     s.chain_mis = plan.traces() ? power_heuristic(bs.pdf, chains_.pdf(sp.position, bs.wi, plan)) : 1.0f;
   else if (!material_is_perfect_specular(*sp.material))
     s.chain_mis = 1.0f;  // a delta lobe of a surface the specular chains stop at
-  if (!bs.delta) ++s.nonspecular;
+  if (!bs.delta) {
+    ++s.nonspecular;
+    s.cone_spread = std::max(s.cone_spread, footprint_spread(bs.pdf));
+  }
   // Low-discrepancy numbers up to the first non-delta bounce only: deeper vertices gain nothing
   // measurable from them and would pay the scrambling (docs/sampling.md).
   if (s.nonspecular > 0) sampler.leave_qmc();

@@ -37,7 +37,7 @@ class BsdfMaterials {
     const size_t index = static_cast<size_t>(sp.material - scene_.materials.data());
     const Precomputed& precomputed = precomputed_[index];
     if (precomputed.constant && sp.color == glm::vec4(1.0f)) return precomputed.material;
-    *scratch = bsdf_material(eval_material(scene_, *sp.material, sp.uv0, sp.uv1, sp.color));
+    *scratch = bsdf_material(eval_material(scene_, *sp.material, sp.uv0, sp.uv1, sp.color, sp.texture_footprint));
     return *scratch;
   }
 

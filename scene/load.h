@@ -27,7 +27,7 @@ struct LoadEstimate {
   uint64_t vertices = 0, triangles = 0;  // instanced
   uint64_t meshes = 0;                   // instanced primitives: each a Mesh, a BVH geometry, a draw
   uint64_t lights = 0;                   // instanced punctual lights
-  uint64_t texture_bytes = 0;            // stored texels of the used textures
+  uint64_t texture_bytes = 0;            // stored texels of the used textures (level 0)
   uint64_t largest_decode_bytes = 0;     // the largest image's decoding buffers
   uint64_t environment_texels = 0;       // the environment map's (--env or the scene's own)
   uint64_t decoded_buffer_bytes = 0;     // EXT_meshopt_compression views, decoded and kept while loading

@@ -21,6 +21,8 @@ enum class Wrap { Repeat, ClampToEdge, MirroredRepeat };
 //   an image used both as sRGB color and as linear data is stored once.
 // - `texels` (linear floats) for 16-bit and HDR sources and environment maps.
 // Exactly one of them is filled (both empty: an invalid texture).
+// `mips` holds levels 1, 2, ... of its mip chain (build_texture_mips, scene/texture.h).
+struct TextureLevel;
 struct Texture {
   std::string name;
   int width = 0;
@@ -31,6 +33,10 @@ struct Texture {
   Wrap wrap_s = Wrap::Repeat;
   Wrap wrap_t = Wrap::Repeat;
   bool nearest = false;  // magFilter NEAREST; otherwise bilinear
+  // Each level half the one before (at least 1 texel), box-filtered in linear light, stored like
+  // level 0; empty: level 0 alone. Read by lookups with a footprint (path vertices after a rough
+  // bounce); shared, like the codes, by copies and by textures with the same texels and encoding.
+  std::shared_ptr<const std::vector<TextureLevel>> mips;
 
   size_t texel_count() const { return width > 0 && height > 0 ? static_cast<size_t>(width) * height : 0; }
   bool is_8bit() const { return texels8 && !texels8->empty(); }
@@ -41,9 +47,23 @@ struct Texture {
   }
   // Texel i (row-major) as linear RGBA; i < texel_count() of a valid texture.
   glm::vec4 texel(size_t i) const;
-  // Bytes of texel storage (shared 8-bit codes counted in full).
-  size_t memory_bytes() const { return texels.size() * sizeof(glm::vec4) + (texels8 ? texels8->size() : 0); }
+  // Bytes of texel storage, the mip chain's included (shared storage counted in full).
+  size_t memory_bytes() const;
 };
+
+// One level of a Texture's mip chain, in the storage of its level 0.
+struct TextureLevel {
+  int width = 0, height = 0;
+  std::vector<glm::vec4> texels;
+  std::vector<unsigned char> texels8;
+};
+
+inline size_t Texture::memory_bytes() const {
+  size_t bytes = texels.size() * sizeof(glm::vec4) + (texels8 ? texels8->size() : 0);
+  if (mips)
+    for (const TextureLevel& level : *mips) bytes += level.texels.size() * sizeof(glm::vec4) + level.texels8.size();
+  return bytes;
+}
 
 // A material's reference to a texture (glTF textureInfo + KHR_texture_transform).
 struct TextureRef {

@@ -275,6 +275,7 @@ class GltfLoader {
     gltf::decode_draco_primitives(model_, file_);  // to the accessor counts just checked
     decode_textures();
     convert_spec_gloss();  // after decoding: textures are baked from their texels
+    build_mips();
     traverse_scene();
     read_scene_defaults();  // before the camera: the default image aspect frames the model
     finish_camera();
@@ -283,6 +284,12 @@ class GltfLoader {
   }
 
   [[noreturn]] void fail(const std::string& problem) const { throw Error(file_ + ": " + problem); }
+
+  // The mip chains of the textures the path tracer reads with footprints (scene/texture.h).
+  void build_mips() {
+    const std::vector<bool> wanted = textures_read_with_footprints(scene_);
+    build_texture_mips(scene_.textures, &wanted);
+  }
 
   // Ray origins come from the camera and from surface points; Embree asserts on origins beyond
   // about 1.8e18, and float precision is long gone well before that.
@@ -1470,7 +1477,9 @@ uint64_t LoadEstimate::bytes() const {
   const uint64_t raster_bins = std::min(mul(triangles, kRasterBinBytesPerTriangle), kRasterBinBytesMax);
   const uint64_t geometry = add(add(add(mul(vertices, kBytesPerVertex), mul(triangles, kBytesPerTriangle)), raster_bins),
                                 add(mul(meshes, kBytesPerMesh), mul(lights, kBytesPerLight)));
-  const uint64_t images = add(add(mul(texture_bytes, 2), largest_decode_bytes),
+  // Level 0 stored and copied by the raster pass, and the path tracer's mip chains (a third of
+  // level 0 at most).
+  const uint64_t images = add(add(add(mul(texture_bytes, 2), texture_bytes / 3), largest_decode_bytes),
                               mul(environment_texels, kBytesPerEnvironmentTexel));
   return add(add(geometry, images), decoded_buffer_bytes);
 }

@@ -735,7 +735,7 @@ TEST(SceneLoadTexture, EightBitStorageLooksUpBitExactly) {
       ASSERT_TRUE(ref.valid()) << warnings_of(scene);
       const Texture& t = scene.textures[ref.texture];
       EXPECT_TRUE(t.is_8bit());
-      EXPECT_EQ(t.memory_bytes(), static_cast<size_t>(w) * h * 4);
+      EXPECT_EQ(t.memory_bytes(), static_cast<size_t>(w * h + 3 * 2 + 1) * 4);  // 7x5 and its mips 3x2, 1x1
       Texture reference = t;
       reference.texels8.reset();
       for (int i = 0; i < w * h; ++i) {
@@ -1413,8 +1413,8 @@ TEST(SceneLoadLimits, EstimateOverTheAvailableMemoryIsRefusedBeforeAllocating) {
   limits.available_memory = 100ull << 20;  // 100 MiB
   std::string msg = error_of([&] { load_scene(path, "", 1.0f, DefaultLight::None, limits); });
   EXPECT_EQ(msg.rfind(path + ": ", 0), 0u) << msg;
-  // 64 MiB stored + 64 MiB raster copy + 128 MiB decoding, and a quad.
-  EXPECT_NE(msg.find("loading needs an estimated 256 MiB (2 triangles, 64 MiB of textures), more than the 100 MiB of memory available"),
+  // 64 MiB stored + 21.3 MiB of mips + 64 MiB raster copy + 128 MiB decoding, and a quad.
+  EXPECT_NE(msg.find("loading needs an estimated 277 MiB (2 triangles, 64 MiB of textures), more than the 100 MiB of memory available"),
             std::string::npos) << msg;
   limits.available_memory = 300ull << 20;
   EXPECT_NO_THROW(load_scene(path, "", 1.0f, DefaultLight::None, limits));
@@ -1424,7 +1424,7 @@ TEST(SceneLoadLimits, EstimateOverTheAvailableMemoryIsRefusedBeforeAllocating) {
   e.triangles = 2;
   e.texture_bytes = 1000;
   e.largest_decode_bytes = 500;
-  EXPECT_EQ(e.bytes(), 4u * 200 + 2u * (136 + 768) + 2u * 1000 + 500);
+  EXPECT_EQ(e.bytes(), 4u * 200 + 2u * (136 + 768) + 2u * 1000 + 1000u / 3 + 500);  // texels stored, copied, mipped
   e.triangles = UINT64_MAX / 2;
   EXPECT_EQ(e.bytes(), UINT64_MAX);  // saturates rather than wrapping
   EXPECT_GT(available_memory_bytes(), 0u);

@@ -2,8 +2,13 @@
 
 #include <algorithm>
 #include <array>
+#include <climits>
 #include <cmath>
+#include <map>
+#include <memory>
+#include <utility>
 
+#include "core/parallel.h"
 #include "image/image.h"
 
 namespace pxf {
@@ -48,20 +53,34 @@ struct TexelReader {
   const glm::vec4* floats = nullptr;
   const unsigned char* codes = nullptr;
   const float* rgb = nullptr;
-  explicit TexelReader(const Texture& t) {
-    if (t.is_8bit()) {
-      codes = t.texels8->data();
-      rgb = t.srgb ? kTexel8Tables.srgb.data() : kTexel8Tables.linear.data();
+  TexelReader(const glm::vec4* float_texels, const unsigned char* code_texels, bool srgb) {
+    if (code_texels) {
+      codes = code_texels;
+      rgb = srgb ? kTexel8Tables.srgb.data() : kTexel8Tables.linear.data();
     } else {
-      floats = t.texels.data();
+      floats = float_texels;
     }
   }
+  explicit TexelReader(const Texture& t)
+      : TexelReader(t.texels.data(), t.is_8bit() ? t.texels8->data() : nullptr, t.srgb) {}
   glm::vec4 operator()(size_t i) const {
     if (floats) return floats[i];
     const unsigned char* p = codes + 4 * i;
     return glm::vec4(rgb[p[0]], rgb[p[1]], rgb[p[2]], kTexel8Tables.linear[p[3]]);
   }
 };
+
+// One level of a texture as the bilinear look-up reads it.
+struct TexelGrid {
+  int width, height;
+  TexelReader read;
+};
+
+TexelGrid level_grid(const Texture& t, int level) {
+  if (level == 0) return {t.width, t.height, TexelReader(t)};
+  const TextureLevel& l = (*t.mips)[static_cast<size_t>(level) - 1];
+  return {l.width, l.height, TexelReader(l.texels.data(), l.texels8.empty() ? nullptr : l.texels8.data(), t.srgb)};
+}
 
 }  // namespace
 
@@ -94,30 +113,146 @@ void wrap_texel_pair(int i, int size, Wrap wrap, int* first, int* second) {
   *second = wrap_texel_index(i + 1, size, wrap);
 }
 
-}  // namespace
-
-glm::vec4 sample_texture(const Texture& texture, glm::vec2 uv) {
-  if (!texture.valid()) return glm::vec4(1.0f);
-  const TexelReader read(texture);
+// The bilinear (or nearest) look-up of one level, under the texture's wrap modes.
+glm::vec4 sample_grid(const Texture& texture, const TexelGrid& grid, glm::vec2 uv) {
+  const TexelReader& read = grid.read;
   // Continuous texel coordinates; texel centers sit at integer + 0.5.
-  float x = sanitize_coordinate(uv.x) * texture.width;
-  float y = sanitize_coordinate(uv.y) * texture.height;
+  float x = sanitize_coordinate(uv.x) * grid.width;
+  float y = sanitize_coordinate(uv.y) * grid.height;
   if (texture.nearest) {
-    const int xi = wrap_texel_index(static_cast<int>(std::floor(x)), texture.width, texture.wrap_s);
-    const int yi = wrap_texel_index(static_cast<int>(std::floor(y)), texture.height, texture.wrap_t);
-    return read(static_cast<size_t>(yi) * texture.width + xi);
+    const int xi = wrap_texel_index(static_cast<int>(std::floor(x)), grid.width, texture.wrap_s);
+    const int yi = wrap_texel_index(static_cast<int>(std::floor(y)), grid.height, texture.wrap_t);
+    return read(static_cast<size_t>(yi) * grid.width + xi);
   }
   x -= 0.5f;
   y -= 0.5f;
   float fx = std::floor(x), fy = std::floor(y);
   float tx = x - fx, ty = y - fy;
   int x0, x1, y0, y1;
-  wrap_texel_pair(static_cast<int>(fx), texture.width, texture.wrap_s, &x0, &x1);
-  wrap_texel_pair(static_cast<int>(fy), texture.height, texture.wrap_t, &y0, &y1);
-  const size_t row0 = static_cast<size_t>(y0) * texture.width, row1 = static_cast<size_t>(y1) * texture.width;
+  wrap_texel_pair(static_cast<int>(fx), grid.width, texture.wrap_s, &x0, &x1);
+  wrap_texel_pair(static_cast<int>(fy), grid.height, texture.wrap_t, &y0, &y1);
+  const size_t row0 = static_cast<size_t>(y0) * grid.width, row1 = static_cast<size_t>(y1) * grid.width;
   glm::vec4 top = glm::mix(read(row0 + x0), read(row0 + x1), tx);
   glm::vec4 bottom = glm::mix(read(row1 + x0), read(row1 + x1), tx);
   return glm::mix(top, bottom, ty);
+}
+
+}  // namespace
+
+glm::vec4 sample_texture(const Texture& texture, glm::vec2 uv) {
+  if (!texture.valid()) return glm::vec4(1.0f);
+  return sample_grid(texture, level_grid(texture, 0), uv);
+}
+
+int texture_level(const Texture& texture, float uv_width) {
+  if (!texture.mips || !(uv_width > 0.0f)) return 0;
+  // Texels of level 0 across the footprint; level k's texels are 2^k of them wide.
+  const float texels = uv_width * static_cast<float>(std::max(texture.width, texture.height));
+  if (!(texels >= 2.0f)) return 0;
+  const int level = std::isfinite(texels) ? std::ilogb(texels) : INT_MAX;
+  return std::min(level, static_cast<int>(texture.mips->size()));
+}
+
+glm::vec4 sample_texture(const Texture& texture, glm::vec2 uv, float uv_width) {
+  if (!texture.valid()) return glm::vec4(1.0f);
+  return sample_grid(texture, level_grid(texture, texture_level(texture, uv_width)), uv);
+}
+
+namespace {
+
+// Level k + 1 of a chain from level k, whose texel i is fine(i) (linear RGBA): each texel the mean
+// of the 2x2 texels it covers (an odd last row or column is averaged with itself).
+template <typename Fine>
+std::vector<glm::vec4> half_level(const Fine& fine, int width, int height, int* half_width, int* half_height) {
+  const int w = std::max(1, width / 2), h = std::max(1, height / 2);
+  std::vector<glm::vec4> out(static_cast<size_t>(w) * h);
+  for (int y = 0; y < h; ++y) {
+    const size_t row0 = static_cast<size_t>(std::min(2 * y, height - 1)) * width;
+    const size_t row1 = static_cast<size_t>(std::min(2 * y + 1, height - 1)) * width;
+    for (int x = 0; x < w; ++x) {
+      const int x0 = std::min(2 * x, width - 1), x1 = std::min(2 * x + 1, width - 1);
+      out[static_cast<size_t>(y) * w + x] =
+          0.25f * (fine(row0 + x0) + fine(row0 + x1) + fine(row1 + x0) + fine(row1 + x1));
+    }
+  }
+  *half_width = w;
+  *half_height = h;
+  return out;
+}
+
+// The code whose decoded value (in `decoded`, ascending) is nearest to v.
+unsigned char nearest_code(const std::array<float, 256>& decoded, float v) {
+  const auto above = std::lower_bound(decoded.begin(), decoded.end(), v);
+  if (above == decoded.begin()) return 0;
+  if (above == decoded.end()) return 255;
+  const auto below = above - 1;
+  return static_cast<unsigned char>((v - *below < *above - v ? below : above) - decoded.begin());  // ties up
+}
+
+// Linear RGBA back to the 8-bit codes of a texture stored as `srgb` (alpha always linear): the
+// code that decodes nearest to each value, so the level's mean light is kept.
+std::vector<unsigned char> encode_level(const std::vector<glm::vec4>& texels, bool srgb) {
+  const std::array<float, 256>& rgb = srgb ? kTexel8Tables.srgb : kTexel8Tables.linear;
+  std::vector<unsigned char> codes(4 * texels.size());
+  for (size_t i = 0; i < texels.size(); ++i) {
+    for (int c = 0; c < 3; ++c) codes[4 * i + c] = nearest_code(rgb, texels[i][c]);
+    codes[4 * i + 3] = nearest_code(kTexel8Tables.linear, texels[i].w);
+  }
+  return codes;
+}
+
+// Level 1 is averaged from level 0's texels as lookups decode them; each level after from the
+// float level before it, so 8-bit levels are rounded once each, not at every halving.
+std::shared_ptr<const std::vector<TextureLevel>> mip_chain(const Texture& texture) {
+  auto chain = std::make_shared<std::vector<TextureLevel>>();
+  const TexelReader level0(texture);
+  std::vector<glm::vec4> level;
+  int width = texture.width, height = texture.height;
+  while (width > 1 || height > 1) {
+    if (chain->empty())
+      level = half_level(level0, width, height, &width, &height);
+    else
+      level = half_level([&](size_t i) { return level[i]; }, width, height, &width, &height);
+    TextureLevel out;
+    out.width = width;
+    out.height = height;
+    if (texture.is_8bit())
+      out.texels8 = encode_level(level, texture.srgb);
+    else
+      out.texels = level;
+    chain->push_back(std::move(out));
+  }
+  return chain;
+}
+
+}  // namespace
+
+void build_texture_mips(std::vector<Texture>& textures, const std::vector<bool>* wanted) {
+  // Textures that share their 8-bit codes and encoding share one chain.
+  std::map<std::pair<const void*, bool>, size_t> first_user;
+  std::vector<size_t> owners;
+  for (size_t t = 0; t < textures.size(); ++t) {
+    const Texture& texture = textures[t];
+    if (!texture.valid() || texture.mips || (wanted && !(t < wanted->size() && (*wanted)[t]))) continue;
+    if (texture.is_8bit() && !first_user.emplace(std::make_pair(texture.texels8.get(), texture.srgb), t).second) continue;
+    owners.push_back(t);
+  }
+  parallel_for(owners.size(), [&](size_t k) { textures[owners[k]].mips = mip_chain(textures[owners[k]]); });
+  for (Texture& texture : textures) {
+    if (!texture.valid() || texture.mips || !texture.is_8bit()) continue;
+    const auto owner = first_user.find(std::make_pair(texture.texels8.get(), texture.srgb));
+    if (owner != first_user.end()) texture.mips = textures[owner->second].mips;
+  }
+}
+
+std::vector<bool> textures_read_with_footprints(const Scene& scene) {
+  std::vector<bool> wanted(scene.textures.size(), false);
+  for (const Material& m : scene.materials)
+    for (const TextureRef* ref : {&m.base_color_texture, &m.metallic_roughness_texture, &m.transmission_texture,
+                                  &m.specular_texture, &m.specular_color_texture, &m.clearcoat_texture,
+                                  &m.clearcoat_roughness_texture, &m.sheen_color_texture, &m.sheen_roughness_texture})
+      if (ref->valid() && ref->texture < static_cast<int>(wanted.size())) wanted[ref->texture] = true;
+  return wanted;
 }
 
 glm::vec2 texture_uv(const TextureRef& ref, glm::vec2 uv0, glm::vec2 uv1) {

@@ -185,6 +185,112 @@ TEST(TextureEval, FallbackWhenUnsetOrOutOfRange) {
   expect_vec4_near(eval_texture(scene, ok, {0.75f, 0.25f}, {}), scene.textures[0].texels[1]);
 }
 
+// --- mip chains and footprints ---------------------------------------------------------------
+
+// A width x height float texture whose texel (x, y) is value(x, y).
+template <typename Value>
+Texture float_texture(int width, int height, const Value& value) {
+  Texture t;
+  t.width = width;
+  t.height = height;
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) t.texels.push_back(value(x, y));
+  return t;
+}
+
+TEST(TextureMips, EachLevelIsTheBoxMeanOfTheOneBefore) {
+  std::vector<Texture> textures = {float_texture(4, 2, [](int x, int y) { return glm::vec4(x, y, x * y, 1); })};
+  build_texture_mips(textures);
+  const Texture& t = textures[0];
+  ASSERT_TRUE(t.mips);
+  ASSERT_EQ(t.mips->size(), 2u);  // 2x1, 1x1
+  const TextureLevel& one = (*t.mips)[0];
+  EXPECT_EQ(one.width, 2);
+  EXPECT_EQ(one.height, 1);
+  expect_vec4_near(one.texels[0], glm::vec4(0.5f, 0.5f, 0.25f, 1.0f));  // x 0,1 over y 0,1
+  expect_vec4_near(one.texels[1], glm::vec4(2.5f, 0.5f, 1.25f, 1.0f));
+  expect_vec4_near((*t.mips)[1].texels[0], glm::vec4(1.5f, 0.5f, 0.75f, 1.0f));
+  EXPECT_EQ(t.memory_bytes(), (8u + 2u + 1u) * sizeof(glm::vec4));
+}
+
+TEST(TextureMips, OddSizesHalveDownToOneTexel) {
+  std::vector<Texture> textures = {float_texture(7, 5, [](int, int) { return glm::vec4(0.25f); })};
+  build_texture_mips(textures);
+  const std::vector<TextureLevel>& chain = *textures[0].mips;
+  ASSERT_EQ(chain.size(), 2u);
+  EXPECT_EQ(chain[0].width, 3);
+  EXPECT_EQ(chain[0].height, 2);
+  EXPECT_EQ(chain[1].width, 1);
+  EXPECT_EQ(chain[1].height, 1);
+  for (const TextureLevel& level : chain)
+    for (const glm::vec4& texel : level.texels) EXPECT_EQ(texel, glm::vec4(0.25f));  // a constant stays exact
+}
+
+// 8-bit sRGB texels are averaged in linear light and re-encoded: black and white give the code of
+// linear 0.5 (188), not the mean code (128). Alpha and linear textures average their codes.
+TEST(TextureMips, EightBitLevelsAverageInLinearLight) {
+  auto codes = std::make_shared<const std::vector<unsigned char>>(
+      std::vector<unsigned char>{0, 0, 0, 0, 255, 255, 255, 255, 0, 0, 0, 0, 255, 255, 255, 255});
+  std::vector<Texture> textures(3);
+  for (Texture& t : textures) {
+    t.width = 2;
+    t.height = 2;
+    t.texels8 = codes;
+  }
+  textures[0].srgb = textures[1].srgb = true;
+  build_texture_mips(textures);
+  const TextureLevel& srgb = (*textures[0].mips)[0];
+  ASSERT_EQ(srgb.texels8.size(), 4u);
+  EXPECT_EQ(srgb.texels8[0], 188);
+  // Linear 0.5 lies halfway between codes 127 and 128.
+  EXPECT_NEAR(srgb.texels8[3], 127.5, 0.5);  // alpha: linear
+  EXPECT_NEAR((*textures[2].mips)[0].texels8[0], 127.5, 0.5);
+  // Textures with the same codes and encoding share one chain; another encoding has its own.
+  EXPECT_EQ(textures[0].mips, textures[1].mips);
+  EXPECT_NE(textures[0].mips, textures[2].mips);
+  EXPECT_NEAR(sample_texture(textures[0], {0.3f, 0.7f}, 1.0f).r, 0.5f, 3e-3f);  // the 1x1 level
+}
+
+TEST(TextureMips, FootprintPicksTheLevelWhoseTexelsFitInIt) {
+  std::vector<Texture> textures = {float_texture(64, 32, [](int x, int y) { return glm::vec4(x % 2, y % 2, 0, 1); })};
+  const Texture bare = textures[0];
+  build_texture_mips(textures);
+  const Texture& t = textures[0];  // levels 1..6 (64 wide down to 1)
+  EXPECT_EQ(texture_level(t, 0.0f), 0);
+  EXPECT_EQ(texture_level(t, 1.9f / 64), 0);
+  EXPECT_EQ(texture_level(t, 2.0f / 64), 1);
+  EXPECT_EQ(texture_level(t, 5.0f / 64), 2);
+  EXPECT_EQ(texture_level(t, 1000.0f), 6);
+  EXPECT_EQ(texture_level(t, std::numeric_limits<float>::infinity()), 6);
+  EXPECT_EQ(texture_level(t, std::numeric_limits<float>::quiet_NaN()), 0);
+  EXPECT_EQ(texture_level(t, -1.0f), 0);
+  EXPECT_EQ(texture_level(bare, 1.0f), 0);  // no chain: level 0
+  // No footprint reads level 0, bit for bit; a footprint of two texels reads the 2x2 means.
+  for (glm::vec2 uv : {glm::vec2(0.13f, 0.71f), glm::vec2(0.5f, 0.5f), glm::vec2(-2.3f, 7.9f)}) {
+    const glm::vec4 fine = sample_texture(t, uv);
+    EXPECT_EQ(sample_texture(t, uv, 0.0f), fine);
+    EXPECT_EQ(sample_texture(bare, uv, 1.0f), fine);
+    expect_vec4_near(sample_texture(t, uv, 2.0f / 64), glm::vec4(0.5f, 0.5f, 0.0f, 1.0f));
+  }
+}
+
+// KHR_texture_transform scales the footprint with the uvs: a texture tiled twice as often reads
+// the level one coarser.
+TEST(TextureMips, TransformScalesTheFootprint) {
+  Scene scene;
+  scene.textures = {float_texture(64, 64, [](int x, int y) { return glm::vec4(static_cast<float>((x / 2 + y / 2) % 2)); })};
+  build_texture_mips(scene.textures);
+  TextureRef ref;
+  ref.texture = 0;
+  const glm::vec2 uv(0.3f, 0.6f);
+  const float width = 2.0f / 64;  // level 1: 2x2 means of 2x2 cells, still the checker
+  EXPECT_EQ(eval_texture(scene, ref, uv, uv, glm::vec4(1.0f), width), sample_texture(scene.textures[0], uv, width));
+  ref.transform = texture_transform_matrix(glm::vec2(0.0f), 0.0f, glm::vec2(2.0f));
+  const glm::vec2 scaled = texture_uv(ref, uv, uv);
+  EXPECT_EQ(eval_texture(scene, ref, uv, uv, glm::vec4(1.0f), width), sample_texture(scene.textures[0], scaled, 2 * width));
+  EXPECT_NEAR(eval_texture(scene, ref, uv, uv, glm::vec4(1.0f), width).r, 0.5f, 1e-6f);  // level 2: grey
+}
+
 }  // namespace
 }  // namespace pxf
 

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "pathtracer/accumulation.h"
+#include "pathtracer/sampling.h"
 
 namespace pxf {
 
