@@ -8,6 +8,7 @@
 
 #include "image/image.h"
 #include "pathtracer/bsdf.h"
+#include "pathtracer/ray_recorder.h"
 #include "scene/texture.h"
 
 namespace pxf {
@@ -125,6 +126,9 @@ namespace {
 
 // Rays go to Embree in chunks of this many (stack buffers; streams of 64 traced as fast as 256).
 constexpr size_t kStreamChunk = 64;
+// Every ray counts hits from its origin on (origins are offset off their surface instead); the
+// ray recorder logs it as the ray's tmin.
+constexpr float kRayTnear = 0.0f;
 
 RTCRay embree_ray(glm::vec3 origin, glm::vec3 direction, float tmax) {
   RTCRay r;
@@ -134,7 +138,7 @@ RTCRay embree_ray(glm::vec3 origin, glm::vec3 direction, float tmax) {
   r.dir_x = direction.x;
   r.dir_y = direction.y;
   r.dir_z = direction.z;
-  r.tnear = 0.0f;
+  r.tnear = kRayTnear;
   r.tfar = tmax;
   r.time = 0.0f;
   r.mask = 0xffffffffu;
@@ -178,14 +182,18 @@ Hit EmbreeScene::intersect(const Ray& ray, float tmax) const {
   RTCIntersectContext context = intersect_context(RayCoherence::Incoherent);
   RTCRayHit rh = embree_ray_hit(ray, tmax);
   rtcIntersect1(rtc_scene_, &context, &rh);
-  return hit_of(rh);
+  const Hit hit = hit_of(rh);
+  if (__builtin_expect(recorder_ != nullptr, 0)) recorder_->closest(ray, kRayTnear, tmax, hit);
+  return hit;
 }
 
 bool EmbreeScene::occluded(glm::vec3 origin, glm::vec3 direction, float tmax) const {
   RTCIntersectContext context = intersect_context(RayCoherence::Incoherent);
   RTCRay r = embree_ray(origin, direction, tmax);
   rtcOccluded1(rtc_scene_, &context, &r);
-  return is_occluded(r);
+  const bool blocked = is_occluded(r);
+  if (__builtin_expect(recorder_ != nullptr, 0)) recorder_->shadow(origin, direction, kRayTnear, tmax, blocked);
+  return blocked;
 }
 
 void EmbreeScene::intersect(const Ray* rays, size_t count, RayCoherence coherence, Hit* hits) const {
@@ -197,6 +205,8 @@ void EmbreeScene::intersect(const Ray* rays, size_t count, RayCoherence coherenc
     rtcIntersect1M(rtc_scene_, &context, chunk, static_cast<unsigned>(n), sizeof(RTCRayHit));
     for (size_t i = 0; i < n; ++i) hits[begin + i] = hit_of(chunk[i]);
   }
+  if (__builtin_expect(recorder_ != nullptr, 0))
+    recorder_->closest_stream(rays, count, kStreamChunk, coherence, kRayTnear, std::numeric_limits<float>::infinity(), hits);
 }
 
 void EmbreeScene::occluded(const ShadowRay* rays, size_t count, bool* occluded) const {
@@ -211,6 +221,7 @@ void EmbreeScene::occluded(const ShadowRay* rays, size_t count, bool* occluded) 
     rtcOccluded1M(rtc_scene_, &context, chunk, static_cast<unsigned>(n), sizeof(RTCRay));
     for (size_t i = 0; i < n; ++i) occluded[begin + i] = is_occluded(chunk[i]);
   }
+  if (__builtin_expect(recorder_ != nullptr, 0)) recorder_->shadow_stream(rays, count, kStreamChunk, kRayTnear, occluded);
 }
 
 float EmbreeScene::triangle_area(unsigned mesh, unsigned prim) const {

@@ -33,6 +33,8 @@ struct ShadowRay {
 // coherent (packet traversal pays off); bounce and shadow rays are not.
 enum class RayCoherence { Coherent, Incoherent };
 
+class RayRecorder;  // pathtracer/ray_recorder.h
+
 struct SurfacePoint {
   glm::vec3 position{0.0f};
   glm::vec3 geometric_normal{0.0f};  // unit, the triangle's winding orientation
@@ -71,6 +73,11 @@ class EmbreeScene {
   float triangle_area(unsigned mesh, unsigned prim) const;
   glm::vec3 face_normal(unsigned mesh, unsigned prim) const { return face_normals_[mesh][prim]; }
 
+  // Ray recording (pathtracer/ray_recorder.h, the throughput bench): while set, the four queries
+  // above log every ray they hand to Embree, with its answer; nullptr (the default) records
+  // nothing, at the cost of one branch per query. Set it only while no thread traces.
+  void set_ray_recorder(RayRecorder* recorder) { recorder_ = recorder; }
+
   // Alpha data handed to Embree's filter functions (one per mesh with a MASK or BLEND material).
   struct MaskData {
     const Scene* scene;
@@ -86,6 +93,7 @@ class EmbreeScene {
   RTCScene rtc_scene_ = nullptr;
   std::vector<std::vector<glm::vec3>> face_normals_;  // per mesh, per triangle, unit
   std::vector<MaskData> mask_data_;
+  RayRecorder* recorder_ = nullptr;  // set_ray_recorder
 };
 
 // Moves a point off a surface to the side `direction` leaves to, scaled to the point's magnitude

@@ -111,6 +111,8 @@ class PathTracer {
   // unblocked environment sample is recorded there. nullptr (the default): the environment is
   // sampled by its radiance alone. The field must not change (end_frame) while a trace runs.
   void set_environment_visibility(EnvironmentVisibility* field) { visibility_ = field; }
+  // Ray recording (EmbreeScene::set_ray_recorder): every ray the traces hand to Embree is logged there.
+  void set_ray_recorder(RayRecorder* recorder) { geometry_.set_ray_recorder(recorder); }
 
   // Path guiding's training light (docs/guiding.md): `count` photons of frame `frame`, traced from
   // the lights; at every non-delta surface a photon reaches after its first bounce (light NEE does

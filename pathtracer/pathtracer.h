@@ -106,6 +106,7 @@ struct TraceStats {
 float environment_light_share(const Scene& scene);
 
 class PathTracer;  // Embree scene, light and environment samplers (pathtracer internals)
+class RayRecorder;  // pathtracer/ray_recorder.h (internals)
 
 // The most paths one pixel traces in one frame (adaptive sampling's counts).
 constexpr uint32_t kMaxPathsPerFrame = 32;
@@ -202,6 +203,12 @@ class ProgressiveRenderer {
 
   // The scene has no emitter and no environment: add_frame() only counts the frame.
   bool scene_is_dark() const;
+
+  // The throughput bench and tests: while `recorder` is set, every ray the frames hand to Embree
+  // (paths, shadow rays, specular chains; guiding's photons too) is logged there; nullptr stops.
+  // The renderer does not own it. Set it between frames. tracer(): the internals that trace.
+  void set_ray_recorder(RayRecorder* recorder);
+  const PathTracer& tracer() const;
 
  private:
   struct Impl;

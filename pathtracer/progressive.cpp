@@ -351,6 +351,8 @@ size_t ProgressiveRenderer::environment_visibility_regions() const {
 }
 const Accumulation& ProgressiveRenderer::accumulation() const { return impl_->acc; }
 const TraceStats& ProgressiveRenderer::stats() const { return impl_->stats; }
+void ProgressiveRenderer::set_ray_recorder(RayRecorder* recorder) { impl_->tracer->set_ray_recorder(recorder); }
+const PathTracer& ProgressiveRenderer::tracer() const { return *impl_->tracer; }
 const Scene& ProgressiveRenderer::scene() const { return impl_->scene; }
 const Camera& ProgressiveRenderer::camera() const { return impl_->camera; }
 const TraceParams& ProgressiveRenderer::params() const { return impl_->params; }
