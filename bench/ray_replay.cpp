@@ -6,6 +6,7 @@
 #include <tbb/parallel_for.h>
 
 #include "core/timing.h"
+#include "pathtracer/embree_scene.h"
 
 namespace pxf {
 
@@ -16,57 +17,17 @@ constexpr size_t kMaxStream = 64;
 // Calls per task: a task then holds a few thousand rays, as one of the tracer's tiles does.
 constexpr size_t kCallsPerTask = 64;
 
-RTCIntersectContext context_for(RayCoherence coherence) {
-  RTCIntersectContext context;
-  rtcInitIntersectContext(&context);
-  context.flags = coherence == RayCoherence::Coherent ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT
-                                                      : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
-  return context;
-}
+RTCRay rtc_ray(const RecordedRay& ray) { return embree_ray(ray.origin, ray.direction, ray.tmax, ray.tmin); }
 
-RTCRay rtc_ray(const RecordedRay& ray) {
-  RTCRay r;
-  r.org_x = ray.origin.x;
-  r.org_y = ray.origin.y;
-  r.org_z = ray.origin.z;
-  r.tnear = ray.tmin;
-  r.dir_x = ray.direction.x;
-  r.dir_y = ray.direction.y;
-  r.dir_z = ray.direction.z;
-  r.time = 0.0f;
-  r.tfar = ray.tmax;
-  r.mask = 0xffffffffu;
-  r.id = 0;
-  r.flags = 0;
-  return r;
-}
+RTCRayHit rtc_ray_hit(const RecordedRay& ray) { return embree_ray_hit(ray.origin, ray.direction, ray.tmax, ray.tmin); }
 
-RTCRayHit rtc_ray_hit(const RecordedRay& ray) {
-  RTCRayHit rh;
-  rh.ray = rtc_ray(ray);
-  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-  return rh;
-}
+// As the tracer reads an answer, and as the recorder logs it.
+RecordedAnswer closest_answer(const RTCRayHit& rh) { return answer_of(hit_of(rh)); }
 
-// As the tracer reads an answer (EmbreeScene's hit_of and is_occluded).
-RecordedAnswer closest_answer(const RTCRayHit& rh) {
-  RecordedAnswer a;
-  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return a;
-  a.mesh = rh.hit.geomID;
-  a.prim = rh.hit.primID;
-  a.t = rh.ray.tfar;
-  return a;
-}
-
-RecordedAnswer shadow_answer(const RTCRay& r) {
-  RecordedAnswer a;
-  a.occluded = r.tfar < 0.0f;
-  return a;
-}
+RecordedAnswer shadow_answer(const RTCRay& r) { return occlusion_answer(is_occluded(r)); }
 
 void replay_single(RTCScene scene, const RecordedCall& call, const RecordedRay* rays, RecordedAnswer* answers) {
-  RTCIntersectContext context = context_for(call.coherence);
+  RTCIntersectContext context = intersect_context(call.coherence);
   for (uint32_t i = call.first; i < call.first + call.count; ++i) {
     if (is_shadow_query(call.query)) {
       RTCRay r = rtc_ray(rays[i]);
@@ -81,7 +42,7 @@ void replay_single(RTCScene scene, const RecordedCall& call, const RecordedRay* 
 }
 
 void replay_stream(RTCScene scene, const RecordedCall& call, const RecordedRay* rays, RecordedAnswer* answers) {
-  RTCIntersectContext context = context_for(call.coherence);
+  RTCIntersectContext context = intersect_context(call.coherence);
   for (uint32_t begin = call.first; begin < call.first + call.count; begin += kMaxStream) {
     const unsigned n = static_cast<unsigned>(std::min<size_t>(kMaxStream, call.first + call.count - begin));
     if (is_shadow_query(call.query)) {

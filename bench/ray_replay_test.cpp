@@ -16,20 +16,6 @@
 namespace pxf {
 namespace {
 
-// The Cornell box with its mirror and glass spheres (specular chains: single-ray queries) and a
-// half-transparent BLEND veil across the view (Embree's alpha filter, which decides a hit by the
-// ray's own numbers, so a replay must give the ray exactly as the tracer did).
-Scene cornell_with_veil() {
-  Scene scene = make_cornell_box(true);
-  Material veil = make_diffuse(glm::vec3(0.6f, 0.3f, 0.2f));
-  veil.base_color.a = 0.5f;
-  veil.alpha_mode = AlphaMode::Blend;
-  scene.materials.push_back(veil);
-  scene.meshes.push_back(make_quad(glm::vec3(-0.7f, -0.6f, 0.4f), glm::vec3(0.9f, 0, 0), glm::vec3(0, 1.2f, 0),
-                                   static_cast<int>(scene.materials.size() - 1)));
-  return scene;
-}
-
 RayLog record_second_frame(ProgressiveRenderer& renderer) {
   renderer.add_frame();
   RayRecorder recorder;
@@ -40,7 +26,7 @@ RayLog record_second_frame(ProgressiveRenderer& renderer) {
 }
 
 TEST(RayReplay, RawEmbreeGivesTheTracersAnswersOnTheRecordedRays) {
-  const Scene scenes[] = {cornell_with_veil(), make_room_with_window()};
+  const Scene scenes[] = {make_cornell_with_veil(), make_room_with_window()};
   for (const Scene& scene : scenes) {
     TraceParams params;
     params.threads = 2;
@@ -70,7 +56,7 @@ TEST(RayReplay, RawEmbreeGivesTheTracersAnswersOnTheRecordedRays) {
 
 // Replaying only the shadow calls leaves the closest-hit rays' answers alone, and the reverse.
 TEST(RayReplay, ReplaysOnlyTheCallsItIsGiven) {
-  const Scene scene = cornell_with_veil();
+  const Scene scene = make_cornell_with_veil();
   TraceParams params;
   params.threads = 1;
   ProgressiveRenderer renderer(scene, params, 24, 24);
@@ -89,7 +75,7 @@ TEST(RayReplay, ReplaysOnlyTheCallsItIsGiven) {
 // answered all of them as it answered the tracer, every rate is there, and the CSV's header and
 // row have as many columns.
 TEST(RayReplay, TheBenchReplaysTheRecordedFrame) {
-  const Scene scene = cornell_with_veil();
+  const Scene scene = make_cornell_with_veil();
   TraceParams params;
   params.threads = 2;
   const BenchResult r = run_benchmark(scene, 32, 24, params, 1, 2);

@@ -129,31 +129,11 @@ constexpr size_t kStreamChunk = 64;
 // Every ray counts hits from its origin on (origins are offset off their surface instead); the
 // ray recorder logs it as the ray's tmin.
 constexpr float kRayTnear = 0.0f;
+constexpr float kInfinity = std::numeric_limits<float>::infinity();
 
-RTCRay embree_ray(glm::vec3 origin, glm::vec3 direction, float tmax) {
-  RTCRay r;
-  r.org_x = origin.x;
-  r.org_y = origin.y;
-  r.org_z = origin.z;
-  r.dir_x = direction.x;
-  r.dir_y = direction.y;
-  r.dir_z = direction.z;
-  r.tnear = kRayTnear;
-  r.tfar = tmax;
-  r.time = 0.0f;
-  r.mask = 0xffffffffu;
-  r.id = 0;
-  r.flags = 0;
-  return r;
-}
 
-RTCRayHit embree_ray_hit(const Ray& ray, float tmax) {
-  RTCRayHit rh;
-  rh.ray = embree_ray(ray.origin, ray.direction, tmax);
-  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-  return rh;
-}
+
+}  // namespace
 
 Hit hit_of(const RTCRayHit& rh) {
   Hit hit;
@@ -176,11 +156,34 @@ RTCIntersectContext intersect_context(RayCoherence coherence) {
   return context;
 }
 
-}  // namespace
+RTCRay embree_ray(glm::vec3 origin, glm::vec3 direction, float tmax, float tnear) {
+  RTCRay r;
+  r.org_x = origin.x;
+  r.org_y = origin.y;
+  r.org_z = origin.z;
+  r.dir_x = direction.x;
+  r.dir_y = direction.y;
+  r.dir_z = direction.z;
+  r.tnear = tnear;
+  r.tfar = tmax;
+  r.time = 0.0f;
+  r.mask = 0xffffffffu;
+  r.id = 0;
+  r.flags = 0;
+  return r;
+}
+
+RTCRayHit embree_ray_hit(glm::vec3 origin, glm::vec3 direction, float tmax, float tnear) {
+  RTCRayHit rh;
+  rh.ray = embree_ray(origin, direction, tmax, tnear);
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  return rh;
+}
 
 Hit EmbreeScene::intersect(const Ray& ray, float tmax) const {
   RTCIntersectContext context = intersect_context(RayCoherence::Incoherent);
-  RTCRayHit rh = embree_ray_hit(ray, tmax);
+  RTCRayHit rh = embree_ray_hit(ray.origin, ray.direction, tmax, kRayTnear);
   rtcIntersect1(rtc_scene_, &context, &rh);
   const Hit hit = hit_of(rh);
   if (__builtin_expect(recorder_ != nullptr, 0)) recorder_->closest(ray, kRayTnear, tmax, hit);
@@ -189,7 +192,7 @@ Hit EmbreeScene::intersect(const Ray& ray, float tmax) const {
 
 bool EmbreeScene::occluded(glm::vec3 origin, glm::vec3 direction, float tmax) const {
   RTCIntersectContext context = intersect_context(RayCoherence::Incoherent);
-  RTCRay r = embree_ray(origin, direction, tmax);
+  RTCRay r = embree_ray(origin, direction, tmax, kRayTnear);
   rtcOccluded1(rtc_scene_, &context, &r);
   const bool blocked = is_occluded(r);
   if (__builtin_expect(recorder_ != nullptr, 0)) recorder_->shadow(origin, direction, kRayTnear, tmax, blocked);
@@ -201,7 +204,8 @@ void EmbreeScene::intersect(const Ray* rays, size_t count, RayCoherence coherenc
   RTCRayHit chunk[kStreamChunk];
   for (size_t begin = 0; begin < count; begin += kStreamChunk) {
     const size_t n = std::min(kStreamChunk, count - begin);
-    for (size_t i = 0; i < n; ++i) chunk[i] = embree_ray_hit(rays[begin + i], std::numeric_limits<float>::infinity());
+    for (size_t i = 0; i < n; ++i)
+      chunk[i] = embree_ray_hit(rays[begin + i].origin, rays[begin + i].direction, kInfinity, kRayTnear);
     rtcIntersect1M(rtc_scene_, &context, chunk, static_cast<unsigned>(n), sizeof(RTCRayHit));
     for (size_t i = 0; i < n; ++i) hits[begin + i] = hit_of(chunk[i]);
   }
@@ -216,7 +220,7 @@ void EmbreeScene::occluded(const ShadowRay* rays, size_t count, bool* occluded) 
     const size_t n = std::min(kStreamChunk, count - begin);
     for (size_t i = 0; i < n; ++i) {
       const ShadowRay& ray = rays[begin + i];
-      chunk[i] = embree_ray(ray.origin, ray.direction, ray.tmax);
+      chunk[i] = embree_ray(ray.origin, ray.direction, ray.tmax, kRayTnear);
     }
     rtcOccluded1M(rtc_scene_, &context, chunk, static_cast<unsigned>(n), sizeof(RTCRay));
     for (size_t i = 0; i < n; ++i) occluded[begin + i] = is_occluded(chunk[i]);

@@ -96,6 +96,16 @@ class EmbreeScene {
   RayRecorder* recorder_ = nullptr;  // set_ray_recorder
 };
 
+// The Embree ray of a query from `origin` (hits in [tnear, tmax]), and the same for a closest-hit
+// query with no hit yet: what EmbreeScene hands Embree, and what `pxf bench pathtracer` replays.
+RTCRay embree_ray(glm::vec3 origin, glm::vec3 direction, float tmax, float tnear);
+// The context of a query, flagged coherent or incoherent.
+RTCIntersectContext intersect_context(RayCoherence coherence);
+// How the queries read Embree's answer: a closest hit (invalid on a miss), and occlusion.
+Hit hit_of(const RTCRayHit& rh);
+bool is_occluded(const RTCRay& r);
+RTCRayHit embree_ray_hit(glm::vec3 origin, glm::vec3 direction, float tmax, float tnear);
+
 // Moves a point off a surface to the side `direction` leaves to, scaled to the point's magnitude
 // so far-away geometry does not self-intersect. Inline: every bounce and shadow ray calls it.
 inline glm::vec3 offset_ray_origin(glm::vec3 position, glm::vec3 geometric_normal, glm::vec3 direction) {

@@ -4,8 +4,6 @@
 
 namespace pxf {
 
-namespace {
-
 RecordedAnswer answer_of(const Hit& hit) {
   RecordedAnswer a;
   a.mesh = hit.mesh;
@@ -19,6 +17,8 @@ RecordedAnswer occlusion_answer(bool occluded) {
   a.occluded = occluded;
   return a;
 }
+
+namespace {
 
 // Opens a call of `count` rays at the end of the log.
 void open_call(RayLog& log, RayQuery query, RayCoherence coherence, size_t count) {

@@ -38,6 +38,10 @@ struct RecordedAnswer {
   }
 };
 
+// The answer as logged: of a closest-hit query's hit, and of a shadow ray.
+RecordedAnswer answer_of(const Hit& hit);
+RecordedAnswer occlusion_answer(bool occluded);
+
 // One Embree call: a single-ray call holds one ray, a stream call the rays of one rtcXxx1M call
 // (EmbreeScene cuts a longer query into chunks; each chunk is its own call here).
 struct RecordedCall {

@@ -15,19 +15,6 @@
 namespace pxf {
 namespace {
 
-// The Cornell box with its mirror and glass spheres (specular chains: single-ray queries) and a
-// half-transparent BLEND veil across the view (Embree's alpha filter on every kind of ray).
-Scene cornell_with_veil() {
-  Scene scene = make_cornell_box(true);
-  Material veil = make_diffuse(glm::vec3(0.6f, 0.3f, 0.2f));
-  veil.base_color.a = 0.5f;
-  veil.alpha_mode = AlphaMode::Blend;
-  scene.materials.push_back(veil);
-  scene.meshes.push_back(make_quad(glm::vec3(-0.7f, -0.6f, 0.4f), glm::vec3(0.9f, 0, 0), glm::vec3(0, 1.2f, 0),
-                                   static_cast<int>(scene.materials.size() - 1)));
-  return scene;
-}
-
 TraceParams two_threads() {
   TraceParams params;
   params.threads = 2;
@@ -97,7 +84,7 @@ TEST(RayRecorder, LogsEachQueryAsEmbreeGotItWithItsAnswer) {
 // shadow and specular-chain rays, on a box with glass, mirror and a veil and in a room lit
 // through a window (light through openings learning from the shadow rays).
 TEST(RayRecorder, RecordsAsManyRaysAsTheFrameCounts) {
-  const Scene scenes[] = {cornell_with_veil(), make_room_with_window()};
+  const Scene scenes[] = {make_cornell_with_veil(), make_room_with_window()};
   for (const Scene& scene : scenes) {
     ProgressiveRenderer renderer(scene, two_threads(), 48, 40);
     renderer.add_frame();
@@ -120,7 +107,7 @@ TEST(RayRecorder, RecordsAsManyRaysAsTheFrameCounts) {
 // The single-ray queries of the specular chains are in the log too (the box's glass sphere is
 // near enough to the floor for chains from the first diffuse vertex).
 TEST(RayRecorder, RecordsTheSpecularChainsSingleRays) {
-  const Scene scene = cornell_with_veil();
+  const Scene scene = make_cornell_with_veil();
   ProgressiveRenderer renderer(scene, two_threads(), 48, 40);
   RayRecorder recorder;
   renderer.set_ray_recorder(&recorder);
@@ -136,7 +123,7 @@ bool same_bits(const std::vector<T>& a, const std::vector<T>& b) {
 
 // Attached or not, the same seed accumulates the same image, bit for bit.
 TEST(RayRecorder, RecordingChangesNothingInTheImage) {
-  const Scene scenes[] = {cornell_with_veil(), make_room_with_window()};
+  const Scene scenes[] = {make_cornell_with_veil(), make_room_with_window()};
   for (const Scene& scene : scenes) {
     ProgressiveRenderer plain(scene, two_threads(), 40, 32), recorded(scene, two_threads(), 40, 32);
     RayRecorder recorder;

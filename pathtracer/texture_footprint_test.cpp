@@ -40,6 +40,18 @@ Texture constant_texture(int size, glm::vec4 value) {
   return t;
 }
 
+// Levels 1, 2, ... of a size x size texture, each holding `value` everywhere (whatever level 0 holds).
+std::shared_ptr<const std::vector<TextureLevel>> constant_levels(int size, glm::vec4 value) {
+  auto levels = std::make_shared<std::vector<TextureLevel>>();
+  for (int width = size / 2; width >= 1; width /= 2) {
+    TextureLevel level;
+    level.width = level.height = width;
+    level.texels.assign(static_cast<size_t>(width) * width, value);
+    levels->push_back(level);
+  }
+  return levels;
+}
+
 TraceParams params_with_seed(uint64_t seed) {
   TraceParams params;
   params.seed = seed;
@@ -62,14 +74,7 @@ glm::dvec3 mean_radiance(const Accumulation& acc) {
 // albedo), while the light that bounced off the walls before reaching it turns red.
 TEST(TextureFootprint, FirstVertexReadsLevelZeroDeeperVerticesCoarserLevels) {
   Texture texture = constant_texture(64, glm::vec4(1.0f));
-  auto red_levels = std::make_shared<std::vector<TextureLevel>>();
-  for (int size = 32; size >= 1; size /= 2) {
-    TextureLevel level;
-    level.width = level.height = size;
-    level.texels.assign(static_cast<size_t>(size) * size, glm::vec4(1.0f, 0.1f, 0.1f, 1.0f));
-    red_levels->push_back(level);
-  }
-  texture.mips = red_levels;
+  texture.mips = constant_levels(64, glm::vec4(1.0f, 0.1f, 0.1f, 1.0f));
   const Scene scene = textured_box(texture);
   ProgressiveRenderer renderer(scene, params_with_seed(3), kWidth, kHeight);
   const Accumulation& acc = render(renderer, 16);
@@ -114,14 +119,7 @@ TEST(TextureFootprint, NormalMapsReadLevelZeroAtEveryVertex) {
       mesh.tangents[i] = glm::vec4(t, 1.0f);
     }
   Scene tilted = flat;
-  auto levels = std::make_shared<std::vector<TextureLevel>>();
-  for (int size = 32; size >= 1; size /= 2) {
-    TextureLevel level;
-    level.width = level.height = size;
-    level.texels.assign(static_cast<size_t>(size) * size, glm::vec4(0.85f, 0.5f, 0.85f, 1.0f));
-    levels->push_back(level);
-  }
-  tilted.textures[1].mips = levels;
+  tilted.textures[1].mips = constant_levels(64, glm::vec4(0.85f, 0.5f, 0.85f, 1.0f));
   ProgressiveRenderer a(flat, params_with_seed(9), kWidth, kHeight), b(tilted, params_with_seed(9), kWidth, kHeight);
   const Accumulation &x = render(a, 4), &y = render(b, 4);
   EXPECT_EQ(x.lv_mean, y.lv_mean);

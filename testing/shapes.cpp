@@ -191,4 +191,15 @@ Environment uniform_environment(float radiance) {
   return env;
 }
 
+Scene make_cornell_with_veil() {
+  Scene scene = make_cornell_box(true);
+  Material veil = make_diffuse(glm::vec3(0.6f, 0.3f, 0.2f));
+  veil.base_color.a = 0.5f;
+  veil.alpha_mode = AlphaMode::Blend;
+  scene.materials.push_back(veil);
+  scene.meshes.push_back(make_quad(glm::vec3(-0.7f, -0.6f, 0.4f), glm::vec3(0.9f, 0, 0), glm::vec3(0, 1.2f, 0),
+                                   static_cast<int>(scene.materials.size() - 1)));
+  return scene;
+}
+
 }  // namespace pxf

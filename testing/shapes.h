@@ -36,4 +36,9 @@ Environment sky_with_sun();
 // sphere; camera at z = 3.4 looking down -z.
 Scene make_cornell_box(bool with_specular_spheres);
 
+// The Cornell box with its mirror and glass spheres (specular chains: single-ray queries) and a
+// half-transparent BLEND veil across the view (Embree's alpha filter on every kind of ray, which
+// decides a hit by the ray's own numbers).
+Scene make_cornell_with_veil();
+
 }  // namespace pxf
