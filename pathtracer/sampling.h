@@ -140,19 +140,67 @@ inline bool is_finite(glm::vec3 v) { return std::isfinite(v.x) && std::isfinite(
 // (a light's two triangles) are counted; more are halved with conditional moves (an environment
 // map's rows and columns: once the map fits in the cache, std::upper_bound's mispredicted loop is
 // most of what its sampling costs).
-inline size_t sorted_upper_bound(const float* sorted, size_t n, float u, size_t count_up_to) {
+// The entries may lie `stride` floats apart (a cdf interleaved with its pmf).
+inline size_t sorted_upper_bound(const float* sorted, size_t n, float u, size_t count_up_to, size_t stride = 1) {
   if (n <= count_up_to) {
     size_t count = 0;
-    for (size_t i = 0; i < n; ++i) count += !(u < sorted[i]);
+    for (size_t i = 0; i < n; ++i) count += !(u < sorted[i * stride]);
     return count;
   }
   size_t first = 0;  // the answer lies in [first, first + n]
   while (n > 1) {
     const size_t half = n / 2;
-    first = !(u < sorted[first + half]) ? first + half : first;
+    first = !(u < sorted[(first + half) * stride]) ? first + half : first;
     n -= half;
   }
-  return first + !(u < sorted[first]);
+  return first + !(u < sorted[first * stride]);
+}
+
+// A piecewise-constant distribution's arrays as its sampling reads them: cdf (n + 1 entries), pmf
+// (n) and, for n >= 64 bins, a guide table of K + 1 entries (Chen's cutpoint method, below; K a power
+// of two). Distribution1D holds one; Distribution2D keeps all of its rows' in three flat arrays,
+// so that a row's are found from its index alone, without loading the row's object first.
+struct BinsView {
+  const float* cdf = nullptr;
+  const float* pmf = nullptr;
+  const uint32_t* guide = nullptr;  // nullptr: no guide table
+  size_t n = 0;                     // bins
+  size_t guide_intervals = 0;       // K
+  size_t stride = 1;                // entry i of cdf and pmf at [i * stride]
+};
+
+// With a guide table: guide[k] counts the CDF entries <= k / K, so the answer for u lies in
+// [guide[k], guide[k + 1]], a range of about one entry. The same index as the full search, at one
+// or two cache lines instead of the search's ten: a large map's rows are sampled at random, and
+// each step of a search in a 4 KB row missed the cache (a sky behind a window spent a fifth of its
+// time there).
+inline size_t upper_bound_index(const BinsView& v, float u) {
+  constexpr size_t kLinearScanEntries = 9;
+  if (!v.guide) return sorted_upper_bound(v.cdf, v.n + 1, u, kLinearScanEntries, v.stride);
+  const size_t last = v.guide_intervals - 1;
+  const double scaled = static_cast<double>(u) * static_cast<double>(v.guide_intervals);
+  // u outside [0, 1) or NaN: the first or last interval (no cast of a value out of range).
+  const size_t k = scaled >= 0.0 && scaled < static_cast<double>(last) ? static_cast<size_t>(scaled)
+                   : scaled >= static_cast<double>(last)                ? last
+                                                                        : 0;
+  const size_t lo = v.guide[k], hi = v.guide[k + 1];
+  return lo + sorted_upper_bound(v.cdf + lo * v.stride, hi - lo, u, kLinearScanEntries, v.stride);
+}
+
+// The bin u falls in, the position u' in [0,1) within it (reused as a fresh random number) and its pmf.
+inline size_t sample_bins(const BinsView& v, float u, float* u_remapped, float* pmf) {
+  size_t i = upper_bound_index(v, u);
+  i = std::min(i == 0 ? size_t(0) : i - 1, v.n - 1);
+  // Skip zero-probability bins that share a CDF value (u exactly on a boundary).
+  const size_t k = v.stride;
+  while (v.pmf[i * k] == 0.0f && i + 1 < v.n) ++i;
+  if (u_remapped) {
+    float width = v.cdf[(i + 1) * k] - v.cdf[i * k];
+    float t = width > 0.0f ? (u - v.cdf[i * k]) / width : 0.5f;
+    *u_remapped = std::min(std::max(t, 0.0f), 0x1.fffffep-1f);
+  }
+  if (pmf) *pmf = v.pmf[i * k];
+  return i;
 }
 
 // Piecewise-constant distribution over n bins from non-negative weights (non-finite or negative
@@ -171,37 +219,14 @@ class Distribution1D {
 
   // Returns the bin and the position u' in [0,1) within the bin (reused as a fresh random number).
   size_t sample(float u, float* u_remapped = nullptr, float* pmf = nullptr) const {
-    size_t i = upper_bound_index(u);
-    i = std::min(i == 0 ? size_t(0) : i - 1, pmf_.size() - 1);
-    // Skip zero-probability bins that share a CDF value (u exactly on a boundary).
-    while (pmf_[i] == 0.0f && i + 1 < pmf_.size()) ++i;
-    if (u_remapped) {
-      float width = cdf_[i + 1] - cdf_[i];
-      float t = width > 0.0f ? (u - cdf_[i]) / width : 0.5f;
-      *u_remapped = std::min(std::max(t, 0.0f), 0x1.fffffep-1f);
-    }
-    if (pmf) *pmf = pmf_[i];
-    return i;
+    return sample_bins(view(), u, u_remapped, pmf);
+  }
+  BinsView view() const {
+    return BinsView{cdf_.data(), pmf_.data(), guide_.empty() ? nullptr : guide_.data(), pmf_.size(),
+                    guide_.empty() ? 0 : guide_.size() - 1};
   }
 
  private:
-  // With a guide table (Chen's cutpoint method): guide_[k] counts the CDF entries <= k / K, K a power
-  // of two (so that k = floor(u K) is exact), and the answer for u lies in [guide_[k], guide_[k + 1]],
-  // a range of about one entry. The same index as the full search, at one or two cache lines instead
-  // of the search's ten: a large map's rows are sampled at random, and each step of a search in a
-  // 4 KB row missed the cache (a sky behind a window spent a fifth of its time there).
-  size_t upper_bound_index(float u) const {
-    if (guide_.empty()) return sorted_upper_bound(cdf_.data(), cdf_.size(), u, kLinearScanEntries);
-    const size_t last = guide_.size() - 2;  // K - 1
-    const double scaled = static_cast<double>(u) * static_cast<double>(last + 1);
-    // u outside [0, 1) or NaN: the first or last interval (no cast of a value out of range).
-    const size_t k = scaled >= 0.0 && scaled < static_cast<double>(last) ? static_cast<size_t>(scaled)
-                     : scaled >= static_cast<double>(last)                ? last
-                                                                          : 0;
-    const size_t lo = guide_[k], hi = guide_[k + 1];
-    return lo + sorted_upper_bound(cdf_.data() + lo, hi - lo, u, kLinearScanEntries);
-  }
-  static constexpr size_t kLinearScanEntries = 9;
   static constexpr size_t kGuidedFrom = 64;  // bins; fewer stay in a cache line or two anyway
 
   // guide_[k] = #{i : cdf_[i] <= k / K} for k = 0 .. K, K the least power of two >= the bins.
@@ -250,26 +275,28 @@ class Distribution2D {
   Distribution2D() = default;
   Distribution2D(const std::vector<float>& weights, int width, int height) : width_(width), height_(height) {
     std::vector<float> row_sums(height);
-    conditional_.reserve(height);
+    std::vector<Distribution1D> rows;
+    rows.reserve(height);
     for (int y = 0; y < height; ++y) {
-      conditional_.emplace_back(weights.data() + static_cast<size_t>(y) * width, width);
-      row_sums[y] = static_cast<float>(conditional_.back().total());
+      rows.emplace_back(weights.data() + static_cast<size_t>(y) * width, width);
+      row_sums[y] = static_cast<float>(rows.back().total());
     }
     marginal_ = Distribution1D(row_sums);
+    flatten_rows(rows);
     // The densities pdf() reads, as sample() computes them: one load instead of two dependent ones
-    // (the row's Distribution1D, then its pmf), which missed the cache at every MIS weight.
+    // (the row's pmf, then the marginal's), which missed the cache at every MIS weight.
     density_.resize(static_cast<size_t>(width) * height);
     for (int y = 0; y < height; ++y)
       for (int x = 0; x < width; ++x)
         density_[static_cast<size_t>(y) * width + x] =
-            marginal_.pmf(y) * conditional_[y].pmf(x) * static_cast<float>(width_) * static_cast<float>(height_);
+            marginal_.pmf(y) * rows[y].pmf(x) * static_cast<float>(width_) * static_cast<float>(height_);
   }
   bool valid() const { return marginal_.valid(); }
 
   glm::vec2 sample(glm::vec2 u, float* pdf) const {
     float uy, ux, pmf_y, pmf_x;
     size_t y = marginal_.sample(u.y, &uy, &pmf_y);
-    size_t x = conditional_[y].sample(u.x, &ux, &pmf_x);
+    size_t x = sample_bins(row(y), u.x, &ux, &pmf_x);
     *pdf = pmf_y * pmf_x * static_cast<float>(width_) * static_cast<float>(height_);
     return glm::vec2((static_cast<float>(x) + ux) / width_, (static_cast<float>(y) + uy) / height_);
   }
@@ -281,9 +308,38 @@ class Distribution2D {
   }
 
  private:
+  // Every row has as many bins, and so as long a guide table: row y's start at y times a row's
+  // length. A row's cdf and pmf are interleaved (cdf[i], pmf[i]), so that the entries a sample
+  // reads after its guide table share a cache line: on a sky behind a window each of the three
+  // arrays missed the cache at nearly every sample.
+  void flatten_rows(const std::vector<Distribution1D>& rows) {
+    const size_t w = static_cast<size_t>(width_);
+    // Rows without light have no guide table: theirs stays 0s (never sampled; it leads to the row's
+    // last bin, as the full search does).
+    guide_intervals_ = 0;
+    for (const Distribution1D& r : rows) guide_intervals_ = std::max(guide_intervals_, r.view().guide_intervals);
+    bins_.assign(rows.size() * 2 * (w + 1), 0.0f);
+    guide_.resize(guide_intervals_ > 0 ? rows.size() * (guide_intervals_ + 1) : 0);
+    for (size_t y = 0; y < rows.size(); ++y) {
+      const BinsView v = rows[y].view();
+      float* row = bins_.data() + y * 2 * (w + 1);
+      for (size_t i = 0; i <= w; ++i) row[2 * i] = v.cdf[i];
+      for (size_t i = 0; i < w; ++i) row[2 * i + 1] = v.pmf[i];
+      if (v.guide) std::copy(v.guide, v.guide + guide_intervals_ + 1, guide_.begin() + y * (guide_intervals_ + 1));
+    }
+  }
+  BinsView row(size_t y) const {
+    const size_t w = static_cast<size_t>(width_);
+    const float* bins = bins_.data() + y * 2 * (w + 1);
+    return BinsView{bins, bins + 1, guide_intervals_ > 0 ? guide_.data() + y * (guide_intervals_ + 1) : nullptr, w,
+                    guide_intervals_, 2};
+  }
+
   int width_ = 0, height_ = 0;
   std::vector<float> density_;
-  std::vector<Distribution1D> conditional_;
+  std::vector<float> bins_;       // per row (cdf[i], pmf[i]) for i <= width (pmf[width] = 0)
+  std::vector<uint32_t> guide_;   // the rows' guide tables (guide_intervals_ + 1 each), if any
+  size_t guide_intervals_ = 0;
   Distribution1D marginal_;
 };
 

@@ -133,5 +133,37 @@ TEST(Distribution1D, NonFiniteUStillPicksABin) {
   }
 }
 
+// Distribution2D keeps its rows in flat arrays: every sample (position and pdf) is the one of a
+// marginal over the rows' totals and one Distribution1D per row, bit for bit, with rows that hold
+// no light (their guide tables left empty) and rows too short for a guide table.
+TEST(Distribution2D, FlatRowsSampleAsOneDistributionPerRow) {
+  for (int width : {5, 100, 1024}) {
+    const int height = 9;
+    std::vector<float> weights(static_cast<size_t>(width) * height);
+    for (int y = 0; y < height; ++y)
+      for (int x = 0; x < width; ++x)
+        weights[static_cast<size_t>(y) * width + x] =
+            y == 0 || y == 4 || y == height - 1 ? 0.0f : static_cast<float>((x * 7 + y * 3) % 5) * (x == width / 2 ? 1e4f : 1.0f);
+    const Distribution2D dist(weights, width, height);
+    std::vector<Distribution1D> rows;
+    std::vector<float> totals;
+    for (int y = 0; y < height; ++y) {
+      rows.emplace_back(weights.data() + static_cast<size_t>(y) * width, width);
+      totals.push_back(static_cast<float>(rows.back().total()));
+    }
+    const Distribution1D marginal(totals);
+    for (int k = 0; k < 4000; ++k) {
+      const glm::vec2 u((k * 0.6180339887f) - std::floor(k * 0.6180339887f), (k + 0.5f) / 4000.0f);
+      float pdf, uy, ux, pmf_y, pmf_x;
+      const glm::vec2 uv = dist.sample(u, &pdf);
+      const size_t y = marginal.sample(u.y, &uy, &pmf_y);
+      const size_t x = rows[y].sample(u.x, &ux, &pmf_x);
+      ASSERT_EQ(uv, glm::vec2((static_cast<float>(x) + ux) / width, (static_cast<float>(y) + uy) / height)) << k;
+      ASSERT_EQ(pdf, pmf_y * pmf_x * static_cast<float>(width) * static_cast<float>(height)) << k;
+      ASSERT_EQ(dist.pdf(uv), pdf) << k;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace pxf
