@@ -12,8 +12,8 @@ namespace pxf {
 
 namespace {
 
-// The longest stream call EmbreeScene makes (its kStreamChunk); a longer one is replayed in pieces.
-constexpr size_t kMaxStream = 64;
+// The longest stream call EmbreeScene makes; the recorder logs each chunk as its own call.
+constexpr size_t kMaxStream = kEmbreeStreamChunk;
 // Calls per task: a task then holds a few thousand rays, as one of the tracer's tiles does.
 constexpr size_t kCallsPerTask = 64;
 

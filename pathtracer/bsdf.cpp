@@ -5,6 +5,7 @@
 
 #include "pathtracer/ggx_albedo.h"
 #include "pathtracer/sheen.h"
+#include "scene/material.h"
 #include "scene/texture.h"
 
 namespace pxf {
@@ -50,6 +51,7 @@ glm::vec3 local_view(const Frame& frame, glm::vec3 wo) {
 
 }  // namespace
 
+// Reads exactly the slots of bsdf_texture_slots (scene/material.h).
 BsdfParams eval_material(const Scene& scene, const Material& m, glm::vec2 uv0, glm::vec2 uv1,
                          glm::vec4 vertex_color, float uv_width) {
   const auto texture = [&](const TextureRef& ref) { return eval_texture(scene, ref, uv0, uv1, glm::vec4(1.0f), uv_width); };
@@ -71,9 +73,8 @@ BsdfParams eval_material(const Scene& scene, const Material& m, glm::vec2 uv0, g
 }
 
 bool eval_material_is_constant(const Material& m) {  // the textures eval_material() reads
-  return constant(m.base_color_texture) && constant(m.metallic_roughness_texture) && constant(m.transmission_texture) &&
-         constant(m.specular_texture) && constant(m.specular_color_texture) && constant(m.clearcoat_texture) &&
-         constant(m.clearcoat_roughness_texture) && constant(m.sheen_color_texture) && constant(m.sheen_roughness_texture);
+  const auto slots = bsdf_texture_slots(m);
+  return std::all_of(slots.begin(), slots.end(), [](const TextureRef* ref) { return constant(*ref); });
 }
 
 glm::vec3 eval_emission(const Scene& scene, const Material& m, glm::vec2 uv0, glm::vec2 uv1) {

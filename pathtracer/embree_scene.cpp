@@ -124,14 +124,11 @@ EmbreeScene::~EmbreeScene() {
 
 namespace {
 
-// Rays go to Embree in chunks of this many (stack buffers; streams of 64 traced as fast as 256).
-constexpr size_t kStreamChunk = 64;
+constexpr size_t kStreamChunk = kEmbreeStreamChunk;
 // Every ray counts hits from its origin on (origins are offset off their surface instead); the
 // ray recorder logs it as the ray's tmin.
 constexpr float kRayTnear = 0.0f;
 constexpr float kInfinity = std::numeric_limits<float>::infinity();
-
-
 
 }  // namespace
 
@@ -210,7 +207,7 @@ void EmbreeScene::intersect(const Ray* rays, size_t count, RayCoherence coherenc
     for (size_t i = 0; i < n; ++i) hits[begin + i] = hit_of(chunk[i]);
   }
   if (__builtin_expect(recorder_ != nullptr, 0))
-    recorder_->closest_stream(rays, count, kStreamChunk, coherence, kRayTnear, std::numeric_limits<float>::infinity(), hits);
+    recorder_->closest_stream(rays, count, kStreamChunk, coherence, kRayTnear, kInfinity, hits);
 }
 
 void EmbreeScene::occluded(const ShadowRay* rays, size_t count, bool* occluded) const {

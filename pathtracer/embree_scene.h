@@ -33,6 +33,10 @@ struct ShadowRay {
 // coherent (packet traversal pays off); bounce and shadow rays are not.
 enum class RayCoherence { Coherent, Incoherent };
 
+// The stream queries hand Embree at most this many rays a call (stack buffers; streams of 64
+// traced as fast as 256).
+constexpr size_t kEmbreeStreamChunk = 64;
+
 class RayRecorder;  // pathtracer/ray_recorder.h
 
 struct SurfacePoint {
@@ -96,15 +100,15 @@ class EmbreeScene {
   RayRecorder* recorder_ = nullptr;  // set_ray_recorder
 };
 
-// The Embree ray of a query from `origin` (hits in [tnear, tmax]), and the same for a closest-hit
-// query with no hit yet: what EmbreeScene hands Embree, and what `pxf bench pathtracer` replays.
+// What EmbreeScene hands Embree, and what `pxf bench pathtracer` replays: the ray of a query from
+// `origin` (hits in [tnear, tmax]), the same for a closest-hit query with no hit yet, and the
+// query's context, flagged coherent or incoherent.
 RTCRay embree_ray(glm::vec3 origin, glm::vec3 direction, float tmax, float tnear);
-// The context of a query, flagged coherent or incoherent.
+RTCRayHit embree_ray_hit(glm::vec3 origin, glm::vec3 direction, float tmax, float tnear);
 RTCIntersectContext intersect_context(RayCoherence coherence);
 // How the queries read Embree's answer: a closest hit (invalid on a miss), and occlusion.
 Hit hit_of(const RTCRayHit& rh);
 bool is_occluded(const RTCRay& r);
-RTCRayHit embree_ray_hit(glm::vec3 origin, glm::vec3 direction, float tmax, float tnear);
 
 // Moves a point off a surface to the side `direction` leaves to, scaled to the point's magnitude
 // so far-away geometry does not self-intersect. Inline: every bounce and shadow ray calls it.

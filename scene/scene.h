@@ -21,7 +21,6 @@ enum class Wrap { Repeat, ClampToEdge, MirroredRepeat };
 //   an image used both as sRGB color and as linear data is stored once.
 // - `texels` (linear floats) for 16-bit and HDR sources and environment maps.
 // Exactly one of them is filled (both empty: an invalid texture).
-// `mips` holds levels 1, 2, ... of its mip chain (build_texture_mips, scene/texture.h).
 struct TextureLevel;
 struct Texture {
   std::string name;
@@ -33,8 +32,8 @@ struct Texture {
   Wrap wrap_s = Wrap::Repeat;
   Wrap wrap_t = Wrap::Repeat;
   bool nearest = false;  // magFilter NEAREST; otherwise bilinear
-  // Each level half the one before (at least 1 texel), box-filtered in linear light, stored like
-  // level 0; empty: level 0 alone. Read by lookups with a footprint (path vertices after a rough
+  // Levels 1, 2, ... (build_texture_mips, scene/texture.h): each half the one before (at least 1
+  // texel), box-filtered in linear light, stored like level 0; empty: level 0 alone. Read by lookups with a footprint (path vertices after a rough
   // bounce); shared, like the codes, by copies and by textures with the same texels and encoding.
   std::shared_ptr<const std::vector<TextureLevel>> mips;
 

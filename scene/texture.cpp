@@ -10,6 +10,7 @@
 
 #include "core/parallel.h"
 #include "image/image.h"
+#include "scene/material.h"
 
 namespace pxf {
 
@@ -248,9 +249,7 @@ void build_texture_mips(std::vector<Texture>& textures, const std::vector<bool>*
 std::vector<bool> textures_read_with_footprints(const Scene& scene) {
   std::vector<bool> wanted(scene.textures.size(), false);
   for (const Material& m : scene.materials)
-    for (const TextureRef* ref : {&m.base_color_texture, &m.metallic_roughness_texture, &m.transmission_texture,
-                                  &m.specular_texture, &m.specular_color_texture, &m.clearcoat_texture,
-                                  &m.clearcoat_roughness_texture, &m.sheen_color_texture, &m.sheen_roughness_texture})
+    for (const TextureRef* ref : bsdf_texture_slots(m))
       if (ref->valid() && ref->texture < static_cast<int>(wanted.size())) wanted[ref->texture] = true;
   return wanted;
 }

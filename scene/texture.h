@@ -26,8 +26,8 @@ int texture_level(const Texture& texture, float uv_width);
 // to the codes nearest those means.
 void build_texture_mips(std::vector<Texture>& textures, const std::vector<bool>* wanted = nullptr);
 
-// The textures the path tracer reads with a footprint: those of every material slot but the
-// normal maps and the emission, which it reads at level 0 (pathtracer/embree_scene.cpp, bsdf.cpp).
+// The textures the path tracer reads with a footprint: those of bsdf_texture_slots (the normal
+// maps and the emission it reads at level 0: pathtracer/embree_scene.cpp, bsdf.cpp).
 std::vector<bool> textures_read_with_footprints(const Scene& scene);
 
 // The coordinates a texture reference reads: picks uv0 or uv1 by ref.texcoord and applies
