@@ -87,10 +87,9 @@ FilterKind& filter_kind(PreviewSettings& s) { return s.filter.kind; }
 FilterSchedule& schedule(PreviewSettings& s) { return s.schedule; }
 SamplerType& sampler(PreviewSettings& s) { return s.trace.sampler; }
 
-std::vector<SettingDescriptor> make_table() {
+// The blend's and the filter's settings.
+void add_filter_settings(std::vector<SettingDescriptor>& t) {
   using E = SettingEffect;
-  std::vector<SettingDescriptor> t;
-  // The blend and the filter.
   t.push_back(number("threshold", "--threshold", "blend threshold t on perceived variance", 0.0, 1e6,
                      [](PreviewSettings& s) -> float& { return s.threshold; }, E::Refilter,
                      {"threshold t", 1e-5, 1.0, true, "%.2e"}));
@@ -140,6 +139,11 @@ std::vector<SettingDescriptor> make_table() {
                      "after a camera move, reproject what the view showed into the new view beside the fresh samples,\n"
                      "its weight falling to 0 over 16 samples (off: a move restarts from nothing; docs/method.md 4.1)",
                      [](PreviewSettings& s) -> bool& { return s.motion_history; }, E::Redisplay, "reproject history"));
+}
+
+// The tracer's settings, then the display's.
+void add_trace_and_display_settings(std::vector<SettingDescriptor>& t) {
+  using E = SettingEffect;
   // Sampling: these change the samples (the state file records them).
   t.push_back(on_off("adaptive", "--adaptive",
                      "adaptive sampling: after 16 uniform frames each frame's paths (as many as a uniform frame's)\n"
@@ -211,6 +215,12 @@ std::vector<SettingDescriptor> make_table() {
   t.push_back(number("white", "--white", "Reinhard white point (0 = none)", 0.0, 1e9,
                      [](PreviewSettings& s) -> float& { return s.tonemap.white; }, E::Redisplay,
                      {"white point", 0.0, 100.0, false, "%.2f"}));
+}
+
+std::vector<SettingDescriptor> make_table() {
+  std::vector<SettingDescriptor> t;
+  add_filter_settings(t);
+  add_trace_and_display_settings(t);
   return t;
 }
 
