@@ -73,7 +73,7 @@ void apply_sample_settings(const SampleSettings& s, SceneOptions& scene, Preview
   preview.trace.replicates = static_cast<int>(s.replicates);
   preview.adaptive = s.adaptive != 0;
   if (s.adaptive != 0) preview.adaptive_params.goal = s.adaptive == 2 ? AdaptiveGoal::Clean : AdaptiveGoal::Error;
-  preview.trace.guiding = s.guiding != 0;
+  preview.trace.guiding = static_cast<GuidingMode>(s.guiding);
   preview.trace.environment_visibility = s.environment_visibility != 0;
   const auto mode = static_cast<SpecularSamplingMode>(s.specular_sampling);
   preview.trace.specular_sampling = mode == SpecularSamplingMode::All;
@@ -100,10 +100,13 @@ void Checkpointer::start(Preview& preview) const {
   if (state.frames.size() != 1 || state.frames[0].begin != range_.begin || state.frames[0].end > range_.end)
     throw Error(options_.resume + ": the state holds frames " + frame_ranges_text(state.frames) +
                 ", which do not start this render's frames " + frame_ranges_text({range_}));
-  if (state.settings.guiding && state.guiding_field.empty())
-    throw Error(options_.resume + ": the state holds no guiding field (a merge of guided shards), so it cannot be "
-                "continued exactly");
+  const std::string no_field = options_.resume + ": the state holds no guiding field (a merge of guided shards), so it "
+                               "cannot be continued exactly";
+  if (state.settings.guiding == static_cast<uint32_t>(GuidingMode::On) && state.guiding_field.empty()) throw Error(no_field);
   preview.load_state(state);
+  // Auto: a render that had started guiding by the frames saved (its visibility field's verdict)
+  // restarts it at once when the state has no field.
+  if (state.guiding_field.empty() && preview.renderer().guiding_active()) throw Error(no_field);
 }
 
 AccumulationState Checkpointer::state_of(const Preview& preview) const {

@@ -9,8 +9,8 @@ TEST(PreviewOptions, CommandLineSetsThePreviewSettingsThemselves) {
   CommandLine cli{"render", "[options]", "test"};
   add_preview_options(cli, s);
   ASSERT_TRUE(cli.parse({"--threshold", "0.02", "--filter", "none", "--schedule", "pow2", "--sampler", "independent",
-                         "--demodulate", "off", "--bias-guard", "off", "--sigma-shrink", "on", "--seed", "7",
-                         "--all-hv"}));
+                         "--demodulate", "off", "--bias-guard", "off", "--sigma-shrink", "off", "--seed", "7",
+                         "--all-hv", "--guiding", "on"}));
   EXPECT_EQ(s.threshold, 0.02f);
   EXPECT_EQ(s.filter.kind, FilterKind::None);
   EXPECT_FALSE(s.filtering());
@@ -18,7 +18,8 @@ TEST(PreviewOptions, CommandLineSetsThePreviewSettingsThemselves) {
   EXPECT_EQ(s.trace.sampler, SamplerType::Independent);
   EXPECT_FALSE(s.demodulate);
   EXPECT_FALSE(s.bias_guard);
-  EXPECT_TRUE(s.shrink_sigma);
+  EXPECT_FALSE(s.shrink_sigma);
+  EXPECT_EQ(s.trace.guiding, GuidingMode::On);
   EXPECT_EQ(s.trace.seed, 7u);
   EXPECT_TRUE(s.trace.all_hv);
 }
@@ -36,7 +37,8 @@ TEST(PreviewOptions, DefaultsAreThoseOfPreviewSettings) {
   EXPECT_EQ(s.trace.sampler, SamplerType::Sobol);
   EXPECT_TRUE(s.demodulate);
   EXPECT_TRUE(s.bias_guard);
-  EXPECT_FALSE(s.shrink_sigma);
+  EXPECT_TRUE(s.shrink_sigma);
+  EXPECT_EQ(s.trace.guiding, GuidingMode::Auto);
 }
 
 TEST(PreviewOptions, FilterNameTableIndexesFilterKind) {

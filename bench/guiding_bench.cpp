@@ -22,7 +22,7 @@ double ms_since(Clock::time_point start) {
 }
 
 TraceParams with_guiding(TraceParams p, bool guiding, uint64_t seed) {
-  p.guiding = guiding;
+  p.guiding = guiding ? GuidingMode::On : GuidingMode::Off;
   p.seed = seed;
   return p;
 }
@@ -129,7 +129,7 @@ ErrorShares lv_hv_error_shares(const GuidingBoundBenchSetup& b, int spp) {
   Accumulation acc[2];
   for (int i = 0; i < 2; ++i) {
     TraceParams params = b.params;
-    params.guiding = false;
+    params.guiding = GuidingMode::Off;
     params.seed = b.params.seed + kErrorShareSeedOffset + static_cast<uint64_t>(i);
     ProgressiveRenderer renderer(b.scene, params, b.width, b.height);
     for (int f = 0; f < spp; ++f) renderer.add_frame();

@@ -115,7 +115,7 @@ Camera cube_face_camera(glm::vec3 origin, glm::vec3 forward, glm::vec3 up) {
 class IndirectLight {
  public:
   IndirectLight(const PathTracer& tracer, const TraceParams& params) : tracer_(tracer), full_(params) {
-    full_.guiding = false;
+    full_.guiding = GuidingMode::Off;
     full_.sampler = SamplerType::Independent;
     full_.max_vertices = std::max(2, params.max_vertices - 1);
     full_.rr_start_vertex = std::max(2, params.rr_start_vertex - 1);
@@ -226,7 +226,7 @@ GuidingBound measure_guiding_bound(const Scene& scene, const TraceParams& params
                                    const GuidingBoundSettings& s) {
   // The field as the renderer trains it.
   TraceParams guided = params;
-  guided.guiding = true;
+  guided.guiding = GuidingMode::On;
   ProgressiveRenderer trainer(scene, guided, width, height);
   for (int i = 0; i < s.train_frames; ++i) trainer.add_frame();
   const std::vector<uint8_t> bytes = trainer.guiding_field();

@@ -408,23 +408,26 @@ TEST(EffectiveThreshold, RealizedPerceivedVarianceMatchesTOnAverage) {
   }
 }
 
-// shrunk_sigma_s: sigma_s up to 4 spp, then sigma_s sqrt(4 / n) down to 2 px; a sigma_s below 2
-// is kept, never widened.
-TEST(SigmaShrink, FallsAsOneOverRootNDownToTwoPixels) {
-  for (uint64_t n : {0, 1, 2, 3, 4}) EXPECT_EQ(shrunk_sigma_s(8.0f, n), 8.0f);
-  EXPECT_FLOAT_EQ(shrunk_sigma_s(8.0f, 16), 4.0f);
-  EXPECT_FLOAT_EQ(shrunk_sigma_s(8.0f, 64), 2.0f);
-  EXPECT_FLOAT_EQ(shrunk_sigma_s(8.0f, 100000), 2.0f);
-  EXPECT_FLOAT_EQ(shrunk_sigma_s(12.0f, 9), 8.0f);
-  EXPECT_FLOAT_EQ(shrunk_sigma_s(1.5f, 1000), 1.5f);
-  EXPECT_FLOAT_EQ(shrunk_sigma_s(3.0f, 16), 2.0f);
-  float previous = 8.0f;
-  for (uint64_t n = 1; n < 5000; n = n * 3 / 2 + 1) {
-    const float s = shrunk_sigma_s(8.0f, n);
-    EXPECT_LE(s, previous);
-    EXPECT_GE(s, kSigmaShrinkMin);
-    previous = s;
-  }
+// noise_sigma_s: sqrt((u / t) / (4 pi)) at the 0.9-quantile of the noisy pixels' u / t, between
+// 2 px and sigma_s; sigma_s up to 4 spp; a sigma_s below 2 is kept, never widened.
+TEST(SigmaShrink, SizesTheKernelForTheNoisiestTenthOfThePixels) {
+  auto sigma = [](float sigma_s, uint64_t n, std::vector<float> needed) { return noise_sigma_s(sigma_s, n, needed); };
+  const float pi4 = 4.0f * 3.14159265f;
+  // 100 pixels of ratio 1..100: the 0.9-quantile (index 90) is 91.
+  std::vector<float> ramp;
+  for (int i = 100; i >= 1; --i) ramp.push_back(float(i));
+  EXPECT_NEAR(sigma(8.0f, 64, ramp), std::sqrt(91.0f / pi4), 1e-4);
+  for (uint64_t n : {0, 1, 2, 3, 4}) EXPECT_EQ(sigma(8.0f, n, ramp), 8.0f);
+  EXPECT_EQ(sigma(8.0f, 64, {}), kSigmaShrinkMin);                      // nothing above t
+  EXPECT_EQ(sigma(8.0f, 64, std::vector<float>(10, 4.0f)), kSigmaShrinkMin);  // needs under 2 px
+  EXPECT_EQ(sigma(8.0f, 64, std::vector<float>(10, 1e6f)), 8.0f);       // needs more than sigma_s
+  EXPECT_EQ(sigma(8.0f, 64, {std::numeric_limits<float>::infinity()}), 8.0f);
+  EXPECT_EQ(sigma(8.0f, 64, {std::nanf("")}), 8.0f);
+  EXPECT_EQ(sigma(1.5f, 1000, ramp), 1.5f);
+  // Ten times the noise: sqrt(10) times the kernel.
+  std::vector<float> louder;
+  for (float r : ramp) louder.push_back(10.0f * r);
+  EXPECT_NEAR(sigma(16.0f, 64, louder) / sigma(16.0f, 64, ramp), std::sqrt(10.0f), 1e-4);
 }
 
 }  // namespace

@@ -35,10 +35,14 @@ float effective_threshold(float t, uint64_t samples) {
   return static_cast<float>(t * ((n - 3.0) / (n - 1.0)));
 }
 
-float shrunk_sigma_s(float sigma_s, uint64_t samples) {
+float noise_sigma_s(float sigma_s, uint64_t samples, std::vector<float>& needed) {
   if (samples <= kSigmaShrinkFromSpp || !(sigma_s > kSigmaShrinkMin)) return sigma_s;
-  const double shrunk = sigma_s * std::sqrt(double(kSigmaShrinkFromSpp) / double(samples));
-  return static_cast<float>(std::max(shrunk, double(kSigmaShrinkMin)));
+  if (needed.empty()) return kSigmaShrinkMin;
+  const size_t k = std::min(needed.size() - 1, static_cast<size_t>(kSigmaNoiseQuantile * double(needed.size())));
+  std::nth_element(needed.begin(), needed.begin() + static_cast<ptrdiff_t>(k), needed.end());
+  const double wanted = std::sqrt(double(needed[k]) / (4.0 * 3.14159265358979323846));
+  if (!(wanted < sigma_s)) return sigma_s;  // a NaN or infinite ratio too: the full kernel
+  return static_cast<float>(std::max(wanted, double(kSigmaShrinkMin)));
 }
 
 // Pass i of the à-trous filter convolves with the B3 spline at hole spacing 2^i, whose variance is

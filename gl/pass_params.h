@@ -130,17 +130,19 @@ float atrous_variance_correction(int pass);
 // 15 % over t at 16 spp. E[1 / S^2] is infinite for n <= 3; there the n = 4 factor 1/3 is used.
 float effective_threshold(float t, uint64_t samples);
 
-// The spatial sigma of a filter run after `samples` samples per pixel, when the preview shrinks it
-// (PreviewSettings::shrink_sigma, off by default; docs/method.md 2.5): sigma_s up to
-// kSigmaShrinkFromSpp samples, then sigma_s sqrt(kSigmaShrinkFromSpp / samples), never below
-// kSigmaShrinkMin (a sigma_s already below it is kept). Why 1 / sqrt(n): the filter has to bring a
-// pixel's perceived variance u down to about t, i.e. average about u / t pixels; u falls as 1 / n,
-// so the kernel's area may fall as 1 / n, and a narrower kernel averages light over less of the
-// scene: less bias. The wide kernel is best at the first few samples, narrower ones once samples
-// accumulate (docs/measurements.md, "Shrinking sigma_s").
+// The spatial sigma of a filter run, when the preview shrinks it to the noise
+// (PreviewSettings::shrink_sigma, on by default; docs/method.md 2.5). The filter has to bring a
+// pixel's perceived variance u down to about t: a Gaussian average of independent neighbours of
+// sigma s divides it by 4 pi s^2, so the pixel needs s = sqrt((u / t) / (4 pi)). The kernel is
+// sized for the noisy pixels' kSigmaNoiseQuantile-quantile of u / t (`needed`: u / t of every
+// pixel with u > t, in any order; it is reordered), never above sigma_s nor below kSigmaShrinkMin
+// (a sigma_s already below it is kept), and sigma_s itself up to kSigmaShrinkFromSpp samples, whose
+// variance estimates are too few to go by. A narrower kernel averages light over less of the
+// scene: less bias where the noise allows it, the full kernel where it does not.
 constexpr uint64_t kSigmaShrinkFromSpp = 4;
 constexpr float kSigmaShrinkMin = 2.0f;
-float shrunk_sigma_s(float sigma_s, uint64_t samples);
+constexpr double kSigmaNoiseQuantile = 0.9;
+float noise_sigma_s(float sigma_s, uint64_t samples, std::vector<float>& needed);
 
 // The blend's parameters besides its threshold t (the perceived-variance threshold, sqrt(t) = the
 // allowed relative standard deviation), which every run is given next to them.

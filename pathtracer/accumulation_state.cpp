@@ -110,7 +110,7 @@ SampleSettings get_settings(ByteReader& r) {
   s.guiding = r.get<uint32_t>("header");
   s.environment_visibility = r.get<uint32_t>("header");
   if (s.all_hv > 1 || s.specular_sampling > static_cast<uint32_t>(SpecularSamplingMode::Chains) || s.sampler > 1 ||
-      s.adaptive > 2 || s.guiding > 1 || s.environment_visibility > 1)
+      s.adaptive > 2 || s.guiding > 2 || s.environment_visibility > 1)
     throw Error("state file has an invalid setting flag (all-hv, sampler, specular sampling, adaptive, guiding or "
                 "env-visibility)");
   if (s.replicates < 1 || s.replicates > kMaxReplicates)
@@ -246,7 +246,7 @@ std::string SampleSettings::difference(const SampleSettings& o) const {
   if (replicates != o.replicates) return diff("replicates", replicates, o.replicates);
   if (specular_sampling != o.specular_sampling) return diff("specular sampling", specular_sampling, o.specular_sampling);
   if (adaptive != o.adaptive) return "adaptive sampling " + adaptive_name(adaptive) + " vs " + adaptive_name(o.adaptive);
-  if (guiding != o.guiding) return std::string("guiding ") + (guiding ? "on" : "off") + " vs " + (o.guiding ? "on" : "off");
+  if (guiding != o.guiding) return "guiding " + guiding_mode_names()[guiding] + " vs " + guiding_mode_names()[o.guiding];
   if (environment_visibility != o.environment_visibility)
     return std::string("env-visibility ") + (environment_visibility ? "on" : "off") + " vs " +
            (o.environment_visibility ? "on" : "off");
@@ -269,7 +269,7 @@ SampleSettings sample_settings(uint64_t scene_hash, int width, int height, const
   s.sampler = static_cast<uint32_t>(params.sampler);
   s.replicates = static_cast<uint32_t>(std::max(params.replicates, 1));
   s.specular_sampling = static_cast<uint32_t>(specular_sampling_mode(params));
-  s.guiding = params.guiding ? 1u : 0u;
+  s.guiding = static_cast<uint32_t>(params.guiding);
   s.environment_visibility = params.environment_visibility ? 1u : 0u;
   return s;
 }

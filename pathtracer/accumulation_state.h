@@ -50,8 +50,9 @@ struct SampleSettings {
   // Not a property of a sample, but a resume must continue the same allocation, and a merge of
   // adaptive and uniform shards would be a render neither option describes.
   uint32_t adaptive = 0;
-  // 1: path guiding (TraceParams::guiding): a sample depends on the field learned before it, so a
-  // resume must continue the same field (AccumulationState::guiding_field).
+  // Path guiding (TraceParams::guiding, the GuidingMode: 0 off, 1 on, 2 auto): a sample depends on
+  // the field learned before it, so a resume must continue the same field
+  // (AccumulationState::guiding_field).
   uint32_t guiding = 0;
   // 1: light through openings (TraceParams::environment_visibility): as with guiding, a sample
   // depends on what was learned before it (AccumulationState::environment_visibility).
@@ -77,9 +78,9 @@ struct AccumulationState {
   std::vector<float> rate;
   std::vector<float> credit;
   std::vector<uint8_t> next_active;
-  // Path guiding's field (settings.guiding only): GuidingField::serialize() of what the render had
-  // learned, so that a resumed render continues exactly; empty in a merged state (each shard learned
-  // its own field), which is therefore not resumed.
+  // Path guiding's field (settings.guiding on or auto): GuidingField::serialize() of what the render
+  // had learned, so that a resumed render continues exactly; empty where auto has not started one,
+  // and in a merged state (each shard learned its own field), which is therefore not resumed.
   std::vector<uint8_t> guiding_field;
   // What light through openings learned (settings.environment_visibility only, and only in a scene
   // with an environment): EnvironmentVisibility::serialize(). Empty in a merged state; a resume

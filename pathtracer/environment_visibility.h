@@ -120,6 +120,8 @@ class EnvironmentVisibility {
   bool learning() const { return frames_ < kLearningFrames; }
   // Learned nothing worth sampling and never will: see kOpenSkyFraction. Sticky; no regions learned.
   bool dormant() const { return dormant_; }
+  // Whether dormant() has been decided (after the field's frame kDormantCheckFrame).
+  bool judged() const { return frames_ >= kDormantCheckFrame; }
 
   size_t learned_regions() const;
   size_t memory_bytes() const;

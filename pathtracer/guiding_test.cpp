@@ -21,7 +21,7 @@ namespace {
 
 TraceParams guided_params() {
   TraceParams params;
-  params.guiding = true;
+  params.guiding = GuidingMode::On;
   params.threads = 2;
   return params;
 }
@@ -68,7 +68,7 @@ TEST(Guiding, WhiteFurnaceStaysOne) {
   EXPECT_NEAR(mean, 1.0, 2e-3);
   EXPECT_LT(worst_excess, 0.03);
   // The field learned and was used: the image is not the unguided one.
-  params.guiding = false;
+  params.guiding = GuidingMode::Off;
   ProgressiveRenderer plain(scene, params, size, size);
   for (int i = 0; i < frames; ++i) plain.add_frame();
   EXPECT_FALSE(same_accumulation(acc, plain.accumulation()));
@@ -95,7 +95,7 @@ TEST(Guiding, TrainedFieldFindsTheMirrorCaustic) {
     PathTracer tracer(scene);
     if (guided) tracer.set_guiding(&field);
     TraceParams p = params;
-    p.guiding = guided;
+    p.guiding = guided ? GuidingMode::On : GuidingMode::Off;
     p.seed = 5;
     // Guiding alone: the specular chains solve for the mirror's caustic themselves (docs/sampling.md).
     p.specular_chains = false;
@@ -175,7 +175,7 @@ TEST(Guiding, GuidedImageAgreesWithUnguidedReference) {
   TraceParams params = guided_params();
   params.seed = 11;
   ProgressiveRenderer guided(scene, params, size, size);
-  params.guiding = false;
+  params.guiding = GuidingMode::Off;
   params.seed = 12;
   ProgressiveRenderer plain(scene, params, size, size);
   for (int i = 0; i < frames; ++i) {
@@ -194,7 +194,7 @@ TEST(Guiding, UntrainedFieldTracesTheUnguidedSamples) {
   const Scene scene = make_cornell_box(true);
   TraceParams params = guided_params();
   ProgressiveRenderer guided(scene, params, 24, 20);
-  params.guiding = false;
+  params.guiding = GuidingMode::Off;
   ProgressiveRenderer plain(scene, params, 24, 20);
   guided.add_frame();
   plain.add_frame();
@@ -226,6 +226,83 @@ TEST(Guiding, RestoredFieldContinuesExactly) {
          const std::vector<uint8_t>& field) { r.restore(acc, 0, k, traced, field); });
 }
 
+// GuidingMode::Auto, the default, starts guiding only where the scene sees at most half of its
+// sky (the visibility field's verdict after frame 4). Under an open sky and without an environment
+// it never starts, and traces Off's samples bit for bit.
+TEST(Guiding, AutoStaysOffUnderAnOpenSkyAndWithoutAnEnvironment) {
+  ASSERT_EQ(TraceParams{}.guiding, GuidingMode::Auto);
+  for (const Scene& scene : {furnace_scene(), make_cornell_box(true)}) {
+    TraceParams params;
+    params.threads = 2;
+    ProgressiveRenderer automatic(scene, params, 24, 20);
+    params.guiding = GuidingMode::Off;
+    ProgressiveRenderer off(scene, params, 24, 20);
+    for (int i = 0; i < 12; ++i) {
+      automatic.add_frame();
+      off.add_frame();
+    }
+    EXPECT_FALSE(automatic.guiding_active());
+    EXPECT_TRUE(automatic.guiding_field().empty());
+    EXPECT_TRUE(same_accumulation(automatic.accumulation(), off.accumulation()));
+  }
+}
+
+// In a room lit through a window, auto starts guiding at the verdict: the field learns from frame
+// 5 on and is trained after it, so frames 1 to 5 are Off's samples and frame 6 is guided.
+TEST(Guiding, AutoStartsInARoomLitThroughAWindow) {
+  const Scene scene = make_room_with_window();
+  TraceParams params;
+  params.threads = 2;
+  ProgressiveRenderer automatic(scene, params, 24, 20);
+  params.guiding = GuidingMode::Off;
+  ProgressiveRenderer off(scene, params, 24, 20);
+  for (int frame = 1; frame <= 5; ++frame) {
+    automatic.add_frame();
+    off.add_frame();
+    EXPECT_EQ(automatic.guiding_active(), frame >= 4) << frame;
+  }
+  EXPECT_TRUE(same_accumulation(automatic.accumulation(), off.accumulation()));
+  automatic.add_frame();
+  off.add_frame();
+  EXPECT_FALSE(same_accumulation(automatic.accumulation(), off.accumulation()));
+  EXPECT_FALSE(automatic.guiding_field().empty());
+}
+
+// Auto's learned state is the visibility field and the guiding field it starts: one blob for the
+// shared resume and thread tests, [guiding field's length, 8 bytes][guiding field][visibility].
+std::vector<uint8_t> auto_learned(const ProgressiveRenderer& r) {
+  const std::vector<uint8_t> field = r.guiding_field(), visibility = r.environment_visibility();
+  std::vector<uint8_t> blob(8);
+  const uint64_t n = field.size();
+  std::memcpy(blob.data(), &n, 8);
+  blob.insert(blob.end(), field.begin(), field.end());
+  blob.insert(blob.end(), visibility.begin(), visibility.end());
+  return blob;
+}
+
+void restore_auto_learned(ProgressiveRenderer& r, const Accumulation& acc, int k, const std::vector<uint32_t>& traced,
+                          const std::vector<uint8_t>& blob) {
+  if (blob.empty()) return r.restore(acc, 0, k, traced);
+  uint64_t n = 0;
+  if (blob.size() < 8) throw Error("not an auto-guiding state");
+  std::memcpy(&n, blob.data(), 8);
+  if (n > blob.size() - 8) throw Error("not an auto-guiding state");
+  const std::vector<uint8_t> field(blob.begin() + 8, blob.begin() + 8 + static_cast<ptrdiff_t>(n));
+  const std::vector<uint8_t> visibility(blob.begin() + 8 + static_cast<ptrdiff_t>(n), blob.end());
+  r.restore(acc, 0, k, traced, field, visibility);
+}
+
+// Auto resumes exactly before its verdict (k = 3), inside the field's first iteration (5) and later
+// (7), and does not depend on the thread count.
+TEST(Guiding, AutoResumesExactlyAndIsDeterministicAcrossThreadCounts) {
+  TraceParams params;
+  params.threads = 2;
+  params.seed = 31;
+  expect_resume_continues_exactly(make_room_with_window(), params, 24, 20, 12, {3, 5, 7}, auto_learned,
+                                  restore_auto_learned);
+  expect_thread_count_independent(make_room_with_window(), params, auto_learned);
+}
+
 // The state file keeps the guiding flag and the field; a corrupt field is refused; a merge of
 // guided shards keeps no field.
 TEST(Guiding, StateKeepsTheField) {
@@ -251,6 +328,8 @@ TEST(Guiding, StateKeepsTheField) {
   SampleSettings unguided = state.settings;
   unguided.guiding = 0;
   EXPECT_EQ(state.settings.difference(unguided), "guiding on vs off");
+  unguided.guiding = 2;
+  EXPECT_EQ(state.settings.difference(unguided), "guiding on vs auto");
 
   // A corrupted byte inside the field, the checksum recomputed: refused by the field's own checks
   // (the field's header counts and indices) or accepted only as a valid field.

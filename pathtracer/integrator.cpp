@@ -524,7 +524,7 @@ bool PathTracer::shade_vertex(Path& path, const Hit& hit, int vertex, const Trac
 GuidingMixture PathTracer::guiding_mixture(const SurfacePoint& sp, const Bsdf& bsdf, glm::vec3 wo,
                                            const TraceParams& params) const {
   GuidingMixture mixture;
-  if (guiding_ && params.guiding && bsdf.has_nondelta() && guiding_->trained()) {
+  if (guiding_ && params.guiding != GuidingMode::Off && bsdf.has_nondelta() && guiding_->trained()) {
     const glm::vec3 n = sp.geometric_normal;
     mixture.guide = guiding_->distribution(sp.position, glm::dot(n, wo) >= 0.0f ? n : -n);
     mixture.guided = mixture.guide.learned();

@@ -101,9 +101,9 @@ class PathTracer {
   // The ray's first surface emits toward it (the emission the path tracer adds at vertex 1).
   bool first_hit_is_emissive(const Ray& camera_ray) const;
 
-  // Path guiding (TraceParams::guiding, docs/guiding.md): traces with params.guiding sample from
-  // `field` once it is trained(), and trace_guiding_photons records into it; nullptr (the
-  // default) traces without guiding whatever params.guiding says. The field must not change
+  // Path guiding (TraceParams::guiding, docs/guiding.md): traces whose params.guiding is not Off
+  // sample from `field` once it is trained(), and trace_guiding_photons records into it; nullptr
+  // (the default, and Auto's until it starts) traces without guiding whatever params.guiding says. The field must not change
   // (apply_records, end_iteration) while a trace runs.
   void set_guiding(GuidingField* field) { guiding_ = field; }
   // Light through openings (TraceParams::environment_visibility, environment_visibility.h): NEE

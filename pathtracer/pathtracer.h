@@ -16,6 +16,18 @@
 
 namespace pxf {
 
+// Path guiding's mode (TraceParams::guiding). Auto: on from the frame at which the environment
+// visibility field (environment_visibility.h) finds that the scene sees at most half of its sky,
+// a room lit through its windows, where light is hard to find; off for good everywhere else (an
+// object under a sky, a scene without an environment, --env-visibility off), where it costs more
+// than it gains (docs/guiding.md). Where it stays off, auto traces the samples of off bit for bit.
+enum class GuidingMode { Off, On, Auto };
+// Names of GuidingMode (index = value): "off", "on", "auto".
+inline const std::vector<std::string>& guiding_mode_names() {
+  static const std::vector<std::string> names = {"off", "on", "auto"};
+  return names;
+}
+
 struct TraceParams {
   int max_vertices = 6;     // path length in vertices, camera and light vertex included
   int rr_start_vertex = 3;  // Russian roulette from this vertex on
@@ -47,9 +59,9 @@ struct TraceParams {
   // photons it traces from the lights after each frame, and once trained every non-delta vertex of
   // a path samples its direction from it with the probability its region learned (times
   // the BSDF's diffuse share), from the BSDF otherwise, weighted by the mixture pdf (one-sample MIS;
-  // NEE and specular sampling MIS against that mixture). Off by default; off traces the samples
-  // of before, bit for bit.
-  bool guiding = false;
+  // NEE and specular sampling MIS against that mixture). Off traces the samples of before, bit for
+  // bit. Auto (the default) starts it where it pays, a scene lit through openings (GuidingMode).
+  GuidingMode guiding = GuidingMode::Auto;
   // Light through openings (docs/sampling.md#light-through-openings): in a scene with an
   // environment, next event estimation learns per region which parts of the sky its shadow rays
   // find unblocked, and draws half of its environment directions from that (MIS-combined with
@@ -156,17 +168,20 @@ class ProgressiveRenderer {
   // render's), empty = `frames` for every pixel. Throws pxf::Error when a size differs from the
   // renderer's.
   // `guiding_field`: GuidingField::serialize() of the field the saved render had learned
-  // (guiding_field()); with TraceParams::guiding an empty one starts a new field (the render then
-  // does not continue exactly), without guiding it is ignored. Throws pxf::Error on a field that
-  // does not deserialize.
+  // (guiding_field()); under GuidingMode::On an empty one starts a new field (the render then
+  // does not continue exactly), under Auto an empty one means none has started (one starts as in
+  // a render from the start, at the visibility field's verdict), under Off it is ignored. Throws
+  // pxf::Error on a field that does not deserialize.
   // `environment_visibility`: EnvironmentVisibility's serialized state (environment_visibility());
   // empty starts a new one, which continues unbiased but not bit for bit.
   void restore(const Accumulation& acc, uint32_t first, int frames, const std::vector<uint32_t>& traced = {},
                const std::vector<uint8_t>& guiding_field = {}, const std::vector<uint8_t>& environment_visibility = {});
-  // The guiding field learned so far, serialized (empty without TraceParams::guiding), and its
-  // memory (GuidingField::memory_bytes(), 0 without guiding).
+  // The guiding field learned so far, serialized (empty while guiding is not active), and its
+  // memory (GuidingField::memory_bytes(), 0 while guiding is not active).
   std::vector<uint8_t> guiding_field() const;
   size_t guiding_memory_bytes() const;
+  // Whether guiding runs now: always under GuidingMode::On, once started under Auto.
+  bool guiding_active() const;
   // What light through openings learned so far, serialized (empty where it is off or the scene has
   // no environment), and its regions with a learned distribution.
   std::vector<uint8_t> environment_visibility() const;

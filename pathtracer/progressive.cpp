@@ -84,8 +84,11 @@ struct ProgressiveRenderer::Impl {
   std::vector<uint32_t> pixel_frames;  // paths traced into each pixel since the reset
   std::vector<PixelSampleJob> jobs;    // the frame's paths (build_jobs), kept to reuse the memory
   std::vector<size_t> chunk_starts;    // where each batch of at most kChunk jobs starts, then the end
-  // Path guiding (params.guiding): learned since the last reset, read by the tracing threads.
+  // Path guiding (params.guiding): learned since it started, read by the tracing threads.
   std::unique_ptr<GuidingField> guiding;
+  // The frame count at which the field started: 0 under GuidingMode::On, the frame of the
+  // visibility field's verdict under Auto. Its iterations count from there.
+  uint64_t guiding_start = 0;
   // Light through openings (params.environment_visibility, a scene with an environment).
   std::unique_ptr<EnvironmentVisibility> visibility;
 
@@ -123,20 +126,33 @@ struct ProgressiveRenderer::Impl {
     attach_visibility();
   }
 
-  // A new, untrained field (params.guiding), or none.
+  // A new, untrained field under GuidingMode::On; none otherwise (Auto starts one later, or never).
   void reset_guiding() {
     guiding.reset();
-    if (params.guiding) {
-      glm::vec3 lo, hi;
-      guiding_box(scene, &lo, &hi);
-      GuidingSettings settings;
-      settings.spatial_threshold = kGuidingSpatialThreshold;
-      settings.parallax_lobes = kGuidingLobes;
-      settings.delta_lobes = kGuidingDeltaLobes;
-      guiding = std::make_unique<GuidingField>(lo, hi, settings);
-    }
+    guiding_start = 0;
+    if (params.guiding == GuidingMode::On) start_guiding();
     tracer->set_guiding(guiding.get());
   }
+
+  // A new, untrained field that learns from the next frame on.
+  void start_guiding() {
+    glm::vec3 lo, hi;
+    guiding_box(scene, &lo, &hi);
+    GuidingSettings settings;
+    settings.spatial_threshold = kGuidingSpatialThreshold;
+    settings.parallax_lobes = kGuidingLobes;
+    settings.delta_lobes = kGuidingDeltaLobes;
+    guiding = std::make_unique<GuidingField>(lo, hi, settings);
+    guiding_start = static_cast<uint64_t>(frames.load());
+    tracer->set_guiding(guiding.get());
+  }
+
+  // GuidingMode::Auto: guiding starts after the frame at which the visibility field judged the
+  // scene lit through openings (it sees at most half of its sky), and never elsewhere.
+  void start_auto_guiding() {
+    if (params.guiding == GuidingMode::Auto && !guiding && lit_through_openings()) start_guiding();
+  }
+  bool lit_through_openings() const { return visibility && visibility->judged() && !visibility->dormant(); }
 
   // After a complete frame (single-threaded): the frame's records go into the field, and at the
   // end of each iteration of doubling length (GuidingField::iteration_ends_after) the field
@@ -148,8 +164,26 @@ struct ProgressiveRenderer::Impl {
     arena->execute([&] {
       tracer->trace_guiding_photons(frame, photons, params);
       guiding->apply_records();
-      if (GuidingField::iteration_ends_after(static_cast<uint64_t>(frames.load()))) guiding->end_iteration();
+      if (GuidingField::iteration_ends_after(static_cast<uint64_t>(frames.load()) - guiding_start)) guiding->end_iteration();
     });
+  }
+
+  // A resumed render's field (after its visibility field and frame count are restored). Empty: a
+  // new one under On (a merge's state), none yet under Auto, which may then start one as usual.
+  void restore_guiding(const std::vector<uint8_t>& field) {
+    guiding.reset();
+    guiding_start = 0;
+    if (params.guiding != GuidingMode::Off && !field.empty()) {
+      guiding = std::make_unique<GuidingField>(GuidingField::deserialize(field.data(), field.size()));
+      // Auto's field started at the visibility field's verdict, kDormantCheckFrame frames after it started.
+      if (params.guiding == GuidingMode::Auto && visibility)
+        guiding_start = static_cast<uint64_t>(frames.load()) - visibility->frames() + EnvironmentVisibility::kDormantCheckFrame;
+    } else if (params.guiding == GuidingMode::On) {
+      start_guiding();
+    } else {
+      start_auto_guiding();
+    }
+    tracer->set_guiding(guiding.get());
   }
 
   int accumulation_replicates() const { return accumulated_replicates(params.sampler, params.replicates); }
@@ -285,6 +319,7 @@ bool ProgressiveRenderer::add_frame_of(const uint8_t* active) {
   ++impl_->frames;
   impl_->learn_guiding();
   impl_->learn_visibility();
+  impl_->start_auto_guiding();
   impl_->stats.last_frame_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return true;
 }
@@ -317,22 +352,15 @@ void ProgressiveRenderer::restore(const Accumulation& acc, uint32_t first, int f
   if (!traced.empty() && traced.size() != impl_->pixel_frames.size())
     throw Error("saved traced counts have " + std::to_string(traced.size()) + " entries, the image " +
                 std::to_string(impl_->pixel_frames.size()) + " pixels");
-  if (impl_->params.guiding) {
-    if (guiding_field.empty()) {
-      impl_->reset_guiding();
-    } else {
-      impl_->guiding = std::make_unique<GuidingField>(GuidingField::deserialize(guiding_field.data(), guiding_field.size()));
-      impl_->tracer->set_guiding(impl_->guiding.get());
-    }
-  }
   impl_->reset_visibility();
   if (impl_->visibility && !environment_visibility.empty()) {
     impl_->visibility->deserialize(environment_visibility.data(), environment_visibility.size());
     impl_->attach_visibility();
   }
+  impl_->frames = frames;
+  impl_->restore_guiding(guiding_field);
   impl_->acc = acc;
   impl_->first_frame = first;
-  impl_->frames = frames;
   if (traced.empty())
     impl_->pixel_frames.assign(impl_->pixel_frames.size(), static_cast<uint32_t>(frames));
   else
@@ -342,6 +370,7 @@ void ProgressiveRenderer::restore(const Accumulation& acc, uint32_t first, int f
 std::vector<uint8_t> ProgressiveRenderer::guiding_field() const {
   return impl_->guiding ? impl_->guiding->serialize() : std::vector<uint8_t>{};
 }
+bool ProgressiveRenderer::guiding_active() const { return impl_->guiding != nullptr; }
 size_t ProgressiveRenderer::guiding_memory_bytes() const { return impl_->guiding ? impl_->guiding->memory_bytes() : 0; }
 std::vector<uint8_t> ProgressiveRenderer::environment_visibility() const {
   return impl_->visibility ? impl_->visibility->serialize() : std::vector<uint8_t>{};

@@ -314,9 +314,29 @@ void Preview::advance_range_buffer() {
   schedule_.pass_ms += last_.range - before;
 }
 
+// u / t of every pixel whose perceived HV noise is above the threshold it is blended at
+// (noise_sigma_s). The blend's background L_f + L_lv is not known before the filter has run; L_u
+// + L_lv, its unfiltered counterpart, stands for it.
+std::vector<float> Preview::noise_over_threshold() const {
+  const Accumulation& acc = renderer_->accumulation();
+  std::vector<float> needed;
+  for (size_t p = 0; p < acc.samples.size(); ++p) {
+    const double variance = acc.variance_of_mean(p), t = effective_threshold(settings_.threshold, acc.samples[p]);
+    const glm::vec3 hv = acc.hv_mean[p], lv = acc.lv_mean[p];
+    const double background = luminance(hv.x, hv.y, hv.z) + luminance(lv.x, lv.y, lv.z);
+    if (!(variance > 0.0) || !(background > 0.0) || !(t > 0.0)) continue;
+    const double ratio = variance / background / background / t;
+    if (ratio > 1.0) needed.push_back(static_cast<float>(std::min(ratio, 1e30)));
+  }
+  return needed;
+}
+
 FilterParams Preview::filter_params_now() const {
   FilterParams p = settings_.filter;
-  if (settings_.shrink_sigma) p.sigma_s = shrunk_sigma_s(p.sigma_s, static_cast<uint64_t>(samples()));
+  if (settings_.shrink_sigma) {
+    std::vector<float> needed = noise_over_threshold();
+    p.sigma_s = noise_sigma_s(p.sigma_s, static_cast<uint64_t>(samples()), needed);
+  }
   return p;
 }
 

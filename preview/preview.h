@@ -45,13 +45,11 @@ struct PreviewSettings {
   // L_f measurably differs from L_u. On: at equal time it lowered the filtered image's error on all
   // four built-in scenes (docs/measurements.md, "Bias guard"); off is the method's blend as published.
   bool bias_guard = true;
-  // Shrink the filter's sigma_s as samples accumulate (shrunk_sigma_s in gl/pass_params.h,
-  // docs/method.md 2.5): filter.sigma_s up to 4 spp, then sigma_s sqrt(4 / n), at least 2 px. Off
-  // by default: it lowers the filtered error a little at equal time once jobs have a few tens of
-  // samples, but with a kernel of 4 px or less the blend's mixed pixels keep well above the
-  // perceived noise t it promises (docs/measurements.md, "Shrinking sigma_s"), and that promise is
-  // the method's.
-  bool shrink_sigma = false;
+  // Shrink the filter's sigma_s to the noise (noise_sigma_s in gl/pass_params.h, docs/method.md
+  // 2.5): the kernel the noisiest pixels need to reach t, between 2 px and filter.sigma_s. On by
+  // default: less bias where samples have accumulated, the full kernel where the noise needs it;
+  // off keeps filter.sigma_s for every run, as the method was published.
+  bool shrink_sigma = true;
   // Adaptive sampling (preview/adaptive.h): after adaptive_params.warmup_frames uniform
   // frames, each frame traces only the pixels the allocation picks, each at its own sample index.
   // Off by default until pxf bench shows it wins.
@@ -171,8 +169,8 @@ class Preview {
   const StageTimes& last_times() const { return last_; }
   const StageTimes& total_times() const { return total_; }
   int filter_runs() const { return filter_runs_; }
-  // The filter's parameters for a run now: settings().filter with sigma_s shrunk for the sample
-  // count when settings().shrink_sigma.
+  // The filter's parameters for a run now: settings().filter with sigma_s shrunk to the noise
+  // (noise_sigma_s) when settings().shrink_sigma.
   FilterParams filter_params_now() const;
   // The sigma_s of the last filter run (0 before the first).
   float last_sigma_s() const { return last_sigma_s_; }
@@ -224,6 +222,7 @@ class Preview {
   std::vector<Layer> buffers();
 
  private:
+  std::vector<float> noise_over_threshold() const;  // filter_params_now's input
   void upload();
   PreviewInputs& pass_inputs() { return combined_now_ ? history_->combined() : inputs_; }
   // reset() without forgetting the history (a camera move keeps it).

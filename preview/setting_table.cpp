@@ -86,6 +86,7 @@ SettingDescriptor choice(const char* key, const char* flag, std::string help, co
 FilterKind& filter_kind(PreviewSettings& s) { return s.filter.kind; }
 FilterSchedule& schedule(PreviewSettings& s) { return s.schedule; }
 SamplerType& sampler(PreviewSettings& s) { return s.trace.sampler; }
+GuidingMode& guiding(PreviewSettings& s) { return s.trace.guiding; }
 
 // The blend's and the filter's settings.
 void add_filter_settings(std::vector<SettingDescriptor>& t) {
@@ -97,10 +98,10 @@ void add_filter_settings(std::vector<SettingDescriptor>& t) {
                      [](PreviewSettings& s) -> float& { return s.filter.sigma_s; }, E::Refilter,
                      {"sigma s (px)", 0.1, kMaxFilterRadius / 3.0, false, "%.2f"}));
   t.push_back(on_off("sigma_shrink", "--sigma-shrink",
-                     "shrink the filter's sigma_s as samples accumulate: --sigma-s up to 4 spp, then\n"
-                     "sigma_s sqrt(4 / spp), at least 2 px (off: --sigma-s for every filter run; on lowers\n"
-                     "the error but mixed pixels keep more noise than t, docs/method.md 2.5)",
-                     [](PreviewSettings& s) -> bool& { return s.shrink_sigma; }, E::Refilter, "shrink sigma s with spp"));
+                     "shrink the filter's sigma_s to the noise: the kernel the noisiest tenth of the pixels\n"
+                     "above t needs to reach it, between 2 px and --sigma-s (--sigma-s up to 4 spp; off:\n"
+                     "--sigma-s for every filter run, docs/method.md 2.5)",
+                     [](PreviewSettings& s) -> bool& { return s.shrink_sigma; }, E::Refilter, "shrink sigma s to the noise"));
   t.push_back(number("sigma_c", "--sigma-c", "range color sigma, linear RGB", 1e-6, 1e6,
                      [](PreviewSettings& s) -> float& { return s.filter.sigma_c; }, E::Refilter,
                      {"sigma c", 1e-4, 10.0, true, "%.3g"}));
@@ -192,11 +193,12 @@ void add_trace_and_display_settings(std::vector<SettingDescriptor>& t) {
     return specular_sampling_mode(a.trace) == specular_sampling_mode(b.trace);
   };
   t.push_back(chains);
-  t.push_back(on_off("guiding", "--guiding",
-                     "path guiding: learn from photons where indirect light comes from (parallax-aware lobes in\n"
-                     "an SD-tree's regions) and send a learned share of every diffuse bounce there,\n"
-                     "MIS-combined with BSDF sampling: unbiased (docs/guiding.md)",
-                     [](PreviewSettings& s) -> bool& { return s.trace.guiding; }, E::Retrace, "path guiding"));
+  t.push_back(choice<&guiding>("guiding", "--guiding",
+                               "path guiding: learn from photons where indirect light comes from (parallax-aware lobes in\n"
+                               "an SD-tree's regions) and send a learned share of every diffuse bounce there,\n"
+                               "MIS-combined with BSDF sampling: unbiased; auto: from the 5th frame on where the scene\n"
+                               "sees at most half of its sky (a room lit through windows), else off (docs/guiding.md)",
+                               guiding_mode_names(), E::Retrace, "path guiding"));
   t.push_back(on_off("environment_visibility", "--env-visibility",
                      "light through openings: learn per region which parts of the environment its shadow rays\n"
                      "find unblocked (a window) and draw up to half of the environment's light samples there,\n"

@@ -230,6 +230,17 @@ TEST(Checkpoint, GuidedResumeAfterSigkillIsBitIdentical) {
   expect_resume_after_kills_is_bit_identical(kScene + " --guiding on", "guided", 3);
 }
 
+// --guiding auto (the default) in a room lit through a window starts guiding at the visibility
+// field's verdict (frame 4): the state holds both fields, so a render killed before or after that
+// frame resumes exactly.
+TEST(Checkpoint, AutoGuidedResumeAfterSigkillIsBitIdentical) {
+  const std::string window = "--scene window --size 40x32 --quiet";
+  const std::string out = temp_dir("auto_guided_probe");
+  ASSERT_EQ(pxf_run("render " + window + " --spp 8 --out " + out).code, 0);
+  EXPECT_EQ(nlohmann::json::parse(slurp(out + "/stats.json"))["guiding_active"], true);
+  expect_resume_after_kills_is_bit_identical(window, "auto_guided", 3);
+}
+
 // Guided shards each learn their own field: their merge is the exact sum of their samples, but it
 // keeps no field, so it is not resumed.
 TEST(Checkpoint, GuidedShardsMergeButAreNotResumed) {
@@ -258,7 +269,7 @@ TEST(Checkpoint, GuidedShardsMergeButAreNotResumed) {
             << layer << " " << p;
       }
   const nlohmann::json stats = nlohmann::json::parse(slurp(merged_dir + "/stats.json"));
-  EXPECT_EQ(stats["settings"]["guiding"], true);
+  EXPECT_EQ(stats["settings"]["guiding"], "on");
   const Result resume = pxf_run("render " + scene + " --spp 32 --resume " + merged_dir + "/state.pxfs --out " +
                                 temp_dir("guided_resumed_merge"));
   EXPECT_EQ(resume.code, 1);
@@ -266,7 +277,7 @@ TEST(Checkpoint, GuidedShardsMergeButAreNotResumed) {
   const Result unguided = pxf_run("render " + kScene + " --spp 16 --resume " + dirs[0] + "/state.pxfs --out " +
                                   temp_dir("unguided_resume"));
   EXPECT_EQ(unguided.code, 1);
-  EXPECT_NE(unguided.err.find("guiding on vs off"), std::string::npos) << unguided.err;
+  EXPECT_NE(unguided.err.find("guiding on vs auto"), std::string::npos) << unguided.err;
 }
 
 TEST(Checkpoint, MergeOfUnevenShardsEqualsOneRender) {

@@ -53,13 +53,17 @@ float sigma_after(const Scene& scene, int frames, bool shrink) {
   return preview.last_sigma_s();
 }
 
-// The preview's filter runs with sigma_s shrunk for the sample count (shrunk_sigma_s), or with
-// --sigma-s itself when shrinking is off; turning it off or on filters again without restarting.
-TEST(PreviewSettings, FilterSigmaShrinksWithTheSampleCount) {
+// The preview's filter runs with sigma_s shrunk to the noise (noise_sigma_s): --sigma-s up to 4
+// spp, then between 2 px and it, less as samples accumulate; --sigma-s itself when shrinking is
+// off; turning it off or on filters again without restarting.
+TEST(PreviewSettings, FilterSigmaShrinksToTheNoise) {
   test_support::headless_context();
   const Scene scene = load_scene("cornell");
   EXPECT_EQ(sigma_after(scene, 4, true), 8.0f);
-  EXPECT_FLOAT_EQ(sigma_after(scene, 16, true), 4.0f);
+  const float at_8 = sigma_after(scene, 8, true), at_64 = sigma_after(scene, 64, true);
+  EXPECT_LT(at_8, 8.0f);
+  EXPECT_LT(at_64, at_8);
+  EXPECT_GE(at_64, kSigmaShrinkMin);
   EXPECT_FLOAT_EQ(sigma_after(scene, 16, false), 8.0f);
   PreviewSettings settings;
   settings.shrink_sigma = true;
