@@ -394,8 +394,8 @@ bool Preview::step_filter_run() {
   if (!open_run_.demodulated) open_run_.filter_ms = filter_.last_ms();
   last_.filter += open_run_.filter_ms;
   filtered_demodulated_ = open_run_.demodulated;
-  schedule_.last_run_ms = open_run_.filter_ms + open_run_.range_ms;
-  schedule_.pass_ms += schedule_.last_run_ms;
+  schedule_.last_run_ms = open_run_.filter_ms;
+  schedule_.pass_ms += open_run_.filter_ms + open_run_.range_ms;
   open_run_ = OpenFilterRun{};
   ++filter_runs_;
   filtered_samples_ = samples();
@@ -594,15 +594,21 @@ bool Preview::range_due() const {
 bool Preview::filter_due_now() const {
   if (!settings_.filtering()) return false;
   if (pending_last_frame_)
-    return filtered_samples_ != samples() && filter_due(settings_.schedule, samples(), true, schedule_);
-  return filter_due(settings_.schedule, samples(), false, schedule_);
+    return filtered_samples_ != samples() && filter_due(settings_.schedule, samples(), true, schedule_now());
+  return filter_due(settings_.schedule, samples(), false, schedule_now());
 }
 
 void Preview::finish_passes() {
   if (settings_.filtering() && filtered_samples_ != samples() &&
-      filter_due(settings_.schedule, samples(), true, schedule_) && filter_worthwhile())
+      filter_due(settings_.schedule, samples(), true, schedule_now()) && filter_worthwhile())
     run_filter();
   blend_and_tonemap();
+}
+
+ScheduleState Preview::schedule_now() const {
+  ScheduleState s = schedule_;
+  s.first_range_ms = range_.frames() == 0 ? range_.last_ms() : 0.0;
+  return s;
 }
 
 TimeBudget Preview::predict_next_frame(double budget_ms, double elapsed_ms) const {
@@ -610,7 +616,7 @@ TimeBudget Preview::predict_next_frame(double budget_ms, double elapsed_ms) cons
   job.schedule = settings_.schedule;
   job.filtering = settings_.filtering();
   job.samples = samples();
-  job.state = schedule_;
+  job.state = schedule_now();
   job.recent_frame_ms = recent_frame_ms_;
   job.display_ms = display_ms_;
   return pxf::predict_next_frame(job, budget_ms, elapsed_ms);

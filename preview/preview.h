@@ -222,6 +222,7 @@ class Preview {
   std::vector<Layer> buffers();
 
  private:
+  ScheduleState schedule_now() const;  // schedule_ with the range frame the next run needs first
   std::vector<float> noise_over_threshold() const;  // filter_params_now's input
   void upload();
   PreviewInputs& pass_inputs() { return combined_now_ ? history_->combined() : inputs_; }

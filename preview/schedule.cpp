@@ -25,7 +25,7 @@ bool is_power_of_two(int n) { return n > 0 && (n & (n - 1)) == 0; }
 
 bool run_fits_share(const ScheduleState& s) {
   if (s.last_run_ms <= 0) return true;  // nothing measured yet: this run measures it
-  return s.pass_ms + s.last_run_ms <= kPassShare * s.tracing_ms;
+  return s.pass_ms + next_run_ms(s) <= kPassShare * s.tracing_ms;
 }
 
 }  // namespace
@@ -60,8 +60,8 @@ TimeBudget predict_next_frame(const MeasuredJob& job, double budget_ms, double e
   after.hv_empty = false;  // the next frame may bring the first HV light: reserve for it
   const bool filtering = job.filtering && !after.all_pixels_case2;
   const bool run_next = filtering && filter_due(job.schedule, job.samples + 1, false, after);
-  t.next_pass_ms = run_next ? job.state.last_run_ms : 0.0;
-  t.finish_ms = (filtering && !run_next ? job.state.last_run_ms : 0.0) + job.display_ms;
+  t.next_pass_ms = run_next ? next_run_ms(job.state) : 0.0;
+  t.finish_ms = (filtering && !run_next ? next_run_ms(job.state) : 0.0) + job.display_ms;
   return t;
 }
 

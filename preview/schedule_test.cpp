@@ -190,6 +190,31 @@ TEST(TimeBudget, StopsSoThatTheFinishEndsWithinTheBudget) {
         }
 }
 
+// The next run renders a range frame first only while the guide has none (the first run, a new
+// camera): the finish of a job whose guide exists reserves the run's own work and the display, and
+// the budget schedule's share counts the range frame only where it is due.
+TEST(TimeBudget, ReservesTheRangeFrameOnlyWhileTheGuideHasNone) {
+  MeasuredJob job;
+  job.schedule = FilterSchedule::Final;
+  job.state.hv_empty = false;
+  job.samples = 5;
+  job.state.tracing_ms = 50;
+  job.recent_frame_ms = {10};
+  job.state.last_run_ms = 30;
+  job.display_ms = 5;
+  EXPECT_DOUBLE_EQ(predict_next_frame(job, 1000, 0).finish_ms, 35.0);
+  job.state.first_range_ms = 20;
+  EXPECT_DOUBLE_EQ(predict_next_frame(job, 1000, 0).finish_ms, 55.0);
+  ScheduleState s;
+  s.hv_empty = false;
+  s.tracing_ms = 1000;
+  s.pass_ms = 40;
+  s.last_run_ms = 50;  // 40 + 50 within 10 % of 1000
+  EXPECT_TRUE(filter_due(FilterSchedule::Budget, 64, false, s));
+  s.first_range_ms = 20;  // 40 + 50 + 20 is not
+  EXPECT_FALSE(filter_due(FilterSchedule::Budget, 64, false, s));
+}
+
 TEST(TimeBudget, NoBudgetNeverStops) {
   TimeBudget t;
   t.elapsed_ms = 1e12;

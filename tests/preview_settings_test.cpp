@@ -77,4 +77,26 @@ TEST(PreviewSettings, FilterSigmaShrinksToTheNoise) {
   EXPECT_EQ(preview.last_sigma_s(), 8.0f);
 }
 
+// `--time` reserves for the last frame's filter run its own work, without the range frame the
+// first run rendered: the guide exists by then. After a camera change the next run renders one
+// first, and the reserve grows by that frame's cost.
+TEST(PreviewSettings, TimeBudgetReservesARangeFrameOnlyForANewGuide) {
+  test_support::headless_context();
+  const Scene scene = load_scene("cornell");
+  PreviewSettings settings;  // schedule final: one measuring run, then the last frame's
+  settings.motion_history = false;
+  Preview preview(scene, settings, 48, 32);
+  preview.add_frame(/*last_frame=*/false, /*display=*/true);
+  preview.add_frame();
+  ASSERT_EQ(preview.filter_runs(), 1);
+  ASSERT_GT(preview.range().frames(), 0);
+  ASSERT_GT(preview.range().last_ms(), 0.0);
+  const double with_guide = preview.predict_next_frame(1e9, 0).finish_ms;
+  Camera moved = scene.camera;
+  moved.camera_to_world[3] += glm::vec4(0.01f, 0.0f, 0.0f, 0.0f);
+  preview.set_camera(moved);
+  ASSERT_EQ(preview.range().frames(), 0);
+  EXPECT_DOUBLE_EQ(preview.predict_next_frame(1e9, 0).finish_ms - with_guide, preview.range().last_ms());
+}
+
 }  // namespace
