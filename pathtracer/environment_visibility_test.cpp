@@ -189,8 +189,11 @@ TEST(EnvironmentVisibility, SerializesExactlyAndRefusesOthers) {
   EXPECT_EQ(c.serialize(), bytes);  // a refused state leaves the field as it was
 }
 
+// Light through openings alone: without the guiding that --guiding auto starts in such a room, so
+// that these figures and resumes are the visibility field's (guiding's own: guiding_test.cpp).
 TraceParams room_params(bool visibility, uint64_t seed) {
   TraceParams params;
+  params.guiding = GuidingMode::Off;
   params.environment_visibility = visibility;
   params.seed = seed;
   params.threads = 2;
