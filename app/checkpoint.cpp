@@ -102,7 +102,8 @@ void Checkpointer::start(Preview& preview) const {
                 ", which do not start this render's frames " + frame_ranges_text({range_}));
   const std::string no_field = options_.resume + ": the state holds no guiding field (a merge of guided shards), so it "
                                "cannot be continued exactly";
-  if (state.settings.guiding == static_cast<uint32_t>(GuidingMode::On) && state.guiding_field.empty()) throw Error(no_field);
+  const bool guiding_on = state.settings.guiding == static_cast<uint32_t>(GuidingMode::On);
+  if (guiding_on && state.guiding_field.empty()) throw Error(no_field);
   preview.load_state(state);
   // Auto: a render that had started guiding by the frames saved (its visibility field's verdict)
   // restarts it at once when the state has no field.

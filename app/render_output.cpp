@@ -53,8 +53,9 @@ nlohmann::json stats_json(Preview& preview, const RenderReport& r) {
   j["filter_range_share_of_tracing"] = pass_share_of_tracing(total);
   j["load_ms"] = r.load_ms;
   j["peak_memory_mib"] = peak_memory_mib();
-  j["guiding_active"] = preview.renderer().guiding_active();  // under --guiding auto, whether it started
-  if (preview.renderer().guiding_active()) j["guiding_field_bytes"] = preview.renderer().guiding_memory_bytes();  // docs/guiding.md
+  // docs/guiding.md: under --guiding auto, whether it started, and the field's size.
+  j["guiding_active"] = preview.renderer().guiding_active();
+  if (preview.renderer().guiding_active()) j["guiding_field_bytes"] = preview.renderer().guiding_memory_bytes();
   // Light through openings: the regions that sample what they learned of the visible sky (docs/sampling.md).
   if (s.trace.environment_visibility) j["environment_visibility_regions"] = preview.renderer().environment_visibility_regions();
   // The loader's estimate (docs/robustness.md), beside the peak it bounds: 0 for a built-in scene.

@@ -103,8 +103,8 @@ class PathTracer {
 
   // Path guiding (TraceParams::guiding, docs/guiding.md): traces whose params.guiding is not Off
   // sample from `field` once it is trained(), and trace_guiding_photons records into it; nullptr
-  // (the default, and Auto's until it starts) traces without guiding whatever params.guiding says. The field must not change
-  // (apply_records, end_iteration) while a trace runs.
+  // (the default, and Auto's until it starts) traces without guiding whatever params.guiding
+  // says. The field must not change (apply_records, end_iteration) while a trace runs.
   void set_guiding(GuidingField* field) { guiding_ = field; }
   // Light through openings (TraceParams::environment_visibility, environment_visibility.h): NEE
   // toward the environment samples what each vertex's region learned of the visible sky, and every

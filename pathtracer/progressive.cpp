@@ -164,7 +164,8 @@ struct ProgressiveRenderer::Impl {
     arena->execute([&] {
       tracer->trace_guiding_photons(frame, photons, params);
       guiding->apply_records();
-      if (GuidingField::iteration_ends_after(static_cast<uint64_t>(frames.load()) - guiding_start)) guiding->end_iteration();
+      const uint64_t learned_frames = static_cast<uint64_t>(frames.load()) - guiding_start;
+      if (GuidingField::iteration_ends_after(learned_frames)) guiding->end_iteration();
     });
   }
 
@@ -175,9 +176,12 @@ struct ProgressiveRenderer::Impl {
     guiding_start = 0;
     if (params.guiding != GuidingMode::Off && !field.empty()) {
       guiding = std::make_unique<GuidingField>(GuidingField::deserialize(field.data(), field.size()));
-      // Auto's field started at the visibility field's verdict, kDormantCheckFrame frames after it started.
-      if (params.guiding == GuidingMode::Auto && visibility)
-        guiding_start = static_cast<uint64_t>(frames.load()) - visibility->frames() + EnvironmentVisibility::kDormantCheckFrame;
+      // Auto's field started at the visibility field's verdict, kDormantCheckFrame frames after
+      // the visibility field started.
+      if (params.guiding == GuidingMode::Auto && visibility) {
+        const uint64_t visibility_start = static_cast<uint64_t>(frames.load()) - visibility->frames();
+        guiding_start = visibility_start + EnvironmentVisibility::kDormantCheckFrame;
+      }
     } else if (params.guiding == GuidingMode::On) {
       start_guiding();
     } else {
