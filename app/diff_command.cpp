@@ -283,8 +283,9 @@ int run_diff(const Args& args) {
   bool perfect_filter = false;
   DisplayMetricOptions display;
   CommandLine cli("diff", "TEST.exr REFERENCE.exr [options]",
-                  "Prints NRMSE (% of the reference mean), RMSE, relative MSE, max |difference| and the\n"
-                  "NaN/Inf count of TEST against REFERENCE over their shared color channels. For RGB images\n"
+                  "Prints NRMSE (% of the reference mean), RMSE, relative MSE, max |difference|, the mean\n"
+                  "ratio (test / reference) and the NaN/Inf count of TEST against REFERENCE over their shared\n"
+                  "color channels. For RGB images\n"
                   "also the display-space NRMSE (both tone-mapped with the reference's Reinhard key and\n"
                   "log-average luminance, compared as sRGB values) and the mean LDR-FLIP of those display\n"
                   "images and the count of outlier pixels (luminance above 5x the reference's, the reference floored\n"

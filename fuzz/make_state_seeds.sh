@@ -36,7 +36,7 @@ head -c 400 c/state.pxfs > "$SEEDS/truncated.pxfs"
 python3 - f/state.pxfs "$SEEDS/frames_2pow31.pxfs" <<'PY'
 import struct, sys
 data = bytearray(open(sys.argv[1], "rb").read()[:-8])
-# After the magic (8), version (4) and settings (60 bytes at version 9), the range count (4), then
+# After the magic (8), version (4) and settings (60 bytes at version 10), the range count (4), then
 # the first range's begin and end.
 settings_end = 8 + 4 + 60
 assert struct.unpack_from("<I", data, settings_end)[0] == 1, "one frame range expected"

@@ -10,7 +10,7 @@ BlendPass::BlendPass(int width, int height)
       guard_columns_program_(Program::from_embedded("fullscreen.vert", "bias_guard_columns.frag")),
       output_(width, height, TextureFormat::RGBA32F), case_(width, height, TextureFormat::R32F),
       guard_rows_(width, height, TextureFormat::RGBA32F), guard_rows_low_x_(width, height, TextureFormat::RGBA32F),
-      guard_rows_high_x_(width, height, TextureFormat::RGBA32F), guard_(width, height, TextureFormat::RG32F),
+      guard_rows_high_x_(width, height, TextureFormat::RGBA32F), guard_(width, height, TextureFormat::RGBA32F),
       counts_(sizeof(uint32_t) * kBlendCaseCount) {
   fbo_.attach(0, output_);
   fbo_.attach(1, case_);
@@ -23,7 +23,7 @@ BlendPass::BlendPass(int width, int height)
   guard_fbo_.check("blend pass, bias guard");
 }
 
-void BlendPass::run_bias_guard(const PreviewInputs& inputs, const Texture2D& filtered) {
+void BlendPass::run_bias_guard(const PreviewInputs& inputs, const Texture2D& filtered, bool split) {
   ++guard_runs_;
   guard_rows_program_.use();
   guard_rows_program_.bind(shared::kUnitHv, inputs.hv());
@@ -35,6 +35,9 @@ void BlendPass::run_bias_guard(const PreviewInputs& inputs, const Texture2D& fil
   guard_columns_program_.bind(shared::kUnitGuardRowsHighX, guard_rows_high_x_);
   guard_columns_program_.bind(shared::kUnitHv, inputs.hv());
   guard_columns_program_.bind(shared::kUnitFiltered, filtered);
+  guard_columns_program_.bind(shared::kUnitHalves, inputs.halves());
+  guard_columns_program_.bind(shared::kUnitHalfVariances, inputs.half_variances());
+  guard_columns_program_.set("split", split ? 1 : 0);
   quad_.draw(guard_columns_program_, guard_fbo_, width_, height_);
 }
 
@@ -53,11 +56,13 @@ void BlendPass::run(const PreviewInputs& inputs, const Texture2D* filtered, cons
     throw Error("blend pass: input size differs from the pass size");
   timer_.begin();
   const bool guard = params.bias_guard && filtered;
-  if (guard) run_bias_guard(inputs, *filtered);
+  const bool split = params.split && inputs.has_halves();
+  if (guard) run_bias_guard(inputs, *filtered, split);
   if (!guide) surface = nullptr;
   RangeWeights range = params.range;
   if (!surface) range.k_n = range.k_r = 0.0f;  // no surface buffer: no surface terms
   last_ = LastRun{&inputs.hv(), &inputs.lv(), filtered, guide, filtered ? centre_weight : nullptr, surface,
+                  split ? &inputs.halves() : nullptr, split ? &inputs.half_variances() : nullptr,
                   shared::BlendSwitches{filtered != nullptr, guide != nullptr, guard, t, params.samples}, range};
   program_.set("has_filtered", last_.switches.has_filtered ? 1 : 0);
   program_.set("has_guide", last_.switches.has_guide ? 1 : 0);
@@ -69,6 +74,7 @@ void BlendPass::run(const PreviewInputs& inputs, const Texture2D* filtered, cons
   program_.set("t", t);
   program_.set("samples", last_.switches.samples);
   program_.set("bias_guard", last_.switches.bias_guard ? 1 : 0);
+  program_.set("split", split ? 1 : 0);
   const std::array<uint32_t, kBlendCaseCount> zeros{};
   counts_.upload(zeros.data(), sizeof zeros);
   counts_.bind_storage(shared::kBufferCounts);
@@ -81,6 +87,8 @@ void BlendPass::run(const PreviewInputs& inputs, const Texture2D* filtered, cons
   program_.bind(shared::kUnitSurface, surface ? *surface : inputs.hv());
   program_.bind(shared::kUnitCentreWeight, centre_weight ? *centre_weight : inputs.hv());
   program_.bind(shared::kUnitGuardSums, guard_);
+  program_.bind(shared::kUnitHalves, inputs.halves());
+  program_.bind(shared::kUnitHalfVariances, inputs.half_variances());
   quad_.draw(program_, fbo_, width_, height_);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
   timer_.end();
@@ -115,19 +123,28 @@ BlendInspection BlendPass::inspect(int x, int y) const {
   i.switches = last_.switches;
   i.texels = {last_.hv->texel(x, y), last_.lv->texel(x, y), (last_.filtered ? last_.filtered : last_.hv)->texel(x, y),
               last_.guide ? last_.guide->texel(x, y).a : 0.0f};
-  i.variance_inputs = shared::blend_variance_inputs_none();
-  if (shared::blend_compares_variances(i.texels, i.switches)) {
-    if (last_.guide)
-      i.variance_inputs.var_u_pooled =
-          shared::pooled_var_u(TextureTexels{last_.hv}, TextureTexels{last_.guide}, TextureTexels{last_.surface}, p,
-                               last_.range.k_c, last_.range.k_d, last_.range.k_n, last_.range.k_r);
-    if (last_.centre_weight) i.variance_inputs.centre_weight = last_.centre_weight->texel(x, y).r;
-    if (last_.switches.bias_guard) {
-      const glm::vec4 g = guard_.texel(x, y);
-      i.variance_inputs.guard = {g.x, g.y};
-    }
+  shared::PooledNeighbours pooled{0.0, 0.0, 0.0};
+  if (last_.guide && shared::blend_case_before_variances(i.texels, i.switches) == shared::kCaseByVariances)
+    pooled = shared::pooled_neighbours(TextureTexels{last_.hv}, TextureTexels{last_.guide},
+                                       TextureTexels{last_.surface}, p, last_.range.k_c, last_.range.k_d,
+                                       last_.range.k_n, last_.range.k_r);
+  const glm::vec4 guard = last_.switches.bias_guard ? guard_.texel(x, y) : glm::vec4(0.0f);
+  const float centre_weight = last_.centre_weight ? last_.centre_weight->texel(x, y).r : 0.0f;
+  auto inputs = [&](const shared::BlendTexels& px, glm::vec2 g) {
+    return shared::blend_variance_inputs(px, i.switches, pooled, centre_weight, g);
+  };
+  i.split = last_.halves != nullptr;
+  if (!i.split) {
+    i.variance_inputs = inputs(i.texels, glm::vec2(guard.x, guard.y));
+    i.decision = shared::blend_pixel(i.texels, i.switches, i.variance_inputs);
+    return i;
   }
-  i.decision = shared::blend_pixel(i.texels, i.switches, i.variance_inputs);
+  i.halves = last_.halves->texel(x, y);
+  i.half_variances = glm::vec2(last_.half_variances->texel(x, y));
+  i.variance_inputs = inputs(shared::decision_texels(i.texels, i.half_variances, 0), glm::vec2(guard.x, guard.y));
+  i.odd_variance_inputs = inputs(shared::decision_texels(i.texels, i.half_variances, 1), glm::vec2(guard.z, guard.w));
+  i.decision = shared::blend_pixel_split(i.texels, i.halves, i.half_variances, i.switches, i.variance_inputs,
+                                         i.odd_variance_inputs);
   return i;
 }
 

@@ -22,8 +22,12 @@ namespace pxf {
 struct BlendInspection {
   shared::BlendTexels texels;
   shared::BlendSwitches switches;
-  shared::BlendVarianceInputs variance_inputs;
+  shared::BlendVarianceInputs variance_inputs;  // under the split decision, the even half's
   shared::BlendPixel decision;
+  bool split = false;  // decided by halves (shared::blend_pixel_split)
+  glm::vec4 halves{0.0f};
+  glm::vec2 half_variances{0.0f};
+  shared::BlendVarianceInputs odd_variance_inputs{};
 };
 
 class BlendPass {
@@ -65,7 +69,7 @@ class BlendPass {
   // The bias guard's finding (bias_guard_estimate in shaders/pass_formulas.h) into guard_: a row
   // pass of 5 reads writes the row sums of three x ranges, a column pass of 5 reads of each adds
   // them into the 5x5 window and its four halves and judges them.
-  void run_bias_guard(const PreviewInputs& inputs, const Texture2D& filtered);
+  void run_bias_guard(const PreviewInputs& inputs, const Texture2D& filtered, bool split);
 
   // What the last run read and its switches (the shader's uniforms), for inspect().
   struct LastRun {
@@ -75,6 +79,8 @@ class BlendPass {
     const Texture2D* guide = nullptr;
     const Texture2D* centre_weight = nullptr;
     const Texture2D* surface = nullptr;
+    const Texture2D* halves = nullptr;  // the split decision's; nullptr: one decision
+    const Texture2D* half_variances = nullptr;
     shared::BlendSwitches switches{};
     RangeWeights range;
   };

@@ -28,9 +28,9 @@ struct TexelView {
 TexelView lv_view(const Image& lv) { return TexelView{&lv, nullptr, 1.0f}; }
 glm::vec4 texelFetch(const TexelView& t, glm::ivec2 p, int) {
   glm::vec4 v(0.0f, 0.0f, 0.0f, t.a_default);
-  if (t.rgb) {
-    v = glm::vec4(t.rgb->at(p.x, p.y, 0), t.rgb->at(p.x, p.y, 1), t.rgb->at(p.x, p.y, 2), t.a_default);
-    if (t.rgb->num_channels() >= 4) v.a = t.rgb->at(p.x, p.y, 3);
+  if (t.rgb) {  // the channels it has (a two-channel image reads (x, y, 0, a_default), as an RG texture)
+    const int channels = std::min(t.rgb->num_channels(), 4);
+    for (int c = 0; c < channels; ++c) v[c] = t.rgb->at(p.x, p.y, c);
   }
   if (t.a) v.a = t.a->at(p.x, p.y, 0);
   return v;
@@ -73,16 +73,18 @@ struct KernelSums {
 }  // namespace
 
 bool case2_skip_decision(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
-                         const Image& depth, const FilterParams& p, float t, int x, int y, const Image* surface) {
+                         const Image& depth, const FilterParams& p, float t, int x, int y, const Image* surface,
+                         const Image* half_variances) {
   const RangeWeights range = range_weights(p);
-  return shared::skip_as_case2(TexelView{&hv, &var_u}, lv_view(lv), TexelView{&range_color, &depth},
-                               surface_view(surface), glm::ivec2(x, y), range.k_c, range.k_d, range.k_n, range.k_r, t);
+  return shared::skip_pixel(filter_skip_mode(p, half_variances != nullptr), TexelView{&hv, &var_u}, lv_view(lv),
+                            TexelView{&range_color, &depth}, surface_view(surface), TexelView{half_variances},
+                            glm::ivec2(x, y), range.k_c, range.k_d, range.k_n, range.k_r, t);
 }
 
 bool skip_as_case2(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
                    const Image& depth, const FilterParams& p, float t, int x, int y, FilterOutput& out,
-                   const Image* surface) {
-  if (!case2_skip_decision(hv, var_u, lv, range_color, depth, p, t, x, y, surface)) return false;
+                   const Image* surface, const Image* half_variances) {
+  if (!case2_skip_decision(hv, var_u, lv, range_color, depth, p, t, x, y, surface, half_variances)) return false;
   const Px lu = rgb_at(hv, x, y);
   for (int c = 0; c < 3; ++c) out.filtered.at(x, y, c) = lu.c[c];
   out.variance.at(x, y, 0) = kVarSkipped;
@@ -113,7 +115,8 @@ namespace {
 // the radius; skipping (final pass only) looks at the unfiltered hv / var_u.
 FilterOutput filter_once(const Image& signal, const Image& signal_var, const Image& hv, const Image& var_u,
                          const Image& lv, const Image& range_color, const Image& depth, const Image* surface,
-                         const FilterParams& p, float t, int ex, int ey, bool final_pass) {
+                         const FilterParams& p, float t, int ex, int ey, bool final_pass,
+                         const Image* half_variances) {
   const int w = hv.width, h = hv.height;
   FilterOutput out{Image::rgb(w, h), Image::gray(w, h), Image::gray(w, h, "Y", 1.0f)};
   const int radius = std::min(kMaxFilterRadius, static_cast<int>(std::ceil(3.0f * std::max(p.sigma_s, 0.0f))));
@@ -121,7 +124,9 @@ FilterOutput filter_once(const Image& signal, const Image& signal_var, const Ima
   const RangeWeights range = range_weights(p);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
-      if (final_pass && p.skip_case2 && skip_as_case2(hv, var_u, lv, range_color, depth, p, t, x, y, out, surface)) continue;
+      if (final_pass && p.skip_case2 &&
+          skip_as_case2(hv, var_u, lv, range_color, depth, p, t, x, y, out, surface, half_variances))
+        continue;
       KernelSums sums;
       for (int qy = std::max(0, y - radius * ey); qy <= std::min(h - 1, y + radius * ey); ++qy)
         for (int qx = std::max(0, x - radius * ex); qx <= std::min(w - 1, x + radius * ex); ++qx) {
@@ -141,7 +146,8 @@ FilterOutput filter_once(const Image& signal, const Image& signal_var, const Ima
 // sums are normalized). Skipping (final pass only) looks at the unfiltered hv / var_u.
 FilterOutput atrous_pass(const Image& signal, const Image& signal_var, const Image& hv, const Image& var_u,
                          const Image& lv, const Image& range_color, const Image& depth, const Image* surface,
-                         const FilterParams& p, float t, int step, float variance_factor, bool final_pass) {
+                         const FilterParams& p, float t, int step, float variance_factor, bool final_pass,
+                         const Image* half_variances) {
   const int w = hv.width, h = hv.height;
   FilterOutput out{Image::rgb(w, h), Image::gray(w, h), Image{}};
   const RangeWeights range = range_weights(p);
@@ -153,7 +159,9 @@ FilterOutput atrous_pass(const Image& signal, const Image& signal_var, const Ima
         out.variance.at(x, y, 0) = final_pass ? kVarSkipped : signal_var.at(x, y, 0);
         continue;
       }
-      if (final_pass && p.skip_case2 && skip_as_case2(hv, var_u, lv, range_color, depth, p, t, x, y, out, surface)) continue;
+      if (final_pass && p.skip_case2 &&
+          skip_as_case2(hv, var_u, lv, range_color, depth, p, t, x, y, out, surface, half_variances))
+        continue;
       KernelSums sums;
       double h_sum = 0;
       const float var_p = atrous_k_l(p) > 0.0f ? shared::edge_stop_variance(TexelView{&signal, &signal_var}, glm::ivec2(x, y))
@@ -183,12 +191,13 @@ FilterOutput atrous_pass(const Image& signal, const Image& signal_var, const Ima
 // weights are 1 (Atrous.WhiteNoiseVarianceShrinksBySumOfSquaredWeights in gl/passes_test.cpp),
 // scaled per pixel by the share of the kernel its range weights keep (atrous_local_correction).
 FilterOutput cpu_atrous(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
-                        const Image& depth, const Image* surface, const FilterParams& p, float t) {
+                        const Image& depth, const Image* surface, const FilterParams& p, float t,
+                        const Image* half_variances) {
   const int passes = atrous_iterations(p.sigma_s);
   FilterOutput level{hv, var_u, Image{}};
   for (int i = 0; i < passes; ++i)
     level = atrous_pass(level.filtered, level.variance, hv, var_u, lv, range_color, depth, surface, p, t, 1 << i,
-                        atrous_variance_correction(i), i + 1 == passes);
+                        atrous_variance_correction(i), i + 1 == passes, half_variances);
   return level;
 }
 
@@ -198,14 +207,16 @@ FilterOutput cpu_atrous(const Image& hv, const Image& var_u, const Image& lv, co
 // its count x the range weights (the spatial weight is in the tap density), taps outside the image
 // left out. Mirrors shaders/subsampled.frag.
 FilterOutput cpu_subsampled(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
-                            const Image& depth, const Image* surface, const FilterParams& p, float t) {
+                            const Image& depth, const Image* surface, const FilterParams& p, float t,
+                            const Image* half_variances) {
   const int w = hv.width, h = hv.height;
   FilterOutput out{Image::rgb(w, h), Image::gray(w, h), Image{}};
   const RangeWeights range = range_weights(p);
   const SubsampledTapTable table = subsampled_tap_table(p.sigma_s, p.subsampled_taps > 0 ? p.subsampled_taps : kSubsampledTaps);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
-      if (p.skip_case2 && skip_as_case2(hv, var_u, lv, range_color, depth, p, t, x, y, out, surface)) continue;
+      if (p.skip_case2 && skip_as_case2(hv, var_u, lv, range_color, depth, p, t, x, y, out, surface, half_variances))
+        continue;
       KernelSums sums;
       const SubsampledTap* taps = &table.taps[static_cast<size_t>(subsampled_rotation(x, y)) * table.per_rotation];
       for (int i = 0; i < table.per_rotation && taps[i].count > 0; ++i) {
@@ -222,22 +233,57 @@ FilterOutput cpu_subsampled(const Image& hv, const Image& var_u, const Image& lv
 }  // namespace
 
 FilterOutput cpu_filter(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
-                        const Image& depth, const FilterParams& p, float t, const Image* surface) {
+                        const Image& depth, const FilterParams& p, float t, const Image* surface,
+                        const Image* half_variances) {
   if (p.kind == FilterKind::None) throw Error("cpu_filter: filter kind none");
-  if (p.kind == FilterKind::Atrous) return cpu_atrous(hv, var_u, lv, range_color, depth, surface, p, t);
-  if (p.kind == FilterKind::Subsampled) return cpu_subsampled(hv, var_u, lv, range_color, depth, surface, p, t);
-  if (p.kind == FilterKind::Grid) return cpu_grid_filter(hv, var_u, lv, range_color, depth, p, t, surface);
-  if (p.kind != FilterKind::Separable) return filter_once(hv, var_u, hv, var_u, lv, range_color, depth, surface, p, t, 1, 1, true);
-  FilterOutput rows = filter_once(hv, var_u, hv, var_u, lv, range_color, depth, surface, p, t, 1, 0, false);
-  FilterOutput out = filter_once(rows.filtered, rows.variance, hv, var_u, lv, range_color, depth, surface, p, t, 0, 1, true);
+  if (p.kind == FilterKind::Atrous) return cpu_atrous(hv, var_u, lv, range_color, depth, surface, p, t, half_variances);
+  if (p.kind == FilterKind::Subsampled)
+    return cpu_subsampled(hv, var_u, lv, range_color, depth, surface, p, t, half_variances);
+  if (p.kind == FilterKind::Grid)
+    return cpu_grid_filter(hv, var_u, lv, range_color, depth, p, t, surface, half_variances);
+  if (p.kind != FilterKind::Separable)
+    return filter_once(hv, var_u, hv, var_u, lv, range_color, depth, surface, p, t, 1, 1, true, half_variances);
+  FilterOutput rows = filter_once(hv, var_u, hv, var_u, lv, range_color, depth, surface, p, t, 1, 0, false, nullptr);
+  FilterOutput out = filter_once(rows.filtered, rows.variance, hv, var_u, lv, range_color, depth, surface, p, t, 0,
+                                 1, true, half_variances);
   out.centre_weight = Image();  // the second pass's centre weight alone would understate it: none
   return out;
 }
 
-// shared::blend_pixel on the images; the guard's finding by the definition of its windows.
+namespace {
+
+// The guard's finding at p, (b2, var_u) of each half (the even half's pixel window judged on the odd
+// half, and the other way round), or the one finding twice, by the definition of its windows.
+glm::vec4 guard_findings(const TexelView& hv, const TexelView& filtered, glm::ivec2 p, const BlendHalves& halves) {
+  const int r = shared::kBiasGuardRadius;
+  auto window = [&](glm::ivec2 lo, glm::ivec2 hi) { return shared::bias_guard_window_sums(hv, filtered, p, lo, hi); };
+  const glm::vec4 full = window({-r, -r}, {r, r}), low_y = window({-r, -r}, {r, 0}), high_y = window({-r, 0}, {r, r});
+  const glm::vec4 low_x = window({-r, -r}, {0, r}), high_x = window({0, -r}, {r, r});
+  const glm::vec4 own = shared::bias_guard_texel(hv, filtered, p);
+  if (!halves.halves) {
+    const shared::BiasGuardEstimate e = shared::bias_guard_estimate(full, low_y, high_y, low_x, high_x, own);
+    return {e.b2, e.var_u, e.b2, e.var_u};
+  }
+  const glm::vec4 u = texelFetch(hv, p, 0), f = texelFetch(filtered, p, 0);
+  const glm::vec4 h = texelFetch(TexelView{halves.halves}, p, 0);
+  const glm::vec2 v(halves.variances->at(p.x, p.y, 0), halves.variances->at(p.x, p.y, 1));
+  auto finding = [&](int which) {  // half `which`'s finding, the other half read at the pixel
+    const glm::vec4 other = shared::bias_guard_texel_of(shared::half_texel(u, h, v, 1 - which), f);
+    const shared::BiasGuardEstimate e = shared::half_guard_estimate(full, low_y, high_y, low_x, high_x, own, other);
+    return glm::vec2(e.b2, e.var_u);
+  };
+  return {finding(0), finding(1)};
+}
+
+}  // namespace
+
+// shared::blend_pixel (or blend_pixel_split) on the images; the guard's finding by the definition
+// of its windows.
 BlendOutput cpu_blend(const Image& lv, const Image& hv, const Image& var_u, const FilterOutput* filtered, float t,
-                      const BlendParams& params, const Image* range_color, const Image* depth, const Image* surface) {
+                      const BlendParams& params, const Image* range_color, const Image* depth, const Image* surface,
+                      BlendHalves halves) {
   const bool pool = range_color && depth;
+  if (!params.split || !halves.variances) halves.halves = nullptr;
   const int w = hv.width, h = hv.height;
   BlendOutput out{Image::rgb(w, h), Image::gray(w, h), Image::gray(w, h)};
   const TexelView hv_texels{&hv, &var_u};
@@ -248,13 +294,28 @@ BlendOutput cpu_blend(const Image& lv, const Image& hv, const Image& var_u, cons
       const glm::ivec2 p(x, y);
       const shared::BlendTexels px{texelFetch(hv_texels, p, 0), texelFetch(lv_view(lv), p, 0),
                                    texelFetch(filtered_texels, p, 0), pool ? depth->at(x, y, 0) : 0.0f};
-      shared::BlendVarianceInputs v = shared::blend_variance_inputs_none();
+      shared::PooledNeighbours pooled{0.0, 0.0, 0.0};
+      glm::vec4 guard(0.0f);
+      float centre_weight = 0.0f;
       if (shared::blend_compares_variances(px, on)) {
-        if (pool) v.var_u_pooled = pooled_var_u(var_u, *range_color, *depth, x, y, params.range, surface);
-        if (!filtered->centre_weight.pixels.empty()) v.centre_weight = filtered->centre_weight.at(x, y, 0);
-        if (params.bias_guard) v.guard = shared::bias_guard_estimate_at(hv_texels, filtered_texels, p);
+        if (pool)
+          pooled = shared::pooled_neighbours(hv_texels, TexelView{range_color, depth}, surface_view(surface), p,
+                                             params.range.k_c, params.range.k_d, params.range.k_n, params.range.k_r);
+        if (!filtered->centre_weight.pixels.empty()) centre_weight = filtered->centre_weight.at(x, y, 0);
+        if (params.bias_guard) guard = guard_findings(hv_texels, filtered_texels, p, halves);
       }
-      const shared::BlendPixel b = shared::blend_pixel(px, on, v);
+      auto inputs = [&](const shared::BlendTexels& decided, glm::vec2 finding) {
+        return shared::blend_variance_inputs(decided, on, pooled, centre_weight, finding);
+      };
+      shared::BlendPixel b;
+      if (halves.halves) {
+        const glm::vec4 hl = texelFetch(TexelView{halves.halves}, p, 0);
+        const glm::vec2 hv2(halves.variances->at(x, y, 0), halves.variances->at(x, y, 1));
+        b = shared::blend_pixel_split(px, hl, hv2, on, inputs(shared::decision_texels(px, hv2, 0), {guard.x, guard.y}),
+                                      inputs(shared::decision_texels(px, hv2, 1), {guard.z, guard.w}));
+      } else {
+        b = shared::blend_pixel(px, on, inputs(px, {guard.x, guard.y}));
+      }
       for (int c = 0; c < 3; ++c) out.final_rgb.at(x, y, c) = b.radiance[c];
       out.s.at(x, y, 0) = b.s;
       out.blend_case.at(x, y, 0) = static_cast<float>(b.blend_case);
@@ -264,7 +325,7 @@ BlendOutput cpu_blend(const Image& lv, const Image& hv, const Image& var_u, cons
 
 DemodulatedInputs cpu_demodulate(const Image& hv, const Image& var_u, const Image& lv, const Image& albedo,
                                  const Image& range_color, const Image& depth, const FilterParams& p, float t,
-                                 const Image* surface) {
+                                 const Image* surface, const Image* half_variances) {
   const int w = hv.width, h = hv.height;
   DemodulatedInputs out{Image::rgb(w, h), Image::gray(w, h), Image::rgb(w, h)};
   for (int y = 0; y < h; ++y)
@@ -272,7 +333,8 @@ DemodulatedInputs cpu_demodulate(const Image& hv, const Image& var_u, const Imag
       const glm::vec4 d = shared::demodulated_texel(TexelView{&hv, &var_u}, TexelView{&albedo}, glm::ivec2(x, y));
       for (int c = 0; c < 3; ++c) out.hv.at(x, y, c) = d[c];
       out.var_u.at(x, y, 0) = d.a;
-      const bool skip = p.skip_case2 && case2_skip_decision(hv, var_u, lv, range_color, depth, p, t, x, y, surface);
+      const bool skip =
+          p.skip_case2 && case2_skip_decision(hv, var_u, lv, range_color, depth, p, t, x, y, surface, half_variances);
       for (int c = 0; c < 3; ++c) out.lv.at(x, y, c) = skip ? kMaxInput : -kMaxInput;
     }
   return out;

@@ -52,20 +52,23 @@ struct FilterOutput {
 };
 // t: the blend threshold, for the case-2 skip. surface: the range pass's surface buffer ("X,Y,Z,R":
 // shading normal, roughness) for the range weight's surface terms; nullptr: none (terms left out).
+// half_variances: the split decision's (two channels, V_even and V_odd, PreviewInputs::upload_halves),
+// which the skip reads under params.split (filter_skip_mode); nullptr: none.
 FilterOutput cpu_filter(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
-                        const Image& depth, const FilterParams& params, float t, const Image* surface = nullptr);
+                        const Image& depth, const FilterParams& params, float t, const Image* surface = nullptr,
+                        const Image* half_variances = nullptr);
 
 // The filter's case-2 skip (FilterParams::skip_case2, final pass only): the blend's u (pooled
 // variance) with the unfiltered background; a zero variance is not trusted. Writes the skip
 // (L_f = L_u, Var = kVarSkipped) into `out` and returns true where the pixel is skipped.
 bool skip_as_case2(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
                    const Image& depth, const FilterParams& p, float t, int x, int y, FilterOutput& out,
-                   const Image* surface = nullptr);
+                   const Image* surface = nullptr, const Image* half_variances = nullptr);
 
-// The filter's case-2 skip decision alone (what skip_as_case2 tests): shared::skip_as_case2.
+// The filter's case-2 skip decision alone (what skip_as_case2 tests): shared::skip_pixel.
 bool case2_skip_decision(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
                          const Image& depth, const FilterParams& p, float t, int x, int y,
-                         const Image* surface = nullptr);
+                         const Image* surface = nullptr, const Image* half_variances = nullptr);
 
 // Albedo demodulation (gl/demodulation.h): shared::demodulated_texel and shared::remodulated_texel.
 struct DemodulatedInputs {
@@ -76,7 +79,7 @@ struct DemodulatedInputs {
 // The filter's inputs under demodulation; albedo "R,G,B" (the mean first non-specular albedo).
 DemodulatedInputs cpu_demodulate(const Image& hv, const Image& var_u, const Image& lv, const Image& albedo,
                                  const Image& range_color, const Image& depth, const FilterParams& params, float t,
-                                 const Image* surface = nullptr);
+                                 const Image* surface = nullptr, const Image* half_variances = nullptr);
 // shared::remodulated_texel of every pixel.
 FilterOutput cpu_remodulate(const FilterOutput& filtered, const Image& albedo);
 
@@ -85,11 +88,18 @@ struct BlendOutput {
   Image s;           // "Y"
   Image blend_case;  // "Y": case codes (kCase*)
 };
+// The halves of the split decision (PreviewInputs::upload_halves): rgb L_even, a n_even / n; and
+// the whole mean's variance from each half alone ("even", "odd" channels).
+struct BlendHalves {
+  const Image* halves = nullptr;
+  const Image* variances = nullptr;
+};
 // `filtered` empty = the filter never ran. range_color and depth both null: no variance pooling.
-// surface: as cpu_filter's, for the pooling's range weights.
+// surface: as cpu_filter's, for the pooling's range weights. With params.split and halves given,
+// shared::blend_pixel_split.
 BlendOutput cpu_blend(const Image& lv, const Image& hv, const Image& var_u, const FilterOutput* filtered, float t,
                       const BlendParams& params, const Image* range_color, const Image* depth,
-                      const Image* surface = nullptr);
+                      const Image* surface = nullptr, BlendHalves halves = {});
 
 double cpu_log_average(const Image& rgb, float delta);
 Image cpu_tonemap(const Image& rgb, const TonemapParams& params);  // "R,G,B" display values in [0,1]

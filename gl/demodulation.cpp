@@ -26,13 +26,14 @@ void Demodulation::demodulate(const PreviewInputs& inputs, const Texture2D& guid
   demod_program_.set("k_n", surface ? range.k_n : 0.0f);
   demod_program_.set("k_r", surface ? range.k_r : 0.0f);
   demod_program_.set("t", t);
-  demod_program_.set("skip_case2", p.skip_case2 ? 1 : 0);
+  demod_program_.set("skip_case2", filter_skip_mode(p, inputs.has_halves()));
   demod_program_.use();
   demod_program_.bind(shared::kUnitHv, inputs.hv());
   demod_program_.bind(shared::kUnitLv, inputs.lv());
   demod_program_.bind(shared::kUnitGuide, guide);
   demod_program_.bind(shared::kUnitSurface, surface ? *surface : guide);
   demod_program_.bind(shared::kUnitAlbedo, inputs.albedo());
+  demod_program_.bind(shared::kUnitHalfVariances, inputs.half_variances());
   quad_.draw(demod_program_, demod_fbo_, width_, height_);
   demod_timer_.end();
   check_gl_error("demodulation");

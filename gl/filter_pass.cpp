@@ -67,13 +67,14 @@ void FilterPass::run_whole_variant(const PreviewInputs& inputs, const Texture2D&
 namespace {
 // The uniforms every variant's shader shares: range weights and the case-2 skip with threshold t.
 // Without a surface buffer the surface terms are off.
-void set_range_and_skip(Program& program, const FilterParams& p, float t, const Texture2D* surface) {
+void set_range_and_skip(Program& program, const FilterParams& p, float t, const Texture2D* surface,
+                        const PreviewInputs& inputs) {
   const RangeWeights range = range_weights(p);
   program.set("k_c", range.k_c);
   program.set("k_d", range.k_d);
   program.set("k_n", surface ? range.k_n : 0.0f);
   program.set("k_r", surface ? range.k_r : 0.0f);
-  program.set("skip_case2", p.skip_case2 ? 1 : 0);
+  program.set("skip_case2", filter_skip_mode(p, inputs.has_halves()));
   program.set("t", t);
 }
 // Makes `program` current with the inputs every variant's shader reads: L_u, L_lv (the skip), the
@@ -85,6 +86,7 @@ void use_with_inputs(const Program& program, const PreviewInputs& inputs, const 
   program.bind(shared::kUnitLv, inputs.lv());
   program.bind(shared::kUnitGuide, guide);
   program.bind(shared::kUnitSurface, surface ? *surface : guide);
+  program.bind(shared::kUnitHalfVariances, inputs.half_variances());
 }
 }  // namespace
 
@@ -92,7 +94,7 @@ void FilterPass::run_bilateral(const PreviewInputs& inputs, const Texture2D& gui
   const int radius = std::min(kMaxFilterRadius, static_cast<int>(std::ceil(3.0f * std::max(p.sigma_s, 0.0f))));
   program_.set("radius", radius);
   program_.set("k_s", inv_two_sigma2(p.sigma_s));
-  set_range_and_skip(program_, p, t, staged_.surface);
+  set_range_and_skip(program_, p, t, staged_.surface, inputs);
   use_with_inputs(program_, inputs, guide, staged_.surface);
   if (p.kind == FilterKind::Separable) {
     program_.set("extent", glm::ivec2(1, 0));
@@ -114,7 +116,7 @@ void FilterPass::run_bilateral(const PreviewInputs& inputs, const Texture2D& gui
 // textures, the last writes output_ (and alone skips case-2 pixels and counts).
 void FilterPass::run_atrous(const PreviewInputs& inputs, const Texture2D& guide, const FilterParams& p, float t) {
   if (!atrous_program_.id()) atrous_program_ = Program::from_embedded("fullscreen.vert", "atrous.frag");
-  set_range_and_skip(atrous_program_, p, t, staged_.surface);
+  set_range_and_skip(atrous_program_, p, t, staged_.surface, inputs);
   use_with_inputs(atrous_program_, inputs, guide, staged_.surface);
   atrous_program_.set("k_l", atrous_k_l(p));
   const int passes = atrous_iterations(p.sigma_s);
@@ -141,7 +143,7 @@ void FilterPass::run_subsampled(const PreviewInputs& inputs, const Texture2D& gu
     subsampled_key_ = {p.sigma_s, taps};
   }
   subsampled_taps_.bind_storage(shared::kBufferTaps);
-  set_range_and_skip(subsampled_program_, p, t, staged_.surface);
+  set_range_and_skip(subsampled_program_, p, t, staged_.surface, inputs);
   subsampled_program_.set("taps_per_rotation", table.per_rotation);
   subsampled_program_.set("rotations", kSubsampledRotations);
   use_with_inputs(subsampled_program_, inputs, guide, staged_.surface);

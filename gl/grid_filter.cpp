@@ -90,13 +90,14 @@ void GridFilter::run_slice() {
   slice_.set("k_d", range.k_d);
   slice_.set("k_n", surface_ ? range.k_n : 0.0f);
   slice_.set("k_r", surface_ ? range.k_r : 0.0f);
-  slice_.set("skip_case2", params_.skip_case2 ? 1 : 0);
+  slice_.set("skip_case2", filter_skip_mode(params_, inputs_->has_halves()));
   slice_.set("t", t_);
   slice_.use();
   slice_.bind(shared::kUnitHv, inputs_->hv());
   slice_.bind(shared::kUnitLv, inputs_->lv());
   slice_.bind(shared::kUnitGuide, *guide_);
   slice_.bind(shared::kUnitSurface, surface_ ? *surface_ : *guide_);
+  slice_.bind(shared::kUnitHalfVariances, inputs_->half_variances());
   bounds_buffer_.bind_storage(shared::kBufferGridBounds);
   grid_[0].bind_storage(shared::kBufferGrid);
   quad_.draw(slice_, *target_, width_, height_);

@@ -132,14 +132,16 @@ void slice(const Grid& g, int x, int y, float luminance_y, FilterOutput& out) {
 }  // namespace
 
 FilterOutput cpu_grid_filter(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
-                             const Image& depth, const FilterParams& p, float t, const Image* surface) {
+                             const Image& depth, const FilterParams& p, float t, const Image* surface,
+                             const Image* half_variances) {
   Grid g = splat(hv, var_u, range_color, p);
   for (int axis = 0; axis < 2; ++axis) blur(g, axis);  // z: in the splat
   FilterOutput out{Image::rgb(hv.width, hv.height), Image::gray(hv.width, hv.height),
                    Image::gray(hv.width, hv.height, "Y", 1.0f)};  // centre weight 1 where skipped
   for (int y = 0; y < hv.height; ++y)
     for (int x = 0; x < hv.width; ++x) {
-      if (p.skip_case2 && skip_as_case2(hv, var_u, lv, range_color, depth, p, t, x, y, out, surface)) continue;
+      if (p.skip_case2 && skip_as_case2(hv, var_u, lv, range_color, depth, p, t, x, y, out, surface, half_variances))
+        continue;
       slice(g, x, y, guide_luminance(range_color, x, y), out);
     }
   return out;

@@ -9,6 +9,6 @@ namespace pxf {
 
 FilterOutput cpu_grid_filter(const Image& hv, const Image& var_u, const Image& lv, const Image& range_color,
                              const Image& depth, const FilterParams& params, float t,
-                             const Image* surface = nullptr);
+                             const Image* surface = nullptr, const Image* half_variances = nullptr);
 
 }  // namespace pxf

@@ -4,12 +4,14 @@ namespace pxf {
 
 PreviewInputs::PreviewInputs(int width, int height)
     : width_(width), height_(height), lv_(width, height, TextureFormat::RGBA32F),
-      hv_(width, height, TextureFormat::RGBA32F), albedo_(width, height, TextureFormat::RGBA32F) {}
+      hv_(width, height, TextureFormat::RGBA32F), albedo_(width, height, TextureFormat::RGBA32F),
+      halves_(width, height, TextureFormat::RGBA32F), half_variances_(width, height, TextureFormat::RG32F) {}
 
 void PreviewInputs::upload_packed(const float* lv_rgb, const float* hv_rgba) {
   timer_.begin();
   lv_.upload(lv_rgb, 3);
   hv_.upload(hv_rgba, 4);
+  has_halves_ = false;
   timer_.end();
 }
 
@@ -17,6 +19,7 @@ void PreviewInputs::upload_packed_with_threshold(const float* lv_rgba, const flo
   timer_.begin();
   lv_.upload(lv_rgba, 4);
   hv_.upload(hv_rgba, 4);
+  has_halves_ = false;
   timer_.end();
 }
 
@@ -56,6 +59,23 @@ void PreviewInputs::upload_albedo(const Image& albedo) {
   if (albedo.width != width_ || albedo.height != height_ || albedo.num_channels() != 3)
     throw Error("preview inputs: the albedo must be an RGB image of the textures' size");
   upload_albedo(albedo.pixels.data());
+}
+
+void PreviewInputs::upload_halves(const float* halves_rgba, const float* variances_rg) {
+  timer_.begin();
+  halves_.upload(halves_rgba, 4);
+  half_variances_.upload(variances_rg, 2);
+  has_halves_ = true;
+  timer_.end();
+}
+
+void PreviewInputs::upload_halves(const Image& halves, const Image& variances) {
+  for (const Image* im : {&halves, &variances})
+    if (im->width != width_ || im->height != height_)
+      throw Error("preview inputs: image size differs from the textures");
+  if (halves.num_channels() != 4 || variances.num_channels() != 2)
+    throw Error("preview inputs: expected RGBA halves and two-channel half variances");
+  upload_halves(halves.pixels.data(), variances.pixels.data());
 }
 
 Image PreviewInputs::lv_image() const { return lv_.download({"R", "G", "B"}); }

@@ -37,10 +37,19 @@ class PreviewInputs {
   // per pixel), for albedo demodulation (gl/demodulation.h). Uploaded only when demodulating.
   void upload_albedo(const float* albedo_rgb);
   void upload_albedo(const Image& albedo);  // "R,G,B"
+  // The halves of each pixel's samples for the blend's split decision (Accumulation::hv_halves):
+  // halves 4 floats per pixel (rgb the even half's mean, a its share n_even / n), variances 2 (the
+  // whole mean's variance from each half alone, even then odd; kVarUnknown below 2 samples). Valid
+  // until the next upload of the HV texture (has_halves).
+  void upload_halves(const float* halves_rgba, const float* variances_rg);
+  void upload_halves(const Image& halves, const Image& variances);  // "R,G,B,A" and two channels
+  bool has_halves() const { return has_halves_; }
 
   const Texture2D& lv() const { return lv_; }  // rgb L_lv, a the pixel's threshold factor
   const Texture2D& hv() const { return hv_; }  // rgb L_u, a Var[L_u] (kVarUnknown where n < 2)
   const Texture2D& albedo() const { return albedo_; }  // rgb mean albedo (upload_albedo)
+  const Texture2D& halves() const { return halves_; }  // rgb L_even, a n_even / n (upload_halves)
+  const Texture2D& half_variances() const { return half_variances_; }  // rg (V_even, V_odd)
   double last_upload_ms() const { return timer_.last_ms(); }
 
   Image lv_image() const;   // "R,G,B"
@@ -50,7 +59,8 @@ class PreviewInputs {
 
  private:
   int width_, height_;
-  Texture2D lv_, hv_, albedo_;
+  Texture2D lv_, hv_, albedo_, halves_, half_variances_;
+  bool has_halves_ = false;
   std::vector<float> packed_;  // staging of upload(): hv rgb + variance interleaved
   StageTimer timer_;
 };

@@ -69,8 +69,17 @@ struct FilterParams {
   // decision needs no history; a skipped pixel gets L_f = L_u and Var[L_f] = kVarSkipped, and the
   // blend uses s = 1 there.
   bool skip_case2 = true;
+  // Skip by the halves of the split decision (BlendParams::split, shared::skip_as_case2_by_halves):
+  // only pixels where both halves' decisions are case 2, where the inputs hold the halves.
+  bool split = false;
   int subsampled_taps = 0;  // taps of the subsampled variant, the centre included; 0 = kSubsampledTaps
 };
+// The skip a filter run applies (the shaders' skip_case2 uniform, shared::skip_pixel): none, by
+// the pixel's own variance, or by its halves' where the inputs hold them (PreviewInputs::has_halves).
+inline int filter_skip_mode(const FilterParams& p, bool inputs_have_halves) {
+  if (!p.skip_case2) return shared::kSkipOff;
+  return p.split && inputs_have_halves ? shared::kSkipByHalves : shared::kSkipOn;
+}
 constexpr int kMaxFilterRadius = 64;
 
 // The subsampled variant's taps per pixel, the centre included: chosen by measurement of time
@@ -156,6 +165,11 @@ struct BlendParams {
   // The run's sample count n, from which the zero-variance rule's decay reads each pixel's own
   // (shared::zero_variance_u, shared::pixel_samples); 0: unknown, no decay.
   float samples = 0.0f;
+  // Blend each half of the pixel's samples with the weight the other half's variance decides
+  // (blend_pixel_split, docs/method.md section 3.8), where the inputs hold the halves
+  // (PreviewInputs::has_halves). Off here, the method's blend as published; the preview's default
+  // turns it on (PreviewSettings).
+  bool split = false;
 };
 
 // TonemapParams: image/tonemap.h (the tone map formula lives there).

@@ -574,6 +574,139 @@ TEST(BlendVsCpu, MatchesReferenceWithFilteredInput) {
   }
 }
 
+// The halves of a scenario's pixels (the split decision, docs/method.md section 3.8): the even
+// half's mean scattered around L_u, its share of the samples between 0.4 and 0.6 (0 and 1 at a few
+// pixels), each half's variance estimate scattered around Var[L_u], some unknown.
+struct Halves {
+  Image halves = Image::rgba(W, H), variances{W, H, {"even", "odd"}};
+};
+Halves make_halves(const Scenario& s, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u01(0.0f, 1.0f);
+  Halves h;
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      const float r = u01(rng);
+      h.halves.at(x, y, 3) = r < 0.03f ? 0.0f : r > 0.97f ? 1.0f : 0.4f + 0.2f * u01(rng);
+      for (int c = 0; c < 3; ++c) h.halves.at(x, y, c) = s.hv.at(x, y, c) * (0.3f + 1.4f * u01(rng));
+      for (int k = 0; k < 2; ++k) {
+        const float v = s.var.at(x, y, 0);
+        h.variances.at(x, y, k) = u01(rng) < 0.08f ? kVarUnknown : v < 0.0f ? v : v * (0.2f + 1.8f * u01(rng));
+      }
+    }
+  return h;
+}
+
+TEST(BlendVsCpu, SplitDecisionMatchesReference) {
+  test::osmesa_context();
+  Scenario s = make_scenario(23);
+  fill_surface(s, 23);
+  const Halves h = make_halves(s, 29);
+  GpuFixture gpu(s);
+  gpu.inputs.upload_halves(h.halves, h.variances);
+  FilterParams fp;
+  fp.skip_case2 = false;
+  FilterOutput ref_f = cpu_filter(s.hv, s.var, s.lv, s.range, s.depth, fp, 0.02f);
+  const Texture2D filtered = filtered_texture(ref_f);
+  const Texture2D centre_weight = [&] {
+    Texture2D tex(W, H, TextureFormat::R32F);
+    tex.upload(ref_f.centre_weight);
+    return tex;
+  }();
+  for (float t : {0.001f, 0.02f})
+    for (int pool : {0, 1})
+      for (bool guard : {false, true}) {
+        SCOPED_TRACE(testing::Message() << "t=" << t << " pool=" << pool << " guard=" << guard);
+        BlendPass blend(W, H);
+        const BlendParams bp{range_weights(fp), guard, 64.0f, true};
+        blend.run(gpu.inputs, &filtered, pool ? &gpu.guide : nullptr, t, bp, &centre_weight,
+                  pool ? &gpu.surface : nullptr);
+        const BlendOutput ref = cpu_blend(s.lv, s.hv, s.var, &ref_f, t, bp, pool ? &s.range : nullptr,
+                                          pool ? &s.depth : nullptr, pool ? &s.surface : nullptr,
+                                          BlendHalves{&h.halves, &h.variances});
+        expect_close(blend.final_image(), ref.final_rgb, 1e-4f, 1e-6f, "final");
+        expect_close(blend.s_image(), ref.s, 1e-4f, 1e-5f, "s");
+        expect_close(blend.case_image(), ref.blend_case, 0.0f, 0.0f, "case");
+        // The inspector decides a pixel again as the pass did.
+        const BlendInspection i = blend.inspect(5, 7);
+        EXPECT_TRUE(i.split);
+        EXPECT_NEAR(i.decision.s, ref.s.at(5, 7, 0), 1e-4f);
+        // The split changes the image: where the halves disagree it is not the one decision's.
+        const BlendOutput one = cpu_blend(s.lv, s.hv, s.var, &ref_f, t, BlendParams{range_weights(fp), guard, 64.0f},
+                                          pool ? &s.range : nullptr, pool ? &s.depth : nullptr,
+                                          pool ? &s.surface : nullptr);
+        EXPECT_NE(one.s.pixels, ref.s.pixels);
+      }
+}
+
+// Where both halves hold the whole pixel's mean and variance, the split decision is the one decision,
+// bit for bit: each half decides what the pixel would, and the halves' difference term is 0. (With
+// the bias guard it is not: the guard judges the pixel alone on the other half's mean, whose
+// variance is twice the whole mean's.)
+TEST(BlendVsCpu, SplitDecisionOfEqualHalvesIsTheOneDecision) {
+  Scenario s = make_scenario(31);
+  Halves h;
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      for (int c = 0; c < 3; ++c) h.halves.at(x, y, c) = s.hv.at(x, y, c);
+      h.halves.at(x, y, 3) = 0.5f;
+      h.variances.at(x, y, 0) = h.variances.at(x, y, 1) = s.var.at(x, y, 0);
+    }
+  FilterParams fp;
+  const FilterOutput f = cpu_filter(s.hv, s.var, s.lv, s.range, s.depth, fp, 0.02f);
+  const BlendOutput one = cpu_blend(s.lv, s.hv, s.var, &f, 0.005f, BlendParams{range_weights(fp), false, 64.0f},
+                                    &s.range, &s.depth);
+  const BlendOutput split = cpu_blend(s.lv, s.hv, s.var, &f, 0.005f, BlendParams{range_weights(fp), false, 64.0f, true},
+                                      &s.range, &s.depth, nullptr, BlendHalves{&h.halves, &h.variances});
+  EXPECT_EQ(split.final_rgb.pixels, one.final_rgb.pixels);
+  EXPECT_EQ(split.blend_case.pixels, one.blend_case.pixels);
+}
+
+// The filter's skip by halves (shared::skip_as_case2_by_halves) in every variant and in the
+// demodulation pass, against the CPU reference; it skips only pixels both halves would leave.
+TEST(FilterVsCpu, SkipByHalvesMatchesReference) {
+  test::osmesa_context();
+  Scenario s = make_scenario(37);
+  const Halves h = make_halves(s, 41);
+  GpuFixture gpu(s);
+  gpu.inputs.upload_halves(h.halves, h.variances);
+  const float t = 0.02f;
+  for (FilterKind kind : {FilterKind::BilateralDepth, FilterKind::Atrous, FilterKind::Subsampled, FilterKind::Grid}) {
+    SCOPED_TRACE(filter_kind_name(kind));
+    FilterParams p;
+    p.kind = kind;
+    p.split = true;
+    FilterPass filter(W, H);
+    filter.run(gpu.inputs, gpu.guide, p, t);
+    const FilterOutput ref = cpu_filter(s.hv, s.var, s.lv, s.range, s.depth, p, t, nullptr, &h.variances);
+    int skipped = 0, skipped_by_own = 0;
+    FilterParams own = p;
+    own.split = false;
+    for (int y = 0; y < H; ++y)
+      for (int x = 0; x < W; ++x) {
+        const bool by_halves =
+            case2_skip_decision(s.hv, s.var, s.lv, s.range, s.depth, p, t, x, y, nullptr, &h.variances);
+        skipped += by_halves;
+        skipped_by_own += case2_skip_decision(s.hv, s.var, s.lv, s.range, s.depth, own, t, x, y);
+        if (by_halves) {
+          EXPECT_EQ(ref.variance.at(x, y, 0), kVarSkipped) << x << "," << y;
+        }
+      }
+    EXPECT_EQ(filter.filtered_pixels(), static_cast<uint32_t>(W * H - skipped));
+    EXPECT_GT(skipped, 0);
+    EXPECT_NE(skipped, skipped_by_own);
+  }
+  FilterParams p;
+  p.split = true;
+  Demodulation demod(W, H);
+  Image albedo = Image::rgb(W, H, 0.5f);
+  gpu.inputs.upload_albedo(albedo);
+  demod.demodulate(gpu.inputs, gpu.guide, p, t);
+  const DemodulatedInputs ref =
+      cpu_demodulate(s.hv, s.var, s.lv, albedo, s.range, s.depth, p, t, nullptr, &h.variances);
+  expect_close(demod.filter_inputs().lv_image(), ref.lv, 0.0f, 0.0f, "the skip decision");
+}
+
 // The bias guard on a flat surface: L_u = m + Gaussian noise of the variance Var[L_u] says, L_f = m + b with Var[L_f] = 0.
 // Unbiased (b = 0) the 5x5 mean of d = L_f - L_u is N(0, Var[L_u] / 25), and the 2-sigma test
 // fires in P(|Z| > 2) = 4.6 % of the pixels (the pixel's own test, at 2.5 sigma, mostly where the

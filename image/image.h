@@ -102,6 +102,7 @@ struct ImageMetrics {
   double rel_mse = 0;        // mean((t - r)^2 / (r^2 + 1e-2))
   double max_abs_diff = 0;
   double reference_mean = 0;
+  double test_mean = 0;  // over the same samples: test_mean / reference_mean is the image's bias
   size_t nan_count = 0;  // samples of the test image (not pixels) that are NaN
   size_t inf_count = 0;  // ... or +-Inf
   size_t samples = 0;    // compared finite samples

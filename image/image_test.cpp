@@ -297,6 +297,7 @@ TEST(ImageMetrics, MatchHandComputedValues) {
   EXPECT_EQ(m.samples, 6u);
   EXPECT_NEAR(m.rmse, std::sqrt(2.0 / 6.0), 1e-12);
   EXPECT_NEAR(m.reference_mean, 2.0, 1e-12);
+  EXPECT_NEAR(m.test_mean, 2.0, 1e-12);
   EXPECT_NEAR(m.nrmse_percent, 100.0 * std::sqrt(2.0 / 6.0) / 2.0, 1e-9);
   EXPECT_NEAR(m.rel_mse, (1.0 / (9 + 1e-2) + 1.0 / (1 + 1e-2)) / 6.0, 1e-12);
   EXPECT_NEAR(m.max_abs_diff, 1.0, 1e-12);

@@ -54,7 +54,7 @@ ImageMetrics compare_images(const Image& test, const Image& reference, const Ima
   if (pairs.empty()) throw Error("the images share no color channel");
 
   ImageMetrics m;
-  double sum_sq = 0, sum_rel = 0, sum_ref = 0;
+  double sum_sq = 0, sum_rel = 0, sum_ref = 0, sum_test = 0;
   const size_t tn = test.channels.size(), rn = reference.channels.size();
   for (size_t p = 0; p < reference.pixel_count(); ++p) {
     if (masked_out(mask, p)) continue;
@@ -70,6 +70,7 @@ ImageMetrics compare_images(const Image& test, const Image& reference, const Ima
       sum_sq += d * d;
       sum_rel += d * d / (rv * rv + 1e-2);
       sum_ref += rv;
+      sum_test += tv;
       m.max_abs_diff = std::max(m.max_abs_diff, std::abs(d));
       ++m.samples;
     }
@@ -81,6 +82,7 @@ ImageMetrics compare_images(const Image& test, const Image& reference, const Ima
   const double n = static_cast<double>(m.samples);
   m.rmse = std::sqrt(sum_sq / n);
   m.reference_mean = sum_ref / n;
+  m.test_mean = sum_test / n;
   m.nrmse_percent = m.reference_mean > 0 ? 100.0 * m.rmse / m.reference_mean : (m.rmse > 0 ? INFINITY : 0.0);
   m.rel_mse = sum_rel / n;
   return m;
@@ -129,9 +131,10 @@ double total_squared_error(const std::vector<double>& squared_errors) {
 std::string format_metrics(const ImageMetrics& m) {
   char line[512];
   std::snprintf(line, sizeof line,
-                "NRMSE %.4f %%  RMSE %.6g  relMSE %.6g  max|diff| %.6g  reference mean %.6g  NaN %zu  Inf %zu  samples %zu",
-                m.nrmse_percent, m.rmse, m.rel_mse, m.max_abs_diff, m.reference_mean, m.nan_count, m.inf_count,
-                m.samples);
+                "NRMSE %.4f %%  RMSE %.6g  relMSE %.6g  max|diff| %.6g  reference mean %.6g  mean ratio %.5f  NaN %zu  "
+                "Inf %zu  samples %zu",
+                m.nrmse_percent, m.rmse, m.rel_mse, m.max_abs_diff, m.reference_mean,
+                m.reference_mean > 0 ? m.test_mean / m.reference_mean : 1.0, m.nan_count, m.inf_count, m.samples);
   return line;
 }
 

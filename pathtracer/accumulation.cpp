@@ -24,25 +24,40 @@ void resize_accumulation(Accumulation& acc, int width, int height, int replicate
   const size_t replicate_slots = acc.replicates > 1 ? n * static_cast<size_t>(acc.replicates) : 0;
   acc.replicate_lum_sum.assign(replicate_slots, 0.0);
   acc.replicate_samples.assign(replicate_slots, 0u);
+  acc.even_hv_mean.assign(n, glm::vec3(0.0f));
+  acc.even_lum_mean.assign(n, 0.0);
+  acc.even_lum_m2.assign(n, 0.0);
+  acc.even_samples.assign(n, 0u);
 }
 
-void accumulate_sample(Accumulation& acc, size_t pixel, glm::vec3 lv, glm::vec3 hv, int replicate, glm::vec3 albedo) {
+namespace {
+void add_welford(double& mean, double& m2, uint32_t n, double y) {
+  const double delta = y - mean;
+  mean += delta / static_cast<double>(n);
+  m2 += delta * (y - mean);
+}
+}  // namespace
+
+void accumulate_sample(Accumulation& acc, size_t pixel, glm::vec3 lv, glm::vec3 hv, uint32_t sample_index,
+                       glm::vec3 albedo) {
   uint32_t n = ++acc.samples[pixel];
   float inv_n = 1.0f / static_cast<float>(n);
   acc.lv_mean[pixel] += (lv - acc.lv_mean[pixel]) * inv_n;
   acc.hv_mean[pixel] += (hv - acc.hv_mean[pixel]) * inv_n;
   acc.albedo_mean[pixel] += (albedo - acc.albedo_mean[pixel]) * inv_n;
-  double y = luminance(hv);
-  double delta = y - acc.hv_lum_mean[pixel];
-  acc.hv_lum_mean[pixel] += delta / static_cast<double>(n);
-  acc.hv_lum_m2[pixel] += delta * (y - acc.hv_lum_mean[pixel]);
-  const double y_lv = luminance(lv), delta_lv = y_lv - acc.lv_lum_mean[pixel];
-  acc.lv_lum_mean[pixel] += delta_lv / static_cast<double>(n);
-  acc.lv_lum_m2[pixel] += delta_lv * (y_lv - acc.lv_lum_mean[pixel]);
+  const double y = luminance(hv);
+  add_welford(acc.hv_lum_mean[pixel], acc.hv_lum_m2[pixel], n, y);
+  add_welford(acc.lv_lum_mean[pixel], acc.lv_lum_m2[pixel], n, luminance(lv));
   if (acc.replicates > 1) {
-    const size_t slot = pixel * static_cast<size_t>(acc.replicates) + static_cast<size_t>(replicate % acc.replicates);
+    const uint32_t replicate = sample_index % static_cast<uint32_t>(acc.replicates);
+    const size_t slot = pixel * static_cast<size_t>(acc.replicates) + replicate;
     acc.replicate_lum_sum[slot] += y;
     ++acc.replicate_samples[slot];
+  }
+  if (sample_index % 2 == 0) {
+    const uint32_t n_even = ++acc.even_samples[pixel];
+    acc.even_hv_mean[pixel] += (hv - acc.even_hv_mean[pixel]) * (1.0f / static_cast<float>(n_even));
+    add_welford(acc.even_lum_mean[pixel], acc.even_lum_m2[pixel], n_even, y);
   }
 }
 
@@ -140,6 +155,36 @@ void Accumulation::hv_and_variance_of_mean(float* rgba) const {
     rgba[4 * p + 2] = hv_mean[p].z;
   }
   variance_of_mean_image(rgba + 3, 4);
+}
+
+void Accumulation::hv_halves(const float* whole_rgba, float* halves, float* half_variances) const {
+  for (size_t p = 0; p < samples.size(); ++p) {
+    const uint32_t n = samples[p], n_even = even_samples[p], n_odd = n - n_even;
+    halves[4 * p + 0] = even_hv_mean[p].x;
+    halves[4 * p + 1] = even_hv_mean[p].y;
+    halves[4 * p + 2] = even_hv_mean[p].z;
+    halves[4 * p + 3] = n > 0 ? static_cast<float>(static_cast<double>(n_even) / n) : 0.0f;
+    // The odd half's Welford state: Chan's combination of the halves into the whole, solved for it.
+    double odd_m2 = 0;
+    if (n_odd > 0 && n_even > 0) {
+      const double odd_mean = (hv_lum_mean[p] * n - even_lum_mean[p] * n_even) / n_odd;
+      const double delta = odd_mean - even_lum_mean[p];
+      odd_m2 = std::max(0.0, hv_lum_m2[p] - even_lum_m2[p] - delta * delta * n_even * n_odd / n);
+    } else if (n_odd > 0) {
+      odd_m2 = hv_lum_m2[p];
+    }
+    // The replicate gain of the whole estimate carries over to each half's.
+    const float per_sample = per_sample_variance_of_mean(p);
+    const float whole = whole_rgba[4 * p + 3];
+    const double gain = per_sample > 0.0f && whole > 0.0f ? static_cast<double>(whole) / per_sample : 1.0;
+    auto estimate = [&](double m2, uint32_t count) {
+      if (count < 2) return -1.0f;
+      const double var = m2 / (count - 1) / n * gain;
+      return static_cast<float>(std::clamp(var, 0.0, static_cast<double>(std::numeric_limits<float>::max())));
+    };
+    half_variances[2 * p + 0] = estimate(even_lum_m2[p], n_even);
+    half_variances[2 * p + 1] = estimate(odd_m2, n_odd);
+  }
 }
 
 }  // namespace pxf

@@ -27,6 +27,14 @@ struct Accumulation {
   int replicates = 1;
   std::vector<double> replicate_lum_sum;
   std::vector<uint32_t> replicate_samples;
+  // The even half: the samples of even sample index (frame k's path j of a pixel has index
+  // k * paths + j, so a pixel's indices are consecutive and its halves differ by at most one
+  // sample). Their HV mean and the Welford state of their luminance; the odd half is the rest. The
+  // blend decides each half's weight from the other half's variance (docs/method.md section 3.8).
+  std::vector<glm::vec3> even_hv_mean;
+  std::vector<double> even_lum_mean;
+  std::vector<double> even_lum_m2;
+  std::vector<uint32_t> even_samples;
 
   // Var[L_u] of the HV luminance mean; negative (-1) when n < 2 (unknown). Without replicates it is
   // s^2 / n. With replicates (randomized QMC, where s^2 / n overestimates), it is s^2 / n times the
@@ -44,12 +52,20 @@ struct Accumulation {
   float lv_variance_of_mean(size_t pixel) const;
   // K'/(K'-1) sum_r (n_r / n)^2 (m_r - m)^2 over the K' replicates with samples; -1 when K' < 2.
   float replicate_variance_of_mean(size_t pixel) const;
+  // The halves of every pixel, for the blend's split decision: 4 floats per pixel in `halves`
+  // (rgb the even half's HV mean, a its share of the samples n_even / n, 0 without samples) and 2 in
+  // `half_variances`: the variance of the whole pixel mean as each half's samples alone estimate
+  // it (s_h^2 / n times the pixel's replicate gain, whole / per_sample_variance_of_mean), even
+  // then odd; -1 where that half holds fewer than 2 samples. whole_rgba: hv_and_variance_of_mean's
+  // buffer, whose alpha is the whole estimate.
+  void hv_halves(const float* whole_rgba, float* halves, float* half_variances) const;
 };
 
 // Adds one accepted sample to pixel `pixel`: running means of LV/HV RGB and Welford (double) of
 // the HV luminance, running mean of the albedo. The caller has already rejected non-finite samples.
-// `replicate` is the sample's replicate (frame mod acc.replicates).
-void accumulate_sample(Accumulation& acc, size_t pixel, glm::vec3 lv, glm::vec3 hv, int replicate = 0,
+// `sample_index` is the sample's index in the pixel's sequence: its replicate is the index mod
+// acc.replicates (for a uniform render, the frame's), its half the index's parity.
+void accumulate_sample(Accumulation& acc, size_t pixel, glm::vec3 lv, glm::vec3 hv, uint32_t sample_index = 0,
                        glm::vec3 albedo = glm::vec3(1.0f));
 void resize_accumulation(Accumulation& acc, int width, int height, int replicates = 1);  // and clear
 

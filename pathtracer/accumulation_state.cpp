@@ -54,6 +54,10 @@ void visit_arrays(Acc& acc, Visit&& visit) {
   const size_t replicate_slots = acc.replicates > 1 ? static_cast<size_t>(acc.replicates) : 0;
   visit(acc.replicate_lum_sum, replicate_slots);
   visit(acc.replicate_samples, replicate_slots);
+  visit(acc.even_hv_mean, 1);
+  visit(acc.even_lum_mean, 1);
+  visit(acc.even_lum_m2, 1);
+  visit(acc.even_samples, 1);
 }
 
 // The per-pixel arrays of a state: the accumulation's, then the traced counts and, in an adaptive
@@ -166,7 +170,14 @@ void check_pixels(const AccumulationState& state) {
                         std::isfinite(a.z) && std::isfinite(acc.hv_lum_mean[i]) &&
                         std::isfinite(acc.hv_lum_m2[i]) && acc.hv_lum_m2[i] >= 0.0 &&
                         std::isfinite(acc.lv_lum_mean[i]) && std::isfinite(acc.lv_lum_m2[i]) && acc.lv_lum_m2[i] >= 0.0;
-    if (!finite) throw Error("state file has a non-finite or negative value at pixel " + std::to_string(i));
+    const glm::vec3 even = acc.even_hv_mean[i];
+    const bool even_finite = std::isfinite(even.x) && std::isfinite(even.y) && std::isfinite(even.z) &&
+                             std::isfinite(acc.even_lum_mean[i]) && std::isfinite(acc.even_lum_m2[i]) &&
+                             acc.even_lum_m2[i] >= 0.0;
+    if (!finite || !even_finite)
+      throw Error("state file has a non-finite or negative value at pixel " + std::to_string(i));
+    if (acc.even_samples[i] > acc.samples[i])
+      throw Error("state file has more even-index samples than samples at pixel " + std::to_string(i));
     if (acc.replicates < 2) continue;
     // The replicate sums split the pixel's samples: their counts add up to its count.
     uint64_t replicate_count = 0;
@@ -192,6 +203,25 @@ void combine_welford(double& mean, double& m2, uint32_t na, double from_mean, do
   m2 += from_m2 + delta * delta * (static_cast<double>(na) * nb / n);
 }
 
+// The even halves of pixel i combine like the whole (sample indices, and so their parities, are the
+// same wherever a frame is traced).
+void merge_even_half(Accumulation& into, const Accumulation& from, size_t i) {
+  const uint32_t na = into.even_samples[i], nb = from.even_samples[i];
+  if (nb == 0) return;
+  if (na == 0) {
+    into.even_hv_mean[i] = from.even_hv_mean[i];
+    into.even_lum_mean[i] = from.even_lum_mean[i];
+    into.even_lum_m2[i] = from.even_lum_m2[i];
+    into.even_samples[i] = nb;
+    return;
+  }
+  const double n = static_cast<double>(na) + nb;
+  for (int c = 0; c < 3; ++c)
+    into.even_hv_mean[i][c] = combine_mean(into.even_hv_mean[i][c], na, from.even_hv_mean[i][c], nb, n);
+  combine_welford(into.even_lum_mean[i], into.even_lum_m2[i], na, from.even_lum_mean[i], from.even_lum_m2[i], nb, n);
+  into.even_samples[i] = na + nb;
+}
+
 void merge_into(Accumulation& into, const Accumulation& from) {
   for (size_t i = 0; i < into.samples.size(); ++i) {
     const uint32_t na = into.samples[i], nb = from.samples[i];
@@ -205,6 +235,7 @@ void merge_into(Accumulation& into, const Accumulation& from) {
       into.lv_lum_mean[i] = from.lv_lum_mean[i];
       into.lv_lum_m2[i] = from.lv_lum_m2[i];
       into.samples[i] = nb;
+      merge_even_half(into, from, i);
       continue;
     }
     const double n = static_cast<double>(na) + nb;
@@ -216,6 +247,7 @@ void merge_into(Accumulation& into, const Accumulation& from) {
     combine_welford(into.hv_lum_mean[i], into.hv_lum_m2[i], na, from.hv_lum_mean[i], from.hv_lum_m2[i], nb, n);
     combine_welford(into.lv_lum_mean[i], into.lv_lum_m2[i], na, from.lv_lum_mean[i], from.lv_lum_m2[i], nb, n);
     into.samples[i] = na + nb;
+    merge_even_half(into, from, i);
   }
   // Each replicate's samples of disjoint frame ranges add up (frame k is in replicate k mod K).
   for (size_t k = 0; k < into.replicate_samples.size(); ++k) {

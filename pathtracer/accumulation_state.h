@@ -17,8 +17,9 @@ namespace pxf {
 // guiding (the flag, the serialized field); 7: adaptive frames trace up to kMaxPathsPerFrame paths per
 // pixel (counts, rates above 1, a shard's sample indices from its first frame * kMaxPathsPerFrame)
 // and the flag names the allocation's goal; 8: the light split of issue 57; 9: light through
-// openings (the flag, the serialized EnvironmentVisibility)
-constexpr uint32_t kStateFormatVersion = 9;
+// openings (the flag, the serialized EnvironmentVisibility); 10: the even half of each pixel's samples (the
+// blend's split decision)
+constexpr uint32_t kStateFormatVersion = 10;
 
 // Frame counts: one render traces at most kMaxRenderFrames frames (--spp, --frames, --shard); a
 // state, also a merge of many shards, holds at most kMaxStateFrames in all, the most the preview's

@@ -41,7 +41,7 @@ AccumulationState render_frames(FrameRange range, int replicates = 1) {
       sample_of(p, f, lv, hv);
       // The albedo of a textured pixel varies with the sample's position in the pixel.
       const glm::vec3 albedo(0.1f + 0.05f * static_cast<float>((p * 7 + f) % 13), 0.5f, (f % 3) * 0.4f);
-      accumulate_sample(state.acc, p, lv, hv, static_cast<int>(f % static_cast<uint32_t>(replicates)), albedo);
+      accumulate_sample(state.acc, p, lv, hv, f, albedo);
     }
   return state;
 }
@@ -71,6 +71,11 @@ void expect_same_accumulation(const Accumulation& a, const Accumulation& b) {
     EXPECT_NEAR(a.hv_lum_m2[i], b.hv_lum_m2[i], 1e-12 * std::abs(b.hv_lum_m2[i])) << i;
     EXPECT_NEAR(a.lv_lum_mean[i], b.lv_lum_mean[i], 1e-12 * std::abs(b.lv_lum_mean[i])) << i;
     EXPECT_NEAR(a.lv_lum_m2[i], b.lv_lum_m2[i], 1e-12 * std::abs(b.lv_lum_m2[i])) << i;
+    EXPECT_EQ(a.even_samples[i], b.even_samples[i]) << i;
+    for (int c = 0; c < 3; ++c)
+      EXPECT_NEAR(a.even_hv_mean[i][c], b.even_hv_mean[i][c], kMeanTolerance * std::abs(b.even_hv_mean[i][c])) << i;
+    EXPECT_NEAR(a.even_lum_mean[i], b.even_lum_mean[i], 1e-12 * std::abs(b.even_lum_mean[i])) << i;
+    EXPECT_NEAR(a.even_lum_m2[i], b.even_lum_m2[i], 1e-12 * std::abs(b.even_lum_m2[i])) << i;
   }
 }
 
@@ -274,6 +279,16 @@ TEST(AccumulationState, ReplicateCountsThatDoNotAddUpAreRefused) {
   state.acc.replicate_lum_sum[0] = std::numeric_limits<double>::infinity();
   const std::vector<uint8_t> inf_bytes = encode_state(state);
   EXPECT_NE(decode_error(inf_bytes).find("non-finite replicate sum at pixel 0"), std::string::npos);
+}
+
+TEST(AccumulationState, EvenHalvesThatDoNotFitTheSamplesAreRefused) {
+  AccumulationState state = render_frames({0, 8});
+  state.acc.even_samples[2] = state.acc.samples[2] + 1;
+  EXPECT_NE(decode_error(encode_state(state)).find("more even-index samples than samples at pixel 2"),
+            std::string::npos);
+  state = render_frames({0, 8});
+  state.acc.even_lum_m2[1] = -1.0;
+  EXPECT_NE(decode_error(encode_state(state)).find("non-finite or negative value at pixel 1"), std::string::npos);
 }
 
 namespace {

@@ -28,6 +28,9 @@ std::vector<uint8_t> pixel_bytes(const Accumulation& acc, size_t p) {
   put(&acc.lv_lum_mean[p], sizeof(double));
   put(&acc.lv_lum_m2[p], sizeof(double));
   put(&acc.samples[p], sizeof(uint32_t));
+  put(&acc.even_hv_mean[p], sizeof(glm::vec3));
+  put(&acc.even_lum_m2[p], sizeof(double));
+  put(&acc.even_samples[p], sizeof(uint32_t));
   for (int r = 0; r < acc.replicates && acc.replicates > 1; ++r) {
     put(&acc.replicate_lum_sum[p * acc.replicates + r], sizeof(double));
     put(&acc.replicate_samples[p * acc.replicates + r], sizeof(uint32_t));
@@ -87,7 +90,7 @@ TEST(ActivePixels, UniformFrameKIsEachPixelsSampleK) {
     for (int x = 0; x < kWidth; ++x)
       for (uint32_t k = 5; k < 8; ++k) {
         const PathSample s = tracer.trace_pixel(scene.camera, kWidth, kHeight, x, y, k, params);
-        if (s.finite()) accumulate_sample(expected, static_cast<size_t>(y) * kWidth + x, s.lv, s.hv, 0, s.albedo);
+        if (s.finite()) accumulate_sample(expected, static_cast<size_t>(y) * kWidth + x, s.lv, s.hv, k, s.albedo);
       }
   expect_same_accumulation(renderer.accumulation(), expected);
 }
@@ -111,8 +114,9 @@ TEST(ActivePixels, AShardStartsAtItsFirstFrameTimesTheStride) {
     for (int x = 0; x < kWidth; ++x) {
       const size_t p = static_cast<size_t>(y) * kWidth + x;
       for (uint32_t k = 0; k < counts[p]; ++k) {
-        const PathSample s = tracer.trace_pixel(scene.camera, kWidth, kHeight, x, y, 2 * kMaxPathsPerFrame + k, params);
-        if (s.finite()) accumulate_sample(expected, p, s.lv, s.hv, 0, s.albedo);
+        const uint32_t index = 2 * kMaxPathsPerFrame + k;
+        const PathSample s = tracer.trace_pixel(scene.camera, kWidth, kHeight, x, y, index, params);
+        if (s.finite()) accumulate_sample(expected, p, s.lv, s.hv, index, s.albedo);
       }
     }
   expect_same_accumulation(renderer.accumulation(), expected);

@@ -227,7 +227,6 @@ struct ProgressiveRenderer::Impl {
 
   void render_frame() {
     const int chunks = static_cast<int>(chunk_starts.size()) - 1;
-    const uint32_t replicates = static_cast<uint32_t>(acc.replicates);
     std::atomic<uint64_t> rays{0}, paths{0}, dropped{0};
     auto render_chunks = [&](const tbb::blocked_range<int>& range) {
       uint64_t chunk_rays = 0, chunk_paths = 0, chunk_dropped = 0;
@@ -247,7 +246,7 @@ struct ProgressiveRenderer::Impl {
             continue;
           }
           accumulate_sample(acc, static_cast<size_t>(job.y) * width + job.x, sample.lv, sample.hv,
-                            static_cast<int>(job.index % replicates), sample.albedo);
+                            job.index, sample.albedo);
         }
       }
       rays += chunk_rays;
@@ -262,10 +261,9 @@ struct ProgressiveRenderer::Impl {
 
   // A dark scene is black: every traced pixel gets an exact zero sample without tracing.
   void add_dark_frame() {
-    const uint32_t replicates = static_cast<uint32_t>(acc.replicates);
     for (const PixelSampleJob& job : jobs)
       accumulate_sample(acc, static_cast<size_t>(job.y) * width + job.x, glm::vec3(0.0f), glm::vec3(0.0f),
-                        static_cast<int>(job.index % replicates));
+                        job.index);
   }
 
   // Every traced pixel's count moves on: its next path takes the next index of its sequence.

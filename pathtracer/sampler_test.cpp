@@ -237,7 +237,7 @@ TEST(Accumulation, ReplicateVarianceFromReplicateMeans) {
   EXPECT_EQ(acc.replicate_variance_of_mean(0), -1.0f);
   // Replicate 0: 1, 3 (mean 2); replicate 1: 5, 7 (mean 6). Overall mean 4; estimate
   // 2/1 * ((1/2)^2 * 4 + (1/2)^2 * 4) = 4.
-  for (float y : {1.0f, 5.0f, 3.0f, 7.0f}) accumulate_sample(acc, 0, glm::vec3(0), glm::vec3(y), acc.samples[0] % 2);
+  for (float y : {1.0f, 5.0f, 3.0f, 7.0f}) accumulate_sample(acc, 0, glm::vec3(0), glm::vec3(y), acc.samples[0]);
   EXPECT_NEAR(acc.replicate_variance_of_mean(0), 4.0f, 1e-5f);
   // One pixel: the pooled gain is its own, so the estimate is the replicate one.
   EXPECT_NEAR(acc.variance_of_mean(0), 4.0f, 1e-5f);

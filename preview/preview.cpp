@@ -287,6 +287,20 @@ void Preview::upload() {
   if (combined_now_) history_->combine(inputs_, static_cast<float>(samples()));
   last_.upload += elapsed_ms(start);
   uploaded_ = true;
+  upload_halves();
+}
+
+// The halves exist for the accumulation alone: a view that adds the reprojected history blends with
+// one decision.
+void Preview::upload_halves() {
+  if (!settings_.split_decision || combined_now_ || inputs_.has_halves()) return;
+  const auto start = BenchClock::now();
+  const size_t pixels = static_cast<size_t>(width_) * static_cast<size_t>(height_);
+  halves_packed_.resize(4 * pixels);
+  half_variances_packed_.resize(2 * pixels);
+  renderer_->accumulation().hv_halves(hv_packed_.data(), halves_packed_.data(), half_variances_packed_.data());
+  inputs_.upload_halves(halves_packed_.data(), half_variances_packed_.data());
+  last_.upload += elapsed_ms(start);
 }
 
 bool Preview::step_range_buffer() {
@@ -333,6 +347,7 @@ std::vector<float> Preview::noise_over_threshold() const {
 
 FilterParams Preview::filter_params_now() const {
   FilterParams p = settings_.filter;
+  p.split = settings_.split_decision;
   if (settings_.shrink_sigma) {
     std::vector<float> needed = noise_over_threshold();
     p.sigma_s = noise_sigma_s(p.sigma_s, static_cast<uint64_t>(samples()), needed);
@@ -454,13 +469,16 @@ void Preview::update_hv_empty() {
 void Preview::blend_and_tonemap() {
   const double upload_before = last_.upload;
   upload();
+  upload_halves();
   // The filter's centre weight is that of the demodulated run too: with a grey factor a,
   // Cov[L_u, a L_f'] = a w Var[L_u] / a = w Var[L_u], the blend's covariance term is unchanged.
   // Once a filter run skipped every pixel, its L_f marks every pixel case 2 and the guard, which
   // acts in cases 1 and 3 only, would change nothing: its passes are left out (the same image).
   const bool guard = settings_.bias_guard && !schedule_.all_pixels_case2;
   blend_.run(inputs(), have_filtered_ ? &filtered_output() : nullptr, &range_.guide(), threshold_now(),
-             BlendParams{range_weights(settings_.filter), guard, static_cast<float>(samples())}, have_filtered_ ? filter_.centre_weight() : nullptr,
+             BlendParams{range_weights(settings_.filter), guard, static_cast<float>(samples()),
+                         settings_.split_decision},
+             have_filtered_ ? filter_.centre_weight() : nullptr,
              &range_.surface());
   last_.blend += blend_.last_ms();
   tonemap_.run(blend_.output(), settings_.tonemap);

@@ -45,6 +45,11 @@ struct PreviewSettings {
   // L_f measurably differs from L_u. On: at equal time it lowered the filtered image's error on all
   // four built-in scenes (docs/measurements.md, "Bias guard"); off is the method's blend as published.
   bool bias_guard = true;
+  // The split decision (BlendParams::split, docs/method.md section 3.8): each half of a pixel's
+  // samples blended by the weight the other half's variance decides, so that the decision does not
+  // correlate with the samples it weighs (one decision darkens: 4.3 % on `window` at 32 spp). Off
+  // by default: it keeps half of each outlier, and at equal time its display error was 1.05-1.2x.
+  bool split_decision = false;
   // Shrink the filter's sigma_s to the noise (noise_sigma_s in gl/pass_params.h, docs/method.md
   // 2.5): the kernel the noisiest pixels need to reach t, between 2 px and filter.sigma_s. On by
   // default: less bias where samples have accumulated, the full kernel where the noise needs it;
@@ -225,6 +230,7 @@ class Preview {
   ScheduleState schedule_now() const;  // schedule_ with the range frame the next run needs first
   std::vector<float> noise_over_threshold() const;  // filter_params_now's input
   void upload();
+  void upload_halves();  // the split decision's halves, where it applies (after upload)
   PreviewInputs& pass_inputs() { return combined_now_ ? history_->combined() : inputs_; }
   // reset() without forgetting the history (a camera move keeps it).
   void restart_samples();
@@ -269,6 +275,7 @@ class Preview {
   TonemapPass tonemap_;
   std::vector<float> hv_packed_;  // the HV texture's data (rgb L_u, a Var[L_u]), filled by the renderer
   std::vector<float> lv_packed_;  // the LV texture's data with per-pixel threshold factors (adaptive)
+  std::vector<float> halves_packed_, half_variances_packed_;  // the split decision's (upload_halves)
   std::vector<uint8_t> next_active_;  // plan_next_frame()'s mask; empty = every pixel
   std::vector<float> active_credit_;  // select_active's credits
   std::vector<float> rates_;          // the last allocation's rates; empty before the first

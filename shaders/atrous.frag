@@ -22,7 +22,8 @@ uniform float k_d;  // 1 / (2 sigma_d^2)
 uniform float k_n;  // 1 / sigma_n^2, 0: no normal term (range_weights)
 uniform float k_r;  // 1 / (2 sigma_r^2), 0: no roughness term
 uniform float k_l;  // 1 / sigma_l, 0: no luminance edge stop (luminance_edge_exponent)
-uniform int skip_case2;
+uniform int skip_case2;  // kSkipOff, kSkipOn or kSkipByHalves (skip_pixel)
+layout(binding = kUnitHalfVariances) uniform sampler2D half_variances_tex;  // kSkipByHalves: (V_even, V_odd)
 uniform float t;
 uniform float variance_correction;  // atrous_variance_correction(pass)
 
@@ -38,7 +39,7 @@ void main() {
     out_filtered = vec4(clean(own.rgb), final_pass != 0 ? kVarSkipped : own.a);
     return;
   }
-  if (final_pass != 0 && skip_case2 != 0 && skip_as_case2(hv_tex, lv_tex, guide_tex, surface_tex, p, k_c, k_d, k_n, k_r, t)) {
+  if (final_pass != 0 && skip_pixel(skip_case2, hv_tex, lv_tex, guide_tex, surface_tex, half_variances_tex, p, k_c, k_d, k_n, k_r, t)) {
     out_filtered = vec4(clean(texelFetch(hv_tex, p, 0).rgb), kVarSkipped);
     return;
   }

@@ -10,7 +10,11 @@ layout(binding = kUnitGuardRowsLowX) uniform sampler2D low_x_tex;     // x in [-
 layout(binding = kUnitGuardRowsHighX) uniform sampler2D high_x_tex;   // x in [0, r]
 layout(binding = kUnitHv) uniform sampler2D hv_tex;                   // the pixel's own window
 layout(binding = kUnitFiltered) uniform sampler2D filtered_tex;
-layout(location = 0) out vec2 out_estimate;  // (b2, var_u) of BiasGuardEstimate
+layout(binding = kUnitHalves) uniform sampler2D halves_tex;                 // split: rgb L_even, a n_even / n
+layout(binding = kUnitHalfVariances) uniform sampler2D half_variances_tex;  // split: (V_even, V_odd)
+uniform int split;  // 1: one finding per half, its windows reading the other half at the pixel (section 3.8)
+// (b2, var_u) of BiasGuardEstimate; split: the even half's, then the odd half's, else the same twice
+layout(location = 0) out vec4 out_estimate;
 
 void main() {
   ivec2 p = ivec2(gl_FragCoord.xy);
@@ -26,7 +30,19 @@ void main() {
     low_x += texelFetch(low_x_tex, q, 0);
     high_x += texelFetch(high_x_tex, q, 0);
   }
-  BiasGuardEstimate e = bias_guard_estimate(low_y + centre + high_y, low_y + centre, centre + high_y, low_x, high_x,
-                                            bias_guard_texel(hv_tex, filtered_tex, p));
-  out_estimate = vec2(e.b2, e.var_u);
+  vec4 full = low_y + centre + high_y;
+  if (split == 0) {
+    BiasGuardEstimate e = bias_guard_estimate(full, low_y + centre, centre + high_y, low_x, high_x,
+                                              bias_guard_texel(hv_tex, filtered_tex, p));
+    out_estimate = vec4(e.b2, e.var_u, e.b2, e.var_u);
+    return;
+  }
+  vec4 hv = texelFetch(hv_tex, p, 0), f = texelFetch(filtered_tex, p, 0), halves = texelFetch(halves_tex, p, 0);
+  vec2 variances = texelFetch(half_variances_tex, p, 0).rg;
+  vec4 own = bias_guard_texel_of(hv, f);
+  BiasGuardEstimate even = half_guard_estimate(full, low_y + centre, centre + high_y, low_x, high_x, own,
+                                               bias_guard_texel_of(half_texel(hv, halves, variances, 1), f));
+  BiasGuardEstimate odd = half_guard_estimate(full, low_y + centre, centre + high_y, low_x, high_x, own,
+                                              bias_guard_texel_of(half_texel(hv, halves, variances, 0), f));
+  out_estimate = vec4(even.b2, even.var_u, odd.b2, odd.var_u);
 }

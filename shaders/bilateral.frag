@@ -18,7 +18,8 @@ uniform float k_c;   // 1 / (2 sigma_c^2)
 uniform float k_d;   // 1 / (2 sigma_d^2), 0 for the color-only variant
 uniform float k_n;  // 1 / sigma_n^2, 0: no normal term (range_weights)
 uniform float k_r;  // 1 / (2 sigma_r^2), 0: no roughness term
-uniform int skip_case2;
+uniform int skip_case2;  // kSkipOff, kSkipOn or kSkipByHalves (skip_pixel)
+layout(binding = kUnitHalfVariances) uniform sampler2D half_variances_tex;  // kSkipByHalves: (V_even, V_odd)
 uniform float t;
 
 layout(std430, binding = kBufferCounts) buffer Counter { uint filtered_pixels; };
@@ -30,7 +31,7 @@ void main() {
   ivec2 size = textureSize(hv_tex, 0);
   vec4 hv_p = texelFetch(hv_tex, p, 0);
   vec3 lu_p = clean(hv_p.rgb);
-  if (final_pass != 0 && skip_case2 != 0 && skip_as_case2(hv_tex, lv_tex, guide_tex, surface_tex, p, k_c, k_d, k_n, k_r, t)) {
+  if (final_pass != 0 && skip_pixel(skip_case2, hv_tex, lv_tex, guide_tex, surface_tex, half_variances_tex, p, k_c, k_d, k_n, k_r, t)) {
     out_filtered = vec4(lu_p, kVarSkipped);
     out_centre_weight = 1.0;
     return;

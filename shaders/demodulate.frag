@@ -16,7 +16,8 @@ uniform float k_d;
 uniform float k_n;  // 1 / sigma_n^2, 0: no normal term (range_weights)
 uniform float k_r;  // 1 / (2 sigma_r^2), 0: no roughness term
 uniform float t;
-uniform int skip_case2;
+uniform int skip_case2;  // kSkipOff, kSkipOn or kSkipByHalves (skip_pixel)
+layout(binding = kUnitHalfVariances) uniform sampler2D half_variances_tex;  // kSkipByHalves: (V_even, V_odd)
 
 layout(location = 0) out vec4 out_hv;  // demodulated_texel
 layout(location = 1) out vec4 out_lv;  // the skip decision (see above)
@@ -24,6 +25,6 @@ layout(location = 1) out vec4 out_lv;  // the skip decision (see above)
 void main() {
   ivec2 p = ivec2(gl_FragCoord.xy);
   out_hv = demodulated_texel(hv_tex, albedo_tex, p);
-  bool skip = skip_case2 != 0 && skip_as_case2(hv_tex, lv_tex, guide_tex, surface_tex, p, k_c, k_d, k_n, k_r, t);
+  bool skip = skip_pixel(skip_case2, hv_tex, lv_tex, guide_tex, surface_tex, half_variances_tex, p, k_c, k_d, k_n, k_r, t);
   out_lv = vec4(vec3(skip ? kMaxInput : -kMaxInput), 1.0);
 }

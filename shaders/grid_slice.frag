@@ -22,7 +22,8 @@ uniform float k_c;  // 1 / (2 sigma_c^2), for skipping
 uniform float k_d;  // 1 / (2 sigma_d^2), for skipping
 uniform float k_n;  // 1 / sigma_n^2, 0: no normal term (range_weights)
 uniform float k_r;  // 1 / (2 sigma_r^2), 0: no roughness term
-uniform int skip_case2;
+uniform int skip_case2;  // kSkipOff, kSkipOn or kSkipByHalves (skip_pixel)
+layout(binding = kUnitHalfVariances) uniform sampler2D half_variances_tex;  // kSkipByHalves: (V_even, V_odd)
 uniform float t;
 
 layout(location = 0) out vec4 out_filtered;  // rgb L_f, a Var[L_f] (kVarUnknown, kVarSkipped)
@@ -30,7 +31,7 @@ layout(location = 1) out float out_centre_weight;  // the pixel's own share of L
 
 void main() {
   ivec2 p = ivec2(gl_FragCoord.xy);
-  if (skip_case2 != 0 && skip_as_case2(hv_tex, lv_tex, guide_tex, surface_tex, p, k_c, k_d, k_n, k_r, t)) {
+  if (skip_pixel(skip_case2, hv_tex, lv_tex, guide_tex, surface_tex, half_variances_tex, p, k_c, k_d, k_n, k_r, t)) {
     out_filtered = vec4(clean(texelFetch(hv_tex, p, 0).rgb), kVarSkipped);
     out_centre_weight = 1.0;
     return;

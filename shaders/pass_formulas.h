@@ -68,10 +68,14 @@ PXF_CONST int kUnitSignal = 3;        // what a filter pass filters: L_u, or the
 PXF_CONST int kUnitFiltered = 4;      // rgb L_f, a Var[L_f] or a sentinel
 PXF_CONST int kUnitCentreWeight = 5;  // r: the filter's centre weight
 PXF_CONST int kUnitAlbedo = 6;        // rgb mean first non-specular albedo
-PXF_CONST int kUnitGuardSums = 7;     // the bias guard's finding (b2, var_u), or the row sums over x in [-r, r]
+// the bias guard's finding (b2, var_u; with halves, the even half's then the odd's), or the row
+// sums over x in [-r, r]
+PXF_CONST int kUnitGuardSums = 7;
 PXF_CONST int kUnitGuardRowsLowX = 8;   // the bias guard's row sums over x in [-r, 0]
 PXF_CONST int kUnitGuardRowsHighX = 9;  // and over x in [0, r]
 PXF_CONST int kUnitSurface = 10;      // the range buffer's surface: xyz shading normal (0: unknown), w roughness
+PXF_CONST int kUnitHalves = 11;       // the split decision: rgb L_even, a n_even / n
+PXF_CONST int kUnitHalfVariances = 12;  // rg: the whole mean's variance from each half alone (even, odd)
 
 // Shader storage buffer bindings of the pass shaders.
 PXF_CONST int kBufferCounts = 0;      // the filters' filtered-pixel counter, the blend's case counts
@@ -300,26 +304,51 @@ PXF_CONST float kMinPooledWeight = 1.17549435e-38f;
 // Both fall as 1/n, so the bias still vanishes. Returns kVarUnknown where n < 2, and 0 where all
 // the pixel's samples were equal and no neighbour variance is known. A neighbour whose range weight
 // is below kMinPooledWeight counts as unknown.
-PXF_SAMPLER_FN float pooled_var_u(sampler2D hv, sampler2D guide, sampler2D surface, ivec2 p, float k_c, float k_d,
-                                   float k_n, float k_r) {
-  float own = clean_var(texelFetch(hv, p, 0).a);
-  if (own < 0.0f) return kVarUnknown;
+// The pooling's sums over the 8 neighbours of p (the pixel itself left out, so that the split
+// decision can pool each half's own estimate, section 3.8) and the pixel's weight with itself.
+struct PooledNeighbours {
+  wide_float sw, swv;  // sum of the weights and of the weighted variances of the known neighbours
+  wide_float centre;   // range_weight of p with itself
+};
+PXF_SAMPLER_FN PooledNeighbours pooled_neighbours(sampler2D hv, sampler2D guide, sampler2D surface, ivec2 p, float k_c,
+                                                  float k_d, float k_n, float k_r) {
   ivec2 size = textureSize(hv, 0);
   vec4 g_p = texelFetch(guide, p, 0);
   vec4 s_p = texelFetch(surface, p, 0);
-  wide_float sw = 0.0f, swv = 0.0f;
+  PooledNeighbours n;
+  n.sw = 0.0f;
+  n.swv = 0.0f;
+  n.centre = range_weight(g_p, g_p, s_p, s_p, k_c, k_d, k_n, k_r);
   for (int dy = -1; dy <= 1; ++dy)
     for (int dx = -1; dx <= 1; ++dx) {
       ivec2 q = p + ivec2(dx, dy);
-      if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) continue;
+      if ((dx == 0 && dy == 0) || any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) continue;
       float v = clean_var(texelFetch(hv, q, 0).a);
       if (!(v > 0.0f)) continue;  // unknown, or all samples equal: no evidence
       wide_float w = range_weight(g_p, texelFetch(guide, q, 0), s_p, texelFetch(surface, q, 0), k_c, k_d, k_n, k_r);
       if (!(w >= kMinPooledWeight)) continue;  // across a range edge: as the GPU flushes it
-      sw += w;
-      swv += w * v;
+      n.sw += w;
+      n.swv += w * v;
     }
+  return n;
+}
+
+// The pooled variance of a pixel whose own estimate is `own` (cleaned; kVarUnknown: unknown).
+PXF_INLINE float pooled_with_own(PooledNeighbours n, float own) {
+  if (own < 0.0f) return kVarUnknown;
+  wide_float sw = n.sw, swv = n.swv;
+  if (own > 0.0f && n.centre >= kMinPooledWeight) {
+    sw += n.centre;
+    swv += n.centre * wide_float(own);
+  }
   return sw > 0.0f ? max(own, float(swv / sw)) : own;
+}
+
+PXF_SAMPLER_FN float pooled_var_u(sampler2D hv, sampler2D guide, sampler2D surface, ivec2 p, float k_c, float k_d,
+                                   float k_n, float k_r) {
+  float own = clean_var(texelFetch(hv, p, 0).a);
+  if (own < 0.0f) return kVarUnknown;
+  return pooled_with_own(pooled_neighbours(hv, guide, surface, p, k_c, k_d, k_n, k_r), own);
 }
 
 // The threshold of pixel p: a run's t (the threshold after the frame count's samples, t_n of
@@ -344,6 +373,38 @@ PXF_SAMPLER_FN bool skip_as_case2(sampler2D hv, sampler2D lv, sampler2D guide, s
   if (own > 0.0f && relative_variance(own, lb) > t_p) return false;
   float v = pooled_var_u(hv, guide, surface, p, k_c, k_d, k_n, k_r);
   return v > 0.0f && relative_variance(v, lb) <= t_p;
+}
+
+// The skip of the split decision (section 3.8): the split blend shows L_u alone where both halves'
+// decisions are case 2, each from the other half's variance, so the skip asks both: the pooled
+// variance with each half's estimate as the pixel's own, and neither above t (a half with fewer
+// than 2 samples is never skipped: its decision is case 4). half_variances: (V_even, V_odd).
+PXF_SAMPLER_FN bool skip_as_case2_by_halves(sampler2D hv, sampler2D lv, sampler2D guide, sampler2D surface,
+                                            vec2 half_variances, ivec2 p, float k_c, float k_d, float k_n, float k_r,
+                                            float t) {
+  vec4 lv_p = texelFetch(lv, p, 0);
+  float lb = max(luminance(clean(vec3(texelFetch(hv, p, 0)))) + luminance(clean(vec3(lv_p))), 0.0f);
+  float t_p = max(pixel_threshold(t, lv_p), 0.0f);
+  float v_even = clean_var(half_variances.x), v_odd = clean_var(half_variances.y);
+  if (v_even < 0.0f || v_odd < 0.0f) return false;
+  if (relative_variance(max(v_even, v_odd), lb) > t_p) return false;  // the pooled variance is no lower
+  PooledNeighbours n = pooled_neighbours(hv, guide, surface, p, k_c, k_d, k_n, k_r);
+  float pooled_even = pooled_with_own(n, v_even), pooled_odd = pooled_with_own(n, v_odd);
+  return pooled_even > 0.0f && pooled_odd > 0.0f && relative_variance(pooled_even, lb) <= t_p &&
+         relative_variance(pooled_odd, lb) <= t_p;
+}
+
+// The filter's skip as its uniform skip_case2 asks for it: none, by the pixel's own variance
+// (skip_as_case2) or by its halves' (skip_as_case2_by_halves, the split decision's).
+PXF_CONST int kSkipOff = 0;
+PXF_CONST int kSkipOn = 1;
+PXF_CONST int kSkipByHalves = 2;
+PXF_SAMPLER_FN bool skip_pixel(int mode, sampler2D hv, sampler2D lv, sampler2D guide, sampler2D surface,
+                               sampler2D half_variances, ivec2 p, float k_c, float k_d, float k_n, float k_r, float t) {
+  if (mode == kSkipByHalves)
+    return skip_as_case2_by_halves(hv, lv, guide, surface, vec2(texelFetch(half_variances, p, 0)), p, k_c, k_d, k_n,
+                                   k_r, t);
+  return mode == kSkipOn && skip_as_case2(hv, lv, guide, surface, p, k_c, k_d, k_n, k_r, t);
 }
 
 // ---- Blend factor ----
@@ -464,15 +525,16 @@ struct BiasGuardSums {
 // variance mean only the first. A variance of 0 (all samples equal) counts as Y(L_f)^2 in both,
 // as in zero_variance_u.
 PXF_CONST float kBiasGuardKnownUnit = 32.0f;  // more than the 25 neighbours: the two counts stay apart
-PXF_SAMPLER_FN vec4 bias_guard_texel(sampler2D hv, sampler2D filtered, ivec2 q) {
-  vec4 u_q = texelFetch(hv, q, 0);
+PXF_INLINE vec4 bias_guard_texel_of(vec4 u_q, vec4 f_q) {
   float vu = clean_var(u_q.a);
   if (vu < 0.0f) return vec4(0.0f);  // n < 2
-  vec4 f_q = texelFetch(filtered, q, 0);
   float y_f = luminance(clean(vec3(f_q)));
   if (vu == 0.0f) vu = y_f * y_f;  // all samples equal: no evidence of low variance
   if (f_q.a < kVarSkippedBelow) return vec4(0.0f, 0.0f, vu, kBiasGuardKnownUnit);  // skipped by the filter
   return vec4(y_f - luminance(clean(vec3(u_q))), vu + max(clean_var(f_q.a), 0.0f), vu, kBiasGuardKnownUnit + 1.0f);
+}
+PXF_SAMPLER_FN vec4 bias_guard_texel(sampler2D hv, sampler2D filtered, ivec2 q) {
+  return bias_guard_texel_of(texelFetch(hv, q, 0), texelFetch(filtered, q, 0));
 }
 
 // Unpacks summed bias_guard_texel values.
@@ -590,6 +652,16 @@ PXF_INLINE BiasGuardEstimate bias_guard_estimate(vec4 full, vec4 low_y, vec4 hig
   return best;
 }
 
+// The finding that decides one half of the pixel's samples under the split decision (section
+// 3.8): every window holds the pixel, and there it reads the other half (`other`, its
+// bias_guard_texel_of) in place of the whole pixel (`own`), so that nothing of the half it
+// decides enters the finding.
+PXF_INLINE BiasGuardEstimate half_guard_estimate(vec4 full, vec4 low_y, vec4 high_y, vec4 low_x, vec4 high_x,
+                                                 vec4 own, vec4 other) {
+  vec4 swap = other - own;
+  return bias_guard_estimate(full + swap, low_y + swap, high_y + swap, low_x + swap, high_x + swap, other);
+}
+
 // The guard's finding at pixel p by the definition of its windows (the CPU reference).
 PXF_SAMPLER_FN BiasGuardEstimate bias_guard_estimate_at(sampler2D hv, sampler2D filtered, ivec2 p) {
   const int r = kBiasGuardRadius;
@@ -680,6 +752,22 @@ PXF_INLINE bool blend_compares_variances(BlendTexels px, BlendSwitches on) {
   return blend_case_before_variances(px, on) == kCaseByVariances;
 }
 
+// What blend_pixel reads where it compares variances: the pooling from its neighbour sums
+// (pooled_neighbours) and the pixel's own variance, the filter's centre weight (0: none) and the
+// guard's finding (b2, var_u).
+PXF_INLINE BlendVarianceInputs blend_variance_inputs(BlendTexels px, BlendSwitches on, PooledNeighbours pooled,
+                                                     float centre_weight, vec2 guard) {
+  BlendVarianceInputs v = blend_variance_inputs_none();
+  if (!blend_compares_variances(px, on)) return v;
+  if (on.has_guide) v.var_u_pooled = pooled_with_own(pooled, clean_var(px.hv.a));
+  v.centre_weight = centre_weight;
+  if (on.bias_guard) {
+    v.guard.b2 = guard.x;
+    v.guard.var_u = guard.y;
+  }
+  return v;
+}
+
 // The blend of one pixel: the case order above, then u from the pooled variance (the pixel's own
 // without a guide; zero_variance_u where it is 0), f, the threshold, the covariance through the
 // centre weight (blend_factor_covariance) and the bias guard (guarded_blend_factor).
@@ -703,6 +791,56 @@ PXF_INLINE BlendPixel blend_pixel(BlendTexels px, BlendSwitches on, BlendVarianc
     if (on.bias_guard) b.s = guarded_blend_factor(v.guard, b.s, b.u, b.f, v.centre_weight, b.lb, b.blend_case);
   }
   b.radiance = clean(lv + b.s * lu + (1.0f - b.s) * lf);
+  return b;
+}
+
+// ---- The split decision (docs/method.md section 3.8) ----
+
+// A decision made from the pixel's own samples correlates with them: a pixel that caught a bright
+// path has a large variance and takes L_f, one that missed it looks quiet and keeps its dark L_u,
+// and the image darkens. So each half of the samples (even and odd sample index) is blended with
+// the weight the other half's variance decides, and the halves are added back with their shares
+// (Rousselle et al. 2012 decide each of two buffers from the other's error estimate).
+// The halves' texels (Accumulation::hv_halves): halves rgb L_even, a w = n_even / n; variances
+// (V_even, V_odd), the whole mean's variance as each half alone estimates it (kVarUnknown: fewer
+// than 2 samples in that half).
+
+// Half `which`'s (0 even, 1 odd) mean and its own variance Var[L_h] = V_h / w_h, as the bias guard reads
+// a pixel (bias_guard_texel_of); the odd mean is (L_u - w L_even) / (1 - w).
+PXF_INLINE vec4 half_texel(vec4 hv, vec4 halves, vec2 variances, int which) {
+  float w_even = clamp(halves.a, 0.0f, 1.0f);
+  float w = which == 0 ? w_even : 1.0f - w_even;
+  vec3 lu = clean(vec3(hv)), le = clean(vec3(halves));
+  if (!(w > 0.0f)) return vec4(lu, kVarUnknown);
+  vec3 l = which == 0 ? le : clean((lu - w_even * le) / w);
+  float v = clean_var(which == 0 ? variances.x : variances.y);
+  return vec4(l, v < 0.0f ? kVarUnknown : min(v / w, kMaxInput));
+}
+
+// The texels half `which` (0 even, 1 odd) is decided by: the pixel's, with the other half's
+// estimate as its variance.
+PXF_INLINE BlendTexels decision_texels(BlendTexels px, vec2 variances, int which) {
+  BlendTexels d = px;
+  d.hv.a = which == 0 ? variances.y : variances.x;
+  return d;
+}
+
+// The blend of one pixel from its halves: each half's s from blend_pixel with the other half's
+// variance as the pixel's own (v_even and v_odd pooled and guarded likewise), then
+// L = L_lv + w (s_e L_e + (1 - s_e) L_f) + (1 - w) (s_o L_o + (1 - s_o) L_f)
+//   = L_lv + s L_u + (1 - s) L_f + w (s_e - s_o) (L_e - L_u),  s = w s_e + (1 - w) s_o,
+// exactly the one-decision blend where the halves agree. The case, u, f and var_u shown are those
+// of the half that takes more of L_f.
+PXF_INLINE BlendPixel blend_pixel_split(BlendTexels px, vec4 halves, vec2 variances, BlendSwitches on,
+                                        BlendVarianceInputs v_even, BlendVarianceInputs v_odd) {
+  BlendPixel be = blend_pixel(decision_texels(px, variances, 0), on, v_even);
+  BlendPixel bo = blend_pixel(decision_texels(px, variances, 1), on, v_odd);
+  float w = clamp(halves.a, 0.0f, 1.0f);
+  BlendPixel b = be.s <= bo.s ? be : bo;
+  b.s = w * be.s + (1.0f - w) * bo.s;
+  vec3 lu = clean(vec3(px.hv)), lv = clean(vec3(px.lv));
+  vec3 lf = on.has_filtered ? clean(vec3(px.filtered)) : lu;
+  b.radiance = clean(lv + b.s * lu + (1.0f - b.s) * lf + (w * (be.s - bo.s)) * (clean(vec3(halves)) - lu));
   return b;
 }
 

@@ -19,7 +19,10 @@ inline bool same_accumulation(const Accumulation& a, const Accumulation& b) {
          std::memcmp(a.lv_mean.data(), b.lv_mean.data(), a.lv_mean.size() * sizeof(glm::vec3)) == 0 &&
          std::memcmp(a.hv_mean.data(), b.hv_mean.data(), a.hv_mean.size() * sizeof(glm::vec3)) == 0 &&
          std::memcmp(a.hv_lum_m2.data(), b.hv_lum_m2.data(), a.hv_lum_m2.size() * sizeof(double)) == 0 &&
-         std::memcmp(a.lv_lum_m2.data(), b.lv_lum_m2.data(), a.lv_lum_m2.size() * sizeof(double)) == 0;
+         std::memcmp(a.lv_lum_m2.data(), b.lv_lum_m2.data(), a.lv_lum_m2.size() * sizeof(double)) == 0 &&
+         a.even_samples == b.even_samples &&
+         std::memcmp(a.even_hv_mean.data(), b.even_hv_mean.data(), a.even_hv_mean.size() * sizeof(glm::vec3)) == 0 &&
+         std::memcmp(a.even_lum_m2.data(), b.even_lum_m2.data(), a.even_lum_m2.size() * sizeof(double)) == 0;
 }
 
 // A render restored after k frames (each of `ks`) from its accumulation and the learned state
