@@ -754,7 +754,8 @@ const std::vector<BenchMode>& bench_modes() {
        "for each file of --list (one 'NAME SCENE [ENV]' a line) and each --times budget in seconds: plain\n"
        "path tracing against the preview at equal wall time of the whole job (the file's load taken off both),\n"
        "--rounds alternating rounds, display and HDR NRMSE and LDR-FLIP against a --reference-spp reference of\n"
-       "another seed (cached in --out); writes files.csv and files_sheet.png (bench/files_bench.h)",
+       "another seed (cached in --out), and the preview's bias (its mean against the unfiltered mean of its own\n"
+       "samples); writes files.csv and files_sheet.png (bench/files_bench.h)",
        files_bench_mode},
   };
   return modes;

@@ -42,13 +42,17 @@ struct FileRow {
   std::vector<TimedRun> plain, filtered;  // one per round
 };
 
-double median_metric(const std::vector<TimedRun>& runs, double RowError::*metric) {
-  std::vector<double> values;
-  for (const TimedRun& r : runs) values.push_back(r.error.*metric);
-  // Two rounds: their mean (median_of takes the upper one).
+// The median of the rounds' values; of two rounds, their mean (median_of takes the upper one).
+double rounds_median(std::vector<double> values) {
   std::sort(values.begin(), values.end());
   const size_t n = values.size();
   return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
+double median_metric(const std::vector<TimedRun>& runs, double RowError::*metric) {
+  std::vector<double> values;
+  for (const TimedRun& r : runs) values.push_back(r.error.*metric);
+  return rounds_median(values);
 }
 
 double median_spp(const std::vector<TimedRun>& runs) {
@@ -60,12 +64,26 @@ double median_spp(const std::vector<TimedRun>& runs) {
 const char* kCsvHeader =
     "name,scene,env,time_s,rounds,unfiltered_spp,filtered_spp,unfiltered_hdr_nrmse_percent,"
     "filtered_hdr_nrmse_percent,hdr_ratio,unfiltered_display_nrmse_percent,filtered_display_nrmse_percent,"
-    "display_ratio,unfiltered_flip,filtered_flip,flip_ratio\n";
+    "display_ratio,unfiltered_flip,filtered_flip,flip_ratio,filtered_mean_bias_percent\n";
 
 // A row's medians over its rounds, unfiltered (u) and filtered (f).
 struct RowMedians {
   double u_spp, f_spp, u_hdr, f_hdr, u_display, f_display, u_flip, f_flip;
+  double f_bias;  // the filtered image's mean over its own samples' unfiltered mean, - 1, in %
 };
+
+// The preview's bias in one run: its image's mean against the unfiltered image of the same samples
+// (paired, so the noise of the mean mostly cancels), in %.
+double mean_bias_percent(const TimedRun& run) {
+  const ImageMetrics m = compare_images(run.image, run.unfiltered);
+  return m.reference_mean > 0.0 ? 100.0 * (m.test_mean / m.reference_mean - 1.0) : 0.0;
+}
+
+double median_bias_percent(const std::vector<TimedRun>& runs) {
+  std::vector<double> values;
+  for (const TimedRun& r : runs) values.push_back(mean_bias_percent(r));
+  return rounds_median(values);
+}
 
 RowMedians medians(const FileRow& row) {
   return {median_spp(row.plain),
@@ -75,7 +93,8 @@ RowMedians medians(const FileRow& row) {
           median_metric(row.plain, &RowError::display_nrmse),
           median_metric(row.filtered, &RowError::display_nrmse),
           median_metric(row.plain, &RowError::flip),
-          median_metric(row.filtered, &RowError::flip)};
+          median_metric(row.filtered, &RowError::flip),
+          median_bias_percent(row.filtered)};
 }
 
 std::string csv_row(const BenchFileEntry& e, const FileRow& row, const RowMedians& m) {
@@ -83,7 +102,7 @@ std::string csv_row(const BenchFileEntry& e, const FileRow& row, const RowMedian
   s << e.name << "," << e.scene << "," << e.env << "," << row.seconds << "," << row.plain.size() << "," << m.u_spp
     << "," << m.f_spp << "," << m.u_hdr << "," << m.f_hdr << "," << m.f_hdr / m.u_hdr << "," << m.u_display << ","
     << m.f_display << "," << m.f_display / m.u_display << "," << m.u_flip << "," << m.f_flip << ","
-    << m.f_flip / m.u_flip << "\n";
+    << m.f_flip / m.u_flip << "," << m.f_bias << "\n";
   return s.str();
 }
 
@@ -168,9 +187,10 @@ int files_bench_mode(const std::vector<std::string>& args, const std::string& su
   std::printf("bench files: %zu files, times %s s, %d rounds, t=%g, filter %s, GL %s (%s)\n", entries.size(),
               times_text.c_str(), rounds, h.settings().threshold, filter_kind_name(h.settings().filter.kind),
               context->backend_name(), context->gl_renderer().c_str());
-  std::printf("display NRMSE, HDR NRMSE and LDR-FLIP: median over rounds, filtered / unfiltered\n");
-  std::printf("%-16s %6s | %9s %9s | %8s %8s %6s | %8s %8s %6s | %7s %7s %6s\n", "file", "time s", "unf spp",
-              "filt spp", "disp unf", "filt", "ratio", "HDR unf", "filt", "ratio", "FLIP unf", "filt", "ratio");
+  std::printf("display NRMSE, HDR NRMSE and LDR-FLIP: median over rounds, filtered / unfiltered; bias: the\n"
+              "filtered image's mean against the unfiltered mean of its own samples\n");
+  std::printf("%-16s %6s | %9s %9s | %8s %8s %6s | %8s %8s %6s | %7s %7s %6s | %6s\n", "file", "time s", "unf spp",
+              "filt spp", "disp unf", "filt", "ratio", "HDR unf", "filt", "ratio", "FLIP unf", "filt", "ratio", "bias");
   std::ostringstream csv;
   csv << kCsvHeader;
   std::unique_ptr<ContactSheet> sheet;
@@ -196,9 +216,10 @@ int files_bench_mode(const std::vector<std::string>& args, const std::string& su
       }
       const RowMedians m = medians(row);
       csv << csv_row(e, row, m);
-      std::printf("%-16s %6g | %9.0f %9.0f | %7.2f%% %7.2f%% %5.2fx | %7.2f%% %7.2f%% %5.2fx | %7.4f %7.4f %5.2fx\n",
+      std::printf("%-16s %6g | %9.0f %9.0f | %7.2f%% %7.2f%% %5.2fx | %7.2f%% %7.2f%% %5.2fx | %7.4f %7.4f %5.2fx | "
+                  "%+5.2f%%\n",
                   e.name.c_str(), times[k], m.u_spp, m.f_spp, m.u_display, m.f_display, m.f_display / m.u_display,
-                  m.u_hdr, m.f_hdr, m.f_hdr / m.u_hdr, m.u_flip, m.f_flip, m.f_flip / m.u_flip);
+                  m.u_hdr, m.f_hdr, m.f_hdr / m.u_hdr, m.u_flip, m.f_flip, m.f_flip / m.u_flip, m.f_bias);
       std::fflush(stdout);
       sheet->put(static_cast<int>(i), 2 * static_cast<int>(k), tonemap_like_reference(row.plain.back().image, reference).test);
       sheet->put(static_cast<int>(i), 2 * static_cast<int>(k) + 1,

@@ -122,7 +122,14 @@ TEST(Cli, FilesBenchWritesItsTableAndSheet) {
   const Result r = run("bench files --list " + out + "/list.txt --size 16x12 --times 0.2,0.3 --rounds 2 "
                        "--reference-spp 4 --out " + out);
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_EQ(lines(slurp(out + "/files.csv")), 5u);  // the header, 2 files x 2 budgets
+  const std::string csv = slurp(out + "/files.csv");
+  EXPECT_EQ(lines(csv), 5u);  // the header, 2 files x 2 budgets
+  // The last column, the filtered image's mean bias against its own samples, is a finite percentage.
+  const std::string header = csv.substr(0, csv.find('\n'));
+  EXPECT_EQ(header.substr(header.rfind(',') + 1), "filtered_mean_bias_percent");
+  const std::string first_row = csv.substr(header.size() + 1, csv.find('\n', header.size() + 1) - header.size() - 1);
+  const double bias = std::stod(first_row.substr(first_row.rfind(',') + 1));
+  EXPECT_TRUE(std::isfinite(bias) && std::abs(bias) < 100.0) << first_row;
   const Image sheet = read_ldr_or_hdr(out + "/files_sheet.png");
   EXPECT_EQ(sheet.width, 5 * (16 + 2));
   EXPECT_EQ(sheet.height, 2 * (12 + 2));
