@@ -296,14 +296,6 @@ PXF_INLINE float pixel_samples(float run_samples, float factor) {
 // and so gave such a pixel another s than the pass.
 PXF_CONST float kMinPooledWeight = 1.17549435e-38f;
 
-// Var[L_u] for the decisions of the blend and the filter's skipping (docs/method.md section 3.3). A
-// variance estimated from few samples is itself noisy, and far more often too low than too high:
-// path contributions are heavy-tailed, and a pixel that missed the rare bright paths looks quiet
-// (dark speckles kept by case 2). So the decision uses the larger of the pixel's own variance and
-// the range-weighted mean of the known variances in its 3x3 neighbourhood (the filter's weights).
-// Both fall as 1/n, so the bias still vanishes. Returns kVarUnknown where n < 2, and 0 where all
-// the pixel's samples were equal and no neighbour variance is known. A neighbour whose range weight
-// is below kMinPooledWeight counts as unknown.
 // The pooling's sums over the 8 neighbours of p (the pixel itself left out, so that the split
 // decision can pool each half's own estimate, section 3.8) and the pixel's weight with itself.
 struct PooledNeighbours {
@@ -344,6 +336,14 @@ PXF_INLINE float pooled_with_own(PooledNeighbours n, float own) {
   return sw > 0.0f ? max(own, float(swv / sw)) : own;
 }
 
+// Var[L_u] for the decisions of the blend and the filter's skipping (docs/method.md section 3.3). A
+// variance estimated from few samples is itself noisy, and far more often too low than too high:
+// path contributions are heavy-tailed, and a pixel that missed the rare bright paths looks quiet
+// (dark speckles kept by case 2). So the decision uses the larger of the pixel's own variance and
+// the range-weighted mean of the known variances in its 3x3 neighbourhood (the filter's weights).
+// Both fall as 1/n, so the bias still vanishes. Returns kVarUnknown where n < 2, and 0 where all
+// the pixel's samples were equal and no neighbour variance is known. A neighbour whose range weight
+// is below kMinPooledWeight counts as unknown.
 PXF_SAMPLER_FN float pooled_var_u(sampler2D hv, sampler2D guide, sampler2D surface, ivec2 p, float k_c, float k_d,
                                    float k_n, float k_r) {
   float own = clean_var(texelFetch(hv, p, 0).a);
