@@ -4,8 +4,7 @@ namespace pxf {
 
 PreviewInputs::PreviewInputs(int width, int height)
     : width_(width), height_(height), lv_(width, height, TextureFormat::RGBA32F),
-      hv_(width, height, TextureFormat::RGBA32F), albedo_(width, height, TextureFormat::RGBA32F),
-      halves_(width, height, TextureFormat::RGBA32F), half_variances_(width, height, TextureFormat::RG32F) {}
+      hv_(width, height, TextureFormat::RGBA32F), albedo_(width, height, TextureFormat::RGBA32F) {}
 
 void PreviewInputs::upload_packed(const float* lv_rgb, const float* hv_rgba) {
   timer_.begin();
@@ -63,8 +62,12 @@ void PreviewInputs::upload_albedo(const Image& albedo) {
 
 void PreviewInputs::upload_halves(const float* halves_rgba, const float* variances_rg) {
   timer_.begin();
-  halves_.upload(halves_rgba, 4);
-  half_variances_.upload(variances_rg, 2);
+  if (!halves_) {
+    halves_ = std::make_unique<Texture2D>(width_, height_, TextureFormat::RGBA32F);
+    half_variances_ = std::make_unique<Texture2D>(width_, height_, TextureFormat::RG32F);
+  }
+  halves_->upload(halves_rgba, 4);
+  half_variances_->upload(variances_rg, 2);
   has_halves_ = true;
   timer_.end();
 }

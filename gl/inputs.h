@@ -8,6 +8,7 @@
 //   ... filter.run(in, range.guide(), ...); blend.run(in, &filter, ...);
 #pragma once
 #include <cstdint>
+#include <memory>
 #include <vector>
 #include "gl/resources.h"
 
@@ -48,8 +49,11 @@ class PreviewInputs {
   const Texture2D& lv() const { return lv_; }  // rgb L_lv, a the pixel's threshold factor
   const Texture2D& hv() const { return hv_; }  // rgb L_u, a Var[L_u] (kVarUnknown where n < 2)
   const Texture2D& albedo() const { return albedo_; }  // rgb mean albedo (upload_albedo)
-  const Texture2D& halves() const { return halves_; }  // rgb L_even, a n_even / n (upload_halves)
-  const Texture2D& half_variances() const { return half_variances_; }  // rg (V_even, V_odd)
+  // rgb L_even, a n_even / n, and rg (V_even, V_odd) (upload_halves). Allocated by the first
+  // upload_halves: before it the HV texture stands in, so that every sampler unit has a texture (no
+  // pass reads it then: has_halves is false).
+  const Texture2D& halves() const { return halves_ ? *halves_ : hv_; }
+  const Texture2D& half_variances() const { return half_variances_ ? *half_variances_ : hv_; }
   double last_upload_ms() const { return timer_.last_ms(); }
 
   Image lv_image() const;   // "R,G,B"
@@ -59,7 +63,8 @@ class PreviewInputs {
 
  private:
   int width_, height_;
-  Texture2D lv_, hv_, albedo_, halves_, half_variances_;
+  Texture2D lv_, hv_, albedo_;
+  std::unique_ptr<Texture2D> halves_, half_variances_;  // the split decision's, when it is on
   bool has_halves_ = false;
   std::vector<float> packed_;  // staging of upload(): hv rgb + variance interleaved
   StageTimer timer_;

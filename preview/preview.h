@@ -103,7 +103,7 @@ constexpr double kFirstFrameExtraShare = 0.5;
 // each pass's textures added since; docs/notebook/measurements.md has the figures): the
 // accumulation (means, variances in double, albedo, replicates), the GL textures of every pass, and
 // the read-backs written to buffers.exr.
-constexpr uint64_t kPreviewBytesPerPixel = 590;
+constexpr uint64_t kPreviewBytesPerPixel = 770;
 uint64_t preview_bytes(int width, int height);
 // Throws pxf::Error, one line naming the size and both figures, when preview_bytes exceeds
 // `available_bytes` (available_memory_bytes() in the constructor).

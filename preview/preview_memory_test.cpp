@@ -24,7 +24,7 @@ TEST(PreviewMemory, HugeSizeIsRefusedWithOneLineNamingTheSizeAndBothFigures) {
   } catch (const Error& e) {
     const std::string message = e.what();
     EXPECT_NE(message.find("--size 16384x16384"), std::string::npos) << message;
-    EXPECT_NE(message.find("147.5 GiB"), std::string::npos) << message;  // 16384^2 x 590 B
+    EXPECT_NE(message.find("192.5 GiB"), std::string::npos) << message;  // 16384^2 x 770 B
     EXPECT_NE(message.find("24.0 GiB available"), std::string::npos) << message;
     EXPECT_EQ(message.find('\n'), std::string::npos) << message;
   }
