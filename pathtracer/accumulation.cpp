@@ -165,11 +165,17 @@ void Accumulation::hv_halves(const float* whole_rgba, float* halves, float* half
     halves[4 * p + 2] = even_hv_mean[p].z;
     halves[4 * p + 3] = n > 0 ? static_cast<float>(static_cast<double>(n_even) / n) : 0.0f;
     // The odd half's Welford state: Chan's combination of the halves into the whole, solved for it.
+    // What is left of the subtraction below kOddM2Resolution of the whole M2 is its rounding: odd
+    // samples that were all equal (all 0 beside one bright even sample) come out as a few ulps of
+    // either sign, which would read as a known, tiny variance in one render and as 0 (no evidence,
+    // shared::zero_variance_u) in the same samples merged from shards.
+    constexpr double kOddM2Resolution = 1e-9;
     double odd_m2 = 0;
     if (n_odd > 0 && n_even > 0) {
       const double odd_mean = (hv_lum_mean[p] * n - even_lum_mean[p] * n_even) / n_odd;
       const double delta = odd_mean - even_lum_mean[p];
-      odd_m2 = std::max(0.0, hv_lum_m2[p] - even_lum_m2[p] - delta * delta * n_even * n_odd / n);
+      odd_m2 = hv_lum_m2[p] - even_lum_m2[p] - delta * delta * n_even * n_odd / n;
+      if (!(odd_m2 > kOddM2Resolution * hv_lum_m2[p])) odd_m2 = 0.0;
     } else if (n_odd > 0) {
       odd_m2 = hv_lum_m2[p];
     }

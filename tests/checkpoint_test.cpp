@@ -304,6 +304,33 @@ TEST(Checkpoint, MergeOfUnevenShardsEqualsOneRender) {
   }
 }
 
+// Under the split decision the blend reads each pixel's halves, which a merge combines from the
+// shards' (docs/method.md 3.8): its image is the one render's, odd cuts (shards that start on an
+// odd sample index) included. The odd half's variance is derived by subtraction, and before its
+// rounding was snapped to 0 a pixel whose odd samples were all equal flipped its decision between
+// the two.
+TEST(Checkpoint, SplitDecisionShardsMergeIntoTheOneRender) {
+  const std::string split = " --split-decision on";
+  const std::string ref = temp_dir("split_single");
+  ASSERT_EQ(pxf_run("render " + kScene + split + " --spp " + std::to_string(kSpp) + " --out " + ref).code, 0);
+  const std::vector<Layer> single = read_exr_layers(ref + "/buffers.exr");
+  const std::vector<int> cuts{0, 5, 11, 24};
+  std::string states;
+  for (size_t i = 0; i + 1 < cuts.size(); ++i) {
+    const std::string dir = temp_dir("split_shard_" + std::to_string(i));
+    const std::string frames = std::to_string(cuts[i]) + ":" + std::to_string(cuts[i + 1]);
+    const Result r = pxf_run("render " + kScene + split + " --frames " + frames + " --out " + dir);
+    ASSERT_EQ(r.code, 0) << r.err;
+    states += " " + dir + "/state.pxfs";
+  }
+  const std::string merged_dir = temp_dir("split_merged");
+  const Result r = pxf_run("merge" + states + " --scene cornell" + split + " --out " + merged_dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::vector<Layer> merged = read_exr_layers(merged_dir + "/buffers.exr");
+  for (const char* layer : {"hv", "blend", "final"})
+    expect_merge_close(layer_image(merged, layer), layer_image(single, layer), layer);
+}
+
 // With --replicates K > 1 (Var[L_u] from independently scrambled Sobol replicates) the state
 // carries the per-replicate sums: a resumed render is bit-identical and a merge of shards that cut
 // the replicate cycle equals one render, variance and blended image included.
