@@ -255,21 +255,17 @@ namespace {
 // The guard's finding at p, (b2, var_u) of each half (the even half's pixel window judged on the odd
 // half, and the other way round), or the one finding twice, by the definition of its windows.
 glm::vec4 guard_findings(const TexelView& hv, const TexelView& filtered, glm::ivec2 p, const BlendHalves& halves) {
-  const int r = shared::kBiasGuardRadius;
-  auto window = [&](glm::ivec2 lo, glm::ivec2 hi) { return shared::bias_guard_window_sums(hv, filtered, p, lo, hi); };
-  const glm::vec4 full = window({-r, -r}, {r, r}), low_y = window({-r, -r}, {r, 0}), high_y = window({-r, 0}, {r, r});
-  const glm::vec4 low_x = window({-r, -r}, {0, r}), high_x = window({0, -r}, {r, r});
-  const glm::vec4 own = shared::bias_guard_texel(hv, filtered, p);
   if (!halves.halves) {
-    const shared::BiasGuardEstimate e = shared::bias_guard_estimate(full, low_y, high_y, low_x, high_x, own);
+    const shared::BiasGuardEstimate e =
+        shared::bias_guard_estimate_at(hv, filtered, p, shared::bias_guard_texel(hv, filtered, p));
     return {e.b2, e.var_u, e.b2, e.var_u};
   }
   const glm::vec4 u = texelFetch(hv, p, 0), f = texelFetch(filtered, p, 0);
   const glm::vec4 h = texelFetch(TexelView{halves.halves}, p, 0);
-  const glm::vec2 v(halves.variances->at(p.x, p.y, 0), halves.variances->at(p.x, p.y, 1));
+  const glm::vec2 v(texelFetch(TexelView{halves.variances}, p, 0));
   auto finding = [&](int which) {  // half `which`'s finding, the other half read at the pixel
     const glm::vec4 other = shared::bias_guard_texel_of(shared::half_texel(u, h, v, 1 - which), f);
-    const shared::BiasGuardEstimate e = shared::half_guard_estimate(full, low_y, high_y, low_x, high_x, own, other);
+    const shared::BiasGuardEstimate e = shared::bias_guard_estimate_at(hv, filtered, p, other);
     return glm::vec2(e.b2, e.var_u);
   };
   return {finding(0), finding(1)};
@@ -310,7 +306,7 @@ BlendOutput cpu_blend(const Image& lv, const Image& hv, const Image& var_u, cons
       shared::BlendPixel b;
       if (halves.halves) {
         const glm::vec4 hl = texelFetch(TexelView{halves.halves}, p, 0);
-        const glm::vec2 hv2(halves.variances->at(x, y, 0), halves.variances->at(x, y, 1));
+        const glm::vec2 hv2(texelFetch(TexelView{halves.variances}, p, 0));
         b = shared::blend_pixel_split(px, hl, hv2, on, inputs(shared::decision_texels(px, hv2, 0), {guard.x, guard.y}),
                                       inputs(shared::decision_texels(px, hv2, 1), {guard.z, guard.w}));
       } else {

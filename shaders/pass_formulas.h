@@ -662,15 +662,17 @@ PXF_INLINE BiasGuardEstimate half_guard_estimate(vec4 full, vec4 low_y, vec4 hig
   return bias_guard_estimate(full + swap, low_y + swap, high_y + swap, low_x + swap, high_x + swap, other);
 }
 
-// The guard's finding at pixel p by the definition of its windows (the CPU reference).
-PXF_SAMPLER_FN BiasGuardEstimate bias_guard_estimate_at(sampler2D hv, sampler2D filtered, ivec2 p) {
+// The guard's finding at pixel p by the definition of its windows (the CPU reference), the pixel
+// itself read as `pixel`: its own bias_guard_texel for the one decision (then nothing is swapped),
+// the other half's for one half of the split decision (half_guard_estimate).
+PXF_SAMPLER_FN BiasGuardEstimate bias_guard_estimate_at(sampler2D hv, sampler2D filtered, ivec2 p, vec4 pixel) {
   const int r = kBiasGuardRadius;
-  return bias_guard_estimate(bias_guard_window_sums(hv, filtered, p, ivec2(-r, -r), ivec2(r, r)),
+  return half_guard_estimate(bias_guard_window_sums(hv, filtered, p, ivec2(-r, -r), ivec2(r, r)),
                              bias_guard_window_sums(hv, filtered, p, ivec2(-r, -r), ivec2(r, 0)),
                              bias_guard_window_sums(hv, filtered, p, ivec2(-r, 0), ivec2(r, r)),
                              bias_guard_window_sums(hv, filtered, p, ivec2(-r, -r), ivec2(0, r)),
                              bias_guard_window_sums(hv, filtered, p, ivec2(0, -r), ivec2(r, r)),
-                             bias_guard_texel(hv, filtered, p));
+                             bias_guard_texel(hv, filtered, p), pixel);
 }
 
 // The guard as the blend applies it (blend_pixel): in cases 1 and 3 only, s and the
