@@ -75,6 +75,7 @@ void apply_sample_settings(const SampleSettings& s, SceneOptions& scene, Preview
   if (s.adaptive != 0) preview.adaptive_params.goal = s.adaptive == 2 ? AdaptiveGoal::Clean : AdaptiveGoal::Error;
   preview.trace.guiding = static_cast<GuidingMode>(s.guiding);
   preview.trace.environment_visibility = s.environment_visibility != 0;
+  preview.trace.split_halves = s.split_halves != 0;
   const auto mode = static_cast<SpecularSamplingMode>(s.specular_sampling);
   preview.trace.specular_sampling = mode == SpecularSamplingMode::All;
   preview.trace.specular_chains = mode == SpecularSamplingMode::Chains;

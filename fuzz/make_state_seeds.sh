@@ -7,6 +7,7 @@
 #   adaptive_6x4              an adaptive render past its warm-up (--spp 20): traced counts and the allocation
 #   adaptive_merged           the merge of two adaptive shards 0:18 and 18:36, adjacent ranges kept apart
 #   guided_4x3                a render with --guiding on (--spp 4): the serialized guiding field
+#   split_4x3                 a render with --split-decision on (--spp 5): the even halves
 #   truncated                 the first 400 bytes of cornell_4x3
 #   frames_2pow31             a 2x1 --frames 0:2 state with its range end patched to 2^31 and the
 #                             checksum recomputed (CountsAndLimits.AStateOf2To31FramesIsRefusedWithOneLine)
@@ -25,6 +26,7 @@ render s0 --scene cornell --size 6x4 --frames 0:18 --adaptive on
 render s1 --scene cornell --size 6x4 --frames 18:36 --adaptive on
 "$PXF" merge s0/state.pxfs s1/state.pxfs --scene cornell --out m >/dev/null
 render g --scene cornell --size 4x3 --spp 4 --guiding on --checkpoint 100
+render h --scene cornell --size 4x3 --spp 5 --split-decision on --checkpoint 100
 render f --scene cornell --size 2x1 --frames 0:2
 cp c/state.pxfs "$SEEDS/cornell_4x3.pxfs"
 cp e/state.pxfs "$SEEDS/envmap_3x2.pxfs"
@@ -32,13 +34,14 @@ cp r/state.pxfs "$SEEDS/shard_replicates.pxfs"
 cp a/state.pxfs "$SEEDS/adaptive_6x4.pxfs"
 cp m/state.pxfs "$SEEDS/adaptive_merged.pxfs"
 cp g/state.pxfs "$SEEDS/guided_4x3.pxfs"
+cp h/state.pxfs "$SEEDS/split_4x3.pxfs"
 head -c 400 c/state.pxfs > "$SEEDS/truncated.pxfs"
 python3 - f/state.pxfs "$SEEDS/frames_2pow31.pxfs" <<'PY'
 import struct, sys
 data = bytearray(open(sys.argv[1], "rb").read()[:-8])
-# After the magic (8), version (4) and settings (60 bytes at version 10), the range count (4), then
+# After the magic (8), version (4) and settings (64 bytes at version 11), the range count (4), then
 # the first range's begin and end.
-settings_end = 8 + 4 + 60
+settings_end = 8 + 4 + 64
 assert struct.unpack_from("<I", data, settings_end)[0] == 1, "one frame range expected"
 struct.pack_into("<I", data, settings_end + 8, 1 << 31)
 h = 0xcbf29ce484222325

@@ -4,11 +4,12 @@
 #include <limits>
 #include <utility>
 
+#include "core/error.h"
 #include "pathtracer/sampling.h"
 
 namespace pxf {
 
-void resize_accumulation(Accumulation& acc, int width, int height, int replicates) {
+void resize_accumulation(Accumulation& acc, int width, int height, int replicates, bool halves) {
   size_t n = static_cast<size_t>(width) * static_cast<size_t>(height);
   acc.width = width;
   acc.height = height;
@@ -24,10 +25,12 @@ void resize_accumulation(Accumulation& acc, int width, int height, int replicate
   const size_t replicate_slots = acc.replicates > 1 ? n * static_cast<size_t>(acc.replicates) : 0;
   acc.replicate_lum_sum.assign(replicate_slots, 0.0);
   acc.replicate_samples.assign(replicate_slots, 0u);
-  acc.even_hv_mean.assign(n, glm::vec3(0.0f));
-  acc.even_lum_mean.assign(n, 0.0);
-  acc.even_lum_m2.assign(n, 0.0);
-  acc.even_samples.assign(n, 0u);
+  acc.split_halves = halves;
+  const size_t half_slots = halves ? n : 0;
+  acc.even_hv_mean.assign(half_slots, glm::vec3(0.0f));
+  acc.even_lum_mean.assign(half_slots, 0.0);
+  acc.even_lum_m2.assign(half_slots, 0.0);
+  acc.even_samples.assign(half_slots, 0u);
 }
 
 namespace {
@@ -54,7 +57,7 @@ void accumulate_sample(Accumulation& acc, size_t pixel, glm::vec3 lv, glm::vec3 
     acc.replicate_lum_sum[slot] += y;
     ++acc.replicate_samples[slot];
   }
-  if (sample_index % 2 == 0) {
+  if (acc.split_halves && sample_index % 2 == 0) {
     const uint32_t n_even = ++acc.even_samples[pixel];
     acc.even_hv_mean[pixel] += (hv - acc.even_hv_mean[pixel]) * (1.0f / static_cast<float>(n_even));
     add_welford(acc.even_lum_mean[pixel], acc.even_lum_m2[pixel], n_even, y);
@@ -158,6 +161,7 @@ void Accumulation::hv_and_variance_of_mean(float* rgba) const {
 }
 
 void Accumulation::hv_halves(const float* whole_rgba, float* halves, float* half_variances) const {
+  if (!split_halves) throw Error("the accumulation keeps no halves (TraceParams::split_halves off)");
   for (size_t p = 0; p < samples.size(); ++p) {
     const uint32_t n = samples[p], n_even = even_samples[p], n_odd = n - n_even;
     halves[4 * p + 0] = even_hv_mean[p].x;

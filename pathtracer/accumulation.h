@@ -31,6 +31,8 @@ struct Accumulation {
   // k * paths + j, so a pixel's indices are consecutive and its halves differ by at most one
   // sample). Their HV mean and the Welford state of their luminance; the odd half is the rest. The
   // blend decides each half's weight from the other half's variance (docs/method.md section 3.8).
+  // Kept only with split_halves (TraceParams::split_halves); empty otherwise.
+  bool split_halves = false;
   std::vector<glm::vec3> even_hv_mean;
   std::vector<double> even_lum_mean;
   std::vector<double> even_lum_m2;
@@ -57,7 +59,7 @@ struct Accumulation {
   // `half_variances`: the variance of the whole pixel mean as each half's samples alone estimate
   // it (s_h^2 / n times the pixel's replicate gain, whole / per_sample_variance_of_mean), even
   // then odd; -1 where that half holds fewer than 2 samples. whole_rgba: hv_and_variance_of_mean's
-  // buffer, whose alpha is the whole estimate.
+  // buffer, whose alpha is the whole estimate. Throws pxf::Error without split_halves.
   void hv_halves(const float* whole_rgba, float* halves, float* half_variances) const;
 };
 
@@ -67,6 +69,7 @@ struct Accumulation {
 // acc.replicates (for a uniform render, the frame's), its half the index's parity.
 void accumulate_sample(Accumulation& acc, size_t pixel, glm::vec3 lv, glm::vec3 hv, uint32_t sample_index = 0,
                        glm::vec3 albedo = glm::vec3(1.0f));
-void resize_accumulation(Accumulation& acc, int width, int height, int replicates = 1);  // and clear
+// Sizes and clears every array; the even half's only with `halves`.
+void resize_accumulation(Accumulation& acc, int width, int height, int replicates = 1, bool halves = false);
 
 }  // namespace pxf

@@ -40,7 +40,8 @@ bool little_endian() {
 
 // The per-pixel arrays of an Accumulation, in file order, with their elements per pixel. A new
 // field of Accumulation is one line here: the writer, the reader and the size check all go through
-// this list. The replicate sums exist only with replicates (acc.replicates > 1, K per pixel).
+// this list. The replicate sums exist only with replicates (acc.replicates > 1, K per pixel), the
+// even half only with acc.split_halves.
 template <class Acc, class Visit>
 void visit_arrays(Acc& acc, Visit&& visit) {
   visit(acc.lv_mean, 1);
@@ -54,10 +55,11 @@ void visit_arrays(Acc& acc, Visit&& visit) {
   const size_t replicate_slots = acc.replicates > 1 ? static_cast<size_t>(acc.replicates) : 0;
   visit(acc.replicate_lum_sum, replicate_slots);
   visit(acc.replicate_samples, replicate_slots);
-  visit(acc.even_hv_mean, 1);
-  visit(acc.even_lum_mean, 1);
-  visit(acc.even_lum_m2, 1);
-  visit(acc.even_samples, 1);
+  const size_t half_slots = acc.split_halves ? 1 : 0;
+  visit(acc.even_hv_mean, half_slots);
+  visit(acc.even_lum_mean, half_slots);
+  visit(acc.even_lum_m2, half_slots);
+  visit(acc.even_samples, half_slots);
 }
 
 // The per-pixel arrays of a state: the accumulation's, then the traced counts and, in an adaptive
@@ -91,6 +93,7 @@ void put_settings(ByteWriter& w, const SampleSettings& s) {
   w.put(s.adaptive);
   w.put(s.guiding);
   w.put(s.environment_visibility);
+  w.put(s.split_halves);
 }
 
 // The adaptive flag as a phrase (SampleSettings::adaptive).
@@ -113,10 +116,11 @@ SampleSettings get_settings(ByteReader& r) {
   s.adaptive = r.get<uint32_t>("header");
   s.guiding = r.get<uint32_t>("header");
   s.environment_visibility = r.get<uint32_t>("header");
+  s.split_halves = r.get<uint32_t>("header");
   if (s.all_hv > 1 || s.specular_sampling > static_cast<uint32_t>(SpecularSamplingMode::Chains) || s.sampler > 1 ||
-      s.adaptive > 2 || s.guiding > 2 || s.environment_visibility > 1)
-    throw Error("state file has an invalid setting flag (all-hv, sampler, specular sampling, adaptive, guiding or "
-                "env-visibility)");
+      s.adaptive > 2 || s.guiding > 2 || s.environment_visibility > 1 || s.split_halves > 1)
+    throw Error("state file has an invalid setting flag (all-hv, sampler, specular sampling, adaptive, guiding, "
+                "env-visibility or split decision)");
   if (s.replicates < 1 || s.replicates > kMaxReplicates)
     throw Error("state file has an invalid replicate count " + std::to_string(s.replicates));
   if (s.width == 0 || s.height == 0 || s.width > kMaxSide || s.height > kMaxSide)
@@ -150,6 +154,15 @@ void check_frame_ranges(const std::vector<FrameRange>& ranges, bool adaptive) {
   check_frame_total(total_frames(ranges), "state file has");
 }
 
+void check_even_half(const Accumulation& acc, size_t i) {
+  const glm::vec3 even = acc.even_hv_mean[i];
+  if (!(std::isfinite(even.x) && std::isfinite(even.y) && std::isfinite(even.z) && std::isfinite(acc.even_lum_mean[i]) &&
+        std::isfinite(acc.even_lum_m2[i]) && acc.even_lum_m2[i] >= 0.0))
+    throw Error("state file has a non-finite or negative value at pixel " + std::to_string(i));
+  if (acc.even_samples[i] > acc.samples[i])
+    throw Error("state file has more even-index samples than samples at pixel " + std::to_string(i));
+}
+
 void check_pixels(const AccumulationState& state) {
   const Accumulation& acc = state.acc;
   const uint32_t frames = state.frame_count();
@@ -170,14 +183,8 @@ void check_pixels(const AccumulationState& state) {
                         std::isfinite(a.z) && std::isfinite(acc.hv_lum_mean[i]) &&
                         std::isfinite(acc.hv_lum_m2[i]) && acc.hv_lum_m2[i] >= 0.0 &&
                         std::isfinite(acc.lv_lum_mean[i]) && std::isfinite(acc.lv_lum_m2[i]) && acc.lv_lum_m2[i] >= 0.0;
-    const glm::vec3 even = acc.even_hv_mean[i];
-    const bool even_finite = std::isfinite(even.x) && std::isfinite(even.y) && std::isfinite(even.z) &&
-                             std::isfinite(acc.even_lum_mean[i]) && std::isfinite(acc.even_lum_m2[i]) &&
-                             acc.even_lum_m2[i] >= 0.0;
-    if (!finite || !even_finite)
-      throw Error("state file has a non-finite or negative value at pixel " + std::to_string(i));
-    if (acc.even_samples[i] > acc.samples[i])
-      throw Error("state file has more even-index samples than samples at pixel " + std::to_string(i));
+    if (!finite) throw Error("state file has a non-finite or negative value at pixel " + std::to_string(i));
+    if (acc.split_halves) check_even_half(acc, i);
     if (acc.replicates < 2) continue;
     // The replicate sums split the pixel's samples: their counts add up to its count.
     uint64_t replicate_count = 0;
@@ -206,6 +213,7 @@ void combine_welford(double& mean, double& m2, uint32_t na, double from_mean, do
 // The even halves of pixel i combine like the whole (sample indices, and so their parities, are the
 // same wherever a frame is traced).
 void merge_even_half(Accumulation& into, const Accumulation& from, size_t i) {
+  if (!into.split_halves) return;
   const uint32_t na = into.even_samples[i], nb = from.even_samples[i];
   if (nb == 0) return;
   if (na == 0) {
@@ -282,6 +290,8 @@ std::string SampleSettings::difference(const SampleSettings& o) const {
   if (environment_visibility != o.environment_visibility)
     return std::string("env-visibility ") + (environment_visibility ? "on" : "off") + " vs " +
            (o.environment_visibility ? "on" : "off");
+  if (split_halves != o.split_halves)
+    return std::string("split decision ") + (split_halves ? "on" : "off") + " vs " + (o.split_halves ? "on" : "off");
   return "";
 }
 
@@ -303,6 +313,7 @@ SampleSettings sample_settings(uint64_t scene_hash, int width, int height, const
   s.specular_sampling = static_cast<uint32_t>(specular_sampling_mode(params));
   s.guiding = static_cast<uint32_t>(params.guiding);
   s.environment_visibility = params.environment_visibility ? 1u : 0u;
+  s.split_halves = params.split_halves ? 1u : 0u;
   return s;
 }
 
@@ -337,6 +348,8 @@ std::vector<uint8_t> encode_state(const AccumulationState& state) {
   if (state.acc.replicates != state_replicates(state.settings))
     throw Error("cannot save a state whose accumulation has " + std::to_string(state.acc.replicates) +
                 " replicates under settings with " + std::to_string(state_replicates(state.settings)));
+  if (state.acc.split_halves != (state.settings.split_halves != 0))
+    throw Error("cannot save a state whose accumulation's halves do not match its split decision setting");
   const size_t pixels = static_cast<size_t>(state.settings.width) * state.settings.height;
   visit_state_arrays(state, [&](const auto& array, size_t per_pixel) {
     if (array.size() != pixels * per_pixel) throw Error("cannot save a state with a per-pixel array of the wrong size");
@@ -392,6 +405,7 @@ AccumulationState decode_state(const uint8_t* data, size_t size) {
   state.acc.width = static_cast<int>(state.settings.width);
   state.acc.height = static_cast<int>(state.settings.height);
   state.acc.replicates = state_replicates(state.settings);
+  state.acc.split_halves = state.settings.split_halves != 0;
   visit_state_arrays(state, [&](auto& array, size_t per_pixel) {
     r.get_array(array, pixels * per_pixel, per_pixel > 1 ? "the replicate arrays" : "the pixel arrays");
   });

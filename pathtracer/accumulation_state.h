@@ -18,8 +18,8 @@ namespace pxf {
 // pixel (counts, rates above 1, a shard's sample indices from its first frame * kMaxPathsPerFrame)
 // and the flag names the allocation's goal; 8: the light split of issue 57; 9: light through
 // openings (the flag, the serialized EnvironmentVisibility); 10: the even half of each pixel's samples (the
-// blend's split decision)
-constexpr uint32_t kStateFormatVersion = 10;
+// blend's split decision); 11: the halves only where the split decision is on (the flag)
+constexpr uint32_t kStateFormatVersion = 11;
 
 // Frame counts: one render traces at most kMaxRenderFrames frames (--spp, --frames, --shard); a
 // state, also a merge of many shards, holds at most kMaxStateFrames in all, the most the preview's
@@ -58,6 +58,9 @@ struct SampleSettings {
   // 1: light through openings (TraceParams::environment_visibility): as with guiding, a sample
   // depends on what was learned before it (AccumulationState::environment_visibility).
   uint32_t environment_visibility = 0;
+  // 1: the accumulation keeps the even half of each pixel's samples (TraceParams::split_halves, the
+  // blend's split decision); its arrays are in the file only then.
+  uint32_t split_halves = 0;
   bool operator==(const SampleSettings& o) const;
   // "" when equal, else one phrase naming the first difference ("seed 1 vs 2").
   std::string difference(const SampleSettings& o) const;

@@ -25,15 +25,17 @@ void sample_of(size_t p, uint32_t frame, glm::vec3& lv, glm::vec3& hv) {
 }
 
 // The frames' accumulation; with replicates (Sobol), frame f goes to replicate f mod K as in the
-// renderer.
-AccumulationState render_frames(FrameRange range, int replicates = 1) {
+// renderer. With the split decision's halves unless `halves` is false, so that every merge and
+// round trip below covers them.
+AccumulationState render_frames(FrameRange range, int replicates = 1, bool halves = true) {
   AccumulationState state;
   TraceParams params;
   params.replicates = replicates;
+  params.split_halves = halves;
   state.settings = sample_settings(0x1234, kW, kH, params);
   state.frames = {range};
   state.traced.assign(static_cast<size_t>(kW) * kH, range.count());
-  resize_accumulation(state.acc, kW, kH, replicates);
+  resize_accumulation(state.acc, kW, kH, replicates, halves);
   for (uint32_t f = range.begin; f < range.end; ++f)
     for (size_t p = 0; p < state.acc.samples.size(); ++p) {
       if ((p + f) % 11 == 3) continue;  // a dropped (non-finite) sample: counts differ per pixel
@@ -71,6 +73,8 @@ void expect_same_accumulation(const Accumulation& a, const Accumulation& b) {
     EXPECT_NEAR(a.hv_lum_m2[i], b.hv_lum_m2[i], 1e-12 * std::abs(b.hv_lum_m2[i])) << i;
     EXPECT_NEAR(a.lv_lum_mean[i], b.lv_lum_mean[i], 1e-12 * std::abs(b.lv_lum_mean[i])) << i;
     EXPECT_NEAR(a.lv_lum_m2[i], b.lv_lum_m2[i], 1e-12 * std::abs(b.lv_lum_m2[i])) << i;
+    ASSERT_EQ(a.split_halves, b.split_halves);
+    if (!a.split_halves) continue;
     EXPECT_EQ(a.even_samples[i], b.even_samples[i]) << i;
     for (int c = 0; c < 3; ++c)
       EXPECT_NEAR(a.even_hv_mean[i][c], b.even_hv_mean[i][c], kMeanTolerance * std::abs(b.even_hv_mean[i][c])) << i;
@@ -175,6 +179,7 @@ TEST(AccumulationState, SamplerSettingsRoundTripAndAreChecked) {
   params.sampler = SamplerType::Independent;
   params.replicates = 4;
   params.specular_sampling = true;
+  params.split_halves = true;
   AccumulationState state = render_frames({0, 4});
   state.settings = sample_settings(0x1234, kW, kH, params);
   const std::vector<uint8_t> bytes = encode_state(state);
@@ -260,6 +265,7 @@ TEST(AccumulationState, ReplicateSumsRoundTripAndMerge) {
   TraceParams independent;
   independent.sampler = SamplerType::Independent;
   independent.replicates = kReplicates;
+  independent.split_halves = true;
   AccumulationState plain = render_frames({0, 4});
   plain.settings = sample_settings(0x1234, kW, kH, independent);
   EXPECT_EQ(decode_state(encode_state(plain).data(), encode_state(plain).size()).acc.replicates, 1);
@@ -291,6 +297,31 @@ TEST(AccumulationState, EvenHalvesThatDoNotFitTheSamplesAreRefused) {
   EXPECT_NE(decode_error(encode_state(state)).find("non-finite or negative value at pixel 1"), std::string::npos);
 }
 
+// Without the split decision the even half is not kept, and not written: a render that does not
+// blend by halves does not pay for them. States with and without halves do not merge.
+TEST(AccumulationState, HalvesAreKeptOnlyWithTheSplitDecision) {
+  const AccumulationState without = render_frames({0, 8}, 1, false);
+  EXPECT_TRUE(without.acc.even_samples.empty());
+  EXPECT_TRUE(without.acc.even_hv_mean.empty());
+  const std::vector<uint8_t> bytes = encode_state(without);
+  const size_t half_bytes = sizeof(glm::vec3) + 2 * sizeof(double) + sizeof(uint32_t);
+  EXPECT_EQ(bytes.size() + kW * kH * half_bytes, encode_state(render_frames({0, 8})).size());
+  const AccumulationState back = decode_state(bytes.data(), bytes.size());
+  EXPECT_FALSE(back.acc.split_halves);
+  EXPECT_EQ(encode_state(back), bytes);
+  try {
+    merge_states({render_frames({0, 4}), render_frames({4, 8}, 1, false)});
+    FAIL() << "a state with halves merged with one without";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("split decision off vs on"), std::string::npos) << e.what();
+  }
+  AccumulationState mismatched = without;
+  mismatched.settings.split_halves = 1;  // arrays that the flag says are there, but are not
+  EXPECT_THROW(encode_state(mismatched), Error);
+  std::vector<float> rgba(4 * kW * kH), halves(4 * kW * kH), variances(2 * kW * kH);
+  EXPECT_THROW(without.acc.hv_halves(rgba.data(), halves.data(), variances.data()), Error);
+}
+
 namespace {
 
 // An adaptive state of the frames `range` in which pixel p was traced in only some frames: its
@@ -298,7 +329,7 @@ namespace {
 AccumulationState render_adaptive(FrameRange range) {
   AccumulationState state = render_frames(range);
   state.settings.adaptive = 1;
-  resize_accumulation(state.acc, kW, kH, 1);
+  resize_accumulation(state.acc, kW, kH, 1, state.acc.split_halves);
   const size_t pixels = state.acc.samples.size();
   state.traced.assign(pixels, 0);
   state.rate.assign(pixels, 0.0f);

@@ -28,9 +28,11 @@ std::vector<uint8_t> pixel_bytes(const Accumulation& acc, size_t p) {
   put(&acc.lv_lum_mean[p], sizeof(double));
   put(&acc.lv_lum_m2[p], sizeof(double));
   put(&acc.samples[p], sizeof(uint32_t));
-  put(&acc.even_hv_mean[p], sizeof(glm::vec3));
-  put(&acc.even_lum_m2[p], sizeof(double));
-  put(&acc.even_samples[p], sizeof(uint32_t));
+  if (acc.split_halves) {
+    put(&acc.even_hv_mean[p], sizeof(glm::vec3));
+    put(&acc.even_lum_m2[p], sizeof(double));
+    put(&acc.even_samples[p], sizeof(uint32_t));
+  }
   for (int r = 0; r < acc.replicates && acc.replicates > 1; ++r) {
     put(&acc.replicate_lum_sum[p * acc.replicates + r], sizeof(double));
     put(&acc.replicate_samples[p * acc.replicates + r], sizeof(uint32_t));
@@ -80,12 +82,13 @@ TEST(ActivePixels, UniformFrameKIsEachPixelsSampleK) {
   const Scene scene = make_cornell_box(true);
   TraceParams params;
   params.threads = 2;
+  params.split_halves = true;  // and each sample in the half of its index's parity
   ProgressiveRenderer renderer(scene, params, kWidth, kHeight);
   renderer.set_first_frame(5);
   for (int f = 0; f < 3; ++f) ASSERT_TRUE(renderer.add_frame());
   PathTracer tracer(scene);
   Accumulation expected;
-  resize_accumulation(expected, kWidth, kHeight);
+  resize_accumulation(expected, kWidth, kHeight, 1, /*halves=*/true);
   for (int y = 0; y < kHeight; ++y)
     for (int x = 0; x < kWidth; ++x)
       for (uint32_t k = 5; k < 8; ++k) {
@@ -102,6 +105,7 @@ TEST(ActivePixels, AShardStartsAtItsFirstFrameTimesTheStride) {
   const Scene scene = make_cornell_box(true);
   TraceParams params;
   params.threads = 2;
+  params.split_halves = true;
   ProgressiveRenderer renderer(scene, params, kWidth, kHeight);
   renderer.set_sample_stride(kMaxPathsPerFrame);
   renderer.set_first_frame(2);
@@ -109,7 +113,7 @@ TEST(ActivePixels, AShardStartsAtItsFirstFrameTimesTheStride) {
   ASSERT_TRUE(renderer.add_frame(counts));
   PathTracer tracer(scene);
   Accumulation expected;
-  resize_accumulation(expected, kWidth, kHeight);
+  resize_accumulation(expected, kWidth, kHeight, 1, /*halves=*/true);
   for (int y = 0; y < kHeight; ++y)
     for (int x = 0; x < kWidth; ++x) {
       const size_t p = static_cast<size_t>(y) * kWidth + x;

@@ -27,10 +27,6 @@ AccumulationState state_of_frames(std::vector<FrameRange> ranges) {
   s.acc.lv_lum_mean.assign(2, 0.5);
   s.acc.lv_lum_m2.assign(2, 0.0);
   s.acc.samples.assign(2, std::min<uint64_t>(s.frame_count(), UINT32_MAX));
-  s.acc.even_hv_mean.assign(2, glm::vec3(0.25f));
-  s.acc.even_lum_mean.assign(2, 0.25);
-  s.acc.even_lum_m2.assign(2, 0.0);
-  s.acc.even_samples.assign(2, (s.acc.samples[0] + 1) / 2);
   s.traced = s.acc.samples;
   return s;
 }

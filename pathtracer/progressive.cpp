@@ -95,7 +95,7 @@ struct ProgressiveRenderer::Impl {
   Impl(const Scene& s, const TraceParams& p, int w, int h) : scene(s), camera(s.camera), params(p), width(w), height(h) {
     if (w <= 0 || h <= 0) throw Error("path tracer: image size must be positive");
     tracer = std::make_unique<PathTracer>(scene);
-    resize_accumulation(acc, w, h, accumulation_replicates());
+    resize_accumulation(acc, w, h, accumulation_replicates(), params.split_halves);
     pixel_frames.assign(static_cast<size_t>(w) * h, 0u);
     make_arena();
     reset_guiding();
@@ -278,7 +278,8 @@ ProgressiveRenderer::~ProgressiveRenderer() = default;
 
 void ProgressiveRenderer::reset() {
   impl_->cancel.store(false);  // a cancel meant for a frame that finished first
-  resize_accumulation(impl_->acc, impl_->width, impl_->height, impl_->accumulation_replicates());
+  resize_accumulation(impl_->acc, impl_->width, impl_->height, impl_->accumulation_replicates(),
+                      impl_->params.split_halves);
   impl_->pixel_frames.assign(impl_->pixel_frames.size(), 0u);
   impl_->stats = TraceStats{};
   impl_->frames = 0;
@@ -351,6 +352,9 @@ void ProgressiveRenderer::restore(const Accumulation& acc, uint32_t first, int f
   if (acc.replicates != impl_->accumulation_replicates())
     throw Error("saved accumulation has " + std::to_string(acc.replicates) + " replicates, the render " +
                 std::to_string(impl_->accumulation_replicates()));
+  if (acc.split_halves != impl_->params.split_halves)
+    throw Error(std::string("saved accumulation has the split decision's halves ") + (acc.split_halves ? "on" : "off") +
+                ", the render " + (impl_->params.split_halves ? "on" : "off"));
   if (!traced.empty() && traced.size() != impl_->pixel_frames.size())
     throw Error("saved traced counts have " + std::to_string(traced.size()) + " entries, the image " +
                 std::to_string(impl_->pixel_frames.size()) + " pixels");

@@ -293,7 +293,7 @@ void Preview::upload() {
 // The halves exist for the accumulation alone: a view that adds the reprojected history blends with
 // one decision.
 void Preview::upload_halves() {
-  if (!settings_.split_decision || combined_now_ || inputs_.has_halves()) return;
+  if (!settings_.trace.split_halves || combined_now_ || inputs_.has_halves()) return;
   const auto start = BenchClock::now();
   const size_t pixels = static_cast<size_t>(width_) * static_cast<size_t>(height_);
   halves_packed_.resize(4 * pixels);
@@ -347,7 +347,7 @@ std::vector<float> Preview::noise_over_threshold() const {
 
 FilterParams Preview::filter_params_now() const {
   FilterParams p = settings_.filter;
-  p.split = settings_.split_decision;
+  p.split = settings_.trace.split_halves;
   if (settings_.shrink_sigma) {
     std::vector<float> needed = noise_over_threshold();
     p.sigma_s = noise_sigma_s(p.sigma_s, static_cast<uint64_t>(samples()), needed);
@@ -477,7 +477,7 @@ void Preview::blend_and_tonemap() {
   const bool guard = settings_.bias_guard && !schedule_.all_pixels_case2;
   blend_.run(inputs(), have_filtered_ ? &filtered_output() : nullptr, &range_.guide(), threshold_now(),
              BlendParams{range_weights(settings_.filter), guard, static_cast<float>(samples()),
-                         settings_.split_decision},
+                         settings_.trace.split_halves},
              have_filtered_ ? filter_.centre_weight() : nullptr,
              &range_.surface());
   last_.blend += blend_.last_ms();

@@ -45,11 +45,6 @@ struct PreviewSettings {
   // L_f measurably differs from L_u. On: at equal time it lowered the filtered image's error on all
   // four built-in scenes (docs/measurements.md, "Bias guard"); off is the method's blend as published.
   bool bias_guard = true;
-  // The split decision (BlendParams::split, docs/method.md section 3.8): each half of a pixel's
-  // samples blended by the weight the other half's variance decides, so that the decision does not
-  // correlate with the samples it weighs (one decision darkens: 4.3 % on `window` at 32 spp). Off
-  // by default: it keeps half of each outlier, and at equal time its display error was 1.05-1.2x.
-  bool split_decision = false;
   // Shrink the filter's sigma_s to the noise (noise_sigma_s in gl/pass_params.h, docs/method.md
   // 2.5): the kernel the noisiest pixels need to reach t, between 2 px and filter.sigma_s. On by
   // default: less bias where samples have accumulated, the full kernel where the noise needs it;

@@ -133,8 +133,9 @@ void add_filter_settings(std::vector<SettingDescriptor>& t) {
   t.push_back(on_off("split_decision", "--split-decision",
                      "blend each half of a pixel's samples (even and odd sample index) by the weight the other\n"
                      "half's variance decides: the image keeps its mean (one decision from all the pixel's\n"
-                     "samples darkens it), and keeps half of each outlier (docs/method.md section 3.8)",
-                     [](PreviewSettings& s) -> bool& { return s.split_decision; }, E::Redisplay, "split decision"));
+                     "samples darkens it), and keeps half of each outlier (docs/method.md section 3.8). The\n"
+                     "render keeps the halves from its first sample, so a change restarts it",
+                     [](PreviewSettings& s) -> bool& { return s.trace.split_halves; }, E::Retrace, "split decision"));
   t.push_back(choice<&schedule>("schedule", "--schedule",
                                "when the filter runs: final = once to measure its cost, then on the last frame (a headless\n"
                                "job shows only that); budget = at power-of-two sample counts while filter + range stay\n"

@@ -30,7 +30,7 @@ struct Frame {
 
 Frame render_flat_surface(uint32_t seed) {
   Frame f;
-  resize_accumulation(f.acc, kSide, kSide);
+  resize_accumulation(f.acc, kSide, kSide, 1, /*halves=*/true);
   std::mt19937 rng(seed);
   for (size_t p = 0; p < static_cast<size_t>(kSide) * kSide; ++p)
     for (uint32_t k = 0; k < kSamples; ++k) accumulate_sample(f.acc, p, glm::vec3(0.0f), glm::vec3(heavy_tailed_sample(rng)), k);
@@ -95,7 +95,7 @@ TEST(SplitDecision, KeepsTheMeanWhereOneDecisionDarkensIt) {
 // Pixel 0's halves against the even- and odd-index samples summed directly.
 TEST(SplitDecision, HalvesAreTheEvenAndOddIndexSamples) {
   Accumulation acc;
-  resize_accumulation(acc, 1, 1);
+  resize_accumulation(acc, 1, 1, 1, /*halves=*/true);
   std::mt19937 rng(7);
   double sum[2] = {0, 0}, sum_sq[2] = {0, 0};
   int count[2] = {0, 0};
@@ -118,7 +118,7 @@ TEST(SplitDecision, HalvesAreTheEvenAndOddIndexSamples) {
     EXPECT_NEAR(variances[h], s2 / n, 1e-6 * s2 / n) << "half " << h;
   }
   // Fewer than 2 samples in a half: unknown.
-  resize_accumulation(acc, 1, 1);
+  resize_accumulation(acc, 1, 1, 1, /*halves=*/true);
   for (uint32_t k = 0; k < 3; ++k) accumulate_sample(acc, 0, glm::vec3(0.0f), glm::vec3(float(k)), k);
   acc.hv_and_variance_of_mean(rgba.data());
   acc.hv_halves(rgba.data(), halves.data(), variances.data());
