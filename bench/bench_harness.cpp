@@ -62,34 +62,42 @@ BenchSetup BenchHarness::setup_scene(const std::string& scene, const std::string
 std::unique_ptr<GlContext> BenchHarness::gl_context() const { return create_gl_context(parse_gl_backend(scene_.gl)); }
 
 Image BenchHarness::reference(const BenchSetup& b, const std::string& layer) const {
-  Image image;
-  if (!reference_path_.empty()) {
-    image = read_exr(reference_path_, layer);
-    check_reference(image, reference_path_);  // as pxf diff checks its reference
+  if (reference_path_.empty()) return cached_reference(b, layer, 7919, "reference");  // independent of the runs judged
+  Image image = read_exr(reference_path_, layer);
+  check_reference(image, reference_path_);  // as pxf diff checks its reference
+  if (image.width != b.width || image.height != b.height) throw Error("reference size differs from --size");
+  return image;
+}
+
+Image BenchHarness::second_reference(const BenchSetup& b) const {
+  if (!reference_path_.empty()) throw UsageError("--reference: a given reference has no second of another seed");
+  return cached_reference(b, "", 7919 + 104729, "reference2");
+}
+
+Image BenchHarness::cached_reference(const BenchSetup& b, const std::string& layer, uint64_t seed_offset,
+                                     const std::string& prefix) const {
+  const auto cache_name = [&](const std::string& kind) {
+    return b.out + "/" + prefix + kind + b.scene_name + "_" + std::to_string(b.width) + "x" + std::to_string(b.height) +
+           "_" + std::to_string(reference_spp_) + "spp.exr";
+  };
+  const std::string cache = cache_name(layer == "hv" ? "_hv_" : "_");
+  if (std::filesystem::exists(cache)) {
+    std::printf("reference: %s (cached)\n", cache.c_str());
   } else {
-    const auto cache_name = [&](const std::string& prefix) {
-      return b.out + "/" + prefix + b.scene_name + "_" + std::to_string(b.width) + "x" + std::to_string(b.height) +
-             "_" + std::to_string(reference_spp_) + "spp.exr";
-    };
-    const std::string cache = cache_name(layer == "hv" ? "reference_hv_" : "reference_");
-    if (std::filesystem::exists(cache)) {
-      std::printf("reference: %s (cached)\n", cache.c_str());
-    } else {
-      TraceParams params = b.plain.trace;
-      params.seed = b.plain.trace.seed + 7919;  // independent of the runs being judged
-      ProgressiveRenderer renderer(b.scene, params, b.width, b.height);
-      const auto start = BenchClock::now();
-      for (int i = 0; i < reference_spp_; ++i) {
-        renderer.add_frame();
-        if ((i + 1) % 256 == 0 || i + 1 == reference_spp_)
-          std::fprintf(stderr, "reference: %d/%d spp, %.0f s\n", i + 1, reference_spp_, elapsed_ms(start) / 1000);
-      }
-      write_exr(cache_name("reference_"), renderer.unfiltered_image());  // both cached: one render serves both
-      write_exr(cache_name("reference_hv_"), renderer.hv_image());
-      std::printf("reference: wrote %s (%d spp, %.1f s)\n", cache.c_str(), reference_spp_, elapsed_ms(start) / 1000);
+    TraceParams params = b.plain.trace;
+    params.seed = b.plain.trace.seed + seed_offset;
+    ProgressiveRenderer renderer(b.scene, params, b.width, b.height);
+    const auto start = BenchClock::now();
+    for (int i = 0; i < reference_spp_; ++i) {
+      renderer.add_frame();
+      if ((i + 1) % 256 == 0 || i + 1 == reference_spp_)
+        std::fprintf(stderr, "reference: %d/%d spp, %.0f s\n", i + 1, reference_spp_, elapsed_ms(start) / 1000);
     }
-    image = read_exr(cache);
+    write_exr(cache_name("_"), renderer.unfiltered_image());  // both cached: one render serves both
+    write_exr(cache_name("_hv_"), renderer.hv_image());
+    std::printf("reference: wrote %s (%d spp, %.1f s)\n", cache.c_str(), reference_spp_, elapsed_ms(start) / 1000);
   }
+  Image image = read_exr(cache);
   if (image.width != b.width || image.height != b.height) throw Error("reference size differs from --size");
   return image;
 }

@@ -48,6 +48,10 @@ class BenchHarness {
   // --reference, else a --reference-spp plain render of another seed, cached in --out. `layer`
   // "hv": the HV buffer alone (layer hv of a given file). Throws pxf::Error on another size.
   Image reference(const BenchSetup& b, const std::string& layer = "") const;
+  // A second --reference-spp render of yet another seed, cached beside the first: how far two
+  // references disagree measures the reference's own error (the files bench's --reference-floor).
+  // Not with --reference.
+  Image second_reference(const BenchSetup& b) const;
 
   const SceneOptions& scene_options() const { return scene_; }
   const std::string& out() const { return out_; }
@@ -55,6 +59,11 @@ class BenchHarness {
   int reference_spp() const { return reference_spp_; }
 
  private:
+  // The --reference-spp render of seed + seed_offset, cached in --out as PREFIX_NAME_WxH_Nspp.exr,
+  // its HV buffer as PREFIX_hv_...; `layer` "hv" reads that one.
+  Image cached_reference(const BenchSetup& b, const std::string& layer, uint64_t seed_offset,
+                         const std::string& prefix) const;
+
   CommandLine cli_;
   SceneOptions scene_;
   PreviewSettings settings_;

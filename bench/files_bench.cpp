@@ -1,6 +1,7 @@
 #include "bench/files_bench.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <set>
@@ -64,7 +65,26 @@ double median_spp(const std::vector<TimedRun>& runs) {
 const char* kCsvHeader =
     "name,scene,env,time_s,rounds,unfiltered_spp,filtered_spp,unfiltered_hdr_nrmse_percent,"
     "filtered_hdr_nrmse_percent,hdr_ratio,unfiltered_display_nrmse_percent,filtered_display_nrmse_percent,"
-    "display_ratio,unfiltered_flip,filtered_flip,flip_ratio,filtered_mean_bias_percent\n";
+    "display_ratio,unfiltered_flip,filtered_flip,flip_ratio,filtered_mean_bias_percent,"
+    "reference_display_floor_percent,reference_hdr_floor_percent,reference_pair_flip,display_ratio_above_floor\n";
+
+// The reference's own error (--reference-floor): a second reference of another seed differs from it
+// by the noise of both (correct_for_reference_noise, image/metrics.h). FLIP is not a variance and
+// is given as it is between the two. display_ratio_above_floor is the ratio of the arms' display
+// errors with the reference's noise taken off each: what a noise-free reference would show.
+struct ReferenceFloor {
+  bool measured = false;
+  RowError pair;  // the second reference against the first
+  double display() const { return correct_for_reference_noise(0.0, pair.display_nrmse).reference_noise_percent; }
+  double hdr() const { return correct_for_reference_noise(0.0, pair.hdr_nrmse).reference_noise_percent; }
+};
+
+// NaN where the floor is not measured or the unfiltered error does not stand above it.
+double ratio_above_floor(double filtered, double unfiltered, const ReferenceFloor& floor) {
+  const ReferenceNoiseCorrection u = correct_for_reference_noise(unfiltered, floor.pair.display_nrmse);
+  if (!floor.measured || u.within_reference_noise) return std::nan("");
+  return correct_for_reference_noise(filtered, floor.pair.display_nrmse).corrected_percent / u.corrected_percent;
+}
 
 // A row's medians over its rounds, unfiltered (u) and filtered (f).
 struct RowMedians {
@@ -97,12 +117,18 @@ RowMedians medians(const FileRow& row) {
           median_bias_percent(row.filtered)};
 }
 
-std::string csv_row(const BenchFileEntry& e, const FileRow& row, const RowMedians& m) {
+std::string csv_row(const BenchFileEntry& e, const FileRow& row, const RowMedians& m, const ReferenceFloor& floor) {
   std::ostringstream s;
   s << e.name << "," << e.scene << "," << e.env << "," << row.seconds << "," << row.plain.size() << "," << m.u_spp
     << "," << m.f_spp << "," << m.u_hdr << "," << m.f_hdr << "," << m.f_hdr / m.u_hdr << "," << m.u_display << ","
     << m.f_display << "," << m.f_display / m.u_display << "," << m.u_flip << "," << m.f_flip << ","
-    << m.f_flip / m.u_flip << "," << m.f_bias << "\n";
+    << m.f_flip / m.u_flip << "," << m.f_bias << ",";
+  if (floor.measured)
+    s << floor.display() << "," << floor.hdr() << "," << floor.pair.flip << ","
+      << ratio_above_floor(m.f_display, m.u_display, floor);
+  else
+    s << ",,,";
+  s << "\n";
   return s.str();
 }
 
@@ -170,11 +196,15 @@ int files_bench_mode(const std::vector<std::string>& args, const std::string& su
   BenchHarness h("files", summary);
   std::string list_path, times_text = "1,4";
   int rounds = 2;
+  bool measure_floor = false;
   h.add_reference_options(1024);
   h.cli().option("--list", &list_path, "FILE", "the files: one 'NAME SCENE [ENV]' a line (required)");
   h.cli().option("--times", &times_text, "LIST", "wall-time budgets of the whole job in seconds (default 1,4)");
   h.cli().option("--rounds", &rounds, "rounds, unfiltered and filtered in turn, alternating which goes first (default 2)",
                  1, 64);
+  h.cli().flag("--reference-floor", &measure_floor,
+               "also render a second reference of another seed and report the reference's own error (the\n"
+               "floor under every figure) and the display ratio above it");
   if (!h.parse(args)) return 0;
   if (list_path.empty()) throw UsageError("--list FILE is required");
   if (h.cli().given("--reference")) throw UsageError("--reference: each file gets its own (--reference-spp)");
@@ -201,6 +231,12 @@ int files_bench_mode(const std::vector<std::string>& args, const std::string& su
     const BenchSetup b = h.setup_scene(e.scene, e.env, e.name, /*needs_filter=*/true);
     const double load_ms = elapsed_ms(load_start);
     const Image reference = h.reference(b);
+    ReferenceFloor floor;
+    if (measure_floor) {
+      floor = {true, row_error(h.second_reference(b), reference)};
+      std::printf("%-16s reference floor (its own error): display %.2f%%, HDR %.2f%%; FLIP between two references %.4f\n",
+                  e.name.c_str(), floor.display(), floor.hdr(), floor.pair.flip);
+    }
     if (!sheet) sheet = std::make_unique<ContactSheet>(static_cast<int>(entries.size()), columns, b.width, b.height);
     for (size_t k = 0; k < times.size(); ++k) {
       FileRow row{e.name, times[k], {}, {}};
@@ -215,11 +251,14 @@ int files_bench_mode(const std::vector<std::string>& args, const std::string& su
         }
       }
       const RowMedians m = medians(row);
-      csv << csv_row(e, row, m);
+      csv << csv_row(e, row, m, floor);
       std::printf("%-16s %6g | %9.0f %9.0f | %7.2f%% %7.2f%% %5.2fx | %7.2f%% %7.2f%% %5.2fx | %7.4f %7.4f %5.2fx | "
                   "%+5.2f%%\n",
                   e.name.c_str(), times[k], m.u_spp, m.f_spp, m.u_display, m.f_display, m.f_display / m.u_display,
                   m.u_hdr, m.f_hdr, m.f_hdr / m.u_hdr, m.u_flip, m.f_flip, m.f_flip / m.u_flip, m.f_bias);
+      if (floor.measured)
+        std::printf("%-16s %6g | display ratio above the reference's floor %.2fx\n", e.name.c_str(), times[k],
+                    ratio_above_floor(m.f_display, m.u_display, floor));
       std::fflush(stdout);
       sheet->put(static_cast<int>(i), 2 * static_cast<int>(k), tonemap_like_reference(row.plain.back().image, reference).test);
       sheet->put(static_cast<int>(i), 2 * static_cast<int>(k) + 1,

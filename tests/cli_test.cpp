@@ -24,6 +24,7 @@
 #include "app/output_set.h"
 #include "gl/pass_params.h"
 #include "image/image.h"
+#include "image/metrics.h"
 #include "pathtracer/pathtracer.h"
 #include "scene/load.h"
 #include "tests/test_support.h"
@@ -115,6 +116,25 @@ TEST(Cli, GuidingBoundWritesItsTable) {
 
 // The files bench end to end, tiny: a row per file and budget in the CSV, a contact sheet of a row
 // per file and two columns per budget plus the reference; a bad list is refused in one line.
+// The first data row of a CSV, by the header's column names (empty fields kept).
+std::map<std::string, std::string> csv_first_row(const std::string& csv) {
+  const auto fields = [](const std::string& line) {
+    std::vector<std::string> out;
+    std::stringstream in(line);
+    for (std::string f; std::getline(in, f, ',');) out.push_back(f);
+    if (!line.empty() && line.back() == ',') out.push_back("");
+    return out;
+  };
+  std::stringstream in(csv);
+  std::string header, first;
+  std::getline(in, header);
+  std::getline(in, first);
+  const std::vector<std::string> names = fields(header), values = fields(first);
+  std::map<std::string, std::string> row;
+  for (size_t i = 0; i < names.size(); ++i) row[names[i]] = i < values.size() ? values[i] : "?";
+  return row;
+}
+
 TEST(Cli, FilesBenchWritesItsTableAndSheet) {
   const std::string out = temp_dir("files_bench");
   fs::create_directories(out);
@@ -124,12 +144,13 @@ TEST(Cli, FilesBenchWritesItsTableAndSheet) {
   ASSERT_EQ(r.code, 0) << r.err;
   const std::string csv = slurp(out + "/files.csv");
   EXPECT_EQ(lines(csv), 5u);  // the header, 2 files x 2 budgets
-  // The last column, the filtered image's mean bias against its own samples, is a finite percentage.
-  const std::string header = csv.substr(0, csv.find('\n'));
-  EXPECT_EQ(header.substr(header.rfind(',') + 1), "filtered_mean_bias_percent");
-  const std::string first_row = csv.substr(header.size() + 1, csv.find('\n', header.size() + 1) - header.size() - 1);
-  const double bias = std::stod(first_row.substr(first_row.rfind(',') + 1));
-  EXPECT_TRUE(std::isfinite(bias) && std::abs(bias) < 100.0) << first_row;
+  // The filtered image's mean bias against its own samples is a finite percentage; without
+  // --reference-floor the floor's columns are empty.
+  const std::map<std::string, std::string> row = csv_first_row(csv);
+  const double bias = std::stod(row.at("filtered_mean_bias_percent"));
+  EXPECT_TRUE(std::isfinite(bias) && std::abs(bias) < 100.0) << bias;
+  EXPECT_EQ(row.at("reference_display_floor_percent"), "");
+  EXPECT_EQ(row.at("display_ratio_above_floor"), "");
   const Image sheet = read_ldr_or_hdr(out + "/files_sheet.png");
   EXPECT_EQ(sheet.width, 5 * (16 + 2));
   EXPECT_EQ(sheet.height, 2 * (12 + 2));
@@ -138,6 +159,35 @@ TEST(Cli, FilesBenchWritesItsTableAndSheet) {
   EXPECT_EQ(bad.code, 1);
   EXPECT_EQ(lines(bad.err), 1u) << bad.err;
   EXPECT_NE(bad.err.find("bad.txt:2: the name 'a' is used twice"), std::string::npos) << bad.err;
+}
+
+// --reference-floor: the reference's own error is its difference from a second reference of
+// another seed over sqrt 2, and the ratio above it takes that off both arms' squared errors.
+TEST(Cli, FilesBenchReferenceFloorIsTheTwoReferencesDifference) {
+  const std::string out = temp_dir("files_floor");
+  fs::create_directories(out);
+  std::ofstream(out + "/list.txt") << "cornell cornell\n";
+  const Result r = run("bench files --list " + out + "/list.txt --size 16x12 --times 0.3 --rounds 1 "
+                       "--reference-spp 4 --reference-floor --out " + out);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::map<std::string, std::string> row = csv_first_row(slurp(out + "/files.csv"));
+  const Image reference = read_exr(out + "/reference_cornell_16x12_4spp.exr");
+  const Image second = read_exr(out + "/reference2_cornell_16x12_4spp.exr");
+  const DisplayMetrics pair = compare_display(second, reference);
+  const double display_floor = std::stod(row.at("reference_display_floor_percent"));
+  EXPECT_GT(display_floor, 0.1);  // 4 spp of another seed: the references differ
+  EXPECT_NEAR(display_floor, pair.display_nrmse_percent / std::sqrt(2.0), 1e-4 * display_floor);
+  const double hdr_floor = std::stod(row.at("reference_hdr_floor_percent"));
+  EXPECT_NEAR(hdr_floor, pair.hdr.nrmse_percent / std::sqrt(2.0), 1e-4 * hdr_floor);
+  EXPECT_NEAR(std::stod(row.at("reference_pair_flip")), pair.flip_mean, 1e-4 * pair.flip_mean);
+  const double u = std::stod(row.at("unfiltered_display_nrmse_percent"));
+  const double f = std::stod(row.at("filtered_display_nrmse_percent"));
+  const std::string above = row.at("display_ratio_above_floor");
+  if (u > display_floor)
+    EXPECT_NEAR(std::stod(above), std::sqrt(std::max(0.0, f * f - display_floor * display_floor) /
+                                            (u * u - display_floor * display_floor)), 1e-3);
+  else
+    EXPECT_EQ(above, "nan");
 }
 
 TEST(Cli, SceneListPrintsTheBuiltins) {
