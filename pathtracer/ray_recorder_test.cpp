@@ -3,13 +3,13 @@
 // count; and attaching it changes nothing in the image.
 #include <gtest/gtest.h>
 
-#include <cstring>
 #include <limits>
 #include <string>
 #include <vector>
 
 #include "pathtracer/integrator.h"
 #include "pathtracer/ray_recorder.h"
+#include "testing/same_bits.h"
 #include "testing/shapes.h"
 
 namespace pxf {
@@ -114,11 +114,6 @@ TEST(RayRecorder, RecordsTheSpecularChainsSingleRays) {
   renderer.add_frame();
   renderer.set_ray_recorder(nullptr);
   EXPECT_GT(recorder.take().ray_count(RayQuery::ClosestSingle), 0u);
-}
-
-template <typename T>
-bool same_bits(const std::vector<T>& a, const std::vector<T>& b) {
-  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
 }
 
 // Attached or not, the same seed accumulates the same image, bit for bit.

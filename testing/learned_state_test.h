@@ -2,7 +2,6 @@
 // thread count and resumes exactly: shared by the tests of each learned state. Header-only: its users link the path tracer, which pxf_testing
 // does not.
 #pragma once
-#include <cstring>
 #include <initializer_list>
 #include <vector>
 
@@ -10,19 +9,16 @@
 
 #include "core/error.h"
 #include "pathtracer/pathtracer.h"
+#include "testing/same_bits.h"
 
 namespace pxf {
 
-// The accumulations hold the same samples, bit for bit.
+// The accumulations hold the same samples, bit for bit (the even halves too, where they are kept).
 inline bool same_accumulation(const Accumulation& a, const Accumulation& b) {
-  return a.samples == b.samples &&
-         std::memcmp(a.lv_mean.data(), b.lv_mean.data(), a.lv_mean.size() * sizeof(glm::vec3)) == 0 &&
-         std::memcmp(a.hv_mean.data(), b.hv_mean.data(), a.hv_mean.size() * sizeof(glm::vec3)) == 0 &&
-         std::memcmp(a.hv_lum_m2.data(), b.hv_lum_m2.data(), a.hv_lum_m2.size() * sizeof(double)) == 0 &&
-         std::memcmp(a.lv_lum_m2.data(), b.lv_lum_m2.data(), a.lv_lum_m2.size() * sizeof(double)) == 0 &&
-         a.even_samples == b.even_samples &&
-         std::memcmp(a.even_hv_mean.data(), b.even_hv_mean.data(), a.even_hv_mean.size() * sizeof(glm::vec3)) == 0 &&
-         std::memcmp(a.even_lum_m2.data(), b.even_lum_m2.data(), a.even_lum_m2.size() * sizeof(double)) == 0;
+  return a.samples == b.samples && same_bits(a.lv_mean, b.lv_mean) && same_bits(a.hv_mean, b.hv_mean) &&
+         same_bits(a.hv_lum_m2, b.hv_lum_m2) && same_bits(a.lv_lum_m2, b.lv_lum_m2) &&
+         a.even_samples == b.even_samples && same_bits(a.even_hv_mean, b.even_hv_mean) &&
+         same_bits(a.even_lum_m2, b.even_lum_m2);
 }
 
 // A render restored after k frames (each of `ks`) from its accumulation and the learned state
