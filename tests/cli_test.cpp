@@ -135,13 +135,21 @@ std::map<std::string, std::string> csv_first_row(const std::string& csv) {
   return row;
 }
 
-TEST(Cli, FilesBenchWritesItsTableAndSheet) {
-  const std::string out = temp_dir("files_bench");
+// `pxf bench files` at 16x12 with 4-spp references over the list `list`, in a new folder `name`;
+// returns the folder.
+std::string run_files_bench(const std::string& name, const std::string& list, const std::string& options) {
+  const std::string out = temp_dir(name);
   fs::create_directories(out);
-  std::ofstream(out + "/list.txt") << "# name scene [env]\ncornell cornell\nbox cornell -\n";
-  const Result r = run("bench files --list " + out + "/list.txt --size 16x12 --times 0.2,0.3 --rounds 2 "
-                       "--reference-spp 4 --out " + out);
-  ASSERT_EQ(r.code, 0) << r.err;
+  std::ofstream(out + "/list.txt") << list;
+  const Result r = run("bench files --list " + out + "/list.txt --size 16x12 --reference-spp 4 " + options +
+                       " --out " + out);
+  EXPECT_EQ(r.code, 0) << r.err;
+  return out;
+}
+
+TEST(Cli, FilesBenchWritesItsTableAndSheet) {
+  const std::string out =
+      run_files_bench("files_bench", "# name scene [env]\ncornell cornell\nbox cornell -\n", "--times 0.2,0.3 --rounds 2");
   const std::string csv = slurp(out + "/files.csv");
   EXPECT_EQ(lines(csv), 5u);  // the header, 2 files x 2 budgets
   // The filtered image's mean bias against its own samples is a finite percentage; without
@@ -164,12 +172,7 @@ TEST(Cli, FilesBenchWritesItsTableAndSheet) {
 // --reference-floor: the reference's own error is its difference from a second reference of
 // another seed over sqrt 2, and the ratio above it takes that off both arms' squared errors.
 TEST(Cli, FilesBenchReferenceFloorIsTheTwoReferencesDifference) {
-  const std::string out = temp_dir("files_floor");
-  fs::create_directories(out);
-  std::ofstream(out + "/list.txt") << "cornell cornell\n";
-  const Result r = run("bench files --list " + out + "/list.txt --size 16x12 --times 0.3 --rounds 1 "
-                       "--reference-spp 4 --reference-floor --out " + out);
-  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string out = run_files_bench("files_floor", "cornell cornell\n", "--times 0.3 --rounds 1 --reference-floor");
   const std::map<std::string, std::string> row = csv_first_row(slurp(out + "/files.csv"));
   const Image reference = read_exr(out + "/reference_cornell_16x12_4spp.exr");
   const Image second = read_exr(out + "/reference2_cornell_16x12_4spp.exr");
