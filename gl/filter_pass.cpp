@@ -150,6 +150,15 @@ void FilterPass::run_subsampled(const PreviewInputs& inputs, const Texture2D& gu
   quad_.draw(subsampled_program_, fbo_, width_, height_);
 }
 
+void FilterPass::prepare(FilterKind kind) {
+  if (kind == FilterKind::Grid && !grid_) grid_ = std::make_unique<GridFilter>(width_, height_);
+  if (kind == FilterKind::Atrous && !atrous_program_.id())
+    atrous_program_ = Program::from_embedded("fullscreen.vert", "atrous.frag");
+  if (kind == FilterKind::Subsampled && !subsampled_program_.id())
+    subsampled_program_ = Program::from_embedded("fullscreen.vert", "subsampled.frag");
+  // The bilateral variants' program is the constructor's.
+}
+
 const Framebuffer& FilterPass::scratch_target(int index) {
   if (!scratch_[index].valid()) {
     scratch_[index] = Texture2D(width_, height_, TextureFormat::RGBA32F);

@@ -36,6 +36,10 @@ class FilterPass {
              const Texture2D* surface = nullptr);
   bool step();
   bool in_progress() const { return staged_.inputs != nullptr; }
+  // Compiles the variant's program (creates its grid), which a run otherwise does on first use: a
+  // caller that times runs to predict the next one (the schedule, --time's reserve) prepares
+  // first, so that the first run's cost is the run's and not the set-up's.
+  void prepare(FilterKind kind);
 
   bool has_output() const { return runs_ > 0; }
   int runs() const { return runs_; }

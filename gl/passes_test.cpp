@@ -204,6 +204,25 @@ TEST(FilterKinds, ConstantHvStaysConstant) {
   }
 }
 
+// prepare() sets a variant up ahead of its first run (FilterPass::prepare) and changes nothing in
+// what the run computes: a prepared pass and a fresh one give the same L_f bit for bit.
+TEST(FilterKinds, APreparedPassFiltersAsAFreshOne) {
+  test::osmesa_context();
+  Scenario s = make_scenario(17);
+  GpuFixture gpu(s);
+  for (const std::string& name : filter_kind_names()) {
+    FilterParams p;
+    p.kind = parse_filter_kind(name);
+    FilterPass fresh(W, H), prepared(W, H);
+    prepared.prepare(p.kind);
+    prepared.prepare(p.kind);  // a second call keeps what the first set up
+    fresh.run(gpu.inputs, gpu.guide, p, test::kTestThreshold);
+    prepared.run(gpu.inputs, gpu.guide, p, test::kTestThreshold);
+    EXPECT_EQ(prepared.raw_variance_image().pixels, fresh.raw_variance_image().pixels) << name;
+    EXPECT_EQ(prepared.filtered_image().pixels, fresh.filtered_image().pixels) << name;
+  }
+}
+
 TEST(Atrous, IterationsFollowSigmaS) {
   // k passes have B3 variance (4^k - 1) / 3: 1, 5, 21, 85, 341; the first that reaches sigma_s^2,
   // at least 1, at most 5 (footprint radius 62 <= kMaxFilterRadius).

@@ -6,8 +6,10 @@
 #include <cstdio>
 #include <cstring>
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include "image/input_file.h"
 #include "shaders/tonemap_formulas.h"
 
 namespace pxf {
@@ -78,6 +80,11 @@ void sync_folder(const std::string& folder) {
 }
 
 void write_file_atomically(const std::string& path, const std::function<void(const std::string&)>& write) {
+  // The rename would replace whatever the name holds: /dev/null given as an output (as root) would
+  // become a regular file. Only a regular file (or a link, which is replaced, not followed) is.
+  struct stat status;
+  if (::lstat(path.c_str(), &status) == 0 && !S_ISREG(status.st_mode) && !S_ISLNK(status.st_mode))
+    throw Error(path + ": not a regular file (" + file_kind_name(status.st_mode) + "), which pxf does not replace");
   const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
   try {
     write(tmp);

@@ -46,6 +46,8 @@ struct Layer {
 const Image& layer_image(const std::vector<Layer>& layers, const std::string& name);
 
 // Writes go to "<path>.tmp-<pid>" and are renamed, so an interrupted run never leaves a truncated file.
+// A `path` that exists and is not a regular file or a symbolic link (a device such as /dev/null, a
+// FIFO, a directory) is refused with one line before anything is written: the rename would replace it.
 void write_file_atomically(const std::string& path, const std::function<void(const std::string& tmp_path)>& write);
 // Writes `size` bytes to `path`, checking every write, the fsync and the close; throws pxf::Error
 // naming the file (a full disk included).

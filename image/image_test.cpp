@@ -1,4 +1,5 @@
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <cmath>
 #include <cstdio>
@@ -260,6 +261,31 @@ TEST(ImageIo, WritesAreAtomicAndLeaveNoTemporaryFile) {
                Error);
   EXPECT_FALSE(fs::exists(failing));
   EXPECT_FALSE(fs::exists(failing + ".tmp-" + std::to_string(::getpid())));
+}
+
+// An output named like a device or a FIFO is refused, and what the name holds is left as it was
+// (an atomic write renames over it: /dev/null written as root became a regular file).
+TEST(ImageIo, AWriteOverAFifoOrADirectoryIsRefusedAndLeavesIt) {
+  const std::string fifo = temp_path("out_fifo.png");
+  std::remove(fifo.c_str());
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  try {
+    write_png(fifo, Image::rgb(2, 2, 0.5f));
+    FAIL() << "a FIFO was written over";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()), fifo + ": not a regular file (a FIFO), which pxf does not replace");
+  }
+  EXPECT_TRUE(fs::is_fifo(fifo));
+  EXPECT_FALSE(fs::exists(fifo + ".tmp-" + std::to_string(::getpid())));
+  const std::string folder = temp_path("out_folder.exr");
+  fs::create_directories(folder);
+  EXPECT_THROW(write_exr(folder, Image::rgb(2, 2, 0.5f)), Error);
+  EXPECT_TRUE(fs::is_directory(folder));
+  // A regular file is replaced, as before.
+  const std::string file = temp_path("out_file.png");
+  write_png(file, Image::rgb(2, 2, 0.0f));
+  write_png(file, Image::rgb(3, 2, 0.0f));
+  EXPECT_EQ(read_ldr_or_hdr(file).width, 3);
 }
 
 TEST(ImagePng, WriteThenReadGivesQuantizedValues) {

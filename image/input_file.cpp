@@ -12,15 +12,17 @@
 
 namespace pxf {
 
-namespace {
-
-std::string kind_of(mode_t mode) {
+std::string file_kind_name(unsigned mode) {
   if (S_ISFIFO(mode)) return "a FIFO";
   if (S_ISCHR(mode)) return "a character device";
   if (S_ISBLK(mode)) return "a block device";
   if (S_ISSOCK(mode)) return "a socket";
+  if (S_ISDIR(mode)) return "a directory";
+  if (S_ISLNK(mode)) return "a symbolic link";
   return "of an unknown kind";
 }
+
+namespace {
 
 Error too_large(const std::string& path, uint64_t size, uint64_t max_bytes) {
   return Error(path + ": " + std::to_string(size) + " bytes, over the limit of " + std::to_string(max_bytes));
@@ -34,7 +36,7 @@ Error too_large(const std::string& path, uint64_t size, uint64_t max_bytes) {
 // The one check, on what stat() or fstat() reported.
 void check_status(const std::string& path, const struct stat& status, uint64_t max_bytes) {
   if (S_ISDIR(status.st_mode)) throw Error(path + ": is a directory");
-  if (!S_ISREG(status.st_mode)) throw Error(path + ": not a regular file (" + kind_of(status.st_mode) + ")");
+  if (!S_ISREG(status.st_mode)) throw Error(path + ": not a regular file (" + file_kind_name(status.st_mode) + ")");
   const uint64_t size = static_cast<uint64_t>(status.st_size);
   if (size > max_bytes) throw too_large(path, size, max_bytes);
 }

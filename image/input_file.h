@@ -16,6 +16,10 @@
 
 namespace pxf {
 
+// What a file that is not a regular one is, for messages: "a FIFO", "a character device", "a block
+// device", "a socket", "a directory", "a symbolic link", else "of an unknown kind". `mode`: stat's st_mode.
+std::string file_kind_name(unsigned mode);
+
 // Throws pxf::Error (above) unless `path` names, after symbolic links, a regular file of at most
 // `max_bytes`. Looks with stat() only: nothing is opened.
 void check_input_file(const std::string& path, uint64_t max_bytes);

@@ -237,6 +237,7 @@ class Preview {
   // A filter run, whole (run_filter) or in parts that the queued Filter step runs one per call
   // (begin_filter_run, then step_filter_run until it returns true).
   void run_filter();
+  void prepare_filter();  // the filter variant's programs (and the demodulation), before a run is timed
   void begin_filter_run();  // the range frame if none yet, the upload, the demodulation
   bool step_filter_run();   // the filter's next GL step; true after the last (then the bookkeeping)
   void run_filter_step();   // PassStep::Filter: begins a due run or steps the open one
