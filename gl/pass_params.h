@@ -167,8 +167,8 @@ struct BlendParams {
   float samples = 0.0f;
   // Blend each half of the pixel's samples with the weight the other half's variance decides
   // (blend_pixel_split, docs/method.md section 3.8), where the inputs hold the halves
-  // (PreviewInputs::has_halves). Off here, the method's blend as published; the preview's default
-  // turns it on (PreviewSettings).
+  // (PreviewInputs::has_halves). Off, the method's blend as published, here and in the preview
+  // unless TraceParams::split_halves (--split-decision) keeps the halves.
   bool split = false;
 };
 

@@ -479,7 +479,6 @@ void Preview::update_hv_empty() {
 void Preview::blend_and_tonemap() {
   const double upload_before = last_.upload;
   upload();
-  upload_halves();
   // The filter's centre weight is that of the demodulated run too: with a grey factor a,
   // Cov[L_u, a L_f'] = a w Var[L_u] / a = w Var[L_u], the blend's covariance term is unchanged.
   // Once a filter run skipped every pixel, its L_f marks every pixel case 2 and the guard, which
