@@ -215,6 +215,7 @@ TEST(FilterKinds, APreparedPassFiltersAsAFreshOne) {
     p.kind = parse_filter_kind(name);
     FilterPass fresh(W, H), prepared(W, H);
     prepared.prepare(p.kind);
+    if (p.kind == FilterKind::Grid) EXPECT_NE(prepared.grid(), nullptr);  // made before the run
     prepared.prepare(p.kind);  // a second call keeps what the first set up
     fresh.run(gpu.inputs, gpu.guide, p, test::kTestThreshold);
     prepared.run(gpu.inputs, gpu.guide, p, test::kTestThreshold);
